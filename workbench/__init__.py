@@ -1,0 +1,40 @@
+"""Rendering workbench: classic image-synthesis methods side by side on one scene, measured.
+
+Public API (stable)::
+
+    import workbench
+    scene = workbench.load_scene("whitted")            # a path or a bundled scene's name
+    result = workbench.render(scene, "phong", width=320, height=240)
+    workbench.compare.metrics(result.image, reference)
+
+Heavy modules (moderngl, numba, pyrender, matplotlib) load only when a method needs them.
+"""
+from __future__ import annotations
+
+import importlib
+
+from .core.errors import NotApplicable, WorkbenchError  # noqa: F401
+from .scene.io import SceneError, load_scene  # noqa: F401
+
+__all__ = ["load_scene", "render", "available_methods", "SceneError", "WorkbenchError",
+           "NotApplicable", "compare", "raytrace", "radiosity"]
+
+_LAZY = {"compare": "workbench.compare", "raytrace": "workbench.render.raytrace",
+         "radiosity": "workbench.render.radiosity"}
+
+
+def render(scene, method, *, width=None, height=None, **options):
+    """Render ``scene`` with a registered method; see :func:`workbench.render.base.render`."""
+    from .render.base import render as _render
+    return _render(scene, method, width=width, height=height, **options)
+
+
+def available_methods() -> list[str]:
+    from .render.base import available
+    return available()
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        return importlib.import_module(_LAZY[name])
+    raise AttributeError(f"module 'workbench' has no attribute {name!r}")

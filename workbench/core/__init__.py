@@ -1,0 +1,1 @@
+"""Core: vector math, transforms, tolerances and colour encoding (imports nothing else of the package)."""

@@ -1,0 +1,72 @@
+"""Image files: sRGB encoding happens here and only here (images in memory are linear)."""
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+
+def srgb_encode(linear: np.ndarray) -> np.ndarray:
+    """IEC 61966-2-1 transfer function on linear values clipped to [0, 1]."""
+    x = np.clip(np.nan_to_num(linear, nan=0.0, posinf=1.0, neginf=0.0), 0.0, 1.0)
+    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
+
+
+def srgb_decode(encoded: np.ndarray) -> np.ndarray:
+    """Inverse of :func:`srgb_encode` (values in [0, 1])."""
+    x = np.asarray(encoded, dtype=np.float64)
+    return np.where(x <= 0.04045, x / 12.92, ((x + 0.055) / 1.055) ** 2.4)
+
+
+def to_srgb8(linear: np.ndarray) -> np.ndarray:
+    """(H, W, 3) linear float -> (H, W, 3) uint8 sRGB."""
+    return (srgb_encode(linear) * 255.0 + 0.5).astype(np.uint8)
+
+
+def _atomic_write(path: Path, write):
+    """Write through a temporary file in the same folder, then rename: never a half-written file."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".tmp-", suffix=path.suffix)
+    os.close(fd)
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def save_png(path, linear: np.ndarray) -> Path:
+    """Save a linear (H, W, 3) image as an sRGB PNG, atomically."""
+    from PIL import Image
+    img = Image.fromarray(to_srgb8(linear))
+    _atomic_write(Path(path), lambda t: img.save(t, format="PNG"))
+    return Path(path)
+
+
+def save_png8(path, rgb8: np.ndarray) -> Path:
+    """Save an already-encoded (H, W, 3|4) uint8 image (plots, grids, heat maps), atomically."""
+    from PIL import Image
+    img = Image.fromarray(np.asarray(rgb8, dtype=np.uint8))
+    _atomic_write(Path(path), lambda t: img.save(t, format="PNG"))
+    return Path(path)
+
+
+def save_npy(path, array: np.ndarray) -> Path:
+    """Save linear data (float32) for exact comparison, atomically."""
+    _atomic_write(Path(path), lambda t: np.save(t, np.asarray(array, dtype=np.float32)))
+    return Path(path)
+
+
+def load_image_linear(path) -> np.ndarray:
+    """Read an 8-bit image file as linear float32 (H, W, C) (sRGB decoded, alpha kept linear)."""
+    from PIL import Image
+    with Image.open(path) as im:
+        a = np.asarray(im.convert("RGBA"), dtype=np.float64) / 255.0
+    out = np.empty_like(a)
+    out[..., :3] = srgb_decode(a[..., :3])
+    out[..., 3] = a[..., 3]
+    return out.astype(np.float32)

@@ -1,0 +1,146 @@
+"""The renderer protocol, ``RenderResult`` and ``render()``: the one entry point of every method.
+
+A renderer is a class with a ``name``, a ``knob`` (its quality parameter, swept by the study),
+a dictionary of accepted ``options`` and a ``render(scene, width, height, **options)`` method
+returning a :class:`RenderResult`.  ``render()`` validates the method and options, times the
+call, and guarantees that the returned image is finite (non-finite pixels are counted in
+``stats["nonfinite_pixels"]`` and replaced by 0, so a NaN is reported, never shown).
+"""
+from __future__ import annotations
+
+import importlib
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable, Protocol
+
+import numpy as np
+
+from ..core.errors import WorkbenchError
+from ..scene.model import Scene
+from .registry import BUILTIN
+
+
+@dataclass(frozen=True)
+class Knob:
+    """A method's quality knob: ``name`` (an option of the method), the sweep ``values`` from
+    cheapest to most accurate, and the ``default``."""
+
+    name: str
+    values: tuple
+    default: Any
+    description: str = ""
+
+
+@dataclass(frozen=True)
+class Option:
+    """An accepted option: converter (``int``, ``float``, ``bool``, ``str`` or a callable that
+    raises ``ValueError``), default, help text and, for strings, the allowed choices."""
+
+    kind: Callable
+    default: Any
+    help: str = ""
+    choices: tuple | None = None
+
+
+@dataclass
+class RenderResult:
+    """What every method returns.
+
+    image : (H, W, 3) float32, linear RGB, top row first, always finite.
+    timings : seconds; ``total`` (wall time of the call), ``compile`` (shader or JIT
+        compilation, part of total), and method-specific phases.
+    stats : counts and facts (rays, patches, GL_RENDERER, ...).
+    features_used / left_out : features of the scene this method built, and those it did not
+        (not needed by the scene, or not supported by the method: each with the reason).
+    depth : (H, W) float32 camera-space depth along the view axis (inf where nothing), if given.
+    """
+
+    method: str
+    image: np.ndarray
+    timings: dict[str, float] = field(default_factory=dict)
+    stats: dict[str, Any] = field(default_factory=dict)
+    features_used: list[str] = field(default_factory=list)
+    left_out: list[str] = field(default_factory=list)
+    options: dict[str, Any] = field(default_factory=dict)
+    depth: np.ndarray | None = None
+
+
+class Renderer(Protocol):
+    name: str
+    knob: Knob
+    options: dict[str, Option]
+
+    def render(self, scene: Scene, width: int, height: int, **options) -> RenderResult: ...
+
+
+_instances: dict[str, Renderer] = {}
+
+
+def available() -> list[str]:
+    """Names of the registered methods."""
+    return list(BUILTIN)
+
+
+def get_renderer(method: str) -> Renderer:
+    """The (cached) renderer instance registered as ``method``."""
+    if method not in BUILTIN:
+        raise WorkbenchError(f"unknown method {method!r} (available: {', '.join(available())})")
+    if method not in _instances:
+        mod, attr = BUILTIN[method].split(":")
+        _instances[method] = getattr(importlib.import_module(mod), attr)()
+    return _instances[method]
+
+
+def _convert_options(r: Renderer, options: dict) -> dict:
+    out = {k: o.default for k, o in r.options.items()}
+    for k, v in options.items():
+        if k not in r.options:
+            raise WorkbenchError(f"method {r.name!r}: unknown option {k!r} "
+                                 f"(accepted: {', '.join(sorted(r.options)) or 'none'})")
+        o = r.options[k]
+        try:
+            if o.kind is bool and isinstance(v, str):
+                if v.lower() not in ("1", "0", "true", "false", "yes", "no", "on", "off"):
+                    raise ValueError(v)
+                val = v.lower() in ("1", "true", "yes", "on")
+            else:
+                val = o.kind(v)
+        except (TypeError, ValueError) as e:
+            raise WorkbenchError(f"method {r.name!r}: option {k!r} expects {getattr(o.kind, '__name__', 'a valid value')}"
+                                 f" ({o.help}), got {v!r}") from None
+        if o.choices is not None and val not in o.choices:
+            raise WorkbenchError(f"method {r.name!r}: option {k!r} must be one of {', '.join(map(str, o.choices))}, got {v!r}")
+        out[k] = val
+    return out
+
+
+def render(scene: Scene, method: str, *, width: int | None = None, height: int | None = None,
+           **options) -> RenderResult:
+    """Render ``scene`` with the method registered as ``method``.
+
+    Parameters
+    ----------
+    width, height : int, optional
+        Image size; the scene camera's resolution by default.  The camera (and its vertical
+        field of view) is otherwise the scene's: every method sees the same view.
+    **options
+        Method options (see ``workbench methods``); unknown ones are an error.
+    """
+    r = get_renderer(method)
+    w = int(width if width is not None else scene.camera.width)
+    h = int(height if height is not None else scene.camera.height)
+    if not (1 <= w <= 16384 and 1 <= h <= 16384):
+        raise WorkbenchError(f"image size must be within 1..16384 pixels, got {w}x{h}")
+    opts = _convert_options(r, options)
+    t0 = time.perf_counter()
+    result = r.render(scene.with_camera(scene.camera.with_resolution(w, h)), w, h, **opts)
+    result.timings["total"] = time.perf_counter() - t0
+    result.timings.setdefault("compile", 0.0)
+    result.options = opts
+    img = np.asarray(result.image, dtype=np.float32)
+    bad = ~np.isfinite(img)
+    result.stats["nonfinite_pixels"] = int(bad.any(-1).sum())
+    if bad.any():
+        img = np.where(bad, 0.0, img).astype(np.float32)
+    result.image = img
+    return result

@@ -1,0 +1,78 @@
+"""The one module that creates OpenGL contexts.
+
+* moderngl: standalone on EGL (Mesa llvmpipe with no display, no GPU).  There is no default
+  framebuffer in a standalone context: every renderer draws into an FBO.
+* pyrender: offscreen through PyOpenGL on EGL (``PYOPENGL_PLATFORM`` must be set before the
+  first ``OpenGL`` import), OSMesa as a fallback.
+
+A UI that owns a window context can install it with :func:`use_context` so that the raster
+methods draw into that context instead.
+"""
+from __future__ import annotations
+
+import os
+import threading
+
+from ..core.errors import WorkbenchError
+
+_local = threading.local()
+
+
+class GLUnavailable(WorkbenchError):
+    """No OpenGL context could be created; the message names the missing piece."""
+
+
+def use_context(ctx) -> None:
+    """Make ``ctx`` (a moderngl context created elsewhere, e.g. by the UI) this thread's context."""
+    _local.ctx = ctx
+
+
+def context():
+    """This thread's moderngl context (created on first use: standalone, EGL backend)."""
+    ctx = getattr(_local, "ctx", None)
+    if ctx is None:
+        import moderngl
+        try:
+            ctx = moderngl.create_context(standalone=True, backend="egl", require=330)
+        except Exception as e:  # glcontext raises plain Exceptions with the loader's text
+            raise GLUnavailable(
+                "cannot create a headless OpenGL context through EGL "
+                f"({e}). Install Mesa's EGL and software rasteriser: "
+                "apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri") from None
+        _local.ctx = ctx
+    return ctx
+
+
+def renderer_name(ctx=None) -> str:
+    """GL_RENDERER of the context, logged with every timing."""
+    ctx = ctx or context()
+    return f"{ctx.info['GL_RENDERER']} (OpenGL {ctx.version_code // 100}.{ctx.version_code % 100 // 10})"
+
+
+def check_errors(ctx=None) -> None:
+    """Raise if the GL error flag is set (``ctx.error`` reads and clears glGetError)."""
+    ctx = ctx or context()
+    err = ctx.error
+    if err != "GL_NO_ERROR":
+        raise RuntimeError(f"OpenGL error: {err}")
+
+
+def pyrender_platform() -> str:
+    """Choose PyOpenGL's platform for pyrender before OpenGL is first imported: EGL when
+    libEGL loads, else OSMesa.  Returns the platform name."""
+    if "PYOPENGL_PLATFORM" not in os.environ:
+        import ctypes.util
+        os.environ["PYOPENGL_PLATFORM"] = "egl" if ctypes.util.find_library("EGL") else "osmesa"
+    return os.environ["PYOPENGL_PLATFORM"]
+
+
+def pyrender_offscreen(width: int, height: int):
+    """A ``pyrender.OffscreenRenderer`` (EGL, OSMesa fallback)."""
+    platform = pyrender_platform()
+    try:
+        import pyrender
+        return pyrender.OffscreenRenderer(width, height)
+    except Exception as e:
+        raise GLUnavailable(f"pyrender cannot open an offscreen context on {platform!r} ({e}). "
+                            "Install libegl1 libgl1-mesa-dri (or libosmesa6 with "
+                            "PYOPENGL_PLATFORM=osmesa)") from None

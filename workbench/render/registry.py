@@ -1,0 +1,11 @@
+"""Where each registered method lives, as ``"module:attribute"`` strings, so that a renderer's
+heavy imports (moderngl, numba, pyrender) happen only when it is used (Mitsuba's plugins by name).
+
+Only methods that exist are listed here: a method that is not implemented is absent.
+"""
+
+BUILTIN: dict[str, str] = {
+    "flat": "workbench.render.raster:FlatRenderer",
+    "gouraud": "workbench.render.raster:GouraudRenderer",
+    "phong": "workbench.render.raster:PhongRenderer",
+}
