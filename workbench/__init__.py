@@ -19,18 +19,18 @@ from .scene.io import SceneError, load_scene  # noqa: F401
 __all__ = ["load_scene", "render", "available_methods", "SceneError", "WorkbenchError",
            "NotApplicable", "compare", "raytrace", "radiosity"]
 
-_LAZY = {"compare": "workbench.compare", "raytrace": "workbench.render.raytrace",
-         "radiosity": "workbench.render.radiosity"}
+_LAZY = {"compare": "workbench.compare", "raytrace": "workbench.renderers.raytrace",
+         "radiosity": "workbench.renderers.radiosity"}
 
 
 def render(scene, method, *, width=None, height=None, **options):
-    """Render ``scene`` with a registered method; see :func:`workbench.render.base.render`."""
-    from .render.base import render as _render
+    """Render ``scene`` with a registered method; see :func:`workbench.renderers.base.render`."""
+    from .renderers.base import render as _render
     return _render(scene, method, width=width, height=height, **options)
 
 
 def available_methods() -> list[str]:
-    from .render.base import available
+    from .renderers.base import available
     return available()
 
 

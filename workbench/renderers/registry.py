@@ -5,7 +5,7 @@ Only methods that exist are listed here: a method that is not implemented is abs
 """
 
 BUILTIN: dict[str, str] = {
-    "flat": "workbench.render.raster:FlatRenderer",
-    "gouraud": "workbench.render.raster:GouraudRenderer",
-    "phong": "workbench.render.raster:PhongRenderer",
+    "flat": "workbench.renderers.raster:FlatRenderer",
+    "gouraud": "workbench.renderers.raster:GouraudRenderer",
+    "phong": "workbench.renderers.raster:PhongRenderer",
 }
