@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# One entry point for the README's two commands:
+#   bash workbench.sh demo   install what is missing, then run the main job on the default scene
+#   bash workbench.sh test   install what is missing, then run the test suite
+# Installing: Debian packages (Mesa EGL/llvmpipe, OSMesa, Xvfb, GLFW, POV-Ray) when missing, and
+# a virtual environment .venv with the package and its test/bench extras.  Safe to re-run.
+set -euo pipefail
+cd "$(dirname "$0")"
+what="${1:-}"
+case "$what" in demo|test) ;; *) echo "usage: bash workbench.sh demo|test" >&2; exit 2 ;; esac
+
+debs=(libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6 xvfb xauth libglfw3 povray)
+missing=()
+for d in "${debs[@]}"; do dpkg -s "$d" >/dev/null 2>&1 || missing+=("$d"); done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "== installing Debian packages: ${missing[*]}"
+  sudo_=""; [ "$(id -u)" -ne 0 ] && sudo_="sudo"
+  $sudo_ apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo_ apt-get install -y -qq "${missing[@]}" >/dev/null
+fi
+
+if [ ! -x .venv/bin/python ]; then
+  echo "== creating .venv"
+  python3 -m venv .venv
+fi
+stamp=.venv/.installed-$(sha1sum pyproject.toml | cut -c1-12)
+if [ ! -f "$stamp" ]; then
+  echo "== installing Python packages into .venv (first run takes a few minutes)"
+  .venv/bin/python -m pip install -q --upgrade pip
+  .venv/bin/python -m pip install -q -e '.[test,bench]'
+  rm -f .venv/.installed-*; touch "$stamp"
+fi
+export NUMBA_CACHE_DIR="$PWD/.numba_cache"
+
+if [ "$what" = test ]; then
+  echo "== running the test suite"
+  exec .venv/bin/python -m pytest -q
+fi
+
+echo "== main job: the default scene (whitted) and the Cornell box"
+mkdir -p out
+.venv/bin/workbench render whitted --method phong -o out/whitted_phong.png
+.venv/bin/workbench render cornell --method phong -o out/cornell_phong.png
+echo "== images written to $PWD/out"
