@@ -1,0 +1,34 @@
+"""Metrics: RMSE/PSNR definitions, FLIP ordering, bad input."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import workbench
+from workbench.core.errors import WorkbenchError
+
+
+def test_rmse_psnr_of_a_known_offset():
+    ref = np.full((8, 8, 3), 0.5, dtype=np.float32)
+    m = workbench.compare.metrics(ref + 0.1, ref)
+    assert m["rmse"] == pytest.approx(0.1, rel=1e-6)
+    assert m["psnr"] == pytest.approx(20.0, rel=1e-5)
+    assert workbench.compare.metrics(ref, ref) == {"rmse": 0.0, "psnr": float("inf"), "flip": 0.0}
+
+
+def test_flip_grows_with_the_error():
+    rng = np.random.default_rng(3)
+    ref = rng.random((32, 32, 3)).astype(np.float32)
+    small = workbench.compare.metrics(np.clip(ref + 0.02, 0, 1), ref)["flip"]
+    large = workbench.compare.metrics(np.clip(ref + 0.2, 0, 1), ref)["flip"]
+    assert 0 < small < large <= 1
+
+
+def test_bad_pairs_are_refused():
+    a = np.zeros((4, 4, 3))
+    with pytest.raises(WorkbenchError, match="same size"):
+        workbench.compare.metrics(a, np.zeros((4, 5, 3)))
+    b = a.copy()
+    b[0, 0, 0] = np.nan
+    with pytest.raises(WorkbenchError, match="finite"):
+        workbench.compare.metrics(b, a)

@@ -1,0 +1,120 @@
+"""Scene files: every bundled scene loads; every kind of bad input gets one clear message."""
+from __future__ import annotations
+
+import copy
+import textwrap
+
+import numpy as np
+import pytest
+
+from workbench.scene import library
+from workbench.scene.io import SceneError, load_scene, scene_from_dict
+
+BASE = {
+    "scene": {"name": "t"},
+    "camera": {"position": [0, 0, -5], "look_at": [0, 0, 0]},
+    "lights": [{"type": "point", "position": [0, 5, -5]}],
+    "materials": {"m": {"color": [1, 0, 0]}},
+    "objects": [{"type": "sphere", "radius": 1.0, "material": "m"}],
+}
+
+
+def _with(path, value):
+    d = copy.deepcopy(BASE)
+    t = d
+    for k in path[:-1]:
+        t = t[k]
+    t[path[-1]] = value
+    return d
+
+
+@pytest.mark.parametrize("path", library.bundled(), ids=lambda p: p.stem)
+def test_bundled_scene_loads_with_header(path):
+    s = load_scene(path)
+    assert s.objects and s.needs()
+    assert len(library.header(path)) > 40, "each bundled scene says what it demonstrates"
+
+
+def test_minimal_scene_is_built():
+    s = scene_from_dict(BASE)
+    assert s.objects[0].radius == 1.0 and s.materials["m"].color == (1.0, 0.0, 0.0)
+    assert {"spheres", "point_lights"} <= s.needs()
+
+
+@pytest.mark.parametrize("data, key, expect", [
+    (_with(["materials", "m", "kdd"], 0.5), "[materials.m].kdd", "unknown key"),
+    (_with(["objects", 0, "radius"], "big"), ".radius", "expected a number"),
+    (_with(["objects", 0, "radius"], -1.0), ".radius", "> 0"),
+    (_with(["objects", 0, "material"], "gold"), ".material", "unknown material 'gold'"),
+    (_with(["camera", "up"], [0, 0, 0]), "[camera].up", "non-zero vector"),
+    (_with(["lights", 0, "position"], [1, 2]), ".position", "list of 3"),
+    (_with(["materials", "m", "ks"], 1.5), "[materials.m].ks", "<= 1"),
+    (_with(["objects", 0], {"type": "quadric", "material": "m", "Q": [[1, 2, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, -1]],
+                            "bounds": {"min": [-1, -1, -1], "max": [1, 1, 1]}}), ".Q", "not symmetric"),
+    (_with(["objects", 0], {"type": "quadric", "material": "m", "shape": "cylinder"}), ".bounds", "unbounded"),
+    (_with(["objects", 0], {"type": "mesh", "material": "m", "path": "nowhere.obj"}), ".path", "file not found"),
+    (_with(["objects", 0], {"type": "polygon", "material": "m", "vertices": [[0, 0, 0], [1, 0, 0], [2, 0, 0]]}), ".vertices", "zero area"),
+    (_with(["objects", 0], {"type": "box", "material": "m", "min": [0, 0, 0], "max": [1, 0, 1]}), ".max", "must exceed"),
+    (_with(["objects", 0, "type"], "torus"), ".type", "expected one of"),
+    (_with(["objects", 0, "transform"], {"scale": 0}), ".transform.scale", "non-zero"),
+    (_with(["camera", "look_at"], [0, 0, -5]), "[camera].look_at", "zero-length"),
+    (_with(["objects", 0], {"type": "csg", "op": "union", "material": "m",
+                            "left": {"type": "sphere", "radius": 1},
+                            "right": {"type": "plane", "normal": [0, 1, 0], "size": [1, 1]}}), ".right.type", "no inside"),
+])
+def test_bad_input_names_key_and_expectation(data, key, expect):
+    with pytest.raises(SceneError) as e:
+        scene_from_dict(data, source="bad.toml")
+    msg = str(e.value)
+    assert msg.startswith("bad.toml: ") and key in msg and expect in msg, msg
+
+
+def test_file_errors_name_the_file(tmp_path):
+    p = tmp_path / "broken.toml"
+    p.write_text("[camera\nposition = 1")
+    with pytest.raises(SceneError, match="broken.toml: not valid TOML"):
+        load_scene(p)
+    with pytest.raises(SceneError, match="no such scene file"):
+        load_scene(tmp_path / "absent.toml")
+
+
+def test_mesh_from_obj_file_and_relative_path(tmp_path):
+    (tmp_path / "tri.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\n")
+    (tmp_path / "s.toml").write_text(textwrap.dedent("""
+        [camera]
+        position = [0, 0, -5]
+        look_at = [0, 0, 0]
+        [materials.m]
+        [[objects]]
+        type = "mesh"
+        material = "m"
+        path = "tri.obj"
+    """))
+    s = load_scene(tmp_path / "s.toml")
+    assert s.objects[0].faces.shape == (2, 3) and "meshes" in s.needs()
+
+
+def test_nothing_half_loaded_scene_is_immutable():
+    s = scene_from_dict(BASE)
+    with pytest.raises(Exception):
+        s.objects[0].world_from_object[0, 0] = 2.0
+    with pytest.raises(Exception):
+        s.name = "x"
+
+
+def test_needs_follow_materials_and_lights():
+    d = _with(["materials", "m"], {"kr": 0.5, "kt": 0.5, "ior": 1.5, "texture": {"type": "checker", "projection": "planar"}})
+    f = scene_from_dict(d).needs()
+    assert {"reflection", "refraction", "textures"} <= f and "bump" not in f and "emitters" not in f
+    d = _with(["lights"], [])
+    assert "shadows" not in scene_from_dict(d).needs()
+
+
+def test_area_light_stand_ins_carry_its_power():
+    s = load_scene("cornell")
+    light = s.lights[0]
+    stand = s.point_lights()
+    assert len(stand) == light.stand_in ** 2
+    total = sum(p.intensity for p in stand)
+    assert total == pytest.approx(light.intensity * light.area / np.pi)
+    assert np.allclose(light.normal, [0, -1, 0])
