@@ -33,6 +33,9 @@ class Tolerances:
     normal_cancel : float
         An interpolated normal shorter than this (before normalisation) is treated as
         cancelled; the geometric normal is used instead.
+    bump_step : float
+        Central-difference step of a bump map's height gradient, as a fraction of one pattern
+        period (the step in object units is ``bump_step / scale``).
     """
 
     zero: float = 1e-12
@@ -41,6 +44,7 @@ class Tolerances:
     planar: float = 5e-3
     symmetric: float = 1e-9
     normal_cancel: float = 1e-6
+    bump_step: float = 1e-3
 
 
 tol = Tolerances()
