@@ -26,8 +26,9 @@ fi
 stamp=.venv/.installed-$(sha1sum pyproject.toml | cut -c1-12)
 if [ ! -f "$stamp" ]; then
   echo "== installing Python packages into .venv (first run takes a few minutes)"
-  .venv/bin/python -m pip install -q --upgrade pip
-  .venv/bin/python -m pip install -q -e '.[test,bench]'
+  # (pip's notes about this machine's unused local index folders are filtered out)
+  { .venv/bin/python -m pip install -q --upgrade pip &&
+    .venv/bin/python -m pip install -q -e '.[test,bench]'; } 2>&1 | { grep -v -e 'is ignored: it is neither' || true; }
   rm -f .venv/.installed-*; touch "$stamp"
 fi
 export NUMBA_CACHE_DIR="$PWD/.numba_cache"
