@@ -1,0 +1,266 @@
+// Texture evaluation, GLSL mirror of workbench/renderers/texturing.py (read its docstring for
+// the formulas; tests compare the two at a few pixels).  Object-space inputs.
+// Needs: TOL_ZERO, BUMP_STEP; the *_KIND / *_PROJ defines of the maps in use.
+#include "common.glsl"
+
+const float TWO_PI = 6.283185307179586;
+const float PI = 3.141592653589793;
+
+// projections (values of TEX_PROJ, BUMP_PROJ, OPACITY_PROJ)
+#define PROJ_UV 0
+#define PROJ_PLANAR 1
+#define PROJ_CYLINDRICAL 2
+#define PROJ_SPHERICAL 3
+#define PROJ_SOLID 4
+// patterns (TEX_KIND; OPACITY_KIND uses K_GRID and K_CHECKER)
+#define K_CHECKER 1
+#define K_BRICKS 2
+#define K_MARBLE 3
+#define K_WOOD 4
+#define K_GRID 5
+#define K_IMAGE 6
+#define K_NOISE 7
+#define K_WAVES 8
+#define K_CONSTANT 9
+
+// A mapping: centre, pole Sp, equator Se (orthogonal to Sp), W = Sp x Se, scale, line width.
+struct Mapping {
+    vec3 center;
+    vec3 sp;
+    vec3 se;
+    vec3 w;
+    float scale;
+    float width;
+};
+
+float wrap01(float u) {
+    u = u - floor(u);
+    return u >= 1.0 ? 0.0 : u;
+}
+
+// u = atan2(d.W, -d.Se) / 2pi in [0, 1); 0 on the axis.
+float longitude(vec3 d, Mapping m) {
+    float x = -dot(d, m.se);
+    float y = dot(d, m.w);
+    bool on_axis = x * x + y * y <= TOL_ZERO * TOL_ZERO * max(1.0, dot(d, d));
+    return wrap01(on_axis ? 0.0 : atan(y, x) / TWO_PI);
+}
+
+// (u, v) before scale; uv is the mesh's (used by PROJ_UV when has_uv).
+vec2 project(int proj, Mapping m, vec3 P, vec2 uv, bool has_uv) {
+    vec3 d = P - m.center;
+    if (proj == PROJ_UV && has_uv) return uv;
+    if (proj == PROJ_PLANAR) return vec2(dot(d, m.se), dot(d, m.w));
+    if (proj == PROJ_CYLINDRICAL) return vec2(longitude(d, m), dot(d, m.sp));
+    float h = dot(d, m.sp);
+    float rho = length(d - h * m.sp);
+    float phi = (rho == 0.0 && h == 0.0) ? 0.0 : atan(rho, -h);
+    return vec2(longitude(d, m), phi / PI);
+}
+
+// Pattern coordinates s: scale * (u, v, 0), or scale * (P - center) for the solid projection.
+vec3 pattern_coords(int proj, Mapping m, vec3 P, vec2 uv, bool has_uv) {
+    if (proj == PROJ_SOLID) return m.scale * (P - m.center);
+    return vec3(m.scale * project(proj, m, P, uv, has_uv), 0.0);
+}
+
+// ---------------------------------------------------------------- noise (lowbias32 value noise)
+float hash3(ivec3 i) {
+    uvec3 u = uvec3(i);
+    uint h = (u.x * 73856093u) ^ (u.y * 19349663u) ^ (u.z * 83492791u);
+    h ^= h >> 16u;
+    h *= 0x7FEB352Du;
+    h ^= h >> 15u;
+    h *= 0x846CA68Bu;
+    h ^= h >> 16u;
+    return float(h >> 8u) / 16777216.0;
+}
+
+vec3 quintic(vec3 t) {
+    return t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
+}
+
+float value_noise(vec3 p) {
+    vec3 fl = floor(p);
+    vec3 f = p - fl;
+    ivec3 i = ivec3(fl);
+    vec3 w = quintic(f);
+    float out_ = 0.0;
+    for (int dx = 0; dx < 2; ++dx)
+        for (int dy = 0; dy < 2; ++dy)
+            for (int dz = 0; dz < 2; ++dz) {
+                float wgt = (dx == 1 ? w.x : 1.0 - w.x) * (dy == 1 ? w.y : 1.0 - w.y)
+                          * (dz == 1 ? w.z : 1.0 - w.z);
+                out_ += wgt * hash3(i + ivec3(dx, dy, dz));
+            }
+    return out_;
+}
+
+float fbm(vec3 p) {
+    float out_ = 0.0;
+    float s = 1.0;
+    for (int k = 0; k < 4; ++k) {
+        out_ += (value_noise(p * s) - 0.5) / s;
+        s *= 2.0;
+    }
+    return out_;
+}
+
+float turbulence(vec3 p) {
+    float out_ = 0.0;
+    float s = 1.0;
+    for (int k = 0; k < 4; ++k) {
+        out_ += abs(2.0 * value_noise(p * s) - 1.0) / (2.0 * s);
+        s *= 2.0;
+    }
+    return out_;
+}
+
+// ---------------------------------------------------------------- patterns
+float mortar_distance(vec3 s) {
+    vec2 b = vec2(s.x + s.z, s.y);
+    float row = floor(b.y / 0.5);
+    float x = b.x + 0.5 * (row - 2.0 * floor(row / 2.0));
+    float fx = x - floor(x);
+    float fy = b.y / 0.5 - row;
+    return min(min(fx, 1.0 - fx), 0.5 * min(fy, 1.0 - fy));
+}
+
+// Blend weight of colors[1] (see texturing.pattern_value).
+float pattern_value(int kind, vec3 s, bool solid, float width) {
+    if (kind == K_CHECKER) {
+        vec3 fl = floor(s);
+        float parity = fl.x + fl.y + fl.z;
+        return parity - 2.0 * floor(parity / 2.0);
+    }
+    if (kind == K_BRICKS) return mortar_distance(s) < 0.5 * width ? 1.0 : 0.0;
+    if (kind == K_GRID) {
+        vec2 f = s.xy - floor(s.xy);
+        return min(f.x, f.y) < width ? 1.0 : 0.0;
+    }
+    if (kind == K_MARBLE) return 0.5 + 0.5 * sin(TWO_PI * (s.x + 2.0 * turbulence(s)));
+    // K_WOOD
+    float r = solid ? length(s.xz) : length(s.xy);
+    float t = 4.0 * (r + 0.3 * fbm(s));
+    return smoothstep(0.0, 0.8, t - floor(t));
+}
+
+// Bilinear lookup, v = 0 at the image's bottom row (images are uploaded bottom row first).
+vec4 sample_image(sampler2D img, vec2 uv) {
+    return texture(img, uv);
+}
+
+const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);
+
+// ---------------------------------------------------------------- colour texture
+#ifdef TEX_KIND
+uniform Mapping u_tex;
+uniform vec3 u_tex_color0;
+uniform vec3 u_tex_color1;
+#if TEX_KIND == K_IMAGE
+uniform sampler2D u_tex_image;
+#endif
+
+vec3 texture_color(vec3 P, vec2 uv, bool has_uv) {
+#if TEX_KIND == K_IMAGE
+    return sample_image(u_tex_image, project(TEX_PROJ, u_tex, P, uv, has_uv) * u_tex.scale).rgb;
+#else
+    float t = pattern_value(TEX_KIND, pattern_coords(TEX_PROJ, u_tex, P, uv, has_uv),
+                            TEX_PROJ == PROJ_SOLID, u_tex.width);
+    return mix(u_tex_color0, u_tex_color1, t);
+#endif
+}
+#endif
+
+// ---------------------------------------------------------------- bump
+#ifdef BUMP_KIND
+uniform Mapping u_bump;
+uniform float u_bump_strength;
+uniform mat3 u_grad_from_object;   // M^-T: object-space gradient -> world-space gradient
+#if BUMP_KIND == K_IMAGE
+uniform sampler2D u_bump_image;
+#endif
+
+float bump_height(vec3 P) {
+#if BUMP_KIND == K_IMAGE
+    return dot(sample_image(u_bump_image, project(BUMP_PROJ, u_bump, P, vec2(0.0), false) * u_bump.scale).rgb, LUMA);
+#else
+    vec3 s = pattern_coords(BUMP_PROJ, u_bump, P, vec2(0.0), false);
+#if BUMP_KIND == K_BRICKS
+    float hw = 0.5 * u_bump.width;
+    return smoothstep(0.5 * hw, 1.5 * hw, mortar_distance(s));
+#elif BUMP_KIND == K_NOISE
+    return 0.5 + fbm(s);
+#else
+    return 0.5 + 0.25 * (sin(TWO_PI * s.x) + sin(TWO_PI * s.y));
+#endif
+#endif
+}
+
+// Perturbed unit world normal (texturing.bump_normal): N' = normalize(N - tangential grad d).
+vec3 bump_normal(vec3 P, vec3 Nw) {
+    float delta = BUMP_STEP / u_bump.scale;
+    vec3 g;
+    for (int k = 0; k < 3; ++k) {
+        vec3 e = vec3(0.0);
+        e[k] = delta;
+        g[k] = (bump_height(P + e) - bump_height(P - e)) / (2.0 * delta);
+    }
+    g *= u_bump_strength / u_bump.scale;
+    vec3 gw = u_grad_from_object * g;
+    vec3 gt = gw - dot(gw, Nw) * Nw;
+    vec3 Np = safe_normalize(Nw - gt);
+    return dot(Np, Np) > 0.0 ? Np : Nw;
+}
+#endif
+
+// ---------------------------------------------------------------- opacity
+#ifdef OPACITY_KIND
+uniform Mapping u_op;
+uniform float u_op_value;
+#if OPACITY_KIND == K_IMAGE
+uniform sampler2D u_op_image;
+uniform float u_op_has_alpha;   // 1: the image's alpha channel, 0: its luminance
+#endif
+
+float opacity(vec3 P, vec2 uv, bool has_uv) {
+#if OPACITY_KIND == K_CONSTANT
+    return u_op_value;
+#elif OPACITY_KIND == K_IMAGE
+    vec4 c = sample_image(u_op_image, project(OPACITY_PROJ, u_op, P, uv, has_uv) * u_op.scale);
+    return u_op_has_alpha > 0.5 ? c.a : dot(c.rgb, LUMA);
+#else
+    vec3 s = pattern_coords(OPACITY_PROJ, u_op, P, uv, has_uv);
+#if OPACITY_KIND == K_GRID
+    return pattern_value(K_GRID, s, false, u_op.width);
+#else
+    return 1.0 - pattern_value(K_CHECKER, s, false, u_op.width);
+#endif
+#endif
+}
+#endif
+
+// ---------------------------------------------------------------- environment
+#ifdef ENV_KIND
+#if ENV_KIND == 2
+uniform sampler2D u_env_image;
+#else
+uniform vec3 u_env_zenith;
+uniform vec3 u_env_horizon;
+uniform vec3 u_env_ground;
+#endif
+
+vec3 environment(vec3 dir) {
+    vec3 d = safe_normalize(dir);
+#if ENV_KIND == 2
+    bool vertical = d.x * d.x + d.z * d.z <= TOL_ZERO * TOL_ZERO;
+    float u = wrap01(0.5 + (vertical ? 0.0 : atan(d.x, -d.z)) / TWO_PI);
+    float v = 0.5 + asin(clamp(d.y, -1.0, 1.0)) / PI;
+    return texture(u_env_image, vec2(u, v)).rgb;
+#else
+    float y = d.y;
+    return y >= 0.0 ? mix(u_env_horizon, u_env_zenith, clamp(y, 0.0, 1.0))
+                    : mix(u_env_horizon, u_env_ground, clamp(-4.0 * y, 0.0, 1.0));
+#endif
+}
+#endif

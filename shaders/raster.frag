@@ -1,0 +1,72 @@
+#version 330 core
+// Fragment stage of flat, Gouraud and Phong shading: texture colour C per fragment, then
+// I = E + C * diffuse + specular (local model, lighting.glsl), + kr * environment(reflected)
+// for environment-mapped materials; opacity maps cut out (alpha < 0.5) or blend.
+// Output: linear RGB and alpha into a float32 colour attachment.
+#include "lighting.glsl"
+#include "texturing.glsl"
+
+in vec3 v_world;
+in vec3 v_normal;
+in vec3 v_obj;
+in vec2 v_uv;
+#if defined(MODE_FLAT)
+flat in vec3 v_diffuse;
+flat in vec3 v_specular;
+#elif defined(MODE_GOURAUD)
+in vec3 v_diffuse;
+in vec3 v_specular;
+#endif
+
+uniform vec3 u_eye;
+uniform vec3 u_color;
+uniform vec3 u_emission;
+uniform float u_kr;
+#ifdef DEPTH_LEVELS
+uniform float u_depth_levels;  // 2^bits - 1: emulated fixed-point depth buffer
+#endif
+
+out vec4 frag_color;
+
+#ifdef HAS_UV
+const bool HAS_UV_ATTR = true;
+#else
+const bool HAS_UV_ATTR = false;
+#endif
+
+void main() {
+    float a = 1.0;
+#ifdef OPACITY_KIND
+    a = opacity(v_obj, v_uv, HAS_UV_ATTR);
+    if (a < 0.5) discard;
+#endif
+    vec3 C = u_color;
+#ifdef TEX_KIND
+    C *= texture_color(v_obj, v_uv, HAS_UV_ATTR);
+#endif
+    vec3 S = safe_normalize(u_eye - v_world);
+    // shading normal: interpolated (or the polygon's, flat); a cancelled one falls back to
+    // the triangle's geometric normal
+    vec3 N = v_normal;
+    if (length(N) < NORMAL_CANCEL) N = cross(dFdx(v_world), dFdy(v_world));
+    N = safe_normalize(N);
+#ifdef BUMP_KIND
+    N = bump_normal(v_obj, N);
+#endif
+    N = face_viewer(N, S);
+#ifdef MODE_PHONG
+    vec3 diffuse, specular;
+    local_terms(v_world, N, S, diffuse, specular);
+#else
+    vec3 diffuse = v_diffuse;
+    vec3 specular = v_specular;
+#endif
+    vec3 color = u_emission + C * diffuse + specular;
+#if defined(ENV_MAP) && defined(ENV_KIND)
+    color += u_kr * environment(2.0 * dot(N, S) * N - S);
+#endif
+    frag_color = vec4(color, a);
+#ifdef DEPTH_LEVELS
+    gl_FragDepth = floor(gl_FragCoord.z * u_depth_levels + 0.5) / u_depth_levels;
+#endif
+}

@@ -1,0 +1,54 @@
+#version 330 core
+// Vertex stage of flat, Gouraud and Phong shading (MODE_FLAT | MODE_GOURAUD | MODE_PHONG).
+// Positions and normals arrive in world space (the tessellator transforms them); the object-
+// space point travels along for the textures.  Flat: one lighting per polygon, at its centroid
+// with its normal (the buffer is unwelded: every vertex of a triangle carries the polygon's
+// normal and centroid).  Gouraud: lighting at the vertex with the averaged normal.
+#include "lighting.glsl"
+
+in vec3 in_position;
+in vec3 in_normal;
+in vec3 in_obj_position;
+#ifdef HAS_UV
+in vec2 in_uv;
+#endif
+#ifdef MODE_FLAT
+in vec3 in_centroid;
+#endif
+
+uniform mat4 u_clip_from_world;
+uniform vec3 u_eye;
+
+out vec3 v_world;
+out vec3 v_normal;
+out vec3 v_obj;
+out vec2 v_uv;
+#if defined(MODE_FLAT)
+flat out vec3 v_diffuse;
+flat out vec3 v_specular;
+#elif defined(MODE_GOURAUD)
+out vec3 v_diffuse;
+out vec3 v_specular;
+#endif
+
+void main() {
+    v_world = in_position;
+    v_normal = in_normal;
+    v_obj = in_obj_position;
+#ifdef HAS_UV
+    v_uv = in_uv;
+#else
+    v_uv = vec2(0.0);
+#endif
+#if defined(MODE_FLAT) || defined(MODE_GOURAUD)
+#ifdef MODE_FLAT
+    vec3 P = in_centroid;
+#else
+    vec3 P = in_position;
+#endif
+    vec3 S = safe_normalize(u_eye - P);
+    vec3 N = face_viewer(safe_normalize(in_normal), S);
+    local_terms(P, N, S, v_diffuse, v_specular);
+#endif
+    gl_Position = u_clip_from_world * vec4(in_position, 1.0);
+}

@@ -1,0 +1,469 @@
+"""Flat, Gouraud and Phong shading in GLSL (moderngl on EGL, into an FBO): the course's
+"lissage" chapter.
+
+* ``flat``: one lighting per polygon, at its centroid with its normal (Lambert's model as the
+  course draws it; the texture colour still varies per fragment).
+* ``gouraud``: lighting at the vertices with normals averaged from the incident faces
+  (analytic for spheres and quadrics), the diffuse and specular terms interpolated.
+* ``phong``: normals interpolated and lighting per fragment (bump mapping needs this).
+
+All three use the local model of :mod:`.local_model` (GLSL mirror in
+``shaders/include/lighting.glsl``) and the textures of :mod:`.texturing` (mirror in
+``shaders/include/texturing.glsl``).
+
+Interactive use (the UI calls this every frame)::
+
+    session = RasterSession(scene, "phong", tessellation=6)   # tessellate + upload once
+    image = session.draw(camera)                # (H, W, 3) float32, linear, row 0 on top
+    session.draw_to(fbo, camera)                # into the caller's moderngl framebuffer
+
+A session keeps its programs, vertex buffers and FBOs; ``render()`` reuses sessions for the
+same scene content (objects, materials, lights), so repeated renders neither re-tessellate nor
+re-upload.
+"""
+from __future__ import annotations
+
+import time
+from collections import OrderedDict
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.errors import WorkbenchError
+from ..scene import features as ft
+from ..scene.model import AreaLight, Camera, DirectionalLight, Environment, Material, Scene
+from ..scene.tessellate import DEFAULT_LEVEL, Part, tessellate_scene
+from . import gl
+from . import texturing as tx
+from .base import Knob, Option, RenderResult
+from .raster_shaders import ProgramCache, base_defines, material_defines
+
+#: The near plane is never closer than this fraction of the far plane when chosen
+#: automatically (keeps 24-bit depth resolution usable when the camera is inside the bounds).
+NEAR_FAR_RATIO = 1e-3
+DEPTH_CHOICES = (16, 24, 32)
+#: Texture units of the image samplers.
+UNITS = {"u_tex_image": 0, "u_bump_image": 1, "u_op_image": 2, "u_env_image": 3}
+#: Shader features and why they may be left out.
+SHADER_FEATURES = (ft.TEXTURES, ft.SOLID_TEXTURES, ft.IMAGE_TEXTURES, ft.BUMP, ft.OPACITY, ft.ENVIRONMENT)
+NOT_RASTER = {
+    ft.SHADOWS: "no shadow feelers in a raster local model",
+    ft.REFLECTION: "mirror reflection needs ray tracing (environment-mapped materials reflect the environment map)",
+    ft.REFRACTION: "refraction needs ray tracing (transmissive surfaces drawn with their local model)",
+    ft.ABSORPTION: "absorption needs ray tracing",
+}
+
+
+def _set(prog, name: str, value) -> None:
+    """Set a uniform if the compiler kept it."""
+    if name in prog:
+        prog[name].value = value
+
+
+def _write(prog, name: str, array: np.ndarray) -> None:
+    if name in prog:
+        prog[name].write(np.ascontiguousarray(array, dtype="f4").tobytes())
+
+
+class _Uniforms:
+    """The uniforms of one draw, recorded once and written before each draw (programs are
+    shared between draws with the same defines)."""
+
+    def __init__(self, prog):
+        self.prog, self.items = prog, []
+
+    def set(self, name: str, value) -> None:
+        if name in self.prog:
+            if isinstance(value, int):
+                self.items.append((self.prog[name], value, False))
+            else:
+                self.items.append((self.prog[name], np.ascontiguousarray(value, dtype="f4").tobytes(), True))
+
+    def apply(self) -> None:
+        for u, v, raw in self.items:
+            if raw:
+                u.write(v)
+            else:
+                u.value = v
+
+
+def _frame(m) -> tuple:
+    sp, se, w = tx.frame(m.pole, m.equator)
+    return sp, se, w
+
+
+@dataclass
+class _Draw:
+    """One part on the GPU: program, vertex array, material and what to bind."""
+
+    part: Part
+    material: Material
+    prog: object
+    vao: object
+    blended: bool
+    centre: np.ndarray
+    images: dict
+    uniforms: _Uniforms
+
+
+def _area_light_parts(scene: Scene, level: int) -> list[tuple[Part, Material]]:
+    """Area lights as emissive polygons of radiance ``color * intensity``."""
+    from ..scene.model import Polygon
+    from ..scene.tessellate import tessellate_object
+    out = []
+    for i, light in enumerate(scene.lights):
+        if isinstance(light, AreaLight):
+            mat = Material(f"area light {i + 1}", color=(0.0, 0.0, 0.0), ka=0.0, kd=0.0, ks=0.0,
+                           emission=tuple(float(x) for x in light.radiance))
+            (part,) = tessellate_object(Polygon(mat.name, vertices=light.vertices, name=mat.name), 1)
+            out.append((part, mat))
+    return out
+
+
+def auto_near_far(camera: Camera, points: np.ndarray) -> tuple[float, float]:
+    """Clip planes enclosing ``points`` (N, 3) seen from ``camera`` (its own near/far win)."""
+    lo, hi = points.min(0), points.max(0)
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    depth = camera.project(corners)[1]
+    far = camera.far or float(max(depth.max(), 0.0) * 1.01 + 1e-9 * np.linalg.norm(hi - lo))
+    near = camera.near or float(max(depth.min() * 0.99, far * NEAR_FAR_RATIO))
+    if far <= near:
+        far = near / NEAR_FAR_RATIO
+    return near, far
+
+
+class RasterSession:
+    """A scene tessellated and uploaded for one shading mode (see the module docstring).
+
+    Parameters
+    ----------
+    scene : the scene (its camera is only the default for :meth:`draw`).
+    mode : ``"flat"``, ``"gouraud"`` or ``"phong"``.
+    tessellation : level of :func:`workbench.scene.tessellate.tessellate_scene`.
+    blinn : Blinn-Phong specular instead of Phong.
+    depth_bits : 16 (emulated fixed point), 24 (fixed point) or 32 (float) depth buffer.
+    """
+
+    def __init__(self, scene: Scene, mode: str, *, tessellation: int = DEFAULT_LEVEL,
+                 blinn: bool = False, depth_bits: int = 24, ctx=None):
+        if mode not in ("flat", "gouraud", "phong"):
+            raise WorkbenchError(f"unknown raster mode {mode!r}")
+        if depth_bits not in DEPTH_CHOICES:
+            raise WorkbenchError(f"depth_bits must be one of {DEPTH_CHOICES}, got {depth_bits}")
+        self.scene, self.mode, self.depth_bits = scene, mode, depth_bits
+        self.ctx = ctx or gl.context()
+        self.programs = ProgramCache(self.ctx)
+        self.timings: dict[str, float] = {}
+        t0 = time.perf_counter()
+        pairs = [(p, scene.materials[p.material]) for p in tessellate_scene(scene, tessellation)]
+        pairs += _area_light_parts(scene, tessellation)
+        self.timings["tessellate"] = time.perf_counter() - t0
+        self.n_triangles = sum(p.n_triangles for p, _ in pairs)
+        pts = np.vstack([p.positions for p, _ in pairs])
+        self.bounds = (pts.min(0), pts.max(0))
+        self.lights = scene.point_lights()
+        self._gl_images: dict[tuple, object] = {}
+        self._fbos: OrderedDict = OrderedDict()
+        t0 = time.perf_counter()
+        self.draws = [self._upload(p, m, blinn) for p, m in pairs]
+        self.background = None
+        if scene.environment is not None:
+            d = base_defines()
+            d["ENV_KIND"] = {"sky": 1, "image": 2}[scene.environment.kind]
+            self.background = (self.programs.get("background", d), self.ctx.vertex_array(
+                self.programs.get("background", d), []))
+        self.timings["upload"] = time.perf_counter() - t0 - self.programs.compile_seconds
+        self.left_out, self.features_used = self._report()
+
+    # ------------------------------------------------------------------ building
+    def _image_texture(self, path: str, repeat_v: bool = True):
+        key = (path, repeat_v)
+        if key not in self._gl_images:
+            img = tx.image(path)
+            tex = self.ctx.texture((img.shape[1], img.shape[0]), 4,
+                                   np.ascontiguousarray(img[::-1], dtype="f4").tobytes(), dtype="f4")
+            import moderngl
+            tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            tex.repeat_x, tex.repeat_y = True, repeat_v
+            self._gl_images[key] = tex
+        return self._gl_images[key]
+
+    def _upload(self, part: Part, mat: Material, blinn: bool) -> _Draw:
+        ctx = self.ctx
+        has_uv = part.uvs is not None
+        defines = material_defines(self.scene, mat, self.mode, n_lights=len(self.lights),
+                                   has_uv=has_uv, blinn=blinn, depth_bits=self.depth_bits,
+                                   allow_bump=self.mode == "phong")
+        prog = self.programs.get("raster", defines)
+        F = part.faces
+        if self.mode == "flat":  # unwelded: each vertex carries its polygon's normal and centroid
+            cols = [part.positions[F], np.repeat(part.face_normals[:, None], 3, 1), part.obj_positions[F]]
+            if has_uv:
+                cols.append(part.uvs[F])
+            cols.append(np.repeat(part.face_centroids[:, None], 3, 1))
+            data = np.concatenate([c.reshape(len(F) * 3, -1) for c in cols], 1)
+            index = None
+        else:
+            cols = [part.positions, part.normals, part.obj_positions] + ([part.uvs] if has_uv else [])
+            data = np.concatenate(cols, 1)
+            index = ctx.buffer(np.ascontiguousarray(F, dtype="i4").tobytes())
+        fmt = "3f 3f 3f" + (" 2f" if has_uv else "") + (" 3f" if self.mode == "flat" else "")
+        names = ["in_position", "in_normal", "in_obj_position"] + (["in_uv"] if has_uv else []) \
+            + (["in_centroid"] if self.mode == "flat" else [])
+        vbo = ctx.buffer(np.ascontiguousarray(data, dtype="f4").tobytes())
+        vao = ctx.vertex_array(prog, [(vbo, fmt, *names)], index, index_element_size=4, skip_errors=True)
+        images = {}
+        if mat.texture is not None and mat.texture.kind == "image":
+            images["u_tex_image"] = self._image_texture(mat.texture.path)
+        if mat.bump is not None and mat.bump.kind == "image" and self.mode == "phong":
+            images["u_bump_image"] = self._image_texture(mat.bump.path)
+        if mat.opacity is not None and mat.opacity.kind == "image":
+            images["u_op_image"] = self._image_texture(mat.opacity.path)
+        env = self.scene.environment
+        if "ENV_MAP" in defines and env is not None and env.kind == "image":
+            images["u_env_image"] = self._image_texture(env.path, repeat_v=False)
+        op = mat.opacity
+        blended = op is not None and (op.kind == "image" or (op.kind == "constant" and op.value < 1.0))
+        uniforms = self._static_uniforms(prog, part, mat)
+        return _Draw(part, mat, prog, vao, blended, part.positions.mean(0), images, uniforms)
+
+    def _static_uniforms(self, prog, part: Part, mat: Material) -> _Uniforms:
+        """Material, maps and lights of one draw (the camera is set per frame)."""
+        u = _Uniforms(prog)
+        u.set("u_color", tuple(mat.color))
+        u.set("u_emission", tuple(mat.emission))
+        for k in ("ka", "kd", "ks", "kr", "shininess"):
+            u.set(f"u_{k}", float(getattr(mat, k)))
+        u.set("u_ambient", tuple(self.scene.ambient))
+        for prefix, m in (("u_tex", mat.texture), ("u_bump", mat.bump), ("u_op", mat.opacity)):
+            if m is None:
+                continue
+            sp, se, w = _frame(m)
+            for name, v in (("center", m.center), ("sp", sp), ("se", se), ("w", w)):
+                u.set(f"{prefix}.{name}", tuple(float(x) for x in v))
+            u.set(f"{prefix}.scale", float(m.scale))
+            width = getattr(m, "width", None) if prefix == "u_op" else m.mortar
+            u.set(f"{prefix}.width", float(width))
+        if mat.texture is not None:
+            u.set("u_tex_color0", tuple(mat.texture.colors[0]))
+            u.set("u_tex_color1", tuple(mat.texture.colors[1]))
+        if mat.bump is not None:
+            u.set("u_bump_strength", float(mat.bump.strength))
+            u.set("u_grad_from_object", np.linalg.inv(part.world_from_object[:3, :3]))
+        if mat.opacity is not None:
+            u.set("u_op_value", float(mat.opacity.value))
+            if mat.opacity.kind == "image":
+                u.set("u_op_has_alpha", float(tx.image(mat.opacity.path)[..., 3].min() < 1.0))
+        env = self.scene.environment
+        if env is None or env.kind == "sky":
+            e = env or Environment()
+            u.set("u_env_zenith", tuple(e.zenith))
+            u.set("u_env_horizon", tuple(e.horizon))
+            u.set("u_env_ground", tuple(e.ground))
+        for name, unit in UNITS.items():
+            u.set(name, unit)
+        if self.lights:
+            pos, col, inv_sq, lobe = [], [], [], []
+            for light in self.lights:
+                c = np.asarray(light.color) * light.intensity
+                col.append(tuple(float(x) for x in c))
+                if isinstance(light, DirectionalLight):
+                    pos.append((*map(float, light.direction), 0.0))
+                    inv_sq.append(0.0)
+                    lobe.append((0.0, 0.0, 0.0, 0.0))
+                else:
+                    pos.append((*map(float, light.position), 1.0))
+                    inv_sq.append(1.0 if light.falloff == "inverse_square" else 0.0)
+                    cn = light.cosine_normal
+                    lobe.append((0.0, 0.0, 0.0, 0.0) if cn is None else (*map(float, cn), 1.0))
+            u.set("u_light_pos", np.array(pos))
+            u.set("u_light_color", np.array(col))
+            u.set("u_light_inv_sq", np.array(inv_sq))
+            u.set("u_light_lobe", np.array(lobe))
+        if self.depth_bits == 16:
+            u.set("u_depth_levels", float(2 ** 16 - 1))
+        return u
+
+    def _report(self) -> tuple[list[str], list[str]]:
+        needs = self.scene.needs()
+        left = [f"{f}: not needed by the scene (not compiled)" for f in SHADER_FEATURES if f not in needs]
+        if ft.BUMP in needs and self.mode != "phong":
+            left.append(f"bump: {self.mode} shading has no per-fragment normal to perturb")
+        for f, why in NOT_RASTER.items():
+            if f in needs:
+                left.append(f"{f}: {why}")
+        used = sorted(f for f in needs if f not in NOT_RASTER and not (f == ft.BUMP and self.mode != "phong"))
+        return left, used
+
+    # ------------------------------------------------------------------ drawing
+    def near_far(self, camera: Camera) -> tuple[float, float]:
+        lo, hi = self.bounds
+        return auto_near_far(camera, np.array([lo, hi]))
+
+    def framebuffer(self, width: int, height: int):
+        """A cached float32 RGBA colour + depth FBO of this size (depth format per
+        ``depth_bits``)."""
+        key = (width, height)
+        if key not in self._fbos:
+            color = self.ctx.texture((width, height), 4, dtype="f4")
+            depth = depth_attachment(self.ctx, (width, height), self.depth_bits)
+            self._fbos[key] = self.ctx.framebuffer([color], depth)
+            if len(self._fbos) > 4:
+                self._fbos.popitem(last=False)
+        return self._fbos[key]
+
+    def draw_to(self, fbo, camera: Camera, near: float | None = None, far: float | None = None):
+        """Draw the scene seen by ``camera`` into ``fbo`` (colour attachment 0 + depth).
+        Returns the (near, far) used."""
+        import moderngl
+        ctx = self.ctx
+        n0, f0 = self.near_far(camera)
+        near, far = near or n0, far or f0
+        V = camera.camera_from_world()
+        clip = camera.clip_from_camera(near, far) @ V
+        eye = tuple(float(x) for x in camera.position)
+        fbo.use()
+        ctx.viewport = (0, 0, fbo.width, fbo.height)
+        bg = tuple(float(x) for x in self.scene.background)
+        fbo.clear(*bg, 0.0, depth=1.0)
+        ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
+        if self.background is not None:
+            prog, vao = self.background
+            ctx.disable(moderngl.DEPTH_TEST)
+            _write(prog, "u_world_from_clip", np.linalg.inv(clip).T)
+            vao.render(moderngl.TRIANGLES, vertices=3)
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<"
+        opaque = [d for d in self.draws if not d.blended]
+        cam_pos = np.asarray(camera.position)
+        blended = sorted((d for d in self.draws if d.blended),
+                         key=lambda d: -float(np.linalg.norm(d.centre - cam_pos)))
+        clip_bytes = np.ascontiguousarray(clip.T, dtype="f4").tobytes()
+        for i, d in enumerate(opaque + blended):
+            if i == len(opaque):
+                ctx.enable(moderngl.BLEND)
+                ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+                fbo.depth_mask = False
+            d.uniforms.apply()
+            d.prog["u_clip_from_world"].write(clip_bytes)
+            _set(d.prog, "u_eye", eye)
+            for name, tex in d.images.items():
+                tex.use(UNITS[name])
+            d.vao.render(moderngl.TRIANGLES)
+        fbo.depth_mask = True
+        ctx.disable(moderngl.BLEND)
+        return near, far
+
+    def draw(self, camera: Camera | None = None, *, near: float | None = None,
+             far: float | None = None, with_depth: bool = False):
+        """Render and read back.
+
+        Returns
+        -------
+        image : (H, W, 3) float32 linear RGB, row 0 at the top.
+        depth : (H, W) float32 camera-space depth (inf where nothing was drawn), only with
+            ``with_depth``, as ``(image, depth, (near, far))``.
+        """
+        camera = camera or self.scene.camera
+        fbo = self.framebuffer(camera.width, camera.height)
+        nf = self.draw_to(fbo, camera, near, far)
+        raw = np.frombuffer(fbo.read(components=4, dtype="f4"), dtype=np.float32)
+        image = raw.reshape(camera.height, camera.width, 4)[::-1, :, :3]
+        if not with_depth:
+            return np.ascontiguousarray(image)
+        d = np.frombuffer(fbo.read(components=1, attachment=-1, dtype="f4"), dtype=np.float32)
+        d = d.reshape(camera.height, camera.width)[::-1].astype(np.float64)
+        n, f = nf
+        z_ndc = 2.0 * d - 1.0
+        with np.errstate(divide="ignore"):
+            depth = np.where(d >= 1.0, np.inf, 2.0 * n * f / ((f + n) - z_ndc * (f - n)))
+        return np.ascontiguousarray(image), depth.astype(np.float32), nf
+
+
+def depth_attachment(ctx, size: tuple[int, int], bits: int):
+    """Depth texture of an FBO: moderngl's 24-bit fixed point (16 bits are emulated by the
+    fragment shader quantising gl_FragDepth to 2^16 - 1 levels, see ``DEPTH_LEVELS``)."""
+    return ctx.depth_texture(size)
+
+
+def depth_view(depth: np.ndarray, near: float, far: float) -> np.ndarray:
+    """Grey image of a depth map: 1 at ``near``, 0 at ``far`` and where nothing was drawn,
+    linear in camera-space depth. (H, W, 3) float32."""
+    g = np.where(np.isfinite(depth), 1.0 - (depth - near) / (far - near), 0.0)
+    return np.repeat(np.clip(g, 0.0, 1.0)[..., None], 3, -1).astype(np.float32)
+
+
+# --------------------------------------------------------------------------- registered methods
+_SESSIONS: OrderedDict = OrderedDict()
+_MAX_SESSIONS = 6
+
+
+def session_for(scene: Scene, mode: str, tessellation: int, blinn: bool, depth_bits: int) -> tuple[RasterSession, bool]:
+    """A cached :class:`RasterSession` for the scene's content (camera excluded); returns
+    ``(session, created)``."""
+    ctx = gl.context()
+    key = (id(ctx), id(scene.objects), id(scene.materials), id(scene.lights), id(scene.environment),
+           scene.ambient, mode, tessellation, blinn, depth_bits)
+    hit = _SESSIONS.get(key)
+    if hit is not None and hit[1] is scene.objects:
+        _SESSIONS.move_to_end(key)
+        return hit[0], False
+    session = RasterSession(scene, mode, tessellation=tessellation, blinn=blinn, depth_bits=depth_bits, ctx=ctx)
+    _SESSIONS[key] = (session, scene.objects)
+    if len(_SESSIONS) > _MAX_SESSIONS:
+        _SESSIONS.popitem(last=False)
+    return session, True
+
+
+class _RasterRenderer:
+    """Shared implementation of the three registered raster methods."""
+
+    name = ""
+    knob = Knob("tessellation", (1, 2, 3, 4, 6, 8, 12, 16, 24, 32), DEFAULT_LEVEL,
+                "tessellation level of analytic primitives (sphere: 4L x 8L, see tessellate)")
+    options = {
+        "tessellation": Option(int, DEFAULT_LEVEL, "tessellation level >= 1 (the quality knob)"),
+        "blinn": Option(bool, False, "Blinn-Phong (N.H)^n instead of Phong (R.S)^n"),
+        "depth_bits": Option(int, 24, "depth buffer: 16 (fixed, emulated), 24 (fixed), 32 (float)",
+                             DEPTH_CHOICES),
+        "view": Option(str, "color", "color image or depth view (white near, black far)", ("color", "depth")),
+        "near": Option(float, 0.0, "near clip plane (0: the camera's, or from the scene bounds)"),
+        "far": Option(float, 0.0, "far clip plane (0: the camera's, or from the scene bounds)"),
+    }
+
+    def render(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
+               blinn: bool = False, depth_bits: int = 24, view: str = "color", near: float = 0.0,
+               far: float = 0.0) -> RenderResult:
+        if tessellation < 1:
+            raise WorkbenchError(f"method {self.name!r}: tessellation must be >= 1, got {tessellation}")
+        if near < 0 or far < 0 or (near and far and far <= near):
+            raise WorkbenchError(f"method {self.name!r}: need 0 < near < far, got near={near}, far={far}")
+        session, created = session_for(scene, self.name, tessellation, blinn, depth_bits)
+        compile0 = 0.0 if created else session.programs.compile_seconds
+        t0 = time.perf_counter()
+        image, depth, (n, f) = session.draw(scene.camera.with_resolution(width, height),
+                                            near=near or None, far=far or None, with_depth=True)
+        t_draw = time.perf_counter() - t0
+        gl.check_errors(session.ctx)
+        timings = {"draw": t_draw, "compile": session.programs.compile_seconds - compile0}
+        if created:
+            timings.update(session.timings)
+        if view == "depth":
+            image = depth_view(depth, n, f)
+        stats = {"gl_renderer": gl.renderer_name(session.ctx), "triangles": session.n_triangles,
+                 "near": n, "far": f, "depth_bits": depth_bits, "programs": len(session.programs.programs),
+                 "draw_calls": len(session.draws), "session_reused": not created}
+        return RenderResult(self.name, image, timings, stats, list(session.features_used),
+                            list(session.left_out), depth=depth)
+
+
+class FlatRenderer(_RasterRenderer):
+    name = "flat"
+
+
+class GouraudRenderer(_RasterRenderer):
+    name = "gouraud"
+
+
+class PhongRenderer(_RasterRenderer):
+    name = "phong"

@@ -1,0 +1,145 @@
+"""Shader files, ``#include`` resolution, ``#define`` injection and the program cache.
+
+Shaders live in ``shaders/*.vert|frag`` with shared code in ``shaders/include/*.glsl``.  The
+only text processing is:
+
+* an ``#include "name.glsl"`` directive line is replaced by that file (each file once per
+  program), bracketed by ``#line`` directives so that compiler messages give the right line
+  and source-string number (see :func:`source_names`);
+* the ``#define``s of a variant are inserted right after ``#version``, followed by
+  ``#line 2 0``.
+
+:func:`material_defines` is the one function that decides, from the scene's needs and the
+material, which code is compiled; :class:`ProgramCache` keys programs by (shader name,
+defines).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..core.errors import WorkbenchError
+from ..core.tol import tol
+from ..scene import features as ft
+from ..scene.model import Material, Scene
+
+SHADER_DIR = Path(__file__).resolve().parents[2] / "shaders"
+INCLUDE_DIR = SHADER_DIR / "include"
+
+PROJ = {"uv": 0, "planar": 1, "cylindrical": 2, "spherical": 3, "solid": 4}
+KIND = {"checker": 1, "bricks": 2, "marble": 3, "wood": 4, "grid": 5, "image": 6, "noise": 7,
+        "waves": 8, "constant": 9}
+ENV_KIND = {"sky": 1, "image": 2}
+MODES = {"flat": "MODE_FLAT", "gouraud": "MODE_GOURAUD", "phong": "MODE_PHONG"}
+
+
+def source_names(stage_file: str) -> list[str]:
+    """Source-string numbers used in ``#line`` directives: 0 is the stage file, then each
+    include in order of first appearance."""
+    names = [stage_file]
+    _resolve(SHADER_DIR / stage_file, names, set())
+    return names
+
+
+def _resolve(path: Path, names: list[str], seen: set[str]) -> str:
+    """File text with its ``#include`` lines replaced by the included files (once each)."""
+    out = []
+    number = names.index(path.name) if path.name in names else 0
+    for lineno, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
+        words = line.split()
+        if len(words) == 2 and words[0] == "#include" and words[1].startswith('"') and words[1].endswith('"'):
+            inc = words[1][1:-1]
+            if inc in seen:
+                continue
+            seen.add(inc)
+            if inc not in names:
+                names.append(inc)
+            inc_path = INCLUDE_DIR / inc
+            if not inc_path.is_file():
+                raise WorkbenchError(f"{path.name}:{lineno}: include file not found: {inc_path}")
+            out.append(f"#line 1 {names.index(inc)}")
+            out.append(_resolve(inc_path, names, seen))
+            out.append(f"#line {lineno + 1} {number}")
+        else:
+            out.append(line)
+    return "\n".join(out)
+
+
+def build_source(stage_file: str, defines: dict[str, object]) -> str:
+    """The full text of one shader stage: defines injected after ``#version``, then ``#line``,
+    includes resolved."""
+    names = [stage_file]
+    text = _resolve(SHADER_DIR / stage_file, names, set())
+    first, _, rest = text.partition("\n")
+    if not first.startswith("#version"):
+        raise WorkbenchError(f"{stage_file}: first line must be #version")
+    lines = [first] + [f"#define {k} {v}".rstrip() for k, v in sorted(defines.items())]
+    lines.append("#line 2 0")
+    return "\n".join(lines) + "\n" + rest + "\n"
+
+
+def _mapping_defines(prefix: str, m) -> dict[str, object]:
+    return {f"{prefix}_KIND": KIND[m.kind], f"{prefix}_PROJ": PROJ[m.projection]}
+
+
+def base_defines() -> dict[str, object]:
+    """Constants every program gets (tolerances from the one ``tol`` object)."""
+    return {"TOL_ZERO": f"{tol.zero:.6e}", "NORMAL_CANCEL": f"{tol.normal_cancel:.6e}",
+            "BUMP_STEP": f"{tol.bump_step:.6e}"}
+
+
+def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: int,
+                     has_uv: bool, blinn: bool, depth_bits: int, allow_bump: bool) -> dict[str, object]:
+    """The ``#define``s of one draw: what the scene needs and this material uses, nothing else.
+
+    ``MODE_*`` (flat, gouraud, phong), ``N_LIGHTS``, ``BLINN`` when asked and a light has a
+    specular material, ``HAS_UV`` (mesh uvs), ``TEX_KIND/TEX_PROJ``, ``BUMP_KIND/BUMP_PROJ``
+    (only when ``allow_bump``: per-fragment normals), ``OPACITY_KIND/OPACITY_PROJ``,
+    ``ENV_MAP`` + ``ENV_KIND`` for environment-mapped materials, ``DEPTH_LEVELS`` for an
+    emulated 16-bit depth buffer.
+    """
+    needs = scene.needs()
+    d = base_defines()
+    d[MODES[mode]] = ""
+    d["N_LIGHTS"] = n_lights
+    if blinn and material.ks > 0:
+        d["BLINN"] = ""
+    if has_uv:
+        d["HAS_UV"] = ""
+    if material.texture is not None and ft.TEXTURES in needs:
+        d.update(_mapping_defines("TEX", material.texture))
+    if material.bump is not None and allow_bump:
+        d.update(_mapping_defines("BUMP", material.bump))
+    if material.opacity is not None:
+        d.update(_mapping_defines("OPACITY", material.opacity))
+    if material.environment and material.kr > 0:
+        d["ENV_MAP"] = ""
+        d["ENV_KIND"] = ENV_KIND[scene.environment.kind if scene.environment else "sky"]
+    if depth_bits == 16:
+        d["DEPTH_LEVELS"] = ""
+    return d
+
+
+class ProgramCache:
+    """moderngl programs of one context keyed by (shader name, defines); compile time summed
+    in ``compile_seconds``."""
+
+    def __init__(self, ctx):
+        self.ctx = ctx
+        self.programs: dict[tuple, object] = {}
+        self.compile_seconds = 0.0
+
+    def get(self, name: str, defines: dict[str, object]):
+        import time
+        key = (name, tuple(sorted((k, str(v)) for k, v in defines.items())))
+        prog = self.programs.get(key)
+        if prog is None:
+            t0 = time.perf_counter()
+            vs, fs = build_source(f"{name}.vert", defines), build_source(f"{name}.frag", defines)
+            try:
+                prog = self.ctx.program(vertex_shader=vs, fragment_shader=fs)
+            except Exception as e:  # moderngl raises its own Error with the driver log
+                raise WorkbenchError(f"shader {name} failed to compile with {dict(key[1])}: {e}\n"
+                                     f"(source strings: {source_names(name + '.frag')})") from None
+            self.programs[key] = prog
+            self.compile_seconds += time.perf_counter() - t0
+        return prog
