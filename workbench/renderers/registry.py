@@ -8,4 +8,6 @@ BUILTIN: dict[str, str] = {
     "flat": "workbench.renderers.raster:FlatRenderer",
     "gouraud": "workbench.renderers.raster:GouraudRenderer",
     "phong": "workbench.renderers.raster:PhongRenderer",
+    "raycast": "workbench.renderers.raytrace.whitted:RaycastRenderer",
+    "raytrace": "workbench.renderers.raytrace.whitted:RaytraceRenderer",
 }

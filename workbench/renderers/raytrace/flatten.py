@@ -1,0 +1,274 @@
+"""Turn a :class:`~workbench.scene.model.Scene` into flat arrays for the numba kernels (pbrt: the
+scene is data, each renderer builds its own runtime objects).
+
+Every analytic primitive (sphere, rectangle, box, polygon, quadric) keeps its own object space:
+the ray is taken into it by ``object_from_world`` (the course's "objet transformé: appliquer la
+transformation au rayon"); the ray parameter ``t`` is unchanged by an affine map, so hits of
+different objects compare directly.  Triangle meshes are moved to world space once and share
+one BVH.  A CSG tree becomes a postfix program over its leaves.
+
+Primitive table (``P`` rows)
+----------------------------
+``ptype`` (P,) int: one of the ``SPHERE`` ... ``CSGNODE`` constants.
+``top`` (P,) bool: intersected on its own (False for CSG leaves and meshes).
+``obj`` (P,) int: index of the scene object (``len(scene.objects) + k`` for area light ``k``).
+``mat`` (P,) int: material index into the material table.
+``xf`` (P, 12): rows of ``object_from_world[:3, :4]``; ``nm`` (P, 9): world normal matrix
+(``object_from_world[:3, :3].T``, row-major) mapping object normals to world normals.
+``par`` (P, 20): per type parameters (see :func:`_params`).
+``solid`` (P,) bool: a closed surface with an inside (refraction enters a medium), else a thin
+sheet (transmission goes straight through).
+``shadow`` (P,) bool: casts shadows (area lights' own polygons do not).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...core.errors import NotApplicable
+from ...core.tol import tol
+from ...scene import model as m
+
+SPHERE, RECT, BOX, POLYGON, QUADRIC, CSGNODE, MESH = range(7)
+CSG_UNION, CSG_INTERSECTION, CSG_DIFFERENCE = -1, -2, -3
+_CSG_OPS = {"union": CSG_UNION, "intersection": CSG_INTERSECTION, "difference": CSG_DIFFERENCE}
+NPAR = 20
+
+
+@dataclass
+class SceneData:
+    """Arrays consumed by the kernels (all float64 / int64 / bool, C-contiguous)."""
+
+    ptype: np.ndarray
+    top: np.ndarray
+    obj: np.ndarray
+    mat: np.ndarray
+    xf: np.ndarray
+    nm: np.ndarray
+    par: np.ndarray
+    solid: np.ndarray
+    shadow: np.ndarray
+    wfo: np.ndarray             # (P, 4, 4) world_from_object (texturing, bump)
+    has_uv: np.ndarray          # (P,) bool: a mesh with uvs (else texturing's own mapping)
+    poly_v: np.ndarray          # (K, 3) polygon vertices, object space
+    csg_prog: np.ndarray        # postfix program: leaf primitive >= 0 or a CSG_* op
+    tri_v: np.ndarray           # (T, 9) world-space vertices, BVH order
+    tri_n: np.ndarray           # (T, 9) world-space vertex normals
+    tri_uv: np.ndarray          # (T, 6)
+    tri_e: np.ndarray           # (T, 9) vertex emission (radiance)
+    tri_prim: np.ndarray        # (T,) the mesh's primitive row
+    bvh_box: np.ndarray         # (Nn, 6) node bounds
+    bvh_meta: np.ndarray        # (Nn, 3) int: leaf (first, count, -1) / inner (right, 0, axis)
+    materials: list             # Material objects, index = mat
+    mat_tab: np.ndarray         # (M, 24) numeric material table (see _material_row)
+    lights: np.ndarray          # (L, 14) light table (see _light_rows)
+    extent: float               # diagonal of the scene's bounds
+    n_objects: int
+    features: dict = field(default_factory=dict)
+    bvh_build_time: float = 0.0
+
+    def kernel_args(self) -> tuple:
+        """The geometry tuple passed to every numba kernel."""
+        return (self.ptype, self.top, self.xf, self.nm, self.par, self.solid, self.shadow,
+                self.poly_v, self.csg_prog, self.tri_v, self.tri_n, self.tri_uv, self.tri_e,
+                self.tri_prim, self.bvh_box, self.bvh_meta)
+
+
+def _material_row(mat: m.Material, front_only: bool = False) -> np.ndarray:
+    """color(3) ka kd ks shininess kr kt ior absorption(3) emission(3) front_only_emitter
+    has_texture has_bump has_opacity environment."""
+    return np.array([*mat.color, mat.ka, mat.kd, mat.ks, mat.shininess, mat.kr, mat.kt, mat.ior,
+                     *mat.absorption, *mat.emission, float(front_only), float(mat.texture is not None),
+                     float(mat.bump is not None), float(mat.opacity is not None),
+                     float(mat.environment), 0.0, 0.0], dtype=np.float64)
+
+
+def light_rows(lights) -> np.ndarray:
+    """(L, 14): kind (0 point, 1 directional), position or direction (3), colour*intensity (3),
+    inverse-square flag, cosine flag, cosine normal (3), spare."""
+    rows = np.zeros((len(lights), 14))
+    for i, lt in enumerate(lights):
+        if isinstance(lt, m.DirectionalLight):
+            rows[i, 0], rows[i, 1:4] = 1.0, lt.direction
+        else:
+            rows[i, 1:4] = lt.position
+            rows[i, 7] = float(lt.falloff == "inverse_square")
+            if lt.cosine_normal is not None:
+                rows[i, 8], rows[i, 9:12] = 1.0, lt.cosine_normal
+        rows[i, 4:7] = np.asarray(lt.color) * lt.intensity
+    return rows
+
+
+class _Builder:
+    def __init__(self, scene: m.Scene):
+        self.scene = scene
+        self.rows: list[dict] = []
+        self.poly_v: list[np.ndarray] = []
+        self.n_poly = 0
+        self.prog: list[int] = []
+        self.meshes: list[tuple[int, m.Mesh, np.ndarray]] = []
+        self.materials = list(scene.materials.values())
+        self.mat_index = {mt.name: i for i, mt in enumerate(self.materials)}
+        self.front_only: set[int] = set()
+        self.bounds: list[np.ndarray] = []
+
+    def add(self, kind, obj_index, mat, world_from_object, par, *, top=True, solid=True, shadow=True):
+        ofw = np.linalg.inv(world_from_object)
+        row = dict(ptype=kind, top=top, obj=obj_index, mat=mat, xf=ofw[:3, :4].reshape(-1),
+                   nm=ofw[:3, :3].T.reshape(-1), par=par, solid=solid, shadow=shadow,
+                   wfo=np.asarray(world_from_object, dtype=np.float64), has_uv=False)
+        self.rows.append(row)
+        return len(self.rows) - 1
+
+    def _bound(self, world_from_object, pts):
+        pts = np.asarray(pts, dtype=np.float64).reshape(-1, 3)
+        self.bounds.append(pts @ world_from_object[:3, :3].T + world_from_object[:3, 3])
+
+    def leaf(self, o: m.SceneObject, obj_index: int, parent: np.ndarray, *, top: bool) -> int:
+        W = parent @ np.asarray(o.world_from_object)
+        mat = self.mat_index[o.material]
+        par = np.zeros(NPAR)
+        if isinstance(o, m.Sphere):
+            par[:4] = (*o.center, o.radius)
+            c, r = np.asarray(o.center), o.radius
+            self._bound(W, [c + r * (2 * np.array(s) - 1) for s in np.ndindex(2, 2, 2)])
+            return self.add(SPHERE, obj_index, mat, W, par, top=top)
+        if isinstance(o, m.Plane):
+            u, v, n = o.frame()
+            par[:14] = (*o.point, *u, *v, *n, o.size[0] / 2, o.size[1] / 2)
+            self._bound(W, o.corners())
+            return self.add(RECT, obj_index, mat, W, par, top=top, solid=False)
+        if isinstance(o, m.Box):
+            par[:6] = (*o.min, *o.max)
+            lo, hi = np.asarray(o.min), np.asarray(o.max)
+            self._bound(W, [np.where(np.array(s, bool), hi, lo) for s in np.ndindex(2, 2, 2)])
+            return self.add(BOX, obj_index, mat, W, par, top=top)
+        if isinstance(o, m.Polygon):
+            return self.polygon(np.asarray(o.vertices), obj_index, mat, W, top=top)
+        if isinstance(o, m.Quadric):
+            Q = np.asarray(o.Q)
+            par[:10] = (Q[0, 0], Q[0, 1], Q[0, 2], Q[0, 3], Q[1, 1], Q[1, 2], Q[1, 3], Q[2, 2], Q[2, 3], Q[3, 3])
+            par[10:16] = (*o.bounds_min, *o.bounds_max)
+            lo, hi = np.asarray(o.bounds_min), np.asarray(o.bounds_max)
+            self._bound(W, [np.where(np.array(s, bool), hi, lo) for s in np.ndindex(2, 2, 2)])
+            return self.add(QUADRIC, obj_index, mat, W, par, top=top)
+        if isinstance(o, m.Mesh):
+            if not top:
+                raise NotApplicable(f"object {o.name or obj_index}: a mesh inside a CSG tree is not "
+                                    "supported by the ray tracer (use spheres, boxes or quadrics)")
+            k = self.add(MESH, obj_index, mat, W, par, top=False, solid=True)
+            self.rows[k]["has_uv"] = o.uvs is not None
+            self.meshes.append((k, o, W))
+            self._bound(W, np.asarray(o.vertices))
+            return k
+        if isinstance(o, m.CSG):
+            raise AssertionError("CSG handled by csg()")
+        raise NotApplicable(f"object kind {o.kind!r} is not supported by the ray tracer")
+
+    def polygon(self, verts, obj_index, mat, W, *, top=True, shadow=True, front_only=False):
+        v = np.asarray(verts, dtype=np.float64)
+        n = np.cross(v[1:-1] - v[0], v[2:] - v[0]).sum(0)
+        n = n / np.linalg.norm(n)
+        par = np.zeros(NPAR)
+        par[:7] = (*n, float(n @ v.mean(0)), self.n_poly, len(v), 0.0)
+        self.poly_v.append(v)
+        self.n_poly += len(v)
+        self._bound(W, v)
+        return self.add(POLYGON, obj_index, mat, W, par, top=top, solid=False, shadow=shadow)
+
+    def csg_program(self, o: m.CSG, obj_index: int, parent: np.ndarray):
+        W = parent @ np.asarray(o.world_from_object)
+        for child in (o.left, o.right):
+            if isinstance(child, m.CSG):
+                self.csg_program(child, obj_index, W)
+            else:
+                self.prog.append(self.leaf(child, obj_index, W, top=False))
+        self.prog.append(_CSG_OPS[o.op])
+
+    def object(self, o: m.SceneObject, i: int):
+        if isinstance(o, m.CSG):
+            start = len(self.prog)
+            self.csg_program(o, i, np.eye(4))
+            par = np.zeros(NPAR)
+            par[:2] = (start, len(self.prog) - start)
+            self.add(CSGNODE, i, self.mat_index[o.material], np.eye(4), par, top=True)
+        else:
+            self.leaf(o, i, np.eye(4), top=True)
+
+    def area_light(self, light: m.AreaLight, k: int):
+        mat = m.Material(f"__area_light_{k}", color=(0.0, 0.0, 0.0), ka=0.0, kd=0.0, ks=0.0,
+                         emission=tuple(float(x) for x in light.radiance))
+        self.materials.append(mat)
+        self.front_only.add(len(self.materials) - 1)
+        self.polygon(light.vertices, len(self.scene.objects) + k, len(self.materials) - 1, np.eye(4),
+                     shadow=False)
+
+
+def _triangles(meshes):
+    """World-space triangle arrays of every mesh, in input order."""
+    tv, tn, tuv, te, tp = [], [], [], [], []
+    for k, mesh, W in meshes:
+        V = np.asarray(mesh.vertices, dtype=np.float64) @ W[:3, :3].T + W[:3, 3]
+        F = np.asarray(mesh.faces, dtype=np.int64)
+        tv.append(V[F].reshape(-1, 9))
+        if mesh.normals is not None:
+            nrm = np.asarray(mesh.normals, dtype=np.float64) @ np.linalg.inv(W[:3, :3])
+            ln = np.linalg.norm(nrm, axis=1, keepdims=True)
+            nrm = np.divide(nrm, ln, out=np.zeros_like(nrm), where=ln > tol.normal_cancel)
+            tn.append(nrm[F].reshape(-1, 9))
+        else:
+            tn.append(np.zeros((len(F), 9)))
+        tuv.append(np.asarray(mesh.uvs, dtype=np.float64)[F].reshape(-1, 6) if mesh.uvs is not None
+                   else np.zeros((len(F), 6)))
+        te.append(np.asarray(mesh.vertex_emission, dtype=np.float64)[F].reshape(-1, 9)
+                  if mesh.vertex_emission is not None else np.zeros((len(F), 9)))
+        tp.append(np.full(len(F), k, dtype=np.int64))
+    if not tv:
+        z = np.zeros((0, 9))
+        return z, z.copy(), np.zeros((0, 6)), z.copy(), np.zeros(0, dtype=np.int64)
+    return (np.concatenate(tv), np.concatenate(tn), np.concatenate(tuv), np.concatenate(te),
+            np.concatenate(tp))
+
+
+def flatten(scene: m.Scene) -> SceneData:
+    """Build the kernel arrays for ``scene`` (area lights become emissive polygons)."""
+    import time
+    b = _Builder(scene)
+    for i, o in enumerate(scene.objects):
+        b.object(o, i)
+    for k, light in enumerate(scene.lights):
+        if isinstance(light, m.AreaLight):
+            b.area_light(light, k)
+    rows = b.rows
+
+    def col(key, dtype):
+        return np.ascontiguousarray(np.array([r[key] for r in rows], dtype=dtype))
+
+    tri_v, tri_n, tri_uv, tri_e, tri_p = _triangles(b.meshes)
+    t0 = time.perf_counter()
+    if len(tri_v):
+        from .bvh import build_bvh
+        order, bvh_box, bvh_meta = build_bvh(tri_v)
+        tri_v, tri_n, tri_uv, tri_e, tri_p = (np.ascontiguousarray(a[order]) for a in
+                                              (tri_v, tri_n, tri_uv, tri_e, tri_p))
+    else:
+        bvh_box, bvh_meta = np.zeros((1, 6)), np.zeros((1, 3), dtype=np.int64)
+    bvh_time = time.perf_counter() - t0
+    allb = np.concatenate(b.bounds) if b.bounds else np.zeros((1, 3))
+    finite = allb[np.isfinite(allb).all(1)]
+    extent = float(np.linalg.norm(np.ptp(finite, axis=0))) if len(finite) else 1.0
+    mat_tab = np.stack([_material_row(mt, i in b.front_only) for i, mt in enumerate(b.materials)])
+    return SceneData(
+        ptype=col("ptype", np.int64), top=col("top", np.bool_), obj=col("obj", np.int64),
+        mat=col("mat", np.int64), xf=col("xf", np.float64).reshape(-1, 12),
+        nm=col("nm", np.float64).reshape(-1, 9), par=col("par", np.float64).reshape(-1, NPAR),
+        solid=col("solid", np.bool_), shadow=col("shadow", np.bool_),
+        wfo=col("wfo", np.float64).reshape(-1, 4, 4), has_uv=col("has_uv", np.bool_),
+        poly_v=np.ascontiguousarray(np.concatenate(b.poly_v) if b.poly_v else np.zeros((1, 3))),
+        csg_prog=np.array(b.prog if b.prog else [0], dtype=np.int64),
+        tri_v=tri_v, tri_n=tri_n, tri_uv=tri_uv, tri_e=tri_e, tri_prim=tri_p,
+        bvh_box=np.ascontiguousarray(bvh_box), bvh_meta=np.ascontiguousarray(bvh_meta),
+        materials=b.materials, mat_tab=np.ascontiguousarray(mat_tab),
+        lights=np.ascontiguousarray(light_rows(scene.point_lights()).reshape(-1, 14)),
+        extent=max(extent, tol.zero), n_objects=len(scene.objects), bvh_build_time=bvh_time)

@@ -1,0 +1,840 @@
+"""Numba kernels of the ray tracer: intersection (closest hit, shadow feelers) and the shading
+and spawning step of one ray generation ("wavefront": each generation of rays is traced, then
+shaded, then its reflected and refracted children form the next generation).
+
+Everything is scalar code over flat arrays (:mod:`.flatten`); the batch kernels are
+``parallel=True`` over chunks of ``CHUNK`` rays (``prange``), each chunk with its own scratch
+arrays (BVH stack, CSG interval stacks).  ``cache=True``: compiled code is kept on disk
+(``NUMBA_CACHE_DIR``), so a warm cache compiles nothing.
+
+The readable version of the same algorithm is :mod:`.reference`; the two are tested against
+each other.  Equations: see the docstrings of the reference's functions.
+"""
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+from numba import prange
+
+from .flatten import (BOX, CSG_DIFFERENCE, CSG_INTERSECTION, CSG_UNION, CSGNODE, POLYGON,
+                      QUADRIC, RECT, SPHERE)
+
+CHUNK = 64
+BVH_STACK = 128
+CSG_DEPTH = 16
+CSG_EVENTS = 32
+# Slab exits are enlarged by 1 + 2 gamma_3 (gamma_n = n u / (1 - n u), u = 2^-53) so that
+# rounding never culls a box the ray touches (Ize, "Robust BVH ray traversal", JCGT 2013).
+BOX_GAMMA = 1.0 + 2.0 * 3.0 * 2.0 ** -53 / (1.0 - 3.0 * 2.0 ** -53)
+
+
+# ----------------------------------------------------------------------------- small helpers
+@nb.njit(cache=True, inline="always")
+def _to_object(xf, k, ox, oy, oz, dx, dy, dz):
+    a = xf[k]
+    return (a[0] * ox + a[1] * oy + a[2] * oz + a[3], a[4] * ox + a[5] * oy + a[6] * oz + a[7],
+            a[8] * ox + a[9] * oy + a[10] * oz + a[11],
+            a[0] * dx + a[1] * dy + a[2] * dz, a[4] * dx + a[5] * dy + a[6] * dz,
+            a[8] * dx + a[9] * dy + a[10] * dz)
+
+
+@nb.njit(cache=True)
+def solve_quadratic(A, B, C, zero):
+    """Real roots of ``A t^2 + B t + C`` sorted (DESIGN errata 7: ``q = -(B + sign(B) sqrt(disc))/2``,
+    roots ``q/A`` and ``C/q``); ``A = 0`` (relative to ``zero``) gives the linear root ``-C/B``.
+    Returns ``(n, t0, t1)``; a tangent (double) root counts as no root (the course ignores it)."""
+    scale = abs(A) + abs(B) + abs(C)
+    if abs(A) <= zero * scale:
+        if abs(B) <= zero * scale:
+            return 0, 0.0, 0.0
+        t = -C / B
+        return 1, t, t
+    disc = B * B - 4.0 * A * C
+    if not disc > 0.0:
+        return 0, 0.0, 0.0
+    sq = math.sqrt(disc)
+    q = -0.5 * (B + sq) if B >= 0.0 else -0.5 * (B - sq)
+    t0 = q / A
+    t1 = C / q if q != 0.0 else -t0
+    if t0 > t1:
+        t0, t1 = t1, t0
+    return 2, t0, t1
+
+
+@nb.njit(cache=True)
+def sphere_roots(par, ox, oy, oz, dx, dy, dz):
+    """Roots of the ray / sphere equation in object space.
+
+    Errata 1 (B uses O - C) and the cancellation-free discriminant of Haines et al.,
+    "Precision improvements for ray/sphere intersection" (Ray Tracing Gems, 2019):
+    ``disc = r^2 - |f - (f.d) d|^2`` with ``f = O - C`` and ``d`` the unit direction."""
+    fx, fy, fz = ox - par[0], oy - par[1], oz - par[2]
+    r = par[3]
+    s = math.sqrt(dx * dx + dy * dy + dz * dz)
+    ux, uy, uz = dx / s, dy / s, dz / s
+    b = fx * ux + fy * uy + fz * uz
+    px, py, pz = fx - b * ux, fy - b * uy, fz - b * uz
+    disc = r * r - (px * px + py * py + pz * pz)
+    if not disc > 0.0:
+        return False, 0.0, 0.0
+    sq = math.sqrt(disc)
+    q = -b - sq if b >= 0.0 else -b + sq
+    c = (math.sqrt(fx * fx + fy * fy + fz * fz) - r) * (math.sqrt(fx * fx + fy * fy + fz * fz) + r)
+    t0 = c / q if q != 0.0 else -sq
+    t1 = q
+    if t0 > t1:
+        t0, t1 = t1, t0
+    return True, t0 / s, t1 / s
+
+
+@nb.njit(cache=True)
+def slab(lo0, lo1, lo2, hi0, hi1, hi2, ox, oy, oz, dx, dy, dz):
+    """Ray / axis-aligned box (Kay & Kajiya slabs).  Returns ``(ok, t_near, face_near, t_far,
+    face_far)``; faces are ``1 + 2 axis + side`` (side 1 = max face)."""
+    tn, tf = -np.inf, np.inf
+    fn, ff = 0, 0
+    for a in range(3):
+        if a == 0:
+            o, d, lo, hi = ox, dx, lo0, hi0
+        elif a == 1:
+            o, d, lo, hi = oy, dy, lo1, hi1
+        else:
+            o, d, lo, hi = oz, dz, lo2, hi2
+        if d == 0.0:
+            if o < lo or o > hi:
+                return False, 0.0, 0, 0.0, 0
+            continue
+        t0 = (lo - o) / d
+        t1 = (hi - o) / d
+        f0, f1 = 1 + 2 * a, 2 + 2 * a
+        if t0 > t1:
+            t0, t1 = t1, t0
+            f0, f1 = f1, f0
+        if t0 > tn:
+            tn, fn = t0, f0
+        if t1 < tf:
+            tf, ff = t1, f1
+    if tn > tf:
+        return False, 0.0, 0, 0.0, 0
+    return True, tn, fn, tf, ff
+
+
+@nb.njit(cache=True)
+def quadric_coeffs(par, ox, oy, oz, dx, dy, dz):
+    """``A = D^T Q D``, ``B = 2 D^T Q P0``, ``C = P0^T Q P0`` with D lifted with w = 0 and P0
+    with w = 1 (errata 2: the cross terms of C carry their factor 2)."""
+    q00, q01, q02, q03, q11, q12, q13, q22, q23, q33 = (par[0], par[1], par[2], par[3], par[4],
+                                                         par[5], par[6], par[7], par[8], par[9])
+    # Q P0 and Q D (first three rows)
+    qp0 = q00 * ox + q01 * oy + q02 * oz + q03
+    qp1 = q01 * ox + q11 * oy + q12 * oz + q13
+    qp2 = q02 * ox + q12 * oy + q22 * oz + q23
+    qp3 = q03 * ox + q13 * oy + q23 * oz + q33
+    qd0 = q00 * dx + q01 * dy + q02 * dz
+    qd1 = q01 * dx + q11 * dy + q12 * dz
+    qd2 = q02 * dx + q12 * dy + q22 * dz
+    A = dx * qd0 + dy * qd1 + dz * qd2
+    B = 2.0 * (dx * qp0 + dy * qp1 + dz * qp2)
+    C = ox * qp0 + oy * qp1 + oz * qp2 + qp3
+    return A, B, C
+
+
+@nb.njit(cache=True)
+def _in_bounds(par, x, y, z, slack):
+    return (par[10] - slack <= x <= par[13] + slack and par[11] - slack <= y <= par[14] + slack
+            and par[12] - slack <= z <= par[15] + slack)
+
+
+# ----------------------------------------------------------------------------- primitives
+@nb.njit(cache=True)
+def prim_hit(k, ptype, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
+    """Closest hit ``tmin < t < tmax`` of analytic primitive ``k`` (object-space ray).
+    Returns ``(t, face)``, ``t = inf`` on a miss."""
+    p = par[k]
+    kind = ptype[k]
+    if kind == SPHERE:
+        ok, t0, t1 = sphere_roots(p, ox, oy, oz, dx, dy, dz)
+        if ok:
+            if tmin < t0 < tmax:
+                return t0, 0
+            if tmin < t1 < tmax:
+                return t1, 0
+        return np.inf, 0
+    if kind == RECT:
+        nx, ny, nz = p[9], p[10], p[11]
+        den = nx * dx + ny * dy + nz * dz
+        if den == 0.0:
+            return np.inf, 0
+        t = ((p[0] - ox) * nx + (p[1] - oy) * ny + (p[2] - oz) * nz) / den
+        if not (tmin < t < tmax):
+            return np.inf, 0
+        qx, qy, qz = ox + t * dx - p[0], oy + t * dy - p[1], oz + t * dz - p[2]
+        if abs(qx * p[3] + qy * p[4] + qz * p[5]) <= p[12] and abs(qx * p[6] + qy * p[7] + qz * p[8]) <= p[13]:
+            return t, 0
+        return np.inf, 0
+    if kind == BOX:
+        ok, tn, fn, tf, ff = slab(p[0], p[1], p[2], p[3], p[4], p[5], ox, oy, oz, dx, dy, dz)
+        if ok:
+            if tmin < tn < tmax:
+                return tn, fn
+            if tmin < tf < tmax:
+                return tf, ff
+        return np.inf, 0
+    if kind == POLYGON:
+        nx, ny, nz = p[0], p[1], p[2]
+        den = nx * dx + ny * dy + nz * dz
+        if den == 0.0:
+            return np.inf, 0
+        t = (p[3] - (nx * ox + ny * oy + nz * oz)) / den
+        if not (tmin < t < tmax):
+            return np.inf, 0
+        qx, qy, qz = ox + t * dx, oy + t * dy, oz + t * dz
+        s, n = int(p[4]), int(p[5])
+        for i in range(n):
+            j = s + (i + 1) % n
+            ax, ay, az = poly_v[s + i, 0], poly_v[s + i, 1], poly_v[s + i, 2]
+            ex, ey, ez = poly_v[j, 0] - ax, poly_v[j, 1] - ay, poly_v[j, 2] - az
+            wx, wy, wz = qx - ax, qy - ay, qz - az
+            cx, cy, cz = ey * wz - ez * wy, ez * wx - ex * wz, ex * wy - ey * wx
+            if cx * nx + cy * ny + cz * nz < 0.0:
+                return np.inf, 0
+        return t, 0
+    if kind == QUADRIC:
+        A, B, C = quadric_coeffs(p, ox, oy, oz, dx, dy, dz)
+        n, t0, t1 = solve_quadratic(A, B, C, zero)
+        for r in range(n):
+            t = t0 if r == 0 else t1
+            if tmin < t < tmax and _in_bounds(p, ox + t * dx, oy + t * dy, oz + t * dz, 0.0):
+                return t, 0
+        return np.inf, 0
+    return np.inf, 0
+
+
+@nb.njit(cache=True)
+def leaf_events(k, ptype, par, ox, oy, oz, dx, dy, dz, zero, et, ep, ef):
+    """Interval list (entering / leaving events along the whole line) of solid leaf ``k``:
+    sphere, box, or quadric inside ``P^T Q P < 0`` intersected with its bounds box.
+    Writes ``et`` (t), ``ep`` (signed primitive code ``k + 1``), ``ef`` (face); returns the count."""
+    p = par[k]
+    kind = ptype[k]
+    if kind == SPHERE:
+        ok, t0, t1 = sphere_roots(p, ox, oy, oz, dx, dy, dz)
+        if not ok:
+            return 0
+        et[0], et[1] = t0, t1
+        ep[0], ep[1] = k + 1, k + 1
+        ef[0], ef[1] = 0, 0
+        return 2
+    if kind == BOX:
+        ok, tn, fn, tf, ff = slab(p[0], p[1], p[2], p[3], p[4], p[5], ox, oy, oz, dx, dy, dz)
+        if not ok or not tn < tf:
+            return 0
+        et[0], et[1] = tn, tf
+        ep[0], ep[1] = k + 1, k + 1
+        ef[0], ef[1] = fn, ff
+        return 2
+    if kind == QUADRIC:
+        ok, sn, sfn, sf, sff = slab(p[10], p[11], p[12], p[13], p[14], p[15], ox, oy, oz, dx, dy, dz)
+        if not ok or not sn < sf:
+            return 0
+        A, B, C = quadric_coeffs(p, ox, oy, oz, dx, dy, dz)
+        n, r0, r1 = solve_quadratic(A, B, C, zero)
+        # the inside {t : A t^2 + B t + C < 0} as up to two intervals (a, b)
+        cnt = 0
+        ia0, ib0, ia1, ib1 = 0.0, 0.0, 0.0, 0.0
+        scale = abs(A) + abs(B) + abs(C)
+        if abs(A) <= zero * scale:
+            if n == 1:
+                if B > 0.0:
+                    ia0, ib0, cnt = -np.inf, r0, 1
+                else:
+                    ia0, ib0, cnt = r0, np.inf, 1
+            elif C < 0.0:
+                ia0, ib0, cnt = -np.inf, np.inf, 1
+        elif A > 0.0:
+            if n == 2:
+                ia0, ib0, cnt = r0, r1, 1
+        else:
+            if n == 2:
+                ia0, ib0, ia1, ib1, cnt = -np.inf, r0, r1, np.inf, 2
+            else:
+                ia0, ib0, cnt = -np.inf, np.inf, 1
+        m = 0
+        for i in range(cnt):
+            a = ia0 if i == 0 else ia1
+            b = ib0 if i == 0 else ib1
+            fa, fb = 0, 0
+            if sn > a:
+                a, fa = sn, sfn
+            if sf < b:
+                b, fb = sf, sff
+            if a < b:
+                et[m], et[m + 1] = a, b
+                ep[m], ep[m + 1] = k + 1, k + 1
+                ef[m], ef[m + 1] = fa, fb
+                m += 2
+        return m
+    return 0
+
+
+@nb.njit(cache=True)
+def _op(op, a, b):
+    if op == CSG_UNION:
+        return a or b
+    if op == CSG_INTERSECTION:
+        return a and b
+    return a and not b
+
+
+@nb.njit(cache=True)
+def combine(op, ta, pa, fa, na, tb, pb, fb, nb_, to, po, fo, eps):
+    """Combine two interval lists by a boolean ``op`` (the course's ``composite_intersect``):
+    sweep the events of both lists in order, grouping events closer than ``eps`` (coincident
+    surfaces), and emit an event wherever ``op(inside A, inside B)`` changes; intervals shorter
+    than ``eps`` are dropped.  A difference flips the normals of B's surfaces (sign of the code).
+    Returns the number of output events."""
+    i, j, m = 0, 0, 0
+    ina, inb, state = False, False, False
+    flip = -1 if op == CSG_DIFFERENCE else 1
+    cap = to.shape[0]
+    while i < na or j < nb_:
+        t = np.inf
+        if i < na:
+            t = ta[i]
+        if j < nb_ and tb[j] < t:
+            t = tb[j]
+        ct, cp, cf = t, 0, 0
+        a_moved = False
+        while i < na and ta[i] <= t + eps:
+            ina = not ina
+            ct, cp, cf = ta[i], pa[i], fa[i]
+            a_moved = True
+            i += 1
+        while j < nb_ and tb[j] <= t + eps:
+            inb = not inb
+            if not a_moved:
+                ct, cp, cf = tb[j], flip * pb[j], fb[j]
+            j += 1
+        new = _op(op, ina, inb)
+        if new != state:
+            state = new
+            if not new and m > 0 and ct - to[m - 1] <= eps:
+                m -= 1  # zero-length interval: drop it
+            elif m < cap:
+                to[m], po[m], fo[m] = ct, cp, cf
+                m += 1
+    if m % 2 == 1:  # truncated by the capacity: close the last interval
+        m -= 1
+    return m
+
+
+@nb.njit(cache=True)
+def csg_hit(start, length, prog, ptype, xf, par, ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps,
+            st, sp_, sf, sn):
+    """Evaluate a CSG postfix program along a ray (the course's recursive ``intersect``, made
+    iterative).  Returns ``(t, code, face)`` of the first boundary in ``(tmin, tmax)``."""
+    top = 0
+    for q in range(start, start + length):
+        c = prog[q]
+        if c >= 0:
+            lo = _to_object(xf, c, ox, oy, oz, dx, dy, dz)
+            sn[top] = leaf_events(c, ptype, par, lo[0], lo[1], lo[2], lo[3], lo[4], lo[5], zero,
+                                  st[top], sp_[top], sf[top])
+            top += 1
+        else:
+            a, b = top - 2, top - 1
+            # write into the spare level, then move down
+            m = combine(c, st[a], sp_[a], sf[a], sn[a], st[b], sp_[b], sf[b], sn[b],
+                        st[top], sp_[top], sf[top], eps)
+            for e in range(m):
+                st[a, e], sp_[a, e], sf[a, e] = st[top, e], sp_[top, e], sf[top, e]
+            sn[a] = m
+            top -= 1
+    for e in range(sn[0]):
+        if st[0, e] > tmin:
+            if st[0, e] < tmax:
+                return st[0, e], sp_[0, e], sf[0, e]
+            break
+    return np.inf, 0, 0
+
+
+@nb.njit(cache=True)
+def tri_hit(tv, i, ox, oy, oz, kx, ky, kz, sx, sy, sz, tmin, tmax):
+    """Watertight ray / triangle test (Woop, Benthin & Wald, JCGT 2013).  Returns
+    ``(t, b1, b2)`` with barycentric weights of vertices 1 and 2, ``t = inf`` on a miss."""
+    a0, a1, a2 = tv[i, 0] - ox, tv[i, 1] - oy, tv[i, 2] - oz
+    b0, b1, b2 = tv[i, 3] - ox, tv[i, 4] - oy, tv[i, 5] - oz
+    c0, c1, c2 = tv[i, 6] - ox, tv[i, 7] - oy, tv[i, 8] - oz
+    A = (a0, a1, a2)
+    B = (b0, b1, b2)
+    Cc = (c0, c1, c2)
+    ax = A[kx] - sx * A[kz]
+    ay = A[ky] - sy * A[kz]
+    bx = B[kx] - sx * B[kz]
+    by = B[ky] - sy * B[kz]
+    cx = Cc[kx] - sx * Cc[kz]
+    cy = Cc[ky] - sy * Cc[kz]
+    U = cx * by - cy * bx
+    V = ax * cy - ay * cx
+    W = bx * ay - by * ax
+    if (U < 0.0 or V < 0.0 or W < 0.0) and (U > 0.0 or V > 0.0 or W > 0.0):
+        return np.inf, 0.0, 0.0
+    det = U + V + W
+    if det == 0.0:
+        return np.inf, 0.0, 0.0
+    T = U * sz * A[kz] + V * sz * B[kz] + W * sz * Cc[kz]
+    t = T / det
+    if not (tmin < t < tmax):
+        return np.inf, 0.0, 0.0
+    return t, V / det, W / det
+
+
+@nb.njit(cache=True)
+def bvh_hit(tv, box, meta, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
+    """Closest (or any) triangle hit through the BVH.  Returns ``(t, tri, b1, b2)``."""
+    ax0, ax1, ax2 = abs(dx), abs(dy), abs(dz)
+    kz = 0
+    if ax1 > ax0 and ax1 >= ax2:
+        kz = 1
+    elif ax2 > ax0 and ax2 > ax1:
+        kz = 2
+    kx = (kz + 1) % 3
+    ky = (kx + 1) % 3
+    d = (dx, dy, dz)
+    if d[kz] < 0.0:
+        kx, ky = ky, kx
+    sx, sy, sz = d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]
+    big = 1e300
+    ix = 1.0 / dx if dx != 0.0 else (big if dx >= 0.0 else -big)
+    iy = 1.0 / dy if dy != 0.0 else (big if dy >= 0.0 else -big)
+    iz = 1.0 / dz if dz != 0.0 else (big if dz >= 0.0 else -big)
+    best, btri, bb1, bb2 = tmax, -1, 0.0, 0.0
+    sp = 0
+    stack[0] = 0
+    sp = 1
+    while sp > 0:
+        sp -= 1
+        nd = stack[sp]
+        t0 = (box[nd, 0] - ox) * ix
+        t1 = (box[nd, 3] - ox) * ix
+        tn, tf = min(t0, t1), max(t0, t1)
+        t0 = (box[nd, 1] - oy) * iy
+        t1 = (box[nd, 4] - oy) * iy
+        tn, tf = max(tn, min(t0, t1)), min(tf, max(t0, t1))
+        t0 = (box[nd, 2] - oz) * iz
+        t1 = (box[nd, 5] - oz) * iz
+        tn, tf = max(tn, min(t0, t1)), min(tf, max(t0, t1))
+        # conservative by a few ulps (Ize, "Robust BVH ray traversal", JCGT 2013)
+        if tn > tf * BOX_GAMMA or tf < tmin or tn > best:
+            continue
+        if meta[nd, 1] > 0:
+            first, cnt = meta[nd, 0], meta[nd, 1]
+            for i in range(first, first + cnt):
+                t, b1, b2 = tri_hit(tv, i, ox, oy, oz, kx, ky, kz, sx, sy, sz, tmin, best)
+                if t < best:
+                    best, btri, bb1, bb2 = t, i, b1, b2
+                    if any_hit:
+                        return best, btri, bb1, bb2
+        elif sp + 2 <= stack.shape[0]:
+            axis = meta[nd, 2]
+            if d[axis] < 0.0:  # visit the far (right) side first when going backwards
+                stack[sp] = nd + 1
+                stack[sp + 1] = meta[nd, 0]
+            else:
+                stack[sp] = meta[nd, 0]
+                stack[sp + 1] = nd + 1
+            sp += 2
+    if btri < 0:
+        return np.inf, -1, 0.0, 0.0
+    return best, btri, bb1, bb2
+
+
+@nb.njit(cache=True)
+def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
+            st, sp_, sf, sn):
+    """Nearest hit of a world ray over all primitives (linear loop over analytic primitives,
+    BVH over triangles).  Returns ``(t, prim, face, tri, b1, b2)``; ``prim = -1`` on a miss,
+    negative ``face`` is never returned (a flipped CSG normal is ``face + 16``)."""
+    (ptype, top, xf, nm, par, solid, shadow, poly_v, prog, tri_v, tri_n, tri_uv, tri_e,
+     tri_prim, bvh_box, bvh_meta) = geo
+    best, bp, bf, btri, bb1, bb2 = tmax, -1, 0, -1, 0.0, 0.0
+    for k in range(ptype.shape[0]):
+        if not top[k] or (shadow_only and not shadow[k]):
+            continue
+        lo = _to_object(xf, k, ox, oy, oz, dx, dy, dz)
+        if ptype[k] == CSGNODE:
+            t, code, f = csg_hit(int(par[k, 0]), int(par[k, 1]), prog, ptype, xf, par, ox, oy, oz,
+                                 dx, dy, dz, tmin, best, zero, eps, st, sp_, sf, sn)
+            if t < best:
+                best, bp, bf = t, abs(code) - 1, f + (16 if code < 0 else 0)
+                btri = -1
+        else:
+            t, f = prim_hit(k, ptype, par, poly_v, lo[0], lo[1], lo[2], lo[3], lo[4], lo[5],
+                            tmin, best, zero)
+            if t < best:
+                best, bp, bf, btri = t, k, f, -1
+        if any_hit and bp >= 0:
+            return best, bp, bf, btri, bb1, bb2
+    if tri_v.shape[0] > 0:
+        t, tri, b1, b2 = bvh_hit(tri_v, bvh_box, bvh_meta, ox, oy, oz, dx, dy, dz, tmin, best,
+                                 any_hit, stack)
+        if tri >= 0:
+            best, bp, bf, btri, bb1, bb2 = t, tri_prim[tri], 0, tri, b1, b2
+    if bp < 0:
+        return np.inf, -1, 0, -1, 0.0, 0.0
+    return best, bp, bf, btri, bb1, bb2
+
+
+@nb.njit(cache=True)
+def object_normal(k, face, ptype, par, x, y, z):
+    """Outward normal (unnormalised) of primitive ``k`` at object-space point, by face."""
+    p = par[k]
+    kind = ptype[k]
+    if face >= 1 and (kind == BOX or kind == QUADRIC):
+        a = (face - 1) // 2
+        s = 1.0 if (face - 1) % 2 == 1 else -1.0
+        return (s if a == 0 else 0.0), (s if a == 1 else 0.0), (s if a == 2 else 0.0)
+    if kind == SPHERE:
+        return x - p[0], y - p[1], z - p[2]
+    if kind == RECT:
+        return p[9], p[10], p[11]
+    if kind == POLYGON:
+        return p[0], p[1], p[2]
+    if kind == QUADRIC:  # gradient of P^T Q P (halved)
+        return (p[0] * x + p[1] * y + p[2] * z + p[3], p[1] * x + p[4] * y + p[5] * z + p[6],
+                p[2] * x + p[5] * y + p[7] * z + p[8])
+    return 0.0, 1.0, 0.0
+
+
+@nb.njit(cache=True)
+def _normalize(x, y, z):
+    n = math.sqrt(x * x + y * y + z * z)
+    if n > 0.0:
+        return x / n, y / n, z / n
+    return 0.0, 0.0, 0.0
+
+
+@nb.njit(cache=True)
+def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_uv, out_po, out_e, i):
+    """Geometric (outward) normal, shading normal, uv (meshes; analytic primitives leave the
+    mapping to the texturing module), object-space point and vertex emission at a hit, written
+    to row ``i`` of the output arrays."""
+    (ptype, top, xf, nm, par, solid, shadow, poly_v, prog, tri_v, tri_n, tri_uv, tri_e,
+     tri_prim, bvh_box, bvh_meta) = geo
+    a = xf[k]
+    x = a[0] * px + a[1] * py + a[2] * pz + a[3]
+    y = a[4] * px + a[5] * py + a[6] * pz + a[7]
+    z = a[8] * px + a[9] * py + a[10] * pz + a[11]
+    out_po[i, 0], out_po[i, 1], out_po[i, 2] = x, y, z
+    out_uv[i, 0], out_uv[i, 1] = 0.0, 0.0
+    out_e[i, 0], out_e[i, 1], out_e[i, 2] = 0.0, 0.0, 0.0
+    if tri >= 0:
+        v = tri_v[tri]
+        e1x, e1y, e1z = v[3] - v[0], v[4] - v[1], v[5] - v[2]
+        e2x, e2y, e2z = v[6] - v[0], v[7] - v[1], v[8] - v[2]
+        gx, gy, gz = _normalize(e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x)
+        b0 = 1.0 - b1 - b2
+        nn = tri_n[tri]
+        sx = b0 * nn[0] + b1 * nn[3] + b2 * nn[6]
+        sy = b0 * nn[1] + b1 * nn[4] + b2 * nn[7]
+        sz = b0 * nn[2] + b1 * nn[5] + b2 * nn[8]
+        ln = math.sqrt(sx * sx + sy * sy + sz * sz)
+        if ln > ncancel:  # a cancelled interpolated normal falls back to Ng
+            sx, sy, sz = sx / ln, sy / ln, sz / ln
+        else:
+            sx, sy, sz = gx, gy, gz
+        uv = tri_uv[tri]
+        out_uv[i, 0] = b0 * uv[0] + b1 * uv[2] + b2 * uv[4]
+        out_uv[i, 1] = b0 * uv[1] + b1 * uv[3] + b2 * uv[5]
+        e = tri_e[tri]
+        for c in range(3):
+            out_e[i, c] = b0 * e[c] + b1 * e[3 + c] + b2 * e[6 + c]
+        out_ng[i, 0], out_ng[i, 1], out_ng[i, 2] = gx, gy, gz
+        out_ns[i, 0], out_ns[i, 1], out_ns[i, 2] = sx, sy, sz
+        return
+    f = face - 16 if face >= 16 else face
+    sgn = -1.0 if face >= 16 else 1.0
+    ux, uy, uz = object_normal(k, f, ptype, par, x, y, z)
+    m = nm[k]
+    wx = sgn * (m[0] * ux + m[1] * uy + m[2] * uz)
+    wy = sgn * (m[3] * ux + m[4] * uy + m[5] * uz)
+    wz = sgn * (m[6] * ux + m[7] * uy + m[8] * uz)
+    gx, gy, gz = _normalize(wx, wy, wz)
+    out_ng[i, 0], out_ng[i, 1], out_ng[i, 2] = gx, gy, gz
+    out_ns[i, 0], out_ns[i, 1], out_ns[i, 2] = gx, gy, gz
+
+
+# ----------------------------------------------------------------------------- batch kernels
+@nb.njit(cache=True, parallel=True)
+def trace_batch(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel,
+                t_out, prim_out, ng, ns, uv, po, ev):
+    """Closest hits of N rays and their surface data (``prim_out = -1``, ``t = inf`` on a miss)."""
+    n = O.shape[0]
+    nchunks = (n + CHUNK - 1) // CHUNK
+    for c in prange(nchunks):
+        stack = np.empty(BVH_STACK, dtype=np.int64)
+        st = np.empty((CSG_DEPTH, CSG_EVENTS))
+        sp_ = np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64)
+        sf = np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64)
+        sn = np.empty(CSG_DEPTH, dtype=np.int64)
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            ox, oy, oz = O[i, 0], O[i, 1], O[i, 2]
+            eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
+            t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, D[i, 0], D[i, 1], D[i, 2], tmin[i],
+                                           tmax[i], False, False, zero, eps, stack, st, sp_, sf, sn)
+            t_out[i], prim_out[i] = t, k
+            if k >= 0:
+                surface(geo, k, f, tri, b1, b2, ox + t * D[i, 0], oy + t * D[i, 1],
+                        oz + t * D[i, 2], ncancel, ng, ns, uv, po, ev, i)
+
+
+@nb.njit(cache=True)
+def _transmittance(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmin, tmax, transmissive, zero,
+                   eps, stack, st, sp_, sf, sn):
+    """Shadow feeler: 1 if nothing blocks the segment, 0 if blocked; with ``transmissive``, the
+    product of the ``kt`` of every surface crossed (at most 32)."""
+    if not transmissive:
+        t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, True, True, zero,
+                                       eps, stack, st, sp_, sf, sn)
+        return 0.0 if k >= 0 else 1.0
+    v = 1.0
+    t0 = tmin
+    for _ in range(32):
+        t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, t0, tmax, True, False, zero,
+                                       eps, stack, st, sp_, sf, sn)
+        if k < 0:
+            return v
+        v *= mat_tab[mat_of[k], 8]
+        if v <= 0.0:
+            return 0.0
+        t0 = t + eps
+    return v
+
+
+@nb.njit(cache=True)
+def _pow(base, n):
+    if n == 0.0:
+        return 1.0
+    return base ** n
+
+
+@nb.njit(cache=True)
+def _ior(mat_tab, stk, ns_):
+    return mat_tab[stk[ns_ - 1], 9] if ns_ > 0 else 1.0
+
+
+@nb.njit(cache=True, parallel=True)
+def shade_batch(geo, mat_of, mat_tab, lights, ambient, O, D, t, prim, ng, nsh, col, ev, w, depth,
+                stk, nstk, opts, contrib, out_o, out_d, out_w, out_stk, out_nstk, out_kind, counts):
+    """Local model with shadow feelers at each hit, then the reflected and refracted children.
+
+    ``opts``: max_depth, threshold, fresnel (0 none, 1 Schlick, 2 exact), transmissive shadows,
+    blinn, shadows on, reflection on, refraction on, tol.ray_offset, tol.t_min, tol.zero,
+    extent.  Child slots: ``2 i`` (reflection), ``2 i + 1`` (refraction); ``out_kind`` 0 = none.
+    ``counts[i]``: shadow rays, ended by depth, ended by threshold, total internal reflections.
+    """
+    n = O.shape[0]
+    max_depth, threshold, fres = int(opts[0]), opts[1], int(opts[2])
+    transmissive, blinn = opts[3] > 0.5, opts[4] > 0.5
+    do_shadow, do_refl, do_refr = opts[5] > 0.5, opts[6] > 0.5, opts[7] > 0.5
+    ray_off, t_min, zero, extent = opts[8], opts[9], opts[10], opts[11]
+    nl = lights.shape[0]
+    solid = geo[5]
+    nchunks = (n + CHUNK - 1) // CHUNK
+    for c in prange(nchunks):
+        stack = np.empty(BVH_STACK, dtype=np.int64)
+        st = np.empty((CSG_DEPTH, CSG_EVENTS))
+        sp_ = np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64)
+        sf = np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64)
+        sn = np.empty(CSG_DEPTH, dtype=np.int64)
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            out_kind[2 * i], out_kind[2 * i + 1] = 0, 0
+            for q in range(4):
+                counts[i, q] = 0
+            k = prim[i]
+            mi = mat_of[k]
+            mt = mat_tab[mi]
+            dx, dy, dz = D[i, 0], D[i, 1], D[i, 2]
+            px, py, pz = O[i, 0] + t[i] * dx, O[i, 1] + t[i] * dy, O[i, 2] + t[i] * dz
+            # Beer-Lambert absorption by the medium the ray travelled through
+            w0, w1, w2 = w[i, 0], w[i, 1], w[i, 2]
+            if nstk[i] > 0:
+                am = mat_tab[stk[i, nstk[i] - 1]]
+                w0 *= math.exp(-am[10] * t[i])
+                w1 *= math.exp(-am[11] * t[i])
+                w2 *= math.exp(-am[12] * t[i])
+            sx, sy, sz = -dx, -dy, -dz
+            gx, gy, gz = ng[i, 0], ng[i, 1], ng[i, 2]
+            nx, ny, nz = nsh[i, 0], nsh[i, 1], nsh[i, 2]
+            if nx * sx + ny * sy + nz * sz < 0.0:  # two-sided: shading normal faces the viewer
+                nx, ny, nz = -nx, -ny, -nz
+            front = gx * sx + gy * sy + gz * sz > 0.0
+            # side of the surface the ray came from
+            fx, fy, fz = (gx, gy, gz) if front else (-gx, -gy, -gz)
+            cr, cg, cb = col[i, 0], col[i, 1], col[i, 2]
+            ka, kd, ks, shin = mt[3], mt[4], mt[5], mt[6]
+            er, eg, eb = ev[i, 0], ev[i, 1], ev[i, 2]
+            if mt[16] < 0.5 or front:
+                er, eg, eb = er + mt[13], eg + mt[14], eb + mt[15]
+            lr = ka * cr * ambient[0] + er
+            lg = ka * cg * ambient[1] + eg
+            lb = ka * cb * ambient[2] + eb
+            pm = max(abs(px), abs(py), abs(pz))
+            off = ray_off * max(pm, extent)
+            eps = off
+            nshadow = 0
+            for li in range(nl):
+                L = lights[li]
+                if L[0] > 0.5:
+                    lx, ly, lz = -L[1], -L[2], -L[3]
+                    dist = np.inf
+                    scale = 1.0
+                else:
+                    vx, vy, vz = L[1] - px, L[2] - py, L[3] - pz
+                    dist = math.sqrt(vx * vx + vy * vy + vz * vz)
+                    lx, ly, lz = _normalize(vx, vy, vz)
+                    scale = 1.0
+                    if L[7] > 0.5:
+                        scale = 1.0 / max(dist * dist, 1e-300)
+                    if L[8] > 0.5:
+                        scale *= max(0.0, -(lx * L[9] + ly * L[10] + lz * L[11]))
+                ndl = nx * lx + ny * ly + nz * lz
+                if ndl <= 0.0 or scale == 0.0:
+                    continue
+                vis = 1.0
+                if do_shadow:
+                    side = 1.0 if gx * lx + gy * ly + gz * lz >= 0.0 else -1.0
+                    qx, qy, qz = px + side * off * gx, py + side * off * gy, pz + side * off * gz
+                    tmx = dist - 2.0 * off if dist < np.inf else np.inf
+                    nshadow += 1
+                    vis = _transmittance(geo, mat_of, mat_tab, qx, qy, qz, lx, ly, lz,
+                                         t_min * max(pm, extent), tmx, transmissive, zero, eps,
+                                         stack, st, sp_, sf, sn)
+                    if vis <= 0.0:
+                        continue
+                spec = 0.0
+                if ks > 0.0:
+                    if blinn:
+                        hx, hy, hz = _normalize(lx + sx, ly + sy, lz + sz)
+                        base = nx * hx + ny * hy + nz * hz
+                    else:
+                        rx, ry, rz = 2.0 * ndl * nx - lx, 2.0 * ndl * ny - ly, 2.0 * ndl * nz - lz
+                        base = rx * sx + ry * sy + rz * sz
+                    base = min(1.0, max(0.0, base))
+                    spec = ks * _pow(base, shin)
+                f = vis * scale
+                lr += L[4] * f * (kd * cr * ndl + spec)
+                lg += L[5] * f * (kd * cg * ndl + spec)
+                lb += L[6] * f * (kd * cb * ndl + spec)
+            contrib[i, 0], contrib[i, 1], contrib[i, 2] = w0 * lr, w1 * lg, w2 * lb
+            counts[i, 0] = nshadow
+            # ---- reflection / transmission weights (Whitted 1980; Fresnel optional)
+            kr, kt = mt[7], mt[8]
+            if not do_refl:
+                kr = 0.0
+            if not do_refr:
+                kt = 0.0
+            if kr <= 0.0 and kt <= 0.0:
+                continue
+            cosi = -(dx * fx + dy * fy + dz * fz)  # >= 0
+            ns_ = nstk[i]
+            is_solid = solid[k]
+            wr, wt = kr, kt
+            tx, ty, tz = dx, dy, dz
+            new_n = ns_
+            if kt > 0.0 and is_solid:
+                # media on both sides (nested dielectrics: a small stack of materials)
+                if front:
+                    n1 = _ior(mat_tab, stk[i], ns_)
+                    n2 = mt[9]
+                else:
+                    n1 = mt[9]
+                    # the medium beyond: the stack without its topmost entry of this material
+                    j = ns_ - 1
+                    while j >= 0 and stk[i, j] != mi:
+                        j -= 1
+                    n2 = 1.0
+                    if j >= 0:
+                        new_n = ns_ - 1
+                        top_ = -1
+                        for q in range(ns_ - 1, -1, -1):
+                            if q != j:
+                                top_ = stk[i, q]
+                                break
+                        n2 = mat_tab[top_, 9] if top_ >= 0 else 1.0
+                    elif ns_ > 0:
+                        n2 = _ior(mat_tab, stk[i], ns_)
+                eta = n1 / n2
+                kk = 1.0 - eta * eta * (1.0 - cosi * cosi)
+                if kk <= 0.0:  # total internal reflection (or exactly critical): all to reflection
+                    wr, wt = kr + kt, 0.0
+                    counts[i, 3] = 1
+                else:
+                    cost = math.sqrt(kk)
+                    tx, ty, tz = _normalize(eta * dx + (eta * cosi - cost) * fx,
+                                            eta * dy + (eta * cosi - cost) * fy,
+                                            eta * dz + (eta * cosi - cost) * fz)
+                    if fres > 0:
+                        if fres == 1:
+                            r0 = (n1 - n2) / (n1 + n2)
+                            r0 *= r0
+                            cc = cosi if n1 <= n2 else cost
+                            F = r0 + (1.0 - r0) * (1.0 - cc) ** 5
+                        else:
+                            rs = (n1 * cosi - n2 * cost) / (n1 * cosi + n2 * cost)
+                            rp = (n2 * cosi - n1 * cost) / (n2 * cosi + n1 * cost)
+                            F = 0.5 * (rs * rs + rp * rp)
+                        wr, wt = kr + kt * F, kt * (1.0 - F)
+            for branch in range(2):
+                kb = wr if branch == 0 else wt
+                if kb <= 0.0:
+                    continue
+                if depth[i] + 1 >= max_depth:
+                    counts[i, 1] += 1
+                    continue
+                b0, b1_, b2_ = w0 * kb, w1 * kb, w2 * kb
+                if max(b0, b1_, b2_) <= threshold:
+                    counts[i, 2] += 1
+                    continue
+                s = 2 * i + branch
+                if branch == 0:
+                    # R = I - 2 (I.N) N with the shading normal on the incident side
+                    mx, my, mz = nx, ny, nz
+                    dn = dx * mx + dy * my + dz * mz
+                    rx, ry, rz = dx - 2.0 * dn * mx, dy - 2.0 * dn * my, dz - 2.0 * dn * mz
+                    if rx * fx + ry * fy + rz * fz <= 0.0:  # below the surface: use Ng
+                        dn = dx * fx + dy * fy + dz * fz
+                        rx, ry, rz = dx - 2.0 * dn * fx, dy - 2.0 * dn * fy, dz - 2.0 * dn * fz
+                    rx, ry, rz = _normalize(rx, ry, rz)
+                    out_o[s, 0], out_o[s, 1], out_o[s, 2] = px + off * fx, py + off * fy, pz + off * fz
+                    out_d[s, 0], out_d[s, 1], out_d[s, 2] = rx, ry, rz
+                    for q in range(4):
+                        out_stk[s, q] = stk[i, q]
+                    out_nstk[s] = ns_
+                    out_kind[s] = 1
+                else:
+                    out_o[s, 0], out_o[s, 1], out_o[s, 2] = px - off * fx, py - off * fy, pz - off * fz
+                    out_d[s, 0], out_d[s, 1], out_d[s, 2] = tx, ty, tz
+                    for q in range(4):
+                        out_stk[s, q] = stk[i, q]
+                    out_nstk[s] = ns_
+                    if is_solid:
+                        if front:
+                            if ns_ < 4:
+                                out_stk[s, ns_] = mi
+                                out_nstk[s] = ns_ + 1
+                        elif new_n < ns_:
+                            # remove the topmost entry of this material
+                            j = ns_ - 1
+                            while stk[i, j] != mi:
+                                j -= 1
+                            q2 = 0
+                            for q in range(ns_):
+                                if q != j:
+                                    out_stk[s, q2] = stk[i, q]
+                                    q2 += 1
+                            out_nstk[s] = ns_ - 1
+                    out_kind[s] = 2
+                out_w[s, 0], out_w[s, 1], out_w[s, 2] = b0, b1_, b2_

@@ -1,0 +1,417 @@
+"""The two registered ray-tracing methods: ``raycast`` (eye rays + shadow feelers, the course's
+"lancer de rayons") and ``raytrace`` (plus recursive reflection and refraction, "suivi de rayons",
+Whitted 1980).
+
+Wavefront organisation: the image is cut into bands of rows ("tiles", delivered to ``on_tile``
+as they finish); for each band, each generation of rays is intersected by a numba kernel,
+coloured (textures through :mod:`workbench.renderers.texturing` in numpy, so that they match the
+raster methods exactly), shaded with shadow feelers by a second kernel, which also spawns the
+reflected and refracted children that form the next generation.  A pixel's colour is the sum of
+``weight x local colour`` over the ray tree (the course's ``raytrace``/``shade`` recursion).
+
+Options (see ``Option`` help texts): ``max_depth`` (quality knob of ``raytrace``: the maximum
+number of ray generations in a path, primary = 1, as the course's ``recurs_max`` and POV-Ray's
+``max_trace_level``), ``threshold`` (the course's perceptual threshold on the accumulated
+weight), ``spp`` (samples per pixel, stratified jitter, seeded by ``seed``), ``fresnel``
+(``none``: constant k_r, k_t; ``schlick``; ``exact`` dielectric), ``transmissive_shadows``,
+``blinn``, ``progress`` (tqdm bar) and ``on_tile``.
+
+``on_tile(y0, y1, x0, x1, tile)`` is called from the rendering thread after each band with
+``tile`` the (y1 - y0, x1 - x0, 3) float32 linear image of rows ``y0:y1`` and columns ``x0:x1``.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from ...core.tol import tol
+from ...scene import features as F
+from ...scene.model import Scene
+from ..base import Knob, Option, RenderResult
+from .flatten import SceneData, flatten
+
+_RAYS_PER_BAND = 1 << 16
+# Opacity maps (model.Opacity): alpha below OPACITY_CUT cuts the surface out; a ray passes
+# through at most MAX_CUTOUTS cut-out surfaces.
+OPACITY_CUT = 0.5
+MAX_CUTOUTS = 64
+
+
+def _callback(v):
+    if v is None or callable(v):
+        return v
+    raise ValueError("expected a callable on_tile(y0, y1, x0, x1, tile) or None")
+
+
+def camera_rays(camera, width: int, height: int, spp: int, seed: int):
+    """Primary rays, ``spp`` per pixel, stratified jitter on an ``m x ceil(spp/m)`` grid
+    (``m = ceil(sqrt(spp))``); one sample per pixel goes through the pixel centre (same rays as
+    :meth:`Camera.rays`).
+
+    Returns origins (H*W*spp, 3), unit directions (H*W*spp, 3) and pixel indices, pixel-major.
+    """
+    th = np.tan(np.radians(camera.fov_y) / 2.0)
+    aspect = width / height
+    jj, ii = np.meshgrid(np.arange(width), np.arange(height))
+    if spp == 1:
+        ox = np.full((height, width, 1), 0.5)
+        oy = np.full((height, width, 1), 0.5)
+    else:
+        m = int(np.ceil(np.sqrt(spp)))
+        m2 = int(np.ceil(spp / m))
+        s = np.arange(spp)
+        rng = np.random.default_rng(seed)
+        jit = rng.random((height, width, spp, 2))
+        ox = ((s % m)[None, None, :] + jit[..., 0]) / m
+        oy = ((s // m)[None, None, :] + jit[..., 1]) / m2
+    x = ((jj[..., None] + ox) / width * 2.0 - 1.0) * th * aspect
+    y = (1.0 - (ii[..., None] + oy) / height * 2.0) * th
+    d_cam = np.stack([x, y, -np.ones_like(x)], -1).reshape(-1, 3)
+    world_from_camera = np.linalg.inv(camera.camera_from_world())
+    d = d_cam @ world_from_camera[:3, :3].T
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    o = np.broadcast_to(np.asarray(camera.position, dtype=np.float64), d.shape).copy()
+    pix = np.repeat(np.arange(height * width), spp)
+    return o, d, pix
+
+
+class _Colorizer:
+    """Surface colour ``C`` (material colour times texture), bumped normals and background
+    radiance, through :mod:`workbench.renderers.texturing` when the scene needs it."""
+
+    def __init__(self, scene: Scene, sd: SceneData):
+        self.scene, self.sd = scene, sd
+        self.base = sd.mat_tab[:, 0:3]
+        needs = scene.needs()
+        self.tex = None
+        self.missing: list[str] = []
+        wanted = [f for f in (F.TEXTURES, F.BUMP, F.OPACITY, F.ENVIRONMENT) if f in needs]
+        if wanted:
+            try:
+                from .. import texturing
+                self.tex = texturing
+            except ImportError:
+                self.missing = [f"{f}: texturing module not available yet (untextured colour used)"
+                                for f in wanted]
+        self.bg = np.asarray(scene.background, dtype=np.float64)
+
+    def _groups(self, prim, attr):
+        """(material, selection, uv or None, world_from_object) for hits whose material has
+        ``attr`` (texture, bump, opacity), split by primitive (each has its own transform)."""
+        sd = self.sd
+        mat = sd.mat[prim]
+        for k in np.unique(prim):
+            m = sd.materials[sd.mat[k]]
+            if getattr(m, attr) is None:
+                continue
+            yield m, prim == k, bool(sd.has_uv[k]), sd.wfo[k]
+
+    def colors(self, prim, P_obj, Ns, uv):
+        """(n, 3) colours ``C`` and (n, 3) shading normals (bumped where a material asks)."""
+        C = self.base[self.sd.mat[prim]].copy()
+        if self.tex is None:
+            return C, Ns
+        for m, sel, has_uv, W in self._groups(prim, "texture"):
+            n_obj = Ns[sel] @ W[:3, :3]
+            C[sel] = self.tex.surface_color(m, P_obj[sel], n_obj, uv[sel] if has_uv else None)
+        for m, sel, has_uv, W in self._groups(prim, "bump"):
+            n_obj = Ns[sel] @ W[:3, :3]
+            Ns[sel] = self.tex.bump_normal(m, P_obj[sel], n_obj, Ns[sel], W, uv[sel] if has_uv else None)
+        return C, Ns
+
+    def alpha(self, prim, P_obj, Ns, uv):
+        """(n,) opacity of the hit surfaces (1 where no opacity map)."""
+        a = np.ones(len(prim))
+        if self.tex is None:
+            return a
+        for m, sel, has_uv, W in self._groups(prim, "opacity"):
+            a[sel] = self.tex.alpha(m, P_obj[sel], Ns[sel] @ W[:3, :3], uv[sel] if has_uv else None)
+        return a
+
+    def background(self, D):
+        if self.scene.environment is not None and self.tex is not None:
+            return np.asarray(self.tex.environment(self.scene.environment, D), dtype=np.float64)
+        return np.broadcast_to(self.bg, D.shape)
+
+
+def _kernels():
+    from . import kernels
+    return kernels
+
+
+def ensure_compiled(sd: SceneData) -> float:
+    """Run each kernel once on one ray (first-call JIT, or a load from the numba disk cache).
+    Returns the seconds spent (0 if already compiled in this process)."""
+    k = _kernels()
+    from .bvh import _build
+    if k.trace_batch.signatures and k.shade_batch.signatures and _build.signatures:
+        return 0.0
+    t0 = time.perf_counter()
+    _build(np.array([[0.0, 0, 0, 1, 0, 0, 0, 1, 0]]))
+    O = np.zeros((1, 3))
+    D = np.array([[0.0, 0.0, 1.0]])
+    arr = _alloc(1)
+    geo = sd.kernel_args()
+    k.trace_batch(geo, O, D, np.zeros(1), np.full(1, np.inf), tol.zero, tol.ray_offset, 1.0,
+                  tol.normal_cancel, arr["t"], arr["prim"], arr["ng"], arr["ns"], arr["uv"],
+                  arr["po"], arr["ev"])
+    ch = _alloc_children(1)
+    k.shade_batch(geo, sd.mat, sd.mat_tab, sd.lights, np.zeros(3), O, D, np.ones(1),
+                  np.zeros(1, np.int64), D.copy(), D.copy(), np.ones((1, 3)), np.zeros((1, 3)),
+                  np.ones((1, 3)), np.zeros(1, np.int64), np.zeros((1, 4), np.int64),
+                  np.zeros(1, np.int64), np.zeros(12), np.zeros((1, 3)), ch["o"], ch["d"], ch["w"],
+                  ch["stk"], ch["nstk"], ch["kind"], np.zeros((1, 4), np.int64))
+    return time.perf_counter() - t0
+
+
+def _alloc(n):
+    return dict(t=np.empty(n), prim=np.empty(n, np.int64), ng=np.zeros((n, 3)),
+                ns=np.zeros((n, 3)), uv=np.zeros((n, 2)), po=np.zeros((n, 3)), ev=np.zeros((n, 3)))
+
+
+def _alloc_children(n):
+    return dict(o=np.empty((2 * n, 3)), d=np.empty((2 * n, 3)), w=np.empty((2 * n, 3)),
+                stk=np.zeros((2 * n, 4), np.int64), nstk=np.zeros(2 * n, np.int64),
+                kind=np.zeros(2 * n, np.int64))
+
+
+class _Tracer:
+    """State of one render: scene arrays, options, counters."""
+
+    def __init__(self, scene: Scene, sd: SceneData, opts: dict, recursive: bool):
+        self.scene, self.sd = scene, sd
+        self.col = _Colorizer(scene, sd)
+        needs = scene.needs()
+        self.do_shadow = bool(len(sd.lights)) and opts["shadows"]
+        refl = recursive and any(m.kr > 0 for m in sd.materials)
+        refr = recursive and any(m.kt > 0 for m in sd.materials)
+        self.do_refl, self.do_refr = refl, refr
+        fres = {"none": 0, "schlick": 1, "exact": 2}[opts["fresnel"]]
+        self.kopts = np.array([opts["max_depth"] if recursive else 1, opts.get("threshold", 0.0), fres,
+                               float(opts["transmissive_shadows"]), float(opts["blinn"]),
+                               float(self.do_shadow), float(refl), float(refr), tol.ray_offset,
+                               tol.t_min, tol.zero, sd.extent])
+        self.ambient = np.asarray(scene.ambient, dtype=np.float64)
+        self.geo = sd.kernel_args()
+        self.stats = dict(primary_rays=0, shadow_rays=0, reflected_rays=0, refracted_rays=0,
+                          ended_by_depth=0, ended_by_threshold=0, escaped_rays=0,
+                          total_internal_reflections=0)
+        self.needs = needs
+        self.has_opacity = F.OPACITY in needs and self.col.tex is not None
+
+    def trace(self, O, D, pix, n_pixels, spp, fwd):
+        """Trace a band's primary rays and their trees; returns (image (n_pixels, 3), depth)."""
+        k = _kernels()
+        sd = self.sd
+        acc = np.zeros((n_pixels, 3))
+        depth_map = np.full(n_pixels, np.inf)
+        n = len(O)
+        self.stats["primary_rays"] += n
+        w = np.ones((n, 3))
+        gen = np.zeros(n, np.int64)
+        stk = np.zeros((n, 4), np.int64)
+        nstk = np.zeros(n, np.int64)
+        tmin = np.zeros(n)
+        first = True
+        while n > 0:
+            h = self._hits(O, D, tmin)
+            hit = h["prim"] >= 0
+            if first:
+                dd = h["t"] * (D @ fwd)
+                sel = hit & (np.arange(n) % spp == 0)
+                depth_map[pix[sel]] = dd[sel]
+                first = False
+            miss = ~hit
+            if miss.any():
+                self.stats["escaped_rays"] += int(miss.sum())
+                _accumulate(acc, pix[miss], w[miss] * self.col.background(D[miss]))
+            if not hit.any():
+                break
+            idx = np.nonzero(hit)[0]
+            O, D, pix, w, gen, stk, nstk = (a[idx] for a in (O, D, pix, w, gen, stk, nstk))
+            t, prim = h["t"][idx], h["prim"][idx]
+            # opacity map: alpha blends the surface with the straight continuation of the ray
+            alpha = h["alpha"][idx]
+            part = np.nonzero(alpha < 1.0)[0]
+            cont = (O[part], D[part], pix[part], w[part] * (1.0 - alpha[part, None]), gen[part],
+                    stk[part], nstk[part], self._past(O[part], D[part], t[part]))
+            w = w * alpha[:, None]
+            ng, ns = h["ng"][idx], h["ns"][idx]
+            C, ns = self.col.colors(prim, h["po"][idx], ns, h["uv"][idx])
+            m = len(idx)
+            contrib = np.zeros((m, 3))
+            ch = _alloc_children(m)
+            counts = np.zeros((m, 4), np.int64)
+            k.shade_batch(self.geo, sd.mat, sd.mat_tab, sd.lights, self.ambient, O, D, t, prim,
+                          ng, np.ascontiguousarray(ns), np.ascontiguousarray(C), h["ev"][idx], w,
+                          gen, stk, nstk, self.kopts, contrib, ch["o"], ch["d"], ch["w"],
+                          ch["stk"], ch["nstk"], ch["kind"], counts)
+            _accumulate(acc, pix, contrib)
+            cs = counts.sum(0)
+            self.stats["shadow_rays"] += int(cs[0])
+            self.stats["ended_by_depth"] += int(cs[1])
+            self.stats["ended_by_threshold"] += int(cs[2])
+            self.stats["total_internal_reflections"] += int(cs[3])
+            kind = ch["kind"]
+            self.stats["reflected_rays"] += int((kind == 1).sum())
+            self.stats["refracted_rays"] += int((kind == 2).sum())
+            live = np.nonzero(kind > 0)[0]
+            parent = live // 2
+            O, D, w = ch["o"][live], ch["d"][live], ch["w"][live]
+            stk, nstk = ch["stk"][live], ch["nstk"][live]
+            pix, gen = pix[parent], gen[parent] + 1
+            tmin = tol.t_min * np.maximum(np.abs(O).max(1), sd.extent)
+            if len(part):
+                O, D, pix, w, gen, stk, nstk, tmin = (np.concatenate([x, y]) for x, y in
+                                                      zip((O, D, pix, w, gen, stk, nstk, tmin), cont))
+            n = len(O)
+        return acc / spp, depth_map
+
+    def _past(self, O, D, t):
+        """``tmin`` that restarts rays just beyond their hit at ``t`` (offset scaled with the
+        hit point, :func:`workbench.core.tol.offset_scale`)."""
+        P = O + t[:, None] * D
+        return t + tol.ray_offset * np.maximum(np.abs(P).max(1), self.sd.extent)
+
+    def _hits(self, O, D, tmin):
+        """Closest hits; surfaces cut out by an opacity map (alpha < 0.5) are passed through."""
+        k = _kernels()
+        n = len(O)
+        h = _alloc(n)
+        k.trace_batch(self.geo, O, D, tmin, np.full(n, np.inf), tol.zero, tol.ray_offset,
+                      self.sd.extent, tol.normal_cancel, h["t"], h["prim"], h["ng"], h["ns"],
+                      h["uv"], h["po"], h["ev"])
+        h["alpha"] = np.ones(n)
+        if not self.has_opacity:
+            return h
+        todo = np.arange(n)
+        for _ in range(MAX_CUTOUTS):
+            sel = todo[h["prim"][todo] >= 0]
+            a = self.col.alpha(h["prim"][sel], h["po"][sel], h["ns"][sel], h["uv"][sel])
+            h["alpha"][sel] = a
+            todo = sel[a < OPACITY_CUT]
+            if not len(todo):
+                break
+            sub = _alloc(len(todo))
+            k.trace_batch(self.geo, O[todo], D[todo], self._past(O[todo], D[todo], h["t"][todo]),
+                          np.full(len(todo), np.inf), tol.zero, tol.ray_offset, self.sd.extent,
+                          tol.normal_cancel, sub["t"], sub["prim"], sub["ng"], sub["ns"],
+                          sub["uv"], sub["po"], sub["ev"])
+            for key, v in sub.items():
+                h[key][todo] = v
+        h["alpha"][h["alpha"] < OPACITY_CUT] = 0.0
+        return h
+
+
+def _accumulate(acc, pix, values):
+    for c in range(3):
+        acc[:, c] += np.bincount(pix, weights=values[:, c], minlength=len(acc))
+
+
+class _WhittedBase:
+    recursive = True
+
+    def render(self, scene: Scene, width: int, height: int, **o) -> RenderResult:
+        timings = {}
+        t0 = time.perf_counter()
+        sd = flatten(scene)
+        timings["build"] = time.perf_counter() - t0
+        timings["bvh_build"] = sd.bvh_build_time
+        timings["compile"] = ensure_compiled(sd)
+        opts = dict(o)
+        opts.setdefault("max_depth", 1)
+        tr = _Tracer(scene, sd, opts, self.recursive)
+        spp = opts["spp"]
+        cam = scene.camera
+        fwd = np.asarray(cam.look_at, float) - np.asarray(cam.position, float)
+        fwd /= np.linalg.norm(fwd)
+        O, D, pix = camera_rays(cam, width, height, spp, opts["seed"])
+        image = np.zeros((height * width, 3), np.float32)
+        depth = np.full(height * width, np.inf, np.float32)
+        rows = max(1, _RAYS_PER_BAND // (width * spp))
+        bands = list(range(0, height, rows))
+        bar = None
+        if opts["progress"]:
+            from tqdm import tqdm
+            bar = tqdm(total=height, unit="row", desc=self.name)
+        t1 = time.perf_counter()
+        for y0 in bands:
+            y1 = min(height, y0 + rows)
+            a, b = y0 * width * spp, y1 * width * spp
+            img, dep = tr.trace(O[a:b], D[a:b], pix[a:b] - y0 * width, (y1 - y0) * width, spp, fwd)
+            image[y0 * width:y1 * width] = img
+            depth[y0 * width:y1 * width] = dep
+            if opts["on_tile"] is not None:
+                opts["on_tile"](y0, y1, 0, width, image[y0 * width:y1 * width].reshape(y1 - y0, width, 3))
+            if bar is not None:
+                bar.update(y1 - y0)
+        if bar is not None:
+            bar.close()
+        timings["trace"] = time.perf_counter() - t1
+        st = tr.stats
+        total = st["primary_rays"] + st["shadow_rays"] + st["reflected_rays"] + st["refracted_rays"]
+        st["total_rays"] = total
+        st["mrays_per_s"] = total / max(timings["trace"], 1e-9) / 1e6
+        st["primitives"] = int(sd.top.sum())
+        st["triangles"] = int(len(sd.tri_v))
+        st["scene_extent"] = sd.extent
+        used, left = self._features(scene, tr)
+        return RenderResult(self.name, image.reshape(height, width, 3), timings, st, used, left,
+                            depth=depth.reshape(height, width))
+
+    def _features(self, scene, tr):
+        needs = scene.needs()
+        left = list(tr.col.missing)
+        if not tr.do_shadow:
+            left.append(f"{F.SHADOWS}: no lights (no shadow rays traced)" if not len(tr.sd.lights)
+                        else f"{F.SHADOWS}: disabled by option (no shadow rays traced)")
+        if not tr.do_refr:
+            left.append(f"{F.REFRACTION}: " + ("raycast traces no secondary rays" if not self.recursive
+                                               else "no transmissive material (no refraction rays traced)"))
+        if not tr.do_refl:
+            left.append(f"{F.REFLECTION}: " + ("raycast traces no secondary rays" if not self.recursive
+                                               else "no reflective material (no reflection rays traced)"))
+        if F.MESHES not in needs:
+            left.append(f"{F.MESHES}: no meshes (no BVH built or traversed)")
+        missing_names = {x.split(":")[0] for x in left}
+        used = sorted(f for f in needs if f not in missing_names)
+        return used, left
+
+
+_COMMON = {
+    "spp": Option(int, 1, "samples per pixel (stratified jitter; 1 = pixel centres)"),
+    "seed": Option(int, 0, "seed of the sample jitter"),
+    "shadows": Option(bool, True, "trace shadow feelers"),
+    "transmissive_shadows": Option(bool, False, "transmissive occluders attenuate shadow feelers by kt instead of blocking"),
+    "blinn": Option(bool, False, "Blinn's half-vector specular instead of Phong's"),
+    "fresnel": Option(str, "none", "reflection/transmission split: none (constant kr, kt), schlick or exact dielectric", ("none", "schlick", "exact")),
+    "progress": Option(bool, False, "show a tqdm progress bar (CLI)"),
+    "on_tile": Option(_callback, None, "callback on_tile(y0, y1, x0, x1, tile) after each band of rows"),
+}
+
+
+class RaycastRenderer(_WhittedBase):
+    """Eye rays and shadow feelers with the shared local model (no secondary rays)."""
+
+    name = "raycast"
+    recursive = False
+    knob = Knob("spp", (1, 2, 4, 8, 16), 1, "samples per pixel")
+    options = dict(_COMMON)
+
+
+class RaytraceRenderer(_WhittedBase):
+    """Whitted ray tracer: raycast plus recursive reflection and refraction."""
+
+    name = "raytrace"
+    knob = Knob("max_depth", (1, 2, 3, 4, 5, 6, 8, 12), 5,
+                "maximum number of ray generations in a path (primary = 1)")
+    options = {**_COMMON,
+               "max_depth": Option(int, 5, "maximum ray generations per path (primary = 1), >= 1"),
+               "threshold": Option(float, 1e-3, "perceptual threshold: a child ray whose accumulated weight (max RGB) is at most this is not traced")}
+
+    def render(self, scene, width, height, **o):
+        from ...core.errors import WorkbenchError
+        if o["max_depth"] < 1:
+            raise WorkbenchError(f"method 'raytrace': option 'max_depth' must be >= 1, got {o['max_depth']}")
+        return super().render(scene, width, height, **o)
