@@ -1,0 +1,210 @@
+"""``workbench compare``: every chosen method on one scene and camera, side by side, with run
+times and errors against the scene's reference (:mod:`workbench.compare.reference`).
+
+Output folder (written all-or-nothing, see :func:`workbench.compare.outputs.staged`)::
+
+    grid.png                 labelled side-by-side grid (reference first)
+    images/<m>.png|.npy      each method's image (sRGB PNG, linear float32 .npy); reference.*
+    heat/<m>_flip.png        FLIP map against the reference, fixed scale [0, 1]
+    heat/<m>_abs.png         mean |linear error| over RGB, scale shared by all methods
+    report.json              every number (metrics, timings with compile apart, stats,
+                             features used / left out, reference and why, machine, GL_RENDERER)
+    report.html              all of it in one self-contained page (images embedded)
+
+Timing: each method is called once cold (compilation happens there and is reported apart) and
+``repeat`` times warm, sequentially in this process; the time shown is the warm median.
+"""
+from __future__ import annotations
+
+import datetime as _dt
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..core.errors import WorkbenchError
+from ..core.imageio import save_npy, save_png, save_png8
+from ..renderers.base import available
+from ..scene.model import Scene
+from . import figures
+from .html import esc, img_tag, page, table
+from .metrics import error_map, metrics
+from .outputs import dumps, machine_info, staged
+from .reference import choose_reference, physical_differences
+from .runs import MethodRun, timed_run
+
+
+def _fmt_opts(opts: dict) -> str:
+    return ", ".join(f"{k}={v}" for k, v in opts.items())
+
+
+def _gl_renderer(runs: list[MethodRun]) -> str | None:
+    for r in runs:
+        if r.result is not None:
+            for k, v in r.result.stats.items():
+                if k.lower() == "gl_renderer":
+                    return str(v)
+    return None
+
+
+def _method_entry(run: MethodRun, ref_features: list[str]) -> dict:
+    e = {"method": run.method, "status": run.status, "reason": run.reason, "options": run.options}
+    if run.result is None:
+        if run.trace:
+            e["traceback"] = run.trace
+        return e
+    res = run.result
+    e.update(options=res.options, time_s=run.time, cold_s=run.cold, compile_s=run.compile,
+             warm_s=run.warm, timings=res.timings, stats=res.stats,
+             features_used=res.features_used, left_out=res.left_out,
+             differs_physically=physical_differences(res.left_out, ref_features))
+    return e
+
+
+def compare(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
+            size: tuple[int, int] | None = None, reference: str | None = None,
+            repeat: int = 1, command: str = "") -> dict:
+    """Render ``scene`` with each method and write the comparison report into ``out_dir``.
+
+    Parameters
+    ----------
+    methods : registered method names (default: all registered; those that raise
+        ``NotApplicable`` are listed with their reason).
+    size : (width, height); the scene camera's resolution by default.
+    reference : force the reference method (default: the rule of :mod:`.reference`).
+    repeat : warm runs per method after the cold one (0: time = cold - compile).
+
+    Returns
+    -------
+    The ``report.json`` content as a dict.
+    """
+    names = list(available()) if not methods else list(methods)
+    unknown = [m for m in names if m not in available()]
+    if unknown:
+        raise WorkbenchError(f"unknown method(s) {', '.join(unknown)} (available: {', '.join(available())})")
+    if repeat < 0:
+        raise WorkbenchError(f"repeat must be >= 0, got {repeat}")
+    w, h = size if size else (scene.camera.width, scene.camera.height)
+    ref = choose_reference(scene, w, h, reference)
+    ref_img = ref.run.image
+    ref_features = list(ref.run.result.features_used)
+    runs = [timed_run(scene, m, w, h, repeat=repeat) for m in names]
+
+    entries = [_method_entry(r, ref_features) for r in runs]
+    maps = {}
+    for r, e in zip(runs, entries):
+        if r.status == "ok":
+            e["metrics"] = metrics(r.image, ref_img)
+            maps[r.method] = (error_map(r.image, ref_img, "flip"), error_map(r.image, ref_img, "abs"))
+    abs_max = max([float(np.percentile(a, 99.5)) for _, a in maps.values()] + [1e-6])
+
+    report = {
+        "kind": "compare", "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        "command": command,
+        "scene": {"name": scene.name, "source": scene.source, "description": scene.description,
+                  "needs": sorted(scene.needs())},
+        "size": [w, h], "repeat": repeat,
+        "timing_protocol": "one cold call (compile reported apart) then `repeat` warm calls, "
+                           "sequential in one process; time_s = median of the warm calls",
+        "reference": {"method": ref.method, "options": ref.options, "reason": ref.reason,
+                      "time_s": ref.run.time, "cold_s": ref.run.cold, "compile_s": ref.run.compile,
+                      "features_used": ref_features, "left_out": ref.run.result.left_out,
+                      "stats": ref.run.result.stats,
+                      "files": {"png": "images/reference.png", "npy": "images/reference.npy"}},
+        "heatmap_scales": {"flip": [0.0, 1.0], "abs": [0.0, abs_max]},
+        "methods": entries,
+        "machine": machine_info(_gl_renderer(runs + [ref.run])),
+    }
+    with staged(out_dir, last=("report.json", "report.html")) as stage:
+        save_png(stage / "images/reference.png", ref_img)
+        save_npy(stage / "images/reference.npy", ref_img)
+        tiles = [{"title": f"reference: {ref.method}",
+                  "lines": [_fmt_opts(ref.options) or "default options", f"time {ref.run.time:.3g} s",
+                            "error 0 by definition"], "image": ref_img}]
+        for r, e in zip(runs, entries):
+            if r.status != "ok":
+                tiles.append({"title": r.method, "lines": [f"{r.status.replace('_', ' ')}: {r.reason}"],
+                              "image": None})
+                continue
+            files = {"png": f"images/{r.method}.png", "npy": f"images/{r.method}.npy",
+                     "heat_flip": f"heat/{r.method}_flip.png", "heat_abs": f"heat/{r.method}_abs.png"}
+            save_png(stage / files["png"], r.image)
+            save_npy(stage / files["npy"], r.image)
+            fmap, amap = maps[r.method]
+            save_png8(stage / files["heat_flip"], figures.heatmap(fmap, 0.0, 1.0, "FLIP", r.method))
+            save_png8(stage / files["heat_abs"], figures.heatmap(amap, 0.0, abs_max, "|linear error|", r.method))
+            e["files"] = files
+            mt = e["metrics"]
+            tiles.append({"title": r.method, "lines": [
+                f"{r.time:.3g} s; compile {r.compile:.2g} s",
+                f"RMSE {mt['rmse']:.3g}  PSNR {mt['psnr']:.3g} dB", f"FLIP {mt['flip']:.3g}"],
+                "image": r.image})
+        save_png8(stage / "grid.png", figures.grid(tiles))
+        (stage / "report.json").write_text(dumps(report))
+        (stage / "report.html").write_text(render_html(report, stage, Path(out_dir)))
+    return json.loads(dumps(report))
+
+
+def _list(items) -> str:
+    return "; ".join(items) if items else "none"
+
+
+def render_html(report: dict, stage: Path, out_dir: Path) -> str:
+    """The self-contained page of a comparison report (images from ``stage``; the study's
+    plot and Pareto table from ``out_dir`` when ``workbench study`` wrote there before)."""
+    ref = report["reference"]
+    scene = report["scene"]
+    b = [f"<h1>{esc(scene['name'])}: methods side by side</h1>",
+         f"<p>{esc(scene['description'])}<br><span class='muted'>{esc(scene['source'])} · "
+         f"{report['size'][0]}x{report['size'][1]} · {esc(report['created'])}</span></p>",
+         f"<p>Scene uses: {esc(', '.join(scene['needs']))}</p>",
+         f"<h2>Reference: {esc(ref['method'])} ({esc(_fmt_opts(ref['options']) or 'default options')})</h2>",
+         f"<p>{esc(ref['reason'])}. Time {ref['time_s']:.3g} s.</p>",
+         "<h2>Side by side</h2>", img_tag(stage / "grid.png", "grid"),
+         f"<p class='muted'>Timing: {esc(report['timing_protocol'])} (repeat = {report['repeat']}).</p>"]
+    rows, cls = [], []
+    for e in report["methods"]:
+        if e["status"] != "ok":
+            rows.append([e["method"], ("raw", f"<b>{esc(e['status'])}</b>: {esc(e['reason'])}"),
+                         "", "", "", "", "", "", "", ""])
+            cls.append("warn" if e["status"] == "not_applicable" else "bad")
+            continue
+        mt = e["metrics"]
+        rows.append([e["method"], _fmt_opts(e["options"]), e["time_s"], e["compile_s"], mt["rmse"],
+                     mt["psnr"], mt["flip"], ", ".join(e["features_used"]), _list(e["left_out"]),
+                     ", ".join(e["differs_physically"]) or "none"])
+        cls.append("")
+    b += ["<h2>Numbers</h2>", table(["method", "options", "time (s, warm)", "compile (s)", "RMSE", "PSNR (dB)",
+                                     "FLIP", "features used", "left out", "differs physically from reference by"],
+                                    rows, numeric={2, 3, 4, 5, 6}, row_class=cls),
+          "<p class='muted'>'differs physically': features the reference computes that the method leaves "
+          "out; its error then measures the missing effect, not only discretisation.</p>",
+          "<h2>Error heat maps against the reference</h2>",
+          "<p>FLIP (perceptual, scale 0..1) and mean |linear error| over RGB "
+          f"(scale 0..{report['heatmap_scales']['abs'][1]:.3g}, shared by all methods).</p>"]
+    for e in report["methods"]:
+        if e["status"] == "ok":
+            b.append("<div>" + "".join(f"<figure>{img_tag(stage / e['files'][k], k)}<figcaption>"
+                                        f"{esc(e['method'])} {k[5:]}</figcaption></figure>"
+                                        for k in ("heat_flip", "heat_abs")) + "</div>")
+    b += [_study_section(out_dir), "<h2>Statistics per method</h2>"]
+    for e in [{"method": f"reference ({ref['method']})", **ref}] + [x for x in report["methods"] if "stats" in x]:
+        b.append(f"<details><summary>{esc(e['method'])}</summary>"
+                 + table(["key", "value"], [[k, v] for k, v in e.get("timings", {}).items()]
+                         + [[k, v] for k, v in e["stats"].items()]) + "</details>")
+    b += ["<h2>Machine</h2>", table(["key", "value"], [[k, v] for k, v in report["machine"].items()])]
+    return page(f"{scene['name']} comparison", "\n".join(b))
+
+
+def _study_section(out_dir: Path) -> str:
+    js, png = out_dir / "study.json", out_dir / "study.png"
+    if not (js.is_file() and png.is_file()):
+        return ("<h2>Error against run time</h2><p class='muted'>No study in this folder "
+                "(run <code>workbench study SCENE --out DIR</code> first to include it).</p>")
+    study = json.loads(js.read_text())
+    rows = [[p["method"], f"{p['knob']}={p['value']}", p["time_s"], p["rmse"], p["flip"]]
+            for p in study["points"] if p.get("pareto")]
+    return ("<h2>Error against run time</h2>" + img_tag(png, "study") +
+            f"<p>Study of {esc(study['scene']['name'])} at {study['size'][0]}x{study['size'][1]} "
+            f"(reference {esc(study['reference']['method'])}); Pareto front:</p>"
+            + table(["method", "setting", "time (s)", "RMSE", "FLIP"], rows, numeric={2, 3, 4}))
