@@ -33,6 +33,10 @@ class Tolerances:
     normal_cancel : float
         An interpolated normal shorter than this (before normalisation) is treated as
         cancelled; the geometric normal is used instead.
+    hemicube_near : float
+        Near-plane distance of a radiosity hemicube, as a fraction of the scene's extent:
+        surfaces closer than this to a patch centre are not seen (the Cornell light hangs
+        0.8 mm = 1.1e-3 extents below the ceiling, hence far less).
     bump_step : float
         Central-difference step of a bump map's height gradient, as a fraction of one pattern
         period (the step in object units is ``bump_step / scale``).
@@ -44,6 +48,7 @@ class Tolerances:
     planar: float = 5e-3
     symmetric: float = 1e-9
     normal_cancel: float = 1e-6
+    hemicube_near: float = 1e-5
     bump_step: float = 1e-3
 
 

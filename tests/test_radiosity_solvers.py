@@ -1,0 +1,104 @@
+"""Solvers against exact solutions: two plates (published entry), sphere interior, the
+furnace (B = E / (1 - rho)) up to rho = 0.999, and honest non-convergence."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from workbench import radiosity
+from workbench.core.errors import WorkbenchError
+
+SOLVERS = ["direct", "jacobi", "gauss_seidel", "progressive"]
+REF = Path(__file__).resolve().parents[2] / "shared/references/published_references.json"
+
+
+def _two_plates():
+    if REF.exists():
+        for e in json.loads(REF.read_text()):
+            if e["id"] == "RAD-plates-E10-r0.5-0.8":
+                return e["inputs"], e["expected"]
+    inp = {"E1": 1, "E2": 0, "rho1": 0.5, "rho2": 0.8}
+    return inp, {"B1": 1 / 0.6, "B2": 0.8 / 0.6}
+
+
+@pytest.mark.parametrize("method", SOLVERS)
+def test_two_plates(method):
+    inp, exp = _two_plates()
+    F = np.array([[0.0, 1.0], [1.0, 0.0]])
+    res = radiosity.solve(F, [inp["E1"], inp["E2"]], [inp["rho1"], inp["rho2"]], method=method,
+                          tol=1e-12)
+    assert res.converged, res.message
+    assert res.radiosity == pytest.approx([exp["B1"], exp["B2"]], rel=1e-11)
+
+
+@pytest.mark.parametrize("method", SOLVERS)
+def test_sphere_interior(method):
+    """Inside a sphere F_ij = A_j / A for every pair (any patches): B_i = E_i + rho_i Bbar with
+    Bbar = Ebar / (1 - rhobar), area means.  RGB, random areas, emission and reflectance."""
+    rng = np.random.default_rng(3)
+    n = 40
+    A = rng.uniform(0.1, 2.0, n)
+    E = rng.uniform(0, 1, (n, 3)) * (rng.random((n, 1)) < 0.2)
+    E[0] = 1.0
+    R = rng.uniform(0.1, 0.95, (n, 3))
+    F = np.broadcast_to(A / A.sum(), (n, n)).copy()
+    w = A / A.sum()
+    Bbar = (w @ E) / (1 - w @ R)
+    exact = E + R * Bbar
+    res = radiosity.solve(F, E, R, method=method, tol=1e-8, areas=A)
+    assert res.converged, res.message
+    assert np.abs(res.radiosity - exact).max() <= 1e-8 * np.abs(exact).max()
+    assert res.error_bound <= 1e-8
+
+
+@pytest.mark.parametrize("rho", [0.5, 0.9, 0.99, 0.999])
+@pytest.mark.parametrize("method", SOLVERS)
+def test_furnace(method, rho):
+    """Closed cube, uniform E and rho: B = E / (1 - rho), and the stopping rule's bound holds
+    for the TRUE error (not just the last update)."""
+    n = 6
+    F = (np.ones((n, n)) - np.eye(n)) / (n - 1)
+    tol = 1e-6
+    res = radiosity.solve(F, np.ones(n), rho, method=method, tol=tol)
+    assert res.converged, res.message
+    exact = 1.0 / (1.0 - rho)
+    true_err = np.abs(res.radiosity - exact).max() / exact
+    assert true_err <= tol
+    assert true_err <= res.error_bound * (1 + 1e-9) + 1e-15
+    if method != "direct":
+        assert res.iterations == len(res.residuals) > 1
+
+
+@pytest.mark.parametrize("method", ["jacobi", "gauss_seidel", "progressive"])
+def test_not_converged_is_said(method):
+    n = 6
+    F = (np.ones((n, n)) - np.eye(n)) / (n - 1)
+    res = radiosity.solve(F, np.ones(n), 0.999, method=method, tol=1e-6, max_iterations=50)
+    assert not res.converged
+    assert "NOT converged" in res.message
+    assert res.error_bound > 1e-6
+
+
+def test_no_bound_when_rows_exceed_one():
+    F = np.full((2, 2), 0.6)   # rows sum to 1.2: rho F has norm 1.188 >= 1
+    res = radiosity.solve(F, [1.0, 0.0], 0.99, method="jacobi", max_iterations=200)
+    assert not res.converged and "no error bound" in res.message
+
+
+def test_matrix_uses_rho_of_the_row():
+    """Errata 3: with rho_j the plates would give the 'wrong_if_rho_j' values."""
+    F = np.array([[0.0, 1.0], [1.0, 0.0]])
+    B = radiosity.solve(F, [1.0, 0.0], [0.5, 0.8]).radiosity
+    assert B[1] == pytest.approx(0.8 * B[0])
+
+
+def test_bad_input():
+    with pytest.raises(WorkbenchError, match="reflectance"):
+        radiosity.solve(np.zeros((2, 2)), [1, 0], [0.5, 1.5])
+    with pytest.raises(WorkbenchError, match="square"):
+        radiosity.solve(np.zeros((2, 3)), [1, 0], 0.5)
+    with pytest.raises(WorkbenchError, match="solver"):
+        radiosity.solve(np.zeros((2, 2)), [1, 0], 0.5, method="magic")

@@ -1,0 +1,242 @@
+"""Form factors three ways, each reported with its row sums and its reciprocity error.
+
+* ``hemicube`` (Cohen & Greenberg 1985): an item buffer on the five faces of a hemicube around
+  each patch centre, drawn with OpenGL (:mod:`.hemicube`); F_ij = sum of the delta form
+  factors of the pixels where patch j is the nearest surface.  A point-to-area estimate from
+  the patch centre, with occlusion; aliasing and proximity errors are inherent (DESIGN errata 6).
+* ``raycast`` (:mod:`.raycast`, numba): cosine-distributed rays from stratified points of patch
+  i (Malley's method); F_ij = fraction of rays whose first hit is the front of patch j.  Area
+  average, with occlusion, unbiased but noisy (relative error ~ 1 / sqrt(rays * F_ij)).
+* ``analytic``: the exact unoccluded point-to-polygon form factor (Lambert's contour formula,
+  Hottel & Sarofim 1967; Baum et al. 1989), the receiving polygon first clipped to the
+  hemisphere above the point, averaged over patch i by Gauss-Legendre quadrature.
+
+Row sums: sum_j F_ij = 1 in a closed scene (the hemicube's is 1 + O(1/n^2), errata 6).
+Reciprocity: A_i F_ij = A_j F_ji.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...core import transform as tf
+from ...core.errors import WorkbenchError
+from ...core.tol import tol
+
+METHODS = ("hemicube", "raycast", "analytic")
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """Patches as the form-factor methods see them (``P`` patches, ``T`` triangles).
+
+    tris : (T, 3, 3) triangles, counter-clockwise seen from the front.
+    tri_patch : (T,) the patch of each triangle.
+    centres, normals : (P, 3); areas : (P,).
+    polygons : list of P arrays (k, 3), the patches' outlines (for the contour formula).
+    """
+
+    tris: np.ndarray
+    tri_patch: np.ndarray
+    centres: np.ndarray
+    normals: np.ndarray
+    areas: np.ndarray
+    polygons: list
+
+    def __len__(self) -> int:
+        return len(self.areas)
+
+    @property
+    def extent(self) -> float:
+        if len(self.tris) == 0:
+            return 1.0
+        p = self.tris.reshape(-1, 3)
+        return float(max(np.linalg.norm(p.max(0) - p.min(0)), tol.zero))
+
+
+def geometry_from_polygons(polygons) -> Geometry:
+    """Validate planar convex polygons (list of (k, 3), k >= 3) and fan them into triangles.
+    A polygon of zero area is accepted (it exchanges nothing)."""
+    if len(polygons) == 0:
+        raise WorkbenchError("form_factors: no polygons given")
+    polys, tris, owner = [], [], []
+    for i, p in enumerate(polygons):
+        p = np.asarray(p, dtype=np.float64)
+        if p.ndim != 2 or p.shape[1] != 3 or p.shape[0] < 3:
+            raise WorkbenchError(f"form_factors: polygon {i} must be a (k, 3) array with k >= 3, "
+                                 f"got shape {p.shape}")
+        if not np.isfinite(p).all():
+            raise WorkbenchError(f"form_factors: polygon {i} has non-finite coordinates")
+        polys.append(p)
+        t = np.stack([np.broadcast_to(p[0], (len(p) - 2, 3)), p[1:-1], p[2:]], 1)
+        tris.append(t)
+        owner.append(np.full(len(t), i))
+    tris_a = np.concatenate(tris)
+    owner_a = np.concatenate(owner)
+    cr = np.cross(tris_a[:, 1] - tris_a[:, 0], tris_a[:, 2] - tris_a[:, 0])
+    n = len(polys)
+    vec = np.zeros((n, 3))
+    np.add.at(vec, owner_a, cr)
+    areas = 0.5 * np.linalg.norm(vec, axis=1)
+    normals = tf.normalize(vec)
+    ta = 0.5 * np.linalg.norm(cr, axis=1)
+    cen = np.zeros((n, 3))
+    np.add.at(cen, owner_a, ta[:, None] * tris_a.mean(1))
+    tsum = np.zeros(n)
+    np.add.at(tsum, owner_a, ta)
+    plain = np.array([p.mean(0) for p in polys])
+    cen = np.where(tsum[:, None] > 0, cen / np.maximum(tsum, tol.zero)[:, None], plain)
+    return Geometry(tris_a, owner_a, cen, normals, areas, polys)
+
+
+@dataclass
+class FormFactors:
+    """A form-factor matrix and its report.  Index it, or ``np.asarray`` it, like ``F``.
+
+    F : (P, P) float64, F[i, j] = fraction of the energy leaving i that reaches j.
+    row_sums : (P,) sum_j F_ij (1 in a closed scene).
+    reciprocity_error : float, ``sum |A_i F_ij - A_j F_ji| / sum (A_i F_ij + A_j F_ji)``
+        over all pairs (0 for exact form factors).
+    reciprocity_max : float, the largest relative pair error
+        ``|A_i F_ij - A_j F_ji| / (A_i F_ij + A_j F_ji)`` over pairs exchanging at least
+        ``1e-3`` of the largest exchange (smaller ones are noise-dominated).
+    method, seconds, info : how it was made (resolution, rays, hemicube weight sum, ...).
+    """
+
+    F: np.ndarray
+    areas: np.ndarray
+    method: str
+    seconds: float = 0.0
+    info: dict = field(default_factory=dict)
+    row_sums: np.ndarray = field(init=False)
+    reciprocity_error: float = field(init=False)
+    reciprocity_max: float = field(init=False)
+
+    def __post_init__(self):
+        self.row_sums = self.F.sum(1)
+        self.reciprocity_error, self.reciprocity_max = reciprocity(self.F, self.areas)
+
+    def __array__(self, dtype=None, copy=None):
+        return self.F if dtype is None else self.F.astype(dtype)
+
+    def __getitem__(self, key):
+        return self.F[key]
+
+    @property
+    def shape(self):
+        return self.F.shape
+
+    def report(self) -> dict:
+        """Plain-number summary (for stats and benchmarks)."""
+        rs = self.row_sums
+        return {"method": self.method, "patches": len(rs), "seconds": self.seconds,
+                "row_sum_min": float(rs.min()) if len(rs) else 0.0,
+                "row_sum_max": float(rs.max()) if len(rs) else 0.0,
+                "reciprocity_error": self.reciprocity_error,
+                "reciprocity_max": self.reciprocity_max, **self.info}
+
+
+def reciprocity(F: np.ndarray, areas: np.ndarray) -> tuple[float, float]:
+    """Aggregate and worst-pair relative reciprocity errors of ``F`` (see :class:`FormFactors`)."""
+    AF = areas[:, None] * F
+    diff = np.abs(AF - AF.T)
+    tot = AF + AF.T
+    s = float(tot.sum())
+    agg = float(diff.sum() / s) if s > 0 else 0.0
+    big = tot > 1e-3 * tot.max() if tot.size and tot.max() > 0 else np.zeros_like(tot, bool)
+    worst = float((diff[big] / tot[big]).max()) if big.any() else 0.0
+    return agg, worst
+
+
+# --------------------------------------------------------------------------- analytic
+def point_polygon(points: np.ndarray, normals: np.ndarray, polygon: np.ndarray) -> np.ndarray:
+    """Exact unoccluded form factor from differential areas to a polygon (Lambert's formula).
+
+    F_{dA -> A_j} = 1/(2 pi) sum_k gamma_k  n . (R_k x R_{k+1}) / |R_k x R_{k+1}|,
+    with R_k the polygon's vertices relative to the point and gamma_k the angle between R_k
+    and R_{k+1}, after clipping the polygon to the half-space in front of the point; only
+    the polygon's front face receives (it must face the point).
+
+    Parameters
+    ----------
+    points, normals : (M, 3) emitting points and their unit normals.
+    polygon : (k, 3) planar convex polygon, counter-clockwise seen from its front.
+
+    Returns
+    -------
+    (M,) form factors in [0, 1].
+    """
+    from .kernels import point_polygon_ff
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    normals = np.ascontiguousarray(normals, dtype=np.float64)
+    return point_polygon_ff(points, normals, np.ascontiguousarray(polygon, dtype=np.float64),
+                            tol.zero)
+
+
+def gauss_points(geom: Geometry, order: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Gauss-Legendre points on every triangle (collapsed-square map, Duffy 1982).
+
+    Returns points (T, order^2, 3), weights (T, order^2) summing to each triangle's area, and
+    the owning patch (T,).
+    """
+    x, w = np.polynomial.legendre.leggauss(order)
+    x, w = (x + 1) / 2, w / 2
+    u, s = np.meshgrid(x, x, indexing="ij")
+    wu, ws = np.meshgrid(w, w, indexing="ij")
+    u, s, wq = u.ravel(), s.ravel(), (wu * ws).ravel()
+    t = geom.tris
+    a2 = np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1)  # 2 * area
+    pts = (t[:, None, 0] + u[None, :, None] * (t[:, None, 1] - t[:, None, 0])
+           + (u * s)[None, :, None] * (t[:, None, 2] - t[:, None, 1]))
+    weights = a2[:, None] * (u * wq)[None, :]
+    return pts, weights, geom.tri_patch
+
+
+def analytic(geom: Geometry, order: int = 8) -> np.ndarray:
+    """F (P, P): the exact point-to-polygon factor averaged over patch i by an ``order``^2
+    Gauss-Legendre rule per triangle.  Unoccluded.  Exact as ``order`` grows."""
+    from .kernels import analytic_matrix
+    pts, w, owner = gauss_points(geom, order)
+    P = len(geom)
+    polys = geom.polygons
+    offsets = np.zeros(P + 1, dtype=np.int64)
+    offsets[1:] = np.cumsum([len(p) for p in polys])
+    flat = np.ascontiguousarray(np.concatenate(polys), dtype=np.float64)
+    F = analytic_matrix(np.ascontiguousarray(pts.reshape(-1, 3)), np.ascontiguousarray(w.ravel()),
+                        np.repeat(owner, pts.shape[1]).astype(np.int64),
+                        np.ascontiguousarray(geom.normals), flat, offsets, P, tol.zero)
+    area = geom.areas
+    return np.divide(F, area[:, None], out=np.zeros_like(F), where=area[:, None] > 0)
+
+
+# --------------------------------------------------------------------------- dispatcher
+def compute(geom: Geometry, method: str = "hemicube", resolution: int = 128, *,
+            rotate: bool = False, rays: int = 4096, order: int = 8, seed: int = 0) -> FormFactors:
+    """Form-factor matrix of ``geom`` by ``method`` (see the module docstring).
+
+    Parameters
+    ----------
+    resolution : hemicube resolution (pixels across the top face, even).
+    rotate : hemicube: rotate each hemicube by a random angle about the normal (aliasing).
+    rays : raycast: rays per patch.
+    order : analytic: Gauss-Legendre order per triangle edge.
+    """
+    if method not in METHODS:
+        raise WorkbenchError(f"form factor method must be one of {', '.join(METHODS)}, got {method!r}")
+    t0 = time.perf_counter()
+    info: dict = {}
+    if method == "hemicube":
+        from .hemicube import Hemicube
+        hc = Hemicube(geom, resolution, rotate=rotate, seed=seed)
+        F = hc.matrix()
+        info = hc.info()
+    elif method == "raycast":
+        from .raycast import raycast
+        F = raycast(geom, rays, seed)
+        info = {"rays_per_patch": int(rays)}
+    else:
+        F = analytic(geom, order)
+        info = {"quadrature_order": int(order)}
+    return FormFactors(F, geom.areas, method, time.perf_counter() - t0, info)

@@ -1,0 +1,297 @@
+"""Patches: every surface of a scene cut into planar pieces no larger than ``patch_size``.
+
+A patch is a planar quadrilateral or triangle (a triangle is stored as a quad whose last vertex
+repeats its third, so that every patch has four corners).  Each surface (one polygon, one face
+of a box, one triangle of a mesh, one area light) is cut into a grid of patches that share
+their corners, so that the radiosity can be interpolated to vertices for Gouraud display
+(Cohen & Greenberg 1985) without smearing it across the crease between two surfaces.
+
+Emitters: an area light's patches emit its radiance ``color * intensity`` and reflect nothing;
+a surface whose material has ``emission`` emits it.  Reflectance is ``Material.reflectance``
+(``kd * color``, RGB).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...core import transform as tf
+from ...core.errors import WorkbenchError
+from ...core.tol import tol
+from ...scene import model as m
+
+
+@dataclass(frozen=True)
+class PatchSet:
+    """Patches of a scene (``P`` patches, ``V`` display vertices).
+
+    Attributes
+    ----------
+    corners : (P, 4, 3) float64
+        Corners counter-clockwise seen from the front; a triangle repeats its third corner.
+    vertex_ids : (P, 4) int64
+        Index of each corner in ``vertices`` (shared between neighbours of one surface).
+    vertices : (V, 3) float64
+        Display vertices.
+    surface : (P,) int64
+        Index of the surface (scene object, box face, light) each patch was cut from.
+    emission : (P, 3) float64
+        Emitted radiance.
+    reflectance : (P, 3) float64
+        Diffuse reflectance rho.
+    surface_names : tuple of str
+        Name of each surface.
+    surface_objects : tuple
+        The scene object (or light) each surface belongs to, ``None`` for raw polygons.
+    """
+
+    corners: np.ndarray
+    vertex_ids: np.ndarray
+    vertices: np.ndarray
+    surface: np.ndarray
+    emission: np.ndarray
+    reflectance: np.ndarray
+    surface_names: tuple = ()
+    surface_objects: tuple = ()
+
+    def __len__(self) -> int:
+        return len(self.corners)
+
+    @property
+    def normals(self) -> np.ndarray:
+        """(P, 3) unit normals (Newell's cross product of the diagonals; zero for zero area)."""
+        c = self.corners
+        return tf.normalize(np.cross(c[:, 2] - c[:, 0], c[:, 3] - c[:, 1]))
+
+    @property
+    def areas(self) -> np.ndarray:
+        """(P,) areas: half the norm of the diagonals' cross product (exact for planar quads
+        and for triangles stored with a repeated corner)."""
+        c = self.corners
+        return 0.5 * np.linalg.norm(np.cross(c[:, 2] - c[:, 0], c[:, 3] - c[:, 1]), axis=-1)
+
+    @property
+    def centres(self) -> np.ndarray:
+        """(P, 3) area centroids (the hemicube's eye point)."""
+        c = self.corners
+        t1 = np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])
+        t2 = np.cross(c[:, 2] - c[:, 0], c[:, 3] - c[:, 0])
+        n = self.normals
+        a1, a2 = np.abs((t1 * n).sum(-1)), np.abs((t2 * n).sum(-1))
+        g1, g2 = (c[:, 0] + c[:, 1] + c[:, 2]) / 3, (c[:, 0] + c[:, 2] + c[:, 3]) / 3
+        s = a1 + a2
+        w1 = np.divide(a1, s, out=np.full_like(s, 0.5), where=s > 0)
+        return w1[:, None] * g1 + (1 - w1[:, None]) * g2
+
+    @property
+    def extent(self) -> float:
+        """Diagonal of the patches' bounding box (the scale of every relative tolerance)."""
+        if len(self) == 0:
+            return 1.0
+        p = self.corners.reshape(-1, 3)
+        return float(max(np.linalg.norm(p.max(0) - p.min(0)), tol.zero))
+
+    def triangles(self) -> tuple[np.ndarray, np.ndarray]:
+        """Two triangles per patch (degenerate second one for a triangle patch).
+
+        Returns
+        -------
+        positions : (2P, 3, 3) float64, counter-clockwise from the front.
+        patch : (2P,) int64, the patch of each triangle.
+        """
+        c = self.corners
+        tri = np.stack([c[:, [0, 1, 2]], c[:, [0, 2, 3]]], 1).reshape(-1, 3, 3)
+        return tri, np.repeat(np.arange(len(self)), 2)
+
+    def geometry(self):
+        """The patches as form-factor :class:`~.formfactors.Geometry`."""
+        from .formfactors import Geometry
+        tri, patch = self.triangles()
+        return Geometry(tri, patch, self.centres, self.normals, self.areas, list(self.corners))
+
+    def vertex_values(self, values: np.ndarray) -> np.ndarray:
+        """Patch values (P, C) interpolated to vertices (V, C): the area-weighted mean of the
+        patches around each vertex (all of one surface, since surfaces share no vertices)."""
+        values = np.asarray(values, dtype=np.float64).reshape(len(self), -1)
+        w = np.repeat(self.areas[:, None], 4, 1)
+        # a triangle's repeated corner must count once
+        w[:, 3] = np.where(self.vertex_ids[:, 3] == self.vertex_ids[:, 2], 0.0, w[:, 3])
+        V = len(self.vertices)
+        num = np.zeros((V, values.shape[1]))
+        den = np.zeros(V)
+        for k in range(4):
+            np.add.at(num, self.vertex_ids[:, k], w[:, k, None] * values)
+            np.add.at(den, self.vertex_ids[:, k], w[:, k])
+        # a vertex touched only by zero-area patches takes their plain mean
+        cnt = np.zeros(V)
+        plain = np.zeros((V, values.shape[1]))
+        for k in range(4):
+            np.add.at(cnt, self.vertex_ids[:, k], 1.0)
+            np.add.at(plain, self.vertex_ids[:, k], values)
+        return np.where(den[:, None] > 0, num / np.maximum(den, tol.zero)[:, None],
+                        plain / np.maximum(cnt, 1.0)[:, None])
+
+
+# --------------------------------------------------------------------------- splitting
+def _split_quad(q: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
+    """Bilinear grid on a planar quad ``q`` (4, 3) with cells no longer than ``h``.
+
+    Returns grid vertices (V, 3) and cells (C, 4) as vertex indices."""
+    nu = max(1, int(np.ceil(max(np.linalg.norm(q[1] - q[0]), np.linalg.norm(q[2] - q[3])) / h)))
+    nv = max(1, int(np.ceil(max(np.linalg.norm(q[3] - q[0]), np.linalg.norm(q[2] - q[1])) / h)))
+    a, b = np.meshgrid(np.linspace(0, 1, nu + 1), np.linspace(0, 1, nv + 1), indexing="ij")
+    a, b = a.reshape(-1, 1), b.reshape(-1, 1)
+    verts = (1 - a) * (1 - b) * q[0] + a * (1 - b) * q[1] + a * b * q[2] + (1 - a) * b * q[3]
+    idx = np.arange((nu + 1) * (nv + 1)).reshape(nu + 1, nv + 1)
+    cells = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], -1).reshape(-1, 4)
+    return verts, cells
+
+
+def _split_triangle(t: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
+    """Regular subdivision of a triangle ``t`` (3, 3) into n^2 triangles with edges <= ``h``.
+
+    Returns vertices (V, 3) and cells (n^2, 4) (triangles with a repeated third corner)."""
+    n = max(1, int(np.ceil(max(np.linalg.norm(t[1] - t[0]), np.linalg.norm(t[2] - t[1]),
+                                np.linalg.norm(t[0] - t[2])) / h)))
+    ids, verts = {}, []
+    for i in range(n + 1):
+        for j in range(n + 1 - i):
+            ids[i, j] = len(verts)
+            verts.append(t[0] + (t[1] - t[0]) * (i / n) + (t[2] - t[0]) * (j / n))
+    cells = []
+    for i in range(n):
+        for j in range(n - i):
+            a, b, c = ids[i, j], ids[i + 1, j], ids[i, j + 1]
+            cells.append((a, b, c, c))
+            if i + j < n - 1:
+                d = ids[i + 1, j + 1]
+                cells.append((b, d, c, c))
+    return np.array(verts), np.array(cells, dtype=np.int64)
+
+
+def split_polygon(poly: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
+    """Cut a planar convex polygon (k, 3), k >= 3, into patches no larger than ``h``.
+
+    A quadrilateral becomes a bilinear grid of quads, any other polygon a fan of triangles
+    each subdivided regularly.  ``h = inf`` keeps the polygon whole (as quads/triangles).
+
+    Returns vertices (V, 3) and cells (C, 4) (corner indices, triangles repeat corner 2)."""
+    poly = np.asarray(poly, dtype=np.float64)
+    if len(poly) == 4:
+        return _split_quad(poly, h)
+    verts, cells = [], []
+    for k in range(1, len(poly) - 1):
+        v, c = _split_triangle(poly[[0, k, k + 1]], h)
+        cells.append(c + sum(len(x) for x in verts))
+        verts.append(v)
+    return np.concatenate(verts), np.concatenate(cells)
+
+
+def _box_faces(b: m.Box) -> list[np.ndarray]:
+    """Six faces (4, 3) of an object-space box, counter-clockwise seen from outside."""
+    x0, y0, z0 = b.min
+    x1, y1, z1 = b.max
+    return [np.array(f, dtype=np.float64) for f in (
+        [(x0, y0, z0), (x0, y0, z1), (x0, y1, z1), (x0, y1, z0)],   # -x
+        [(x1, y0, z0), (x1, y1, z0), (x1, y1, z1), (x1, y0, z1)],   # +x
+        [(x0, y0, z0), (x1, y0, z0), (x1, y0, z1), (x0, y0, z1)],   # -y
+        [(x0, y1, z0), (x0, y1, z1), (x1, y1, z1), (x1, y1, z0)],   # +y
+        [(x0, y0, z0), (x0, y1, z0), (x1, y1, z0), (x1, y0, z0)],   # -z
+        [(x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)],   # +z
+    )]
+
+
+def _tessellated(obj) -> np.ndarray | None:
+    """Triangles (T, 3, 3) of a curved object from the raster engineer's tessellator, if it
+    exists (``workbench.scene.tessellate``); ``None`` otherwise."""
+    try:
+        from ...scene import tessellate  # noqa: PLC0415
+    except ImportError:
+        return None
+    fn = getattr(tessellate, "tessellate", None)
+    if fn is None:
+        return None
+    out = fn(obj)
+    verts, faces = np.asarray(out[0], dtype=np.float64), np.asarray(out[1], dtype=np.int64)
+    return verts[faces]
+
+
+def _surfaces(scene: m.Scene) -> tuple[list, list[str]]:
+    """World-space planar surfaces of a scene: a list of (polygon (k, 3), material or None,
+    emission RGB, object, name), and the ``left_out`` entries for objects not cut into
+    patches."""
+    out, left_out = [], []
+    for i, obj in enumerate(scene.objects):
+        name = obj.name or f"{obj.kind}_{i}"
+        mat = scene.material_of(obj)
+        W = obj.world_from_object
+        polys: list[np.ndarray] = []
+        if isinstance(obj, m.Polygon):
+            polys = [obj.vertices]
+        elif isinstance(obj, m.Plane):
+            polys = [obj.corners()]
+        elif isinstance(obj, m.Box):
+            polys = _box_faces(obj)
+        elif isinstance(obj, m.Mesh):
+            polys = list(np.asarray(obj.vertices)[np.asarray(obj.faces)])
+        else:
+            tris = _tessellated(obj)
+            if tris is None:
+                left_out.append(f"{obj.kind} ({name}): curved surfaces are not cut into patches "
+                                "(no tessellator available)")
+                continue
+            polys = list(tris)
+        for k, p in enumerate(polys):
+            pw = tf.transform_points(W, np.asarray(p))
+            out.append((pw, mat, np.asarray(mat.emission, dtype=np.float64), obj,
+                        name if len(polys) == 1 else f"{name}[{k}]"))
+    for i, light in enumerate(scene.lights):
+        if isinstance(light, m.AreaLight):
+            out.append((np.asarray(light.vertices), None, light.radiance, light, f"area_light_{i}"))
+    return out, left_out
+
+
+def _assemble(surfaces: list, h: float) -> PatchSet:
+    """Cut each (polygon, reflectance, emission, object, name) into patches."""
+    corners, vids, verts, surf, E, R = [], [], [], [], [], []
+    nv = 0
+    for s, (poly, rho, emis, obj, _name) in enumerate(surfaces):
+        v, cells = split_polygon(poly, h)
+        corners.append(v[cells])
+        vids.append(cells + nv)
+        verts.append(v)
+        nv += len(v)
+        surf.append(np.full(len(cells), s))
+        E.append(np.broadcast_to(emis, (len(cells), 3)))
+        R.append(np.broadcast_to(rho, (len(cells), 3)))
+    if not corners:
+        z3 = np.zeros((0, 3))
+        return PatchSet(np.zeros((0, 4, 3)), np.zeros((0, 4), np.int64), z3, np.zeros(0, np.int64),
+                        z3, z3)
+    return PatchSet(np.concatenate(corners), np.concatenate(vids), np.concatenate(verts),
+                    np.concatenate(surf), np.concatenate(E).astype(np.float64),
+                    np.concatenate(R).astype(np.float64),
+                    tuple(x[4] for x in surfaces), tuple(x[3] for x in surfaces))
+
+
+def patches_from_scene(scene: m.Scene, patch_size: float) -> tuple[PatchSet, list[str]]:
+    """Cut every surface of ``scene`` into patches no longer than ``patch_size`` (scene units).
+
+    Returns the patches and the ``left_out`` list (objects that could not be cut, with why).
+    """
+    if not (patch_size > 0 and np.isfinite(patch_size)):
+        raise WorkbenchError(f"patch_size must be a positive length in scene units, got {patch_size!r}")
+    surfaces, left_out = _surfaces(scene)
+    surfaces = [(p, np.zeros(3) if mat is None else mat.reflectance, e, o, n)
+                for p, mat, e, o, n in surfaces]
+    return _assemble(surfaces, patch_size), left_out
+
+
+def patch_size_for_count(scene: m.Scene, count: int) -> float:
+    """The patch size that cuts ``scene`` into about ``count`` patches (total area / count,
+    square cells)."""
+    surfaces, _ = _surfaces(scene)
+    area = sum(0.5 * np.linalg.norm(np.cross(p[1:-1] - p[0], p[2:] - p[0]).sum(0))
+               for p, *_ in surfaces)
+    return float(np.sqrt(area / max(count, 1)))

@@ -1,0 +1,291 @@
+"""Radiosity solvers for B = E + diag(rho) F B (Goral et al. 1984; Cohen & Greenberg 1985).
+
+In radiance units (L = Le + rho F L) a diffuse patch's value is what the image shows.  The
+system matrix is ``M = I - diag(rho) F``: diagonal 1 - rho_i F_ii, off-diagonal -rho_i F_ij,
+rho of the ROW (DESIGN errata 3).  RGB is solved as three independent systems.
+
+Stopping rule that bounds the TRUE error.  With K = diag(rho) F >= 0 and q = ||K||_inf (the
+largest rho_i sum_j F_ij, <= rho_max for a closed scene), Jacobi and Gauss-Seidel contract
+by at least q per sweep in the infinity norm, so after an update of size d,
+||B* - B||_inf <= q / (1 - q) d.  Progressive refinement leaves unshot radiosity dB and
+B* - B = (I - K)^{-1} K dB, so ||B* - B||_inf <= q / (1 - q) ||dB||_inf.  Each stops when that
+bound is below ``tol * ||B||_inf``: the tolerance is scaled by (1 - q) ~ (1 - rho_max).  If
+the iteration cap comes first, or q >= 1 (no bound exists), the result says so
+(``converged = False`` and a message), never a silent early stop.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from ...core.errors import WorkbenchError
+
+METHODS = ("direct", "jacobi", "gauss_seidel", "progressive")
+MAX_AUTO_ITERATIONS = 1_000_000
+
+
+@dataclass
+class SolveResult:
+    """Solution and report.
+
+    radiosity : (P,) or (P, C) the solution (bounded by the stopping rule).
+    display : same shape; for progressive refinement the radiosity plus Cohen et al.'s
+        ambient term rho_i * ambient (an estimate of what is still unshot); else = radiosity.
+    iterations : sweeps (Jacobi, Gauss-Seidel), shots (progressive) or 1 (direct).
+    residuals : relative update (or unshot) size max_c ||.||_inf / ||B_c||_inf per iteration.
+    error_bound : bound on max_c ||B* - B||_inf / ||B_c||_inf at the end (inf if none).
+    q : ||diag(rho) F||_inf, the contraction factor the bound uses.
+    converged, message : whether the requested tolerance was reached, and why not.
+    """
+
+    radiosity: np.ndarray
+    display: np.ndarray
+    method: str
+    iterations: int
+    residuals: np.ndarray
+    error_bound: float
+    q: float
+    converged: bool
+    message: str
+    seconds: float = 0.0
+    info: dict = field(default_factory=dict)
+
+
+def _prepare(emission, reflectance, n: int | None):
+    """Emission (P, C), reflectance (P, C) (broadcast from a scalar or (P,)), and whether the
+    caller gave one channel."""
+    E = np.asarray(emission, dtype=np.float64)
+    if E.ndim not in (1, 2):
+        raise WorkbenchError(f"solve: emission must be (P,) or (P, C), got shape {E.shape}")
+    scalar = E.ndim == 1
+    E2 = E.reshape(len(E), -1)
+    if n is not None and len(E2) != n:
+        raise WorkbenchError(f"solve: emission has {len(E2)} entries for {n} patches")
+    R = np.asarray(reflectance, dtype=np.float64)
+    if R.ndim == 1:
+        R = R[:, None]
+    try:
+        R2 = np.ascontiguousarray(np.broadcast_to(R, E2.shape))
+    except ValueError:
+        raise WorkbenchError(f"solve: reflectance of shape {R.shape} does not match emission "
+                             f"{E.shape}") from None
+    if not (np.isfinite(E2).all() and np.isfinite(R2).all()):
+        raise WorkbenchError("solve: emission and reflectance must be finite")
+    if (R2 < 0).any() or (R2 > 1).any():
+        raise WorkbenchError("solve: reflectance must lie in [0, 1] (energy conservation)")
+    if (E2 < 0).any():
+        raise WorkbenchError("solve: emission must be >= 0")
+    return E2, R2, scalar
+
+
+def _auto_iterations(q: float, tol: float, per: int = 1) -> int:
+    """Enough iterations for the bound to be met, with a 10x margin."""
+    if not (0 < q < 1):
+        return 10_000 * per
+    k = np.log(tol * (1 - q) / q) / np.log(q) if tol * (1 - q) < q else 1
+    return int(min(MAX_AUTO_ITERATIONS * per, max(100, 10 * np.ceil(k)) * per))
+
+
+def _stop_level(q: float, tol: float) -> float:
+    """Update size (relative) at which the true error is <= tol: tol (1 - q) / q."""
+    return tol * (1 - q) / q if 0 < q < 1 else (tol if q == 0 else 0.0)
+
+
+def _finish(B, display, method, it, hist, q, tol, reached, cap, t0, scalar, info=None):
+    last = hist[-1] if len(hist) else 0.0
+    bound = q / (1 - q) * last if 0 <= q < 1 else np.inf
+    if q >= 1:
+        conv, msg = False, (f"no error bound: ||rho F||_inf = {q:.6g} >= 1 (form-factor rows "
+                            f"sum to more than 1/rho); stopped after {it} iterations with update "
+                            f"{last:.3g}")
+    elif reached:
+        conv, msg = True, f"converged in {it} iterations: true relative error <= {bound:.3g}"
+    else:
+        conv, msg = False, (f"NOT converged: iteration cap {cap} reached; true relative error "
+                            f"<= {bound:.3g} > tol {tol:.3g} (rho close to 1 needs about "
+                            f"{_auto_iterations(q, tol) // 10} iterations)")
+    sh = (lambda a: a[:, 0]) if scalar else (lambda a: a)
+    return SolveResult(sh(B), sh(display), method, int(it), np.asarray(hist), float(bound),
+                       float(q), conv, msg, time.perf_counter() - t0, info or {})
+
+
+def solve(F, emission, reflectance, method: str = "direct", tol: float = 1e-6,
+          max_iterations: int | None = None, ambient: bool = True, areas=None) -> SolveResult:
+    """Solve (I - diag(rho) F) B = E.
+
+    Parameters
+    ----------
+    F : (P, P) form factors (array or :class:`~.formfactors.FormFactors`).
+    emission : (P,) or (P, C) emitted radiosity/radiance E.
+    reflectance : (P,), (P, C) or scalar rho in [0, 1].
+    method : direct | jacobi | gauss_seidel | progressive.
+    tol : requested bound on the true relative error ||B* - B||_inf / ||B||_inf.
+    max_iterations : cap on sweeps / shots; ``None`` = 10x what the bound predicts.
+    ambient : progressive only: add Cohen et al.'s ambient term to ``display``.
+    areas : (P,) patch areas; progressive only: rank shooters by power A_i dB_i and weight the
+        ambient term (unit areas if not given).
+    """
+    if method not in METHODS:
+        raise WorkbenchError(f"solver must be one of {', '.join(METHODS)}, got {method!r}")
+    if not (0 < tol < 1):
+        raise WorkbenchError(f"solve: tol must be in (0, 1), got {tol!r}")
+    F = np.asarray(F, dtype=np.float64)
+    if F.ndim != 2 or F.shape[0] != F.shape[1]:
+        raise WorkbenchError(f"solve: F must be a square (P, P) matrix, got shape {F.shape}")
+    if not np.isfinite(F).all() or (F < 0).any():
+        raise WorkbenchError("solve: form factors must be finite and >= 0")
+    E, R, scalar = _prepare(emission, reflectance, F.shape[0])
+    t0 = time.perf_counter()
+    q = float((R.max(1) * F.sum(1)).max()) if len(F) else 0.0
+    if method == "direct":
+        return _direct(F, E, R, q, t0, scalar)
+    cap = max_iterations if max_iterations is not None else _auto_iterations(
+        q, tol, F.shape[0] if method == "progressive" else 1)
+    if method == "progressive":
+        A = np.ones(len(F)) if areas is None else np.asarray(areas, dtype=np.float64).ravel()
+        if A.shape != (len(F),):
+            raise WorkbenchError(f"solve: areas must be ({len(F)},), got shape {A.shape}")
+        return _progressive_matrix(F, E, R, A, q, tol, cap, ambient, t0, scalar)
+    return _sweeps(F, E, R, q, tol, cap, method, t0, scalar)
+
+
+def _direct(F, E, R, q, t0, scalar) -> SolveResult:
+    """LU factorisation (LAPACK gesv through numpy), one system per channel."""
+    B = np.zeros_like(E)
+    n = len(F)
+    try:
+        for c in range(E.shape[1]):
+            M = np.eye(n) - R[:, c:c + 1] * F
+            B[:, c] = np.linalg.solve(M, E[:, c])
+    except np.linalg.LinAlgError:
+        res = _finish(E * 0, E * 0, "direct", 1, [np.inf], q, 0, False, 1, t0, scalar)
+        res.converged, res.message = False, ("direct solve failed: I - rho F is singular (a closed "
+                                             "room with rho = 1 has no unique solution)")
+        return res
+    r = np.abs(B - R * (F @ B) - E).max(0) / np.maximum(np.abs(B).max(0), 1e-300)
+    res = _finish(B, B, "direct", 1, [float(r.max())], q, 0, True, 1, t0, scalar)
+    if q < 1:
+        res.error_bound = float(r.max() / (1 - q))  # ||e|| <= ||(I-K)^-1|| ||residual||
+        res.message = f"direct LU solve; relative residual {r.max():.3g}"
+    if not np.isfinite(B).all() or (B < -1e-9 * np.abs(B).max()).any():
+        res.converged = False
+        res.message = "direct solve gave non-finite or negative radiosity: the system is ill-posed"
+    return res
+
+
+def _sweeps(F, E, R, q, tol, cap, method, t0, scalar) -> SolveResult:
+    """Jacobi B <- E + K B, or Gauss-Seidel (I - D - L) B' = E + U B (one triangular solve per
+    channel and sweep)."""
+    from scipy.linalg import solve_triangular
+    stop = _stop_level(q, tol)
+    B = E.copy()
+    hist = []
+    n, C = E.shape
+    if method == "gauss_seidel":
+        lowers = [np.eye(n) - np.tril(R[:, c:c + 1] * F) for c in range(C)]
+        uppers = [np.triu(R[:, c:c + 1] * F, 1) for c in range(C)]
+    reached = False
+    it = 0
+    for it in range(1, cap + 1):
+        if method == "jacobi":
+            Bn = E + R * (F @ B)
+        else:
+            Bn = np.empty_like(B)
+            for c in range(C):
+                Bn[:, c] = solve_triangular(lowers[c], E[:, c] + uppers[c] @ B[:, c], lower=True,
+                                            check_finite=False)
+        d = np.abs(Bn - B).max(0)
+        m = np.abs(Bn).max(0)
+        rel = np.divide(d, m, out=np.zeros_like(d), where=m > 0)
+        B = Bn
+        hist.append(float(rel.max()))
+        if (d <= stop * m).all() and q < 1:
+            reached = True
+            break
+        if q >= 1 and (d <= tol * m).all():
+            break
+        if not np.isfinite(B).all():
+            break
+    return _finish(B, B, method, it, hist, q, tol, reached, cap, t0, scalar)
+
+
+def _ambient(dB, R, areas) -> np.ndarray:
+    """Cohen et al. 1988 ambient radiosity (C,): 1/(1 - rho_avg) * area-mean unshot radiosity."""
+    A = areas / max(areas.sum(), 1e-300)
+    rho_avg = (A[:, None] * R).sum(0)
+    return (A[:, None] * dB).sum(0) / np.maximum(1 - rho_avg, 1e-12)
+
+
+def _progressive_matrix(F, E, R, areas, q, tol, cap, ambient, t0, scalar) -> SolveResult:
+    """Shooting on an explicit matrix (numba kernel): the shot from i reaches j through F_ji
+    directly (no reciprocity needed); areas only rank the shooters."""
+    from .kernels import shoot
+    B, dB = E.copy(), E.copy()
+    hist = np.zeros(int(cap))
+    shots = shoot(np.ascontiguousarray(F), areas, R, B, dB, int(cap), _stop_level(q, tol), hist)
+    hist = hist[:shots]
+    reached = bool(shots < cap or (len(hist) and hist[-1] <= _stop_level(q, tol)))
+    disp = B + R * _ambient(dB, R, areas) if ambient else B
+    return _finish(B, disp, "progressive", shots, hist, q, tol, reached and q < 1, cap, t0, scalar)
+
+
+def progressive_rows(row: Callable[[np.ndarray], np.ndarray], areas, emission, reflectance, *,
+                     tol: float = 1e-3, max_shots: int | None = None, batch: int = 16,
+                     ambient: bool = True, q: float | None = None, time_limit: float | None = None,
+                     on_batch: Callable | None = None) -> SolveResult:
+    """Progressive refinement without the matrix (Cohen et al. 1988): only the rows of the
+    patches that shoot are computed, ``row(indices) -> (k, P)`` (one hemicube each, from the
+    shooting patch), and never stored beyond the current batch.
+
+    Each round takes the ``batch`` patches with the most unshot power A_i sum_c dB_ic, computes
+    their rows in one call, and shoots them in turn: for every j,
+    dB_j += rho_j F_ij (A_i / A_j) dB_i (reciprocity gives F_ji from row i).
+
+    ``q`` bounds ||diag(rho) F||_inf; default rho_max (exact form factors of a closed scene;
+    the hemicube's rows can exceed 1 by O(1/res^2), pass it in).  ``on_batch(B, dB, shots)`` is
+    called after each round (the benchmark records convergence with it).
+    """
+    t0 = time.perf_counter()
+    A = np.asarray(areas, dtype=np.float64)
+    E, R, scalar = _prepare(emission, reflectance, len(A))
+    n, C = E.shape
+    q = float(R.max()) if q is None else float(q)
+    stop = _stop_level(q, tol)
+    cap = max_shots if max_shots is not None else _auto_iterations(q, tol, n)
+    B, dB = E.copy(), E.copy()
+    hist: list[float] = []
+    shots, reached = 0, False
+    live = A > 0
+    invA = np.divide(1.0, A, out=np.zeros_like(A), where=live)
+    while shots < cap:
+        power = A * dB.sum(1)
+        k = min(batch, cap - shots)
+        top = np.argpartition(-power, k - 1)[:k] if k < n else np.arange(n)
+        top = top[np.argsort(-power[top])]
+        top = top[power[top] > 0]
+        if len(top) == 0:
+            reached = True
+            break
+        rows = row(top)
+        for r, i in zip(rows, top):
+            shot = dB[i].copy()
+            dB[i] = 0.0
+            inc = (R * (r * A[i] * invA)[:, None]) * shot[None, :]
+            B += inc
+            dB += inc
+            shots += 1
+            mb, md = np.abs(B).max(0), np.abs(dB).max(0)
+            rel = np.divide(md, mb, out=np.zeros_like(md), where=mb > 0)
+            hist.append(float(rel.max()))
+            if (md <= stop * mb).all():
+                reached = True
+                break
+        if on_batch is not None:
+            on_batch(B, dB, shots)
+        if reached or (time_limit is not None and time.perf_counter() - t0 > time_limit):
+            break
+    disp = B + R * _ambient(dB, R, A) if ambient else B
+    return _finish(B, disp, "progressive", shots, hist, q, tol, reached and q < 1, cap, t0, scalar)
