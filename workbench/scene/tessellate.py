@@ -208,22 +208,29 @@ def _quadric_gradient(Q: np.ndarray, P: np.ndarray) -> np.ndarray:
 
 def _quadric_solid(q: m.Quadric, level: int):
     """Closed mesh of ``{P^T Q P <= 0} ∩ bounds`` by marching tetrahedra (manifold3d level
-    set); returns the Manifold."""
+    set, about ``8 level`` cells along the bounds' diagonal); returns the Manifold.
+
+    The signed function handed to manifold3d is ``min(-q(P) / |grad q(P)|, distance inside
+    the box)`` (first-order distance to the quadric), evaluated with plain floats because
+    manifold3d calls it once per grid point."""
     import manifold3d
-    Q = np.asarray(q.Q, dtype=np.float64)
-    lo, hi = np.asarray(q.bounds_min, dtype=np.float64), np.asarray(q.bounds_max, dtype=np.float64)
-    diag = float(np.linalg.norm(hi - lo))
+    Q = [[float(x) for x in row] for row in np.asarray(q.Q, dtype=np.float64)]
+    lo = [float(x) for x in q.bounds_min]
+    hi = [float(x) for x in q.bounds_max]
+    diag = float(np.linalg.norm(np.subtract(hi, lo)))
+    floor = diag * tol.normal_cancel
     h = diag / (8.0 * level)
 
     def sdf(x, y, z):
-        p = np.array([x, y, z])
-        H = np.append(p, 1.0)
-        g = 2.0 * (Q @ H)[:3]
-        f = -(H @ Q @ H) / max(np.linalg.norm(g), diag * tol.normal_cancel)
-        return float(min(f, (p - lo).min(), (hi - p).min()))
+        p = (x, y, z, 1.0)
+        qp = [Q[i][0] * x + Q[i][1] * y + Q[i][2] * z + Q[i][3] for i in range(4)]
+        value = qp[0] * p[0] + qp[1] * p[1] + qp[2] * p[2] + qp[3]
+        grad = 2.0 * (qp[0] * qp[0] + qp[1] * qp[1] + qp[2] * qp[2]) ** 0.5
+        inside_box = min(x - lo[0], y - lo[1], z - lo[2], hi[0] - x, hi[1] - y, hi[2] - z)
+        return min(-value / max(grad, floor), inside_box)
 
     pad = 2.0 * h
-    bounds = [*(lo - pad), *(hi + pad)]
+    bounds = [lo[0] - pad, lo[1] - pad, lo[2] - pad, hi[0] + pad, hi[1] + pad, hi[2] + pad]
     return manifold3d.Manifold.level_set(sdf, bounds, h)
 
 
