@@ -1,0 +1,44 @@
+"""``workbench study SCENE --out DIR``: error against run time along each method's quality knob."""
+from __future__ import annotations
+
+from .cmd_compare import methods_list
+from .cmd_render import _size
+
+
+def add_parser(sub):
+    p = sub.add_parser("study", help="sweep each method's quality knob: error against run time (CSV, JSON, plot)")
+    p.add_argument("scene", help="scene file or bundled scene name")
+    p.add_argument("--out", required=True, help="output folder (study.csv, study.json, study.png, study.html)")
+    p.add_argument("--methods", type=methods_list, help="comma-separated methods (default: every registered one)")
+    p.add_argument("--size", type=_size, help="WIDTHxHEIGHT (default: 160 wide with --quick, else the camera's)")
+    p.add_argument("--quick", action="store_true", help="small sweep: at most 4 knob values, 2 warm runs, 160 px wide")
+    p.add_argument("--repeat", type=int, help="warm runs per point (default 2 quick, 5 otherwise)")
+    p.add_argument("--reference", help="force the reference method (default: the documented rule)")
+    p.add_argument("--jobs", type=int, default=1,
+                   help="worker processes for the error evaluation, run after all timing (default 1)")
+    p.set_defaults(run=run)
+
+
+def run(args) -> int:
+    import sys
+    from pathlib import Path
+
+    from ..compare.study import study
+    from ..core.errors import WorkbenchError
+    from ..scene.io import load_scene
+    if args.jobs < 1:
+        raise WorkbenchError(f"--jobs must be >= 1, got {args.jobs}")
+    scene = load_scene(args.scene)
+    res = study(scene, args.out, methods=args.methods, size=args.size, quick=args.quick, repeat=args.repeat,
+                reference=args.reference, jobs=args.jobs, progress=sys.stderr.isatty(),
+                command=" ".join(["workbench"] + sys.argv[1:]))
+    ref = res["reference"]
+    print(f"{scene.name} {res['size'][0]}x{res['size'][1]}: reference {ref['method']} {ref['options']}")
+    for p in res["points"]:
+        if p["status"] == "ok":
+            print(f"  {p['method']:<10} {p['knob']}={p['value']!s:<6} {p['time_s']:9.4g} s  RMSE {p['rmse']:.4g}"
+                  f"  FLIP {p['flip']:.4g}{'  *pareto' if p.get('pareto') else ''}")
+        else:
+            print(f"  {p['method']:<10} {p['knob']}={p['value']}: {p['status']}: {p['reason']}")
+    print(f"study: {(Path(args.out) / 'study.png').resolve()}")
+    return 0
