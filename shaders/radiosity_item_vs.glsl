@@ -9,8 +9,6 @@ uniform vec4 rect[MAX_FACES];   // (scale x, offset x, scale y, offset y) in NDC
 uniform float far_plane;
 
 in vec3 in_pos;
-in uint in_id;
-flat out uint v_id;
 out float v_depth;
 out float gl_ClipDistance[4];
 
@@ -23,5 +21,4 @@ void main() {
     vec4 r = rect[gl_InstanceID];
     gl_Position = vec4(c.x * r.x + c.w * r.y, c.y * r.z + c.w * r.w, c.z, c.w);
     v_depth = c.w / far_plane;   // distance along the face axis, linear (no 1/z precision loss)
-    v_id = in_id;
 }

@@ -47,9 +47,8 @@ void main() {
     vec3 S = safe_normalize(u_eye - v_world);
     // shading normal: interpolated (or the polygon's, flat); a cancelled one falls back to
     // the triangle's geometric normal
-    vec3 N = v_normal;
-    if (length(N) < NORMAL_CANCEL) N = cross(dFdx(v_world), dFdy(v_world));
-    N = safe_normalize(N);
+    vec3 Ng = cross(dFdx(v_world), dFdy(v_world));  // outside any branch (derivatives)
+    vec3 N = safe_normalize(length(v_normal) < NORMAL_CANCEL ? Ng : v_normal);
 #ifdef BUMP_KIND
     N = bump_normal(v_obj, N);
 #endif

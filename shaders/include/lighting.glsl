@@ -7,7 +7,7 @@
 //
 // It is split as I = E + C * diffuse + specular so that flat and Gouraud shading can light at
 // the polygon / vertex and still modulate by a per-fragment texture colour C.
-// Needs: N_LIGHTS, TOL_ZERO (defines).
+// Needs: N_LIGHTS, TOL_ZERO; SPECULAR when ks > 0 (defines).
 #include "common.glsl"
 
 uniform vec3 u_ambient;      // the scene's Ia
@@ -17,7 +17,7 @@ uniform float u_ks;
 uniform float u_shininess;
 
 #if N_LIGHTS > 0
-uniform vec4 u_light_pos[N_LIGHTS];     // xyz position (w = 1) or travel direction (w = 0)
+uniform vec4 u_light_pos[N_LIGHTS];     // xyz position (w = 1) or direction towards the light (w = 0)
 uniform vec3 u_light_color[N_LIGHTS];   // color * intensity
 uniform float u_light_inv_sq[N_LIGHTS]; // 1: inverse-square falloff
 uniform vec4 u_light_lobe[N_LIGHTS];    // xyz emitter normal of an area light's stand-in, w = 1 if set
@@ -28,22 +28,17 @@ float spec_pow(float x, float n) {
     return n == 0.0 ? 1.0 : pow(clamp(x, 0.0, 1.0), n);
 }
 
-// Direction to light l and received intensity at P.
+// Direction to light l and received intensity at P.  Branch-free (llvmpipe runs both sides
+// of a branch it cannot prove uniform): a directional light has w = 0, so d = lp.xyz.
 void light_incidence(int l, vec3 P, out vec3 L, out vec3 I) {
 #if N_LIGHTS > 0
     vec4 lp = u_light_pos[l];
-    if (lp.w == 0.0) {
-        L = -lp.xyz;
-        I = u_light_color[l];
-        return;
-    }
-    vec3 d = lp.xyz - P;
+    vec3 d = lp.xyz - P * lp.w;
     float r2 = dot(d, d);
     L = safe_normalize(d);
-    float s = 1.0;
-    if (u_light_inv_sq[l] > 0.5) s = 1.0 / max(r2, TOL_ZERO * TOL_ZERO);
-    if (u_light_lobe[l].w > 0.5) s *= max(0.0, -dot(L, u_light_lobe[l].xyz));
-    I = u_light_color[l] * s;
+    float falloff = mix(1.0, 1.0 / max(r2, TOL_ZERO * TOL_ZERO), u_light_inv_sq[l]);
+    float lobe = mix(1.0, max(0.0, -dot(L, u_light_lobe[l].xyz)), u_light_lobe[l].w);
+    I = u_light_color[l] * (falloff * lobe);
 #else
     L = vec3(0.0);
     I = vec3(0.0);
@@ -60,14 +55,14 @@ void local_terms(vec3 P, vec3 N, vec3 S, out vec3 diffuse, out vec3 specular) {
         light_incidence(l, P, L, I);
         float ndl = dot(N, L);
         diffuse += I * (u_kd * max(ndl, 0.0));
-        if (u_ks > 0.0 && ndl > 0.0) {
+#ifdef SPECULAR
 #ifdef BLINN
-            float base = dot(N, safe_normalize(L + S));
+        float base = dot(N, safe_normalize(L + S));
 #else
-            float base = dot(2.0 * ndl * N - L, S);
+        float base = dot(2.0 * ndl * N - L, S);
 #endif
-            specular += I * (u_ks * spec_pow(base, u_shininess));
-        }
+        specular += I * (ndl > 0.0 ? u_ks * spec_pow(base, u_shininess) : 0.0);
+#endif
     }
 }
 

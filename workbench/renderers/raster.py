@@ -303,7 +303,7 @@ class RasterSession:
                 c = np.asarray(light.color) * light.intensity
                 col.append(tuple(float(x) for x in c))
                 if isinstance(light, DirectionalLight):
-                    pos.append((*map(float, light.direction), 0.0))
+                    pos.append((*(-float(x) for x in light.direction), 0.0))  # towards the light
                     inv_sq.append(0.0)
                     lobe.append((0.0, 0.0, 0.0, 0.0))
                 else:
@@ -372,8 +372,10 @@ class RasterSession:
             bg_draw.vao.render(moderngl.TRIANGLES, vertices=3)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
-        opaque = [d for d in self.draws if not d.blended]
         cam_pos = np.asarray(camera.position)
+        # opaque front to back (early depth rejection), blended back to front
+        opaque = sorted((d for d in self.draws if not d.blended),
+                        key=lambda d: float(np.linalg.norm(d.centre - cam_pos)))
         blended = sorted((d for d in self.draws if d.blended),
                          key=lambda d: -float(np.linalg.norm(d.centre - cam_pos)))
         clip_bytes = np.ascontiguousarray(clip.T, dtype="f4").tobytes()

@@ -91,8 +91,8 @@ def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: i
                      has_uv: bool, blinn: bool, depth_bits: int, allow_bump: bool) -> dict[str, object]:
     """The ``#define``s of one draw: what the scene needs and this material uses, nothing else.
 
-    ``MODE_*`` (flat, gouraud, phong), ``N_LIGHTS``, ``BLINN`` when asked and a light has a
-    specular material, ``HAS_UV`` (mesh uvs), ``TEX_KIND/TEX_PROJ``, ``BUMP_KIND/BUMP_PROJ``
+    ``MODE_*`` (flat, gouraud, phong), ``N_LIGHTS``, ``SPECULAR`` for a material with
+    ``ks > 0`` (and ``BLINN`` when asked), ``HAS_UV`` (mesh uvs), ``TEX_KIND/TEX_PROJ``, ``BUMP_KIND/BUMP_PROJ``
     (only when ``allow_bump``: per-fragment normals), ``OPACITY_KIND/OPACITY_PROJ``,
     ``ENV_MAP`` + ``ENV_KIND`` for environment-mapped materials, ``DEPTH_LEVELS`` for an
     emulated 16-bit depth buffer.
@@ -101,8 +101,10 @@ def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: i
     d = base_defines()
     d[MODES[mode]] = ""
     d["N_LIGHTS"] = n_lights
-    if blinn and material.ks > 0:
-        d["BLINN"] = ""
+    if material.ks > 0:
+        d["SPECULAR"] = ""
+        if blinn:
+            d["BLINN"] = ""
     if has_uv:
         d["HAS_UV"] = ""
     if material.texture is not None and ft.TEXTURES in needs:

@@ -1,0 +1,93 @@
+"""Raster throughput: flat, Gouraud and Phong at 512 x 512 on every bundled scene (llvmpipe).
+
+For each scene and method: a :class:`RasterSession` is built (tessellation, upload and shader
+compile, including llvmpipe's JIT at the first draw, reported apart), 3 warm-up frames are
+drawn, then frames are timed for at least ``--seconds`` (and at least 10 frames):
+
+* ``fps``: full frames (draw + read the float32 image back to numpy), what ``render()`` does;
+* ``fps_draw``: draw into the FBO and ``ctx.finish()`` without read-back (the UI's case).
+
+pyrender's frame time (its offscreen render + read-back) on the same scene and camera is
+measured beside ours, in a child process (``workbench.renderers.reference``).
+
+    .venv/bin/python bench/raster_fps.py [--seconds 1.0] [--size 512] [--scenes a,b]
+
+Writes ``bench/results/raster_fps.json`` and prints it.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import time
+from pathlib import Path
+
+import workbench
+from workbench.renderers import gl
+from workbench.renderers.raster import RasterSession
+from workbench.scene.library import bundled
+
+OUT = Path(__file__).resolve().parent / "results" / "raster_fps.json"
+
+
+def _rate(fn, seconds: float) -> float:
+    for _ in range(3):
+        fn()
+    n, t0 = 0, time.perf_counter()
+    while n < 10 or time.perf_counter() - t0 < seconds:
+        fn()
+        n += 1
+    return n / (time.perf_counter() - t0)
+
+
+def bench_scene(name: str, size: int, seconds: float) -> dict:
+    scene = workbench.load_scene(name)
+    cam = scene.camera.with_resolution(size, size)
+    row = {"scene": name, "methods": {}}
+    for mode in ("flat", "gouraud", "phong"):
+        t0 = time.perf_counter()
+        session = RasterSession(scene, mode)
+        setup = time.perf_counter() - t0
+        ctx = session.ctx
+        fbo = session.framebuffer(size, size)
+
+        def draw_only():
+            session.draw_to(fbo, cam)
+            ctx.finish()
+
+        row["methods"][mode] = {
+            "triangles": session.n_triangles,
+            "setup_seconds": round(setup, 4),
+            "compile_seconds": round(session.timings["compile"], 4),
+            "tessellate_seconds": round(session.timings["tessellate"], 4),
+            "fps": round(_rate(lambda: session.draw(cam), seconds), 1),
+            "fps_draw": round(_rate(draw_only, seconds), 1),
+        }
+        print(name, mode, row["methods"][mode], flush=True)
+    try:
+        from workbench.renderers.reference import frame_time_in_child
+        row["pyrender"] = frame_time_in_child(name, size, size, frames=10)
+    except Exception as e:  # reported, never fatal for the benchmark
+        row["pyrender"] = {"error": str(e)}
+    print(name, "pyrender", row["pyrender"], flush=True)
+    return row
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seconds", type=float, default=1.0)
+    ap.add_argument("--size", type=int, default=512)
+    ap.add_argument("--scenes", default="")
+    args = ap.parse_args()
+    names = args.scenes.split(",") if args.scenes else [p.stem for p in bundled()]
+    rows = [bench_scene(n, args.size, args.seconds) for n in names]
+    result = {"benchmark": "raster_fps", "size": [args.size, args.size], "gl_renderer": gl.renderer_name(),
+              "machine": platform.platform(), "cpu_count": __import__("os").cpu_count(),
+              "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "scenes": rows}
+    OUT.parent.mkdir(parents=True, exist_ok=True)
+    OUT.write_text(json.dumps(result, indent=2))
+    print(json.dumps(result, indent=2))
+
+
+if __name__ == "__main__":
+    main()
