@@ -174,11 +174,14 @@ def knoll_ordered(colors: np.ndarray, palette: np.ndarray, thresholds: np.ndarra
     target even where no single entry is close.  (Adding the threshold to the colour, as done
     for direct modes, only works on a regular grid of levels.)
     """
+    from scipy.spatial import cKDTree
+
     from .color import LUMINANCE_WEIGHTS
+    tree = cKDTree(palette)
     err = np.zeros_like(colors)
     picks = np.empty((candidates,) + colors.shape)
     for i in range(candidates):
-        picks[i] = palette[nearest(colors + err, palette)]
+        picks[i] = palette[tree.query(colors + err)[1]]
         err += colors - picks[i]
     order = np.argsort(picks @ LUMINANCE_WEIGHTS, axis=0, kind="stable")
     which = np.minimum((thresholds * candidates).astype(int), candidates - 1)
