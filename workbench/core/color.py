@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .errors import WorkbenchError
 from .tol import tol
 
 #: Linear sRGB -> CIE XYZ (IEC 61966-2-1:1999, eq. (6) as printed, 4 decimals; the row for Y
@@ -60,7 +61,6 @@ LUMINANCE_WEIGHTS = XYZ_FROM_RGB[1].copy()
 def _as3(a, n: int = 3) -> np.ndarray:
     a = np.asarray(a, dtype=np.float64)
     if a.ndim == 0 or a.shape[-1] != n:
-        from .errors import WorkbenchError
         raise WorkbenchError(f"colour array must have {n} components on its last axis, "
                              f"got shape {a.shape}")
     return a

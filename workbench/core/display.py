@@ -15,7 +15,9 @@ Modes
                         each pixel stores the index of the nearest entry (Euclidean distance in
                         encoded RGB).  Palette ``-mediancut`` (Heckbert 1982, default) or
                         ``-kmeans`` (Lloyd iterations started from the median-cut palette).
-suffix ``-bayer``       ordered dithering with the 8 x 8 Bayer (1973) matrix.
+suffix ``-bayer``       ordered dithering with the 8 x 8 Bayer (1973) matrix: threshold added
+                        per channel for direct modes, Knoll's pattern dithering for a CLUT
+                        (:func:`knoll_ordered`).
 suffix ``-fs``          error diffusion (Floyd & Steinberg 1976, weights 7, 3, 5, 1 / 16).
 
 Examples: ``"direct24"``, ``"direct16-565-bayer"``, ``"indexed16-kmeans-fs"``, ``"indexed2"``.

@@ -75,7 +75,8 @@ def wheel_image(base_hue: float = 0.0, kind: str = "triad", size: int = 256,
         d = _segment_distance(xx, yy, pts[i], pts[(i + 1) % len(pts)])
         img = _over(img, np.zeros(3), _cover(line - d))
     r_m = _MARKER_RADIUS * size
-    for (px, py), col in zip(pts, hsv_to_rgb(np.stack([hues, np.ones_like(hues), np.full_like(hues, value)], -1))):
+    colors = hsv_to_rgb(np.stack([hues, np.ones_like(hues), np.full_like(hues, value)], -1))
+    for (px, py), col in zip(pts, colors):
         d = np.hypot(xx - px, yy - py)
         img = _over(img, np.ones(3), _cover(r_m + 2 * line - d))
         img = _over(img, np.zeros(3), _cover(r_m + line - d))
