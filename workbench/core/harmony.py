@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .color import hsv_to_rgb
+from .color import clip_to_gamut, hsv_to_rgb
 from .errors import WorkbenchError
 from .imageio import srgb_decode
 
@@ -43,7 +43,7 @@ def harmony_colors(base_hue: float, kind: str, saturation: float = 1.0,
     """Linear RGB ``(n, 3)`` of a harmony's colours at the given HSV saturation and value."""
     h = harmony_hues(base_hue, kind)
     hsv = np.stack([h, np.full_like(h, saturation), np.full_like(h, value)], -1)
-    return srgb_decode(np.clip(hsv_to_rgb(hsv), 0.0, 1.0))
+    return srgb_decode(clip_to_gamut(hsv_to_rgb(hsv)))
 
 
 def wheel_image(base_hue: float = 0.0, kind: str = "triad", size: int = 256,
@@ -81,7 +81,7 @@ def wheel_image(base_hue: float = 0.0, kind: str = "triad", size: int = 256,
         img = _over(img, np.ones(3), _cover(r_m + 2 * line - d))
         img = _over(img, np.zeros(3), _cover(r_m + line - d))
         img = _over(img, col, _cover(r_m - d))
-    return srgb_decode(np.clip(img, 0.0, 1.0)).astype(np.float32)
+    return srgb_decode(clip_to_gamut(img)).astype(np.float32)
 
 
 def _cover(signed_distance: np.ndarray) -> np.ndarray:
