@@ -1,8 +1,10 @@
 #version 330 core
 // The environment seen through each pixel (what rays leaving the scene see).
+in vec2 v_ndc;
+const bool HAS_UV_ATTR = false;
+const vec2 v_uv = vec2(0.0);
 #include "texturing.glsl"
 
-in vec2 v_ndc;
 uniform mat4 u_world_from_clip;
 out vec4 frag_color;
 

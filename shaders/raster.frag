@@ -3,13 +3,18 @@
 // I = E + C * diffuse + specular (local model, lighting.glsl), + kr * environment(reflected)
 // for environment-mapped materials; opacity maps cut out (alpha < 0.5) or blend.
 // Output: linear RGB and alpha into a float32 colour attachment.
-#include "lighting.glsl"
-#include "texturing.glsl"
-
 in vec3 v_world;
 in vec3 v_normal;
 in vec3 v_obj;
 in vec2 v_uv;
+#ifdef HAS_UV
+const bool HAS_UV_ATTR = true;
+#else
+const bool HAS_UV_ATTR = false;
+#endif
+
+#include "lighting.glsl"
+#include "texturing.glsl"
 #if defined(MODE_FLAT)
 flat in vec3 v_diffuse;
 flat in vec3 v_specular;
@@ -28,21 +33,15 @@ uniform float u_depth_levels;  // 2^bits - 1: emulated fixed-point depth buffer
 
 out vec4 frag_color;
 
-#ifdef HAS_UV
-const bool HAS_UV_ATTR = true;
-#else
-const bool HAS_UV_ATTR = false;
-#endif
-
 void main() {
     float a = 1.0;
 #ifdef OPACITY_KIND
-    a = opacity(v_obj, v_uv, HAS_UV_ATTR);
+    a = opacity(v_obj, v_uv);
     if (a < 0.5) discard;
 #endif
     vec3 C = u_color;
 #ifdef TEX_KIND
-    C *= texture_color(v_obj, v_uv, HAS_UV_ATTR);
+    C *= texture_color(v_obj, v_uv);
 #endif
     vec3 S = safe_normalize(u_eye - v_world);
     // shading normal: interpolated (or the polygon's, flat); a cancelled one falls back to

@@ -1,6 +1,7 @@
 // Texture evaluation, GLSL mirror of workbench/renderers/texturing.py (read its docstring for
 // the formulas; tests compare the two at a few pixels).  Object-space inputs.
-// Needs: TOL_ZERO, BUMP_STEP; the *_KIND / *_PROJ defines of the maps in use.
+// Needs: TOL_ZERO, BUMP_STEP, HAS_UV_ATTR (const bool) and v_uv (the mesh uv, when a bump map
+// uses the uv projection); the *_KIND / *_PROJ defines of the maps in use.
 #include "common.glsl"
 
 const float TWO_PI = 6.283185307179586;
@@ -46,23 +47,32 @@ float longitude(vec3 d, Mapping m) {
     return wrap01(on_axis ? 0.0 : atan(y, x) / TWO_PI);
 }
 
-// (u, v) before scale; uv is the mesh's (used by PROJ_UV when has_uv).
-vec2 project(int proj, Mapping m, vec3 P, vec2 uv, bool has_uv) {
-    vec3 d = P - m.center;
-    if (proj == PROJ_UV && has_uv) return uv;
-    if (proj == PROJ_PLANAR) return vec2(dot(d, m.se), dot(d, m.w));
-    if (proj == PROJ_CYLINDRICAL) return vec2(longitude(d, m), dot(d, m.sp));
+vec2 project_planar(Mapping m, vec3 d) {
+    return vec2(dot(d, m.se), dot(d, m.w));
+}
+
+vec2 project_cylindrical(Mapping m, vec3 d) {
+    return vec2(longitude(d, m), dot(d, m.sp));
+}
+
+vec2 project_spherical(Mapping m, vec3 d) {
     float h = dot(d, m.sp);
     float rho = length(d - h * m.sp);
     float phi = (rho == 0.0 && h == 0.0) ? 0.0 : atan(rho, -h);
     return vec2(longitude(d, m), phi / PI);
 }
 
+// (u, v) before scale of object point P under projection PROJ (a literal define, so that the
+// compiler keeps one branch); uv is the mesh's, used by PROJ_UV when HAS_UV_ATTR, else the
+// spherical fallback.
+#define PROJECT(PROJ, m, P, uv) ((PROJ) == PROJ_UV && HAS_UV_ATTR ? (uv) \
+    : (PROJ) == PROJ_PLANAR ? project_planar(m, (P) - m.center) \
+    : (PROJ) == PROJ_CYLINDRICAL ? project_cylindrical(m, (P) - m.center) \
+    : project_spherical(m, (P) - m.center))
+
 // Pattern coordinates s: scale * (u, v, 0), or scale * (P - center) for the solid projection.
-vec3 pattern_coords(int proj, Mapping m, vec3 P, vec2 uv, bool has_uv) {
-    if (proj == PROJ_SOLID) return m.scale * (P - m.center);
-    return vec3(m.scale * project(proj, m, P, uv, has_uv), 0.0);
-}
+#define PATTERN_COORDS(PROJ, m, P, uv) ((PROJ) == PROJ_SOLID ? m.scale * ((P) - m.center) \
+    : vec3(m.scale * PROJECT(PROJ, m, P, uv), 0.0))
 
 // ---------------------------------------------------------------- noise (lowbias32 value noise)
 float hash3(ivec3 i) {
@@ -126,20 +136,27 @@ float mortar_distance(vec3 s) {
     return min(min(fx, 1.0 - fx), 0.5 * min(fy, 1.0 - fy));
 }
 
-// Blend weight of colors[1] (see texturing.pattern_value).
-float pattern_value(int kind, vec3 s, bool solid, float width) {
-    if (kind == K_CHECKER) {
-        vec3 fl = floor(s);
-        float parity = fl.x + fl.y + fl.z;
-        return parity - 2.0 * floor(parity / 2.0);
-    }
-    if (kind == K_BRICKS) return mortar_distance(s) < 0.5 * width ? 1.0 : 0.0;
-    if (kind == K_GRID) {
-        vec2 f = s.xy - floor(s.xy);
-        return min(f.x, f.y) < width ? 1.0 : 0.0;
-    }
-    if (kind == K_MARBLE) return 0.5 + 0.5 * sin(TWO_PI * (s.x + 2.0 * turbulence(s)));
-    // K_WOOD
+// Blend weights of colors[1] (see texturing.pattern_value), one function per pattern.
+float checker(vec3 s) {
+    vec3 fl = floor(s);
+    float parity = fl.x + fl.y + fl.z;
+    return parity - 2.0 * floor(parity / 2.0);
+}
+
+float bricks(vec3 s, float width) {
+    return mortar_distance(s) < 0.5 * width ? 1.0 : 0.0;
+}
+
+float grid(vec3 s, float width) {
+    vec2 f = s.xy - floor(s.xy);
+    return min(f.x, f.y) < width ? 1.0 : 0.0;
+}
+
+float marble(vec3 s) {
+    return 0.5 + 0.5 * sin(TWO_PI * (s.x + 2.0 * turbulence(s)));
+}
+
+float wood(vec3 s, bool solid) {
     float r = solid ? length(s.xz) : length(s.xy);
     float t = 4.0 * (r + 0.3 * fbm(s));
     return smoothstep(0.0, 0.8, t - floor(t));
@@ -161,12 +178,22 @@ uniform vec3 u_tex_color1;
 uniform sampler2D u_tex_image;
 #endif
 
-vec3 texture_color(vec3 P, vec2 uv, bool has_uv) {
+vec3 texture_color(vec3 P, vec2 uv) {
 #if TEX_KIND == K_IMAGE
-    return sample_image(u_tex_image, project(TEX_PROJ, u_tex, P, uv, has_uv) * u_tex.scale).rgb;
+    return sample_image(u_tex_image, PROJECT(TEX_PROJ, u_tex, P, uv) * u_tex.scale).rgb;
 #else
-    float t = pattern_value(TEX_KIND, pattern_coords(TEX_PROJ, u_tex, P, uv, has_uv),
-                            TEX_PROJ == PROJ_SOLID, u_tex.width);
+    vec3 s = PATTERN_COORDS(TEX_PROJ, u_tex, P, uv);
+#if TEX_KIND == K_CHECKER
+    float t = checker(s);
+#elif TEX_KIND == K_BRICKS
+    float t = bricks(s, u_tex.width);
+#elif TEX_KIND == K_GRID
+    float t = grid(s, u_tex.width);
+#elif TEX_KIND == K_MARBLE
+    float t = marble(s);
+#else
+    float t = wood(s, TEX_PROJ == PROJ_SOLID);
+#endif
     return mix(u_tex_color0, u_tex_color1, t);
 #endif
 }
@@ -183,9 +210,9 @@ uniform sampler2D u_bump_image;
 
 float bump_height(vec3 P) {
 #if BUMP_KIND == K_IMAGE
-    return dot(sample_image(u_bump_image, project(BUMP_PROJ, u_bump, P, vec2(0.0), false) * u_bump.scale).rgb, LUMA);
+    return dot(sample_image(u_bump_image, PROJECT(BUMP_PROJ, u_bump, P, v_uv) * u_bump.scale).rgb, LUMA);
 #else
-    vec3 s = pattern_coords(BUMP_PROJ, u_bump, P, vec2(0.0), false);
+    vec3 s = PATTERN_COORDS(BUMP_PROJ, u_bump, P, v_uv);
 #if BUMP_KIND == K_BRICKS
     float hw = 0.5 * u_bump.width;
     return smoothstep(0.5 * hw, 1.5 * hw, mortar_distance(s));
@@ -223,18 +250,18 @@ uniform sampler2D u_op_image;
 uniform float u_op_has_alpha;   // 1: the image's alpha channel, 0: its luminance
 #endif
 
-float opacity(vec3 P, vec2 uv, bool has_uv) {
+float opacity(vec3 P, vec2 uv) {
 #if OPACITY_KIND == K_CONSTANT
     return u_op_value;
 #elif OPACITY_KIND == K_IMAGE
-    vec4 c = sample_image(u_op_image, project(OPACITY_PROJ, u_op, P, uv, has_uv) * u_op.scale);
+    vec4 c = sample_image(u_op_image, PROJECT(OPACITY_PROJ, u_op, P, uv) * u_op.scale);
     return u_op_has_alpha > 0.5 ? c.a : dot(c.rgb, LUMA);
 #else
-    vec3 s = pattern_coords(OPACITY_PROJ, u_op, P, uv, has_uv);
+    vec3 s = PATTERN_COORDS(OPACITY_PROJ, u_op, P, uv);
 #if OPACITY_KIND == K_GRID
-    return pattern_value(K_GRID, s, false, u_op.width);
+    return grid(s, u_op.width);
 #else
-    return 1.0 - pattern_value(K_CHECKER, s, false, u_op.width);
+    return 1.0 - checker(s);
 #endif
 #endif
 }
