@@ -31,6 +31,10 @@ def add_parser(sub):
                    help="method option, repeatable (see 'workbench methods')")
     p.add_argument("--npy", help="also save the linear float32 image as .npy")
     p.add_argument("--json", help="also save timings, stats and left-out features as JSON")
+    p.add_argument("--display", metavar="MODE", default="direct24",
+                   help="display mode post-process: direct24, direct16-555, direct16-565, "
+                        "indexedN[-mediancut|-kmeans][-bayer|-fs] (N = 2..256); its error against "
+                        "direct24 is printed")
     p.set_defaults(run=run)
 
 
@@ -44,13 +48,22 @@ def run(args) -> int:
     from ..scene.io import load_scene
     if not args.output.lower().endswith(".png"):
         raise WorkbenchError(f"output must be a .png file, got {args.output!r}")
+    from ..core.display import apply_display_mode, display_mode
+    display_mode(args.display)  # refuse a bad mode before rendering
     scene = load_scene(args.scene)
     w, h = args.size if args.size else (None, None)
     options = dict(args.set)
     if "progress" in _accepted(args.method):
         options.setdefault("progress", "true")
     result = render(scene, args.method, width=w, height=h, **options)
-    save_png(args.output, result.image)
+    image = result.image
+    if args.display != "direct24":
+        from ..compare.metrics import metrics
+        reference = apply_display_mode(image, "direct24")
+        image = apply_display_mode(image, args.display)
+        m = metrics(image, reference)
+        print(f"  display {args.display} vs direct24: rmse {m['rmse']:.4g}, psnr {m['psnr']:.2f} dB, flip {m['flip']:.4f}")
+    save_png(args.output, image)
     if args.npy:
         save_npy(args.npy, result.image)
     t = ", ".join(f"{k} {v:.3f} s" for k, v in result.timings.items())
