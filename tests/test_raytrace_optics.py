@@ -1,0 +1,189 @@
+"""Geometric optics of the ray tracer: Snell-Descartes, critical angle, lateral offset through a
+slab, Fresnel, furnaces (mirror and dielectric), Beer-Lambert, nested media, shadow feelers,
+and the local model against the numpy reference."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import workbench
+from workbench.renderers import local_model
+from workbench.renderers.raytrace import reference
+from workbench.scene.io import scene_from_dict
+
+
+def make(objects, materials, lights=(), camera=None, **scene_kw):
+    d = {"scene": dict(scene_kw), "camera": camera or {"position": [0, 0, -10], "look_at": [0, 0, 0], "resolution": [16, 12]},
+         "materials": materials, "lights": list(lights), "objects": objects}
+    return scene_from_dict(d)
+
+
+# --------------------------------------------------------------------------- Snell, TIR
+@pytest.mark.parametrize("deg", [0.0, 10.0, 30.0, 41.0, 41.8, 60.0, 89.0])
+def test_snell_descartes_and_critical_angle(deg):
+    """n_i sin(i) = n_t sin(t), T in the plane of incidence, unit; from glass (1.5) to air the
+    critical angle is asin(1/1.5) = 41.81 deg: beyond it, total internal reflection."""
+    th = np.radians(deg)
+    N = np.array([0.0, 0.0, -1.0])  # on the incident side
+    D = np.array([np.sin(th), 0.0, np.cos(th)])
+    T, cosi, cost = reference.refraction(D, N, 1.0, 1.5)  # entering glass: always refracts
+    assert np.sin(th) == pytest.approx(1.5 * np.linalg.norm(np.cross(T, -N)), abs=1e-12)
+    assert np.linalg.norm(T) == pytest.approx(1.0) and abs(T[1]) < 1e-15
+    T, cosi, cost = reference.refraction(D, N, 1.5, 1.0)
+    crit = np.degrees(np.arcsin(1 / 1.5))
+    assert crit == pytest.approx(41.81, abs=5e-3)
+    if deg < crit:
+        assert T is not None and 1.5 * np.sin(th) == pytest.approx(np.linalg.norm(np.cross(T, -N)), abs=1e-12)
+    else:
+        assert T is None
+
+
+def test_exactly_at_the_critical_angle_is_reflection_not_nan():
+    th = np.arcsin(1 / 1.5)
+    D = np.array([np.sin(th), 0.0, np.cos(th)])
+    T, cosi, cost = reference.refraction(D, np.array([0.0, 0.0, -1.0]), 1.5, 1.0)
+    assert T is None or (np.isfinite(T).all() and abs(T[2]) < 1e-6)
+
+
+@pytest.mark.parametrize("mode", ["schlick", "exact"])
+def test_fresnel_limits(mode):
+    assert reference.fresnel(mode, 1.0, 1.5, 1.0, 1.0) == pytest.approx(0.04)
+    cos_t = np.sqrt(1 - (1 / 1.5) ** 2 * (1 - 1e-8))
+    assert reference.fresnel(mode, 1.0, 1.5, 1e-4, cos_t) == pytest.approx(1.0, abs=2e-3)
+    if mode == "exact":  # Brewster: rp = 0 -> F = rs^2 / 2
+        b = np.arctan(1.5)
+        ci, ct = np.cos(b), np.sqrt(1 - (np.sin(b) / 1.5) ** 2)
+        rs = (ci - 1.5 * ct) / (ci + 1.5 * ct)
+        assert reference.fresnel(mode, 1.0, 1.5, ci, ct) == pytest.approx(rs * rs / 2)
+
+
+@pytest.mark.parametrize("deg", [20.0, 50.0])
+def test_lateral_offset_through_a_glass_slab(deg):
+    """A slab of thickness e: the ray leaves parallel to itself, shifted by
+    e sin(i - t) / cos(t) (ray tree of the centre pixel, reference tracer)."""
+    e = 0.4
+    slab = {"type": "box", "min": [-3, -3, -e / 2], "max": [3, 3, e / 2], "material": "glass",
+            "transform": {"rotate": [0, deg, 0]}}
+    sc = make([slab], {"glass": {"kt": 1.0, "ior": 1.5, "ka": 0.0, "kd": 0.0}},
+              camera={"position": [0, 0, -10], "look_at": [0, 0, 0], "resolution": [3, 3]})
+    tree = workbench.raytrace.ray_tree(sc, 1, 1, max_depth=4, threshold=0.0)
+    D0 = np.array(tree["direction"])
+    inside = tree["children"][0]["ray"]
+    out = inside["children"][-1]["ray"]
+    D2 = np.array(out["direction"])
+    assert D2 == pytest.approx(D0, abs=1e-12)
+    i = np.radians(deg)
+    t = np.arcsin(np.sin(i) / 1.5)
+    P0, P2 = np.array(tree["origin"]), np.array(out["origin"])
+    w = P2 - P0
+    shift = np.linalg.norm(w - (w @ D0) * D0)
+    # up to the secondary rays' origin offsets (tol.offset_scale: 1e-7 x the scene extent)
+    assert shift == pytest.approx(e * np.sin(i - t) / np.cos(t), abs=1e-5)
+
+
+# --------------------------------------------------------------------------- furnaces
+@pytest.mark.parametrize("kr,threshold,expected_terms", [(1.0, 0.0, 6), (0.5, 0.0, 6), (0.5, 0.1, 4)])
+def test_mirror_furnace(kr, threshold, expected_terms):
+    """Inside an emitting mirror sphere (emission E, reflectance kr) every pixel sees
+    E (1 + kr + ... + kr^(n-1)): n = max_depth, or fewer when kr^k falls to the threshold."""
+    E = 0.2
+    sc = make([{"type": "sphere", "radius": 5.0, "material": "mirror"}],
+              {"mirror": {"kr": kr, "ka": 0.0, "kd": 0.0, "emission": [E, E, E]}},
+              camera={"position": [0, 0.5, 0.3], "look_at": [1, 0, 2], "resolution": [12, 9]})
+    r = workbench.render(sc, "raytrace", max_depth=6, threshold=threshold)
+    expected = E * sum(kr ** k for k in range(expected_terms))
+    assert np.allclose(r.image, expected, rtol=1e-6)
+    assert r.stats["escaped_rays"] == 0
+    n = 12 * 9
+    if threshold == 0.0:
+        assert r.stats["ended_by_depth"] == n and r.stats["reflected_rays"] == 5 * n
+    else:
+        assert r.stats["ended_by_threshold"] == n and r.stats["ended_by_depth"] == 0
+
+
+@pytest.mark.parametrize("shape,fresnel", [("sphere", "exact"), ("sphere", "schlick"), ("box", "none"), ("box", "exact")])
+def test_dielectric_in_a_white_furnace_conserves_energy(shape, fresnel):
+    """A lossless dielectric (kt = 1, nothing absorbed) under a uniform white background looks
+    white: Fresnel splits energy between reflection and transmission, and total internal
+    reflection sends it all to reflection (never a made-up colour)."""
+    obj = ({"type": "sphere", "radius": 1.0} if shape == "sphere" else
+           {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 1], "transform": {"rotate": [30, 40, 0]}})
+    sc = make([dict(obj, material="glass")], {"glass": {"kt": 1.0, "ior": 1.5, "ka": 0.0, "kd": 0.0}},
+              camera={"position": [0, 0, -4], "look_at": [0, 0, 0], "resolution": [24, 24]},
+              background=[1.0, 1.0, 1.0])
+    r = workbench.render(sc, "raytrace", max_depth=40, threshold=1e-9, fresnel=fresnel)
+    assert r.stats["refracted_rays"] > 0
+    if shape == "box":
+        assert r.stats["total_internal_reflections"] > 0
+    lost = 1.0 - r.image
+    assert lost.min() > -1e-9
+    assert np.mean(lost) < 1e-3
+
+
+def test_beer_lambert_absorption():
+    a, e = 0.7, 0.5
+    sc = make([{"type": "box", "min": [-2, -2, 0], "max": [2, 2, e], "material": "tinted"}],
+              {"tinted": {"kt": 1.0, "ior": 1.0, "ka": 0.0, "kd": 0.0, "absorption": [a, 2 * a, 0.0]}},
+              camera={"position": [0, 0, -5], "look_at": [0, 0, 0], "resolution": [1, 1]},
+              background=[1.0, 1.0, 1.0])
+    r = workbench.render(sc, "raytrace")
+    assert r.image[0, 0] == pytest.approx([np.exp(-a * e), np.exp(-2 * a * e), 1.0], rel=1e-6)
+
+
+def test_nested_media_use_the_ratio_of_their_indices():
+    """A ball of water inside a ball of water is invisible (eta = 1.33 / 1.33 at its surface);
+    an air bubble inside is not."""
+    def render(inner_ior):
+        objs = [{"type": "plane", "point": [0, 0, 4], "normal": [0, 0, -1], "size": [20, 20], "material": "board"},
+                {"type": "sphere", "radius": 2.0, "material": "water"}]
+        if inner_ior:
+            objs.append({"type": "sphere", "radius": 1.0, "center": [0.2, 0.1, 0], "material": "inner"})
+        sc = make(objs, {"board": {"texture": {"type": "checker", "projection": "planar", "pole": [0, 0, 1], "scale": 2.0}},
+                         "water": {"kt": 1.0, "ior": 1.33, "ka": 0.0, "kd": 0.0},
+                         "inner": {"kt": 1.0, "ior": inner_ior or 1.0, "ka": 0.0, "kd": 0.0}},
+                  lights=[{"type": "directional", "direction": [0, 0, 1]}],
+                  camera={"position": [0, 0, -8], "look_at": [0, 0, 0], "resolution": [32, 32]})
+        return workbench.render(sc, "raytrace", max_depth=8).image
+    alone = render(None)
+    assert np.allclose(render(1.33), alone, atol=1e-6)
+    assert np.abs(render(1.0) - alone).max() > 0.1
+
+
+@pytest.mark.parametrize("transmissive", [False, True])
+def test_shadow_feelers_and_transmissive_occluders(transmissive):
+    objs = [{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "size": [20, 20], "material": "floor"},
+            {"type": "plane", "point": [0, 2, 0], "normal": [0, 1, 0], "size": [2, 2], "material": "sheet"}]
+    sc = make(objs, {"floor": {"ka": 0.0, "kd": 1.0, "color": [1, 1, 1]},
+                     "sheet": {"ka": 0.0, "kd": 0.0, "kt": 0.5}},
+              lights=[{"type": "point", "position": [0, 10, 0]}],
+              camera={"position": [0, 1, -6], "look_at": [0, 0, 0], "resolution": [1, 1]})
+    P = np.array([[0.0, 0.0, 0.0]])
+    r = workbench.render(sc, "raycast", transmissive_shadows=transmissive)
+    # the single pixel sees the floor's centre (not the sheet), which is in the sheet's shadow
+    t, n, obj = workbench.raytrace.intersect(sc, np.array([[0, 1, -6.0]]), np.array([[0, -1, 6.0]]))
+    assert obj[0] == 0
+    lit = local_model.shade(P, np.array([[0, 1.0, 0]]), np.array([[0, 1, -6.0]]) / np.sqrt(37),
+                            np.ones(3), sc.materials["floor"], sc.point_lights(), sc.ambient)
+    assert r.image[0, 0] == pytest.approx(lit[0] * (0.5 if transmissive else 0.0), rel=1e-6, abs=1e-9)
+    assert r.stats["shadow_rays"] == 1
+
+
+@pytest.mark.parametrize("shininess,blinn", [(0.0, False), (20.0, False), (20.0, True), (1e4, False)])
+def test_raycast_equals_the_local_model(shininess, blinn):
+    """The kernel's local model is local_model.shade at the hit points (two lights, one with
+    inverse-square falloff, ambient, two-sided)."""
+    sc = make([{"type": "sphere", "radius": 1.5, "material": "m"}],
+              {"m": {"color": [0.9, 0.5, 0.2], "ka": 0.3, "kd": 0.7, "ks": 0.5, "shininess": shininess}},
+              lights=[{"type": "point", "position": [3, 4, -5], "intensity": 0.8},
+                      {"type": "point", "position": [-3, 1, -2], "intensity": 9.0, "falloff": "inverse_square"}],
+              camera={"position": [0, 0, -6], "look_at": [0, 0, 0], "resolution": [24, 18]},
+              ambient=[0.2, 0.2, 0.2])
+    r = workbench.render(sc, "raycast", blinn=blinn)
+    O, D = sc.camera.rays()
+    t, n, obj = workbench.raytrace.intersect(sc, O.reshape(-1, 3), D.reshape(-1, 3))
+    hit = obj >= 0
+    P = O.reshape(-1, 3)[hit] + t[hit, None] * D.reshape(-1, 3)[hit]
+    ref = local_model.shade(P, n[hit], -D.reshape(-1, 3)[hit], np.array([0.9, 0.5, 0.2]), sc.materials["m"],
+                            sc.point_lights(), sc.ambient, blinn=blinn)
+    assert np.allclose(r.image.reshape(-1, 3)[hit], ref, atol=2e-6)
+    assert np.allclose(r.image.reshape(-1, 3)[~hit], 0.0)
