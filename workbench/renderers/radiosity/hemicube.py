@@ -12,9 +12,12 @@ with dA = (2/res)^2.  Their sum is 1 + O(1/res^2) (DESIGN errata 6), reported as
 ``weight_sum``.  Aliasing (small or distant patches falling between pixel centres) and
 proximity (the hemicube sees from the centre only) are inherent errors.
 
-Speed on llvmpipe: the scene is uploaded once; the five faces of ``batch`` patches are drawn
-by ONE instanced draw call into one framebuffer (each instance maps its face into its own
-rectangle, ``gl_ClipDistance`` clipping it there) and read back once.
+Speed on llvmpipe (whose vertex/primitive front end is single-threaded, ~2.5 M triangles/s):
+the scene's vertices are uploaded once per face slot; for ``batch`` patches at a time the
+CPU keeps, for each face, only the triangles not wholly outside one of its frustum planes
+(outcodes), and ONE draw call (llvmpipe pays ~0.5 ms per draw) renders the 5 x batch lists
+into one framebuffer (each face mapped into its own rectangle, ``gl_ClipDistance`` clipping
+it there), read back once.
 """
 from __future__ import annotations
 
@@ -31,6 +34,7 @@ from .formfactors import Geometry
 SHADERS = Path(__file__).resolve().parents[3] / "shaders"
 MAX_FACES = 80          # must match MAX_FACES in radiosity_item_vs.glsl
 FACES = 5
+TRI_ROW = 4096          # must match TRI_ROW in radiosity_item_fs.glsl
 GL_CLIP_DISTANCE0 = 0x3000
 
 
@@ -89,19 +93,32 @@ class Hemicube:
         self.rotate = rotate
         self.weights = delta_form_factors(self.res)
         self.P = len(geom)
-        ext = geom.extent
+        self.extent = ext = geom.extent
         self.origin = geom.tris.reshape(-1, 3).mean(0) if len(geom.tris) else np.zeros(3)
         self.near = tol.hemicube_near * ext
         self.far = 2.0 * ext
         self.ctx = ctx = gl.context()
         src = [(SHADERS / f"radiosity_item_{s}.glsl").read_text() for s in ("vs", "fs")]
         self.prog = ctx.program(vertex_shader=src[0], fragment_shader=src[1])
-        pos = (geom.tris.reshape(-1, 3) - self.origin).astype("f4")
-        ids = np.repeat(geom.tri_patch.astype("u4"), 3)
-        data = np.empty(len(pos), dtype=[("p", "f4", 3), ("i", "u4")])
-        data["p"], data["i"] = pos, ids
-        self.vbo = ctx.buffer(data.tobytes())
-        self.vao = ctx.vertex_array(self.prog, [(self.vbo, "3f 1u", "in_pos", "in_id")])
+        # shared vertices + index buffer (each vertex shaded once per face, not per triangle);
+        # the patch comes from gl_PrimitiveID through a texture
+        pos, index = np.unique(geom.tris.reshape(-1, 3), axis=0, return_inverse=True)
+        self.pos_h = np.concatenate([pos - self.origin, np.ones((len(pos), 1))], 1)
+        self.index = index.reshape(-1, 3).astype("u4")
+        self.U = U = len(pos)
+        slots = FACES * self.batch
+        verts = np.empty((slots, U), dtype=[("p", "f4", 3), ("f", "u4")])
+        verts["p"] = (pos - self.origin).astype("f4")[None]
+        verts["f"] = np.arange(slots, dtype="u4")[:, None]
+        self.vbo = ctx.buffer(verts.tobytes())
+        max_tris = slots * len(self.index)
+        self.ibo = ctx.buffer(reserve=max(12, 12 * max_tris))
+        self.vao = ctx.vertex_array(self.prog, [(self.vbo, "3f 1u", "in_pos", "in_face")],
+                                    self.ibo, index_element_size=4)
+        self.lut_rows = max(1, -(-max_tris // TRI_ROW))
+        self.lut = ctx.texture((TRI_ROW, self.lut_rows), 1, dtype="u4")
+        self.lut.filter = (ctx.NEAREST, ctx.NEAREST)
+        self.prog["tri_patch"].value = 0
         W, H = 3 * self.res, self.batch * self.res
         self.item = ctx.texture((W, H), 1, dtype="u4")
         self.depth = ctx.depth_renderbuffer((W, H))
@@ -110,6 +127,7 @@ class Hemicube:
         self.rects = self._rects()
         self._proj_top = _frustum(-self.near, self.near, -self.near, self.near, self.near, self.far)
         self._proj_side = _frustum(-self.near, self.near, 0.0, self.near, self.near, self.far)
+        self.u, self.v, self.n = self._frames()
         self.drawn = 0
 
     def _rects(self) -> np.ndarray:
@@ -123,30 +141,54 @@ class Hemicube:
                 out.append((w / W, w / W + 2 * x0 / W - 1, h / H, h / H + 2 * y0 / H - 1))
         return np.array(out, dtype="f4")
 
-    def _frame(self, i: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        n = self.geom.normals[i]
-        poly = self.geom.polygons[i]
-        u = poly[1] - poly[0]
-        u = u - (u @ n) * n
-        if np.linalg.norm(u) <= tol.zero * self.geom.extent:
-            u = np.cross(n, [1.0, 0.0, 0.0] if abs(n[0]) < 0.9 else [0.0, 1.0, 0.0])
-        u = tf.normalize(u)
+    def _frames(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Hemicube axes (P, 3) each: u along each patch's first edge (turned by a random
+        angle if ``rotate``), v = n x u, n the normal."""
+        g = self.geom
+        n = g.normals
+        first = np.array([p[1] - p[0] for p in g.polygons]) if len(g) else np.zeros((0, 3))
+        u = first - (first * n).sum(1, keepdims=True) * n
+        bad = np.linalg.norm(u, axis=1) <= tol.zero * self.extent
+        alt = np.where(np.abs(n[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+        u = tf.normalize(np.where(bad[:, None], np.cross(n, alt), u))
         v = np.cross(n, u)
         if self.rotate:
-            a = self.rng.uniform(0.0, 2.0 * np.pi)
+            a = self.rng.uniform(0.0, 2.0 * np.pi, len(g))[:, None]
             u, v = np.cos(a) * u + np.sin(a) * v, -np.sin(a) * u + np.cos(a) * v
         return u, v, n
 
-    def _face_matrices(self, i: int) -> list[np.ndarray]:
-        """clip_from_world (4, 4) of the five faces of patch i's hemicube (world relative to
-        ``origin``)."""
-        u, v, n = self._frame(i)
+    def _face_matrices(self, patches: np.ndarray) -> np.ndarray:
+        """clip_from_world (len(patches) * 5, 4, 4) of the hemicube faces (world relative to
+        ``origin``): the top looks along n (up v), the sides along +-u, +-v (up n)."""
+        u, v, n = self.u[patches], self.v[patches], self.n[patches]
         # eye lifted by the near distance: coplanar neighbours fall below the side faces
-        c = self.geom.centres[i] - self.origin + self.near * n
-        mats = [self._proj_top @ tf.look_at(c, c + n, v)]
-        for axis in (u, -u, v, -v):
-            mats.append(self._proj_side @ tf.look_at(c, c + axis, n))
-        return mats
+        eye = self.geom.centres[patches] - self.origin + self.near * n
+        looks = np.stack([n, u, -u, v, -v], 1)               # (B, 5, 3) view directions
+        ups = np.stack([v, n, n, n, n], 1)
+        f = looks
+        r = np.cross(f, ups)
+        up = np.cross(r, f)
+        view = np.zeros(looks.shape[:2] + (4, 4))
+        view[..., 0, :3], view[..., 1, :3], view[..., 2, :3] = r, up, -f
+        view[..., :3, 3] = -np.einsum("bfij,bj->bfi", view[..., :3, :3], eye)
+        view[..., 3, 3] = 1.0
+        proj = np.stack([self._proj_top] + [self._proj_side] * 4)   # (5, 4, 4)
+        return (proj[None] @ view).reshape(-1, 4, 4)
+
+    def _cull(self, mats: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Triangles each face keeps: those not wholly outside one plane of its clip volume.
+
+        mats : (S, 4, 4) clip_from_world of face slots 0..S-1.
+        Returns the vertex indices (K, 3) into the per-slot vertex buffer, and the patch of
+        each kept triangle (K,)."""
+        c = self.pos_h @ mats.transpose(0, 2, 1)            # (S, U, 4)
+        x, y, z, w = c[..., 0], c[..., 1], c[..., 2], c[..., 3]
+        code = ((x < -w).astype(np.uint8) | ((x > w) << 1) | ((y < -w) << 2) | ((y > w) << 3)
+                | ((z < -w) << 4) | ((z > w) << 5)).astype(np.uint8)
+        t = code[:, self.index]                              # (S, T, 3)
+        slot, tri = np.nonzero((t[..., 0] & t[..., 1] & t[..., 2]) == 0)
+        return (self.index[tri] + (slot * self.U).astype("u4")[:, None],
+                self.geom.tri_patch[tri].astype("u4"))
 
     def rows(self, patches) -> np.ndarray:
         """Rows F[i, :] (len(patches), P) of the patches listed."""
@@ -159,23 +201,33 @@ class Hemicube:
             ctx.enable_direct(GL_CLIP_DISTANCE0 + k)
         try:
             self.fbo.use()
+            self.lut.use(0)
             for s in range(0, len(patches), self.batch):
                 chunk = patches[s:s + self.batch]
-                live = [b for b, i in enumerate(chunk) if self.geom.areas[i] > 0 and
-                        np.linalg.norm(self.geom.normals[i]) > 0]
-                if not live:
+                live = np.nonzero(self.geom.areas[chunk] > 0)[0]
+                if len(live) == 0:
                     continue
-                mats = np.zeros((MAX_FACES, 4, 4), dtype="f4")
-                rects = np.zeros((MAX_FACES, 4), dtype="f4")
-                for slot, b in enumerate(live):
-                    for f, M in enumerate(self._face_matrices(int(chunk[b]))):
-                        mats[FACES * slot + f] = M.T  # GLSL matrices are column-major
-                        rects[FACES * slot + f] = self.rects[FACES * b + f]
-                self.prog["clip_from_world"].write(mats.tobytes())
-                self.prog["rect"].write(rects.tobytes())
+                live_p = chunk[live]
+                mats = self._face_matrices(live_p)
+                rects = self.rects.reshape(self.batch, FACES, 4)[live].reshape(-1, 4)
+                nf = FACES * len(live)
+                tri_idx, tri_patch = self._cull(mats[:nf])
+                if len(tri_idx):
+                    self.ibo.write(tri_idx.astype("u4").tobytes())
+                    lut = np.zeros(-(-len(tri_patch) // TRI_ROW) * TRI_ROW, dtype="u4")
+                    lut[:len(tri_patch)] = tri_patch
+                    self.lut.write(lut.tobytes(), viewport=(0, 0, TRI_ROW, len(lut) // TRI_ROW))
+                # GLSL matrices are column-major
+                pad_m = np.zeros((MAX_FACES, 4, 4), dtype="f4")
+                pad_m[:nf] = mats.transpose(0, 2, 1)
+                pad_r = np.zeros((MAX_FACES, 4), dtype="f4")
+                pad_r[:nf] = rects
+                self.prog["clip_from_world"].write(pad_m.tobytes())
+                self.prog["rect"].write(pad_r.tobytes())
                 self.fbo.clear(depth=1.0)
                 self.item.write(np.zeros(self.item.size[::-1], dtype="u4").tobytes())
-                self.vao.render(instances=FACES * len(live))
+                if len(tri_idx):
+                    self.vao.render(vertices=3 * len(tri_idx))
                 ids = np.frombuffer(self.fbo.read(components=1, dtype="u4"), dtype="u4")
                 ids = ids.reshape(self.batch, self.res, 3 * self.res)[:len(chunk)]
                 shift = (np.arange(len(chunk)) * (self.P + 1))[:, None, None]
@@ -202,5 +254,6 @@ class Hemicube:
                 "hemicubes_drawn": self.drawn}
 
     def release(self) -> None:
-        for o in (self.vao, self.vbo, self.fbo, self.item, self.depth, self.prog):
+        for o in (self.vao, self.vbo, self.ibo, self.lut, self.fbo, self.item, self.depth,
+                  self.prog):
             o.release()
