@@ -8,6 +8,7 @@ BUILTIN: dict[str, str] = {
     "flat": "workbench.renderers.raster:FlatRenderer",
     "gouraud": "workbench.renderers.raster:GouraudRenderer",
     "phong": "workbench.renderers.raster:PhongRenderer",
+    "pyrender": "workbench.renderers.reference:PyrenderRenderer",
     "raycast": "workbench.renderers.raytrace.whitted:RaycastRenderer",
     "raytrace": "workbench.renderers.raytrace.whitted:RaytraceRenderer",
 }
