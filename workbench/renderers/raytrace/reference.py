@@ -23,6 +23,7 @@ from ...core.tol import offset_scale, tol
 from ...scene import model as m
 from .. import local_model
 from . import csg, shapes
+from .whitted import MAX_CUTOUTS, OPACITY_CUT
 
 DEFAULTS = dict(max_depth=5, threshold=1e-3, fresnel="none", transmissive_shadows=False,
                 blinn=False, shadows=True)
@@ -72,7 +73,7 @@ class Context:
                 self.items.append(Item(len(scene.objects) + k, m.Polygon(name, vertices=light.vertices),
                                        np.eye(4), shadow=False))
         self.texturing = None
-        if {"textures", "bump", "environment"} & scene.needs():
+        if {"textures", "bump", "environment", "opacity"} & scene.needs():
             from .. import texturing
             self.texturing = texturing
 
@@ -234,7 +235,7 @@ def raytrace(ctx: Context, O, D, recurs=0, weight=np.ones(3), media=(), tmin=0.0
                 children=[], shadow_feelers=[])
     if tree is not None:
         tree.append(node)
-    hit = closest(ctx, O, D, tmin)
+    hit, a = visible_hit(ctx, O, D, tmin)
     if hit is None:
         node.update(object=None, stop="left the scene")
         return background(ctx, D)
@@ -242,7 +243,31 @@ def raytrace(ctx: Context, O, D, recurs=0, weight=np.ones(3), media=(), tmin=0.0
     att = np.ones(3)
     if media:
         att = np.exp(-np.asarray(media[-1].absorption) * hit.t)
-    return att * shade(ctx, hit, D, recurs, weight * att, list(media), node)
+    color = a * att * shade(ctx, hit, D, recurs, weight * att * a, list(media), node)
+    if a < 1.0:  # alpha blending: the ray also goes on, straight through
+        sub: list = []
+        color = color + (1 - a) * raytrace(ctx, O, D, recurs, weight * (1 - a), media, past(ctx, hit), sub)
+        node["children"].append(dict(kind="transparency", coefficient=1 - a, ray=sub[0]))
+    return color
+
+
+def past(ctx, hit) -> float:
+    """``tmin`` just beyond a hit (offset scaled with the hit point)."""
+    return hit.t + tol.ray_offset * max(float(np.abs(hit.P).max()), ctx.extent)
+
+
+def visible_hit(ctx, O, D, tmin):
+    """The closest hit not cut out by an opacity map (alpha < 0.5), and its alpha."""
+    for _ in range(MAX_CUTOUTS):
+        hit = closest(ctx, O, D, tmin)
+        if hit is None or hit.material.opacity is None or ctx.texturing is None:
+            return hit, 1.0
+        uv = None if hit.uv is None else hit.uv[None]
+        a = float(ctx.texturing.alpha(hit.material, hit.P_obj[None], (hit.Ns @ hit.W[:3, :3])[None], uv)[0])
+        if a >= OPACITY_CUT:
+            return hit, a
+        tmin = past(ctx, hit)
+    return None, 1.0
 
 
 def shade(ctx, hit: Hit, D, recurs, weight, media, node):
