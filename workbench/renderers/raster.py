@@ -337,15 +337,21 @@ class RasterSession:
 
     def framebuffer(self, width: int, height: int):
         """A cached float32 RGBA colour + depth FBO of this size (depth format per
-        ``depth_bits``)."""
+        ``depth_bits``: 24-bit fixed point, also used for the emulated 16 bits, or 32-bit
+        float)."""
         key = (width, height)
         if key not in self._fbos:
             color = self.ctx.texture((width, height), 4, dtype="f4")
-            depth = depth_attachment(self.ctx, (width, height), self.depth_bits)
-            self._fbos[key] = self.ctx.framebuffer([color], depth)
+            if self.depth_bits == 32:
+                from .raster_depth import FloatDepthFramebuffer
+                holder = FloatDepthFramebuffer(self.ctx, color)
+                self._fbos[key] = (holder.fbo, holder.release)
+            else:
+                fbo = self.ctx.framebuffer([color], self.ctx.depth_texture((width, height)))
+                self._fbos[key] = (fbo, fbo.release)
             if len(self._fbos) > 4:
-                self._fbos.popitem(last=False)
-        return self._fbos[key]
+                self._fbos.popitem(last=False)[1][1]()
+        return self._fbos[key][0]
 
     def draw_to(self, fbo, camera: Camera, near: float | None = None, far: float | None = None):
         """Draw the scene seen by ``camera`` into ``fbo`` (colour attachment 0 + depth).
@@ -360,7 +366,7 @@ class RasterSession:
         fbo.use()
         ctx.viewport = (0, 0, fbo.width, fbo.height)
         bg = tuple(float(x) for x in self.scene.background)
-        fbo.clear(*bg, 0.0, depth=1.0)
+        fbo.clear(*bg, 0.0, depth=1.0, viewport=(0, 0, fbo.width, fbo.height))
         ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
         if self.background is not None:
             bg_draw = self.background
@@ -418,12 +424,6 @@ class RasterSession:
         with np.errstate(divide="ignore"):
             depth = np.where(d >= 1.0, np.inf, 2.0 * n * f / ((f + n) - z_ndc * (f - n)))
         return np.ascontiguousarray(image), depth.astype(np.float32), nf
-
-
-def depth_attachment(ctx, size: tuple[int, int], bits: int):
-    """Depth texture of an FBO: moderngl's 24-bit fixed point (16 bits are emulated by the
-    fragment shader quantising gl_FragDepth to 2^16 - 1 levels, see ``DEPTH_LEVELS``)."""
-    return ctx.depth_texture(size)
 
 
 def depth_view(depth: np.ndarray, near: float, far: float) -> np.ndarray:
