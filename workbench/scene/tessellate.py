@@ -22,7 +22,8 @@ quadric     surface ``P^T Q P = 0`` inside the object's bounds, not capped (open
             hyperboloids, paraboloid): parametric surfaces of revolution, ``4 level`` rows x
             ``8 level`` segments, cut along the bounds' planes.  General Q: marching
             tetrahedra (manifold3d's ``level_set``) on a grid of about ``8 level`` cells
-            along the bounds' diagonal.  Normals: the gradient ``Q P``
+            along the bounds' diagonal, vertices pulled onto the surface by Newton steps.
+            Normals: the gradient ``Q P``
 mesh        as given (the level does not apply); its normals, or the face normal
 csg         leaves tessellated as closed solids (quadrics capped by their bounds), then
             real mesh booleans by manifold3d; normals from each leaf (analytic for spheres
@@ -313,6 +314,13 @@ def _general_quadric(q: m.Quadric, level: int) -> tuple[np.ndarray, np.ndarray]:
     for axis in range(3):
         for plane in (lo[axis], hi[axis]):
             on_cap |= (np.abs(P[F][:, :, axis] - plane) <= tol.planar * (hi[axis] - lo[axis])).all(1)
+    # vertices of the crease between surface and caps are interpolated across it: pull every
+    # vertex onto the surface (Newton steps along the gradient), staying inside the bounds
+    Q = np.asarray(q.Q, dtype=np.float64)
+    for _ in range(3):
+        g = _quadric_gradient(Q, P)
+        g2 = np.maximum(np.sum(g * g, -1), tol.zero)
+        P = np.clip(P - (_quadric_value(Q, P) / g2)[:, None] * g, lo, hi)
     return P, F[~on_cap]
 
 
