@@ -1,9 +1,8 @@
 """Analytic images of sphere-only scenes: the exact limit that Gouraud / Phong approach as the
 tessellation is refined, computed independently of every registered method.
 
-Each pixel's primary ray (``Camera.rays``, pixel centres) is intersected with every sphere by
-the stable quadratic (DESIGN.md errata 1 and 7: ``B = 2 d.(o - c)``, ``q = -(B + sign(B)
-sqrt(disc)) / 2``, ``t = q / A, C / q``) and shaded with the one local model
+Each pixel's primary ray (``Camera.rays``, pixel centres) is intersected with every sphere
+without cancellation (:func:`ray_sphere`) and shaded with the one local model
 (:func:`workbench.renderers.local_model.shade`), visibility 1 (no shadow feelers, like the
 raster methods).  Used as the reference of the study tests and of the stress cases.
 """
@@ -18,29 +17,36 @@ from ..scene.model import Scene, Sphere
 
 
 def ray_sphere(o: np.ndarray, d: np.ndarray, c, r: float) -> np.ndarray:
-    """Nearest positive hit parameter of rays with one sphere.
+    """Nearest positive hit parameter of rays with one sphere, free of cancellation.
+
+    The textbook discriminant ``B^2 - 4AC`` loses every digit for a small sphere far away
+    (``B^2 ~ 4 |o - c|^2`` while the discriminant is ``~ 4 (r^2 - b^2)``).  Instead, with unit
+    ``d``: ``t_ca = d.(c - o)``, the impact parameter ``b = |(c - o) - t_ca d|`` computed as the
+    norm of a vector, ``h = (r - b)(r + b)``, and the stable root pair (errata 7)
+    ``q = t_ca + sign(t_ca) sqrt(h)``, ``t = q`` and ``C / q`` with ``C = (|c - o| - r)(|c - o| + r)``.
 
     Parameters
     ----------
-    o, d : (N, 3) float64 ray origins and unit directions.
+    o, d : (N, 3) float64 ray origins and directions (normalised here).
     c : (3,) centre; r : radius.
 
     Returns
     -------
     (N,) float64, ``inf`` where the ray misses.
     """
-    oc = o - np.asarray(c, dtype=np.float64)
-    A = np.sum(d * d, -1)
-    B = 2.0 * np.sum(d * oc, -1)
-    # C = |oc|^2 - r^2 factored to limit cancellation for far spheres (|oc| >> r)
-    C = (np.linalg.norm(oc, axis=-1) - r) * (np.linalg.norm(oc, axis=-1) + r)
-    disc = B * B - 4.0 * A * C
-    hit = disc >= 0.0
-    sq = np.sqrt(np.where(hit, disc, 0.0))
-    q = -0.5 * (B + np.where(B >= 0.0, sq, -sq))
+    d = normalize(np.asarray(d, dtype=np.float64))
+    oc = np.asarray(c, dtype=np.float64) - o
+    tca = np.sum(d * oc, -1)
+    b = np.linalg.norm(oc - tca[:, None] * d, axis=-1)
+    h = (r - b) * (r + b)
+    hit = h >= 0.0
+    sq = np.sqrt(np.where(hit, h, 0.0))
+    L = np.linalg.norm(oc, axis=-1)
+    C = (L - r) * (L + r)
+    q = tca + np.where(tca >= 0.0, sq, -sq)
     with np.errstate(divide="ignore", invalid="ignore"):
-        t1, t2 = q / A, np.where(q != 0.0, C / q, 0.0)
-    lo, hi = np.minimum(t1, t2), np.maximum(t1, t2)
+        t2 = np.where(q != 0.0, C / q, 0.0)
+    lo, hi = np.minimum(q, t2), np.maximum(q, t2)
     t = np.where(lo > 0.0, lo, np.where(hi > 0.0, hi, np.inf))
     return np.where(hit, t, np.inf)
 
@@ -61,6 +67,13 @@ def sphere_image(scene: Scene, width: int | None = None, height: int | None = No
     Returns
     -------
     (H, W, 3) float32 linear RGB (background where no sphere is hit).
+    """
+    return sphere_hits(scene, width, height)[0]
+
+
+def sphere_hits(scene: Scene, width: int | None = None, height: int | None = None
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`sphere_image` and the (H, W) int index of the object seen (-1: background).
 
     Raises
     ------
@@ -97,7 +110,19 @@ def sphere_image(scene: Scene, width: int | None = None, height: int | None = No
         N = normalize(P - c)
         mat = scene.material_of(obj)
         img[sel] = shade(P, N, -d[sel], np.asarray(mat.color), mat, lights, scene.ambient)
-    return img.reshape(H, W, 3).astype(np.float32)
+    return img.reshape(H, W, 3).astype(np.float32), which.reshape(H, W)
 
 
-__all__ = ["ray_sphere", "sphere_image"]
+def interior(index: np.ndarray) -> np.ndarray:
+    """(H, W) bool: pixels whose 3 x 3 neighbourhood sees the same object (or background):
+    away from silhouettes, where discretised geometry (tessellation) moves the outline."""
+    H, W = index.shape
+    pad = np.pad(index, 1, mode="edge")
+    same = np.ones((H, W), dtype=bool)
+    for di in range(3):
+        for dj in range(3):
+            same &= pad[di:di + H, dj:dj + W] == index
+    return same
+
+
+__all__ = ["interior", "ray_sphere", "sphere_hits", "sphere_image"]

@@ -1,0 +1,24 @@
+"""``workbench stress --out DIR``: the stiff and extreme cases of the catalogue, with verdicts."""
+from __future__ import annotations
+
+
+def add_parser(sub):
+    p = sub.add_parser("stress", help="run the stiff/extreme case catalogue; table with expected, measured, verdict")
+    p.add_argument("--out", required=True, help="output folder (stress.csv, stress.json, stress.md, stress.html)")
+    p.add_argument("--only", metavar="PATTERN", help="case ids matching this (substring or shell pattern)")
+    p.add_argument("--catalogue", help="catalogue file (default: stress/cases.toml of the repository)")
+    p.set_defaults(run=run)
+
+
+def run(args) -> int:
+    import sys
+    from pathlib import Path
+
+    from ..compare.stress import CATALOGUE, stress
+    res = stress(args.out, only=args.only, catalogue=args.catalogue or CATALOGUE, progress=sys.stderr.isatty(),
+                 command=" ".join(["workbench"] + sys.argv[1:]))
+    for r in res["rows"]:
+        print(f"  {r['case']:<32} {r['method']:<10} {r['verdict']}")
+    print("summary: " + ", ".join(f"{k} {v}" for k, v in res["summary"].items()))
+    print(f"table: {(Path(args.out) / 'stress.html').resolve()}")
+    return 0
