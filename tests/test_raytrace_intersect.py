@@ -36,7 +36,7 @@ def test_sphere_away_from_origin_t4_and_t6():
     assert n[0] == pytest.approx([0, 0, -1]) and n[1] == pytest.approx([0, 0, 1])
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=60, deadline=None, derandomize=True)
 @given(b=st.floats(0.0, 3.0), phi=st.floats(0, 2 * np.pi), r=st.floats(0.1, 2.0),
        scale=st.sampled_from([1e-6, 1.0, 1e6]))
 def test_hit_iff_ray_passes_within_radius(b, phi, r, scale):
@@ -203,7 +203,7 @@ def test_bvh_equals_brute_force(blob):
     assert np.isfinite(t).sum() > 100
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=40, deadline=None, derandomize=True)
 @given(seed=st.integers(0, 10_000))
 def test_mesh_is_watertight_at_edges_and_vertices(seed, blob):
     """Rays aimed exactly at vertices and edge points of a closed mesh from outside always hit
@@ -217,7 +217,9 @@ def test_mesh_is_watertight_at_edges_and_vertices(seed, blob):
     # from the front of the face (a silhouette edge, grazed, may be missed by rounding)
     nf = np.cross(V[f[:, 1]] - V[f[:, 0]], V[f[:, 2]] - V[f[:, 0]])
     nf /= np.linalg.norm(nf, axis=1, keepdims=True)
-    O = targets + 3 * (nf + 0.3 * rng.normal(size=(64, 3)))
+    dirs = nf + 0.3 * rng.normal(size=(64, 3))
+    dirs = np.where(np.sum(dirs * nf, 1, keepdims=True) > 0.5 * np.linalg.norm(dirs, axis=1, keepdims=True), dirs, nf)
+    O = targets + 3 * dirs
     t, n, obj = cast(sc, O, targets - O)
     assert (obj == 0).all()
     assert (t <= 1.0 + 1e-9).all()
@@ -231,7 +233,7 @@ def test_vertex_normals_do_not_change_geometric_normal(blob):
 
 
 # --------------------------------------------------------------------------- self-intersection
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=40, deadline=None, derandomize=True)
 @given(seed=st.integers(0, 10_000), scale=st.sampled_from([1e-6, 1e-3, 1.0, 1e3, 1e6]))
 def test_no_self_intersection_of_offset_rays(seed, scale):
     """Secondary rays leave a surface from ``P + offset N`` (offset scaled with the hit point
