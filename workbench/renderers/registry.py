@@ -11,4 +11,5 @@ BUILTIN: dict[str, str] = {
     "pyrender": "workbench.renderers.reference:PyrenderRenderer",
     "raycast": "workbench.renderers.raytrace.whitted:RaycastRenderer",
     "raytrace": "workbench.renderers.raytrace.whitted:RaytraceRenderer",
+    "radiosity": "workbench.renderers.radiosity.method:RadiosityRenderer",
 }

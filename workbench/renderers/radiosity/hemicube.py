@@ -199,6 +199,7 @@ class Hemicube:
         ctx.disable(ctx.CULL_FACE)
         for k in range(4):
             ctx.enable_direct(GL_CLIP_DISTANCE0 + k)
+        previous = ctx.fbo     # rebound afterwards: releasing a bound FBO breaks the next one
         try:
             self.fbo.use()
             self.lut.use(0)
@@ -241,6 +242,8 @@ class Hemicube:
         finally:
             for k in range(4):
                 ctx.disable_direct(GL_CLIP_DISTANCE0 + k)
+            if previous is not None:
+                previous.use()
         gl.check_errors(ctx)
         return out
 

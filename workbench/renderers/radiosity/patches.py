@@ -21,6 +21,8 @@ from ...core.errors import WorkbenchError
 from ...core.tol import tol
 from ...scene import model as m
 
+MAX_CURVED_LEVEL = 24   # finest tessellation level asked of workbench.scene.tessellate
+
 
 @dataclass(frozen=True)
 class PatchSet:
@@ -202,30 +204,33 @@ def _box_faces(b: m.Box) -> list[np.ndarray]:
     )]
 
 
-def _tessellated(obj) -> np.ndarray | None:
-    """Triangles (T, 3, 3) of a curved object from the raster engineer's tessellator, if it
-    exists (``workbench.scene.tessellate``); ``None`` otherwise."""
-    try:
-        from ...scene import tessellate  # noqa: PLC0415
-    except ImportError:
-        return None
-    fn = getattr(tessellate, "tessellate", None)
-    if fn is None:
-        return None
-    out = fn(obj)
-    verts, faces = np.asarray(out[0], dtype=np.float64), np.asarray(out[1], dtype=np.int64)
-    return verts[faces]
+def _edge_max(P: np.ndarray, F: np.ndarray) -> float:
+    t = P[F]
+    return float(np.linalg.norm(t - np.roll(t, 1, axis=1), axis=-1).max()) if len(F) else 0.0
 
 
-def _surfaces(scene: m.Scene) -> tuple[list, list[str]]:
-    """World-space planar surfaces of a scene: a list of (polygon (k, 3), material or None,
-    emission RGB, object, name), and the ``left_out`` entries for objects not cut into
-    patches."""
+def _curved(obj, h: float) -> list:
+    """World-space triangle meshes (vertices, faces, material name) of a curved object from
+    :mod:`workbench.scene.tessellate`, at the level whose triangles are about ``h`` long."""
+    from ...scene.tessellate import tessellate_object
+    base = tessellate_object(obj, 1)
+    e1 = max((_edge_max(p.positions, p.faces) for p in base), default=0.0)
+    level = int(np.clip(np.ceil(e1 / h), 1, MAX_CURVED_LEVEL)) if np.isfinite(h) else 1
+    parts = base if level == 1 else tessellate_object(obj, level)
+    return [(p.positions, p.faces, p.material) for p in parts]
+
+
+def _surfaces(scene: m.Scene, h: float) -> tuple[list, list[str]]:
+    """World-space surfaces of a scene, each ``(kind, geometry, material or None, emission,
+    object, name)``: kind ``"polygon"`` (a planar convex polygon (k, 3), cut later) or
+    ``"mesh"`` (vertices (V, 3), faces (F, 3): one patch per triangle, shared vertices).
+    Also returns the ``left_out`` entries."""
     out, left_out = [], []
     for i, obj in enumerate(scene.objects):
         name = obj.name or f"{obj.kind}_{i}"
         mat = scene.material_of(obj)
         W = obj.world_from_object
+        emis = np.asarray(mat.emission, dtype=np.float64)
         polys: list[np.ndarray] = []
         if isinstance(obj, m.Polygon):
             polys = [obj.vertices]
@@ -234,30 +239,43 @@ def _surfaces(scene: m.Scene) -> tuple[list, list[str]]:
         elif isinstance(obj, m.Box):
             polys = _box_faces(obj)
         elif isinstance(obj, m.Mesh):
-            polys = list(np.asarray(obj.vertices)[np.asarray(obj.faces)])
+            Pw = tf.transform_points(W, np.asarray(obj.vertices))
+            F = np.asarray(obj.faces, dtype=np.int64)
+            if _edge_max(Pw, F) <= h:
+                out.append(("mesh", (Pw, F), mat, emis, obj, name))
+            else:
+                polys = list(np.asarray(obj.vertices)[F])
         else:
-            tris = _tessellated(obj)
-            if tris is None:
-                left_out.append(f"{obj.kind} ({name}): curved surfaces are not cut into patches "
-                                "(no tessellator available)")
+            try:
+                parts = _curved(obj, h)
+            except WorkbenchError as e:
+                left_out.append(f"{obj.kind} ({name}): not cut into patches ({e})")
                 continue
-            polys = list(tris)
+            for k, (P, F, mname) in enumerate(parts):
+                pm = scene.materials[mname]
+                out.append(("mesh", (P, F), pm, np.asarray(pm.emission, dtype=np.float64), obj,
+                            name if len(parts) == 1 else f"{name}[{k}]"))
         for k, p in enumerate(polys):
             pw = tf.transform_points(W, np.asarray(p))
-            out.append((pw, mat, np.asarray(mat.emission, dtype=np.float64), obj,
-                        name if len(polys) == 1 else f"{name}[{k}]"))
+            out.append(("polygon", pw, mat, emis, obj, name if len(polys) == 1 else f"{name}[{k}]"))
     for i, light in enumerate(scene.lights):
         if isinstance(light, m.AreaLight):
-            out.append((np.asarray(light.vertices), None, light.radiance, light, f"area_light_{i}"))
+            out.append(("polygon", np.asarray(light.vertices), None, light.radiance, light,
+                        f"area_light_{i}"))
     return out, left_out
 
 
 def _assemble(surfaces: list, h: float) -> PatchSet:
-    """Cut each (polygon, reflectance, emission, object, name) into patches."""
+    """Cut each surface ``(kind, geometry, reflectance, emission, object, name)`` into
+    patches."""
     corners, vids, verts, surf, E, R = [], [], [], [], [], []
     nv = 0
-    for s, (poly, rho, emis, obj, _name) in enumerate(surfaces):
-        v, cells = split_polygon(poly, h)
+    for s, (kind, geo, rho, emis, _obj, _name) in enumerate(surfaces):
+        if kind == "polygon":
+            v, cells = split_polygon(geo, h)
+        else:
+            v, F = geo
+            cells = np.concatenate([F, F[:, 2:3]], 1)
         corners.append(v[cells])
         vids.append(cells + nv)
         verts.append(v)
@@ -272,26 +290,37 @@ def _assemble(surfaces: list, h: float) -> PatchSet:
     return PatchSet(np.concatenate(corners), np.concatenate(vids), np.concatenate(verts),
                     np.concatenate(surf), np.concatenate(E).astype(np.float64),
                     np.concatenate(R).astype(np.float64),
-                    tuple(x[4] for x in surfaces), tuple(x[3] for x in surfaces))
+                    tuple(x[5] for x in surfaces), tuple(x[4] for x in surfaces))
+
+
+def scene_extent(scene: m.Scene) -> float:
+    """Diagonal of the bounding box of the scene's surfaces (patch sizes are fractions of it)."""
+    surfaces, _ = _surfaces(scene, np.inf)
+    pts = [g if k == "polygon" else g[0] for k, g, *_ in surfaces]
+    if not pts:
+        return 1.0
+    p = np.concatenate(pts)
+    return float(max(np.linalg.norm(p.max(0) - p.min(0)), tol.zero))
 
 
 def patches_from_scene(scene: m.Scene, patch_size: float) -> tuple[PatchSet, list[str]]:
-    """Cut every surface of ``scene`` into patches no longer than ``patch_size`` (scene units).
+    """Cut every surface of ``scene`` into patches no longer than ``patch_size`` (scene units;
+    curved surfaces: triangles about that long).
 
     Returns the patches and the ``left_out`` list (objects that could not be cut, with why).
     """
     if not (patch_size > 0 and np.isfinite(patch_size)):
         raise WorkbenchError(f"patch_size must be a positive length in scene units, got {patch_size!r}")
-    surfaces, left_out = _surfaces(scene)
-    surfaces = [(p, np.zeros(3) if mat is None else mat.reflectance, e, o, n)
-                for p, mat, e, o, n in surfaces]
+    surfaces, left_out = _surfaces(scene, patch_size)
+    surfaces = [(k, g, np.zeros(3) if mat is None else mat.reflectance, e, o, n)
+                for k, g, mat, e, o, n in surfaces]
     return _assemble(surfaces, patch_size), left_out
 
 
 def patch_size_for_count(scene: m.Scene, count: int) -> float:
-    """The patch size that cuts ``scene`` into about ``count`` patches (total area / count,
-    square cells)."""
-    surfaces, _ = _surfaces(scene)
-    area = sum(0.5 * np.linalg.norm(np.cross(p[1:-1] - p[0], p[2:] - p[0]).sum(0))
-               for p, *_ in surfaces)
+    """The patch size that cuts ``scene``'s planar surfaces into about ``count`` patches
+    (total area / count, square cells)."""
+    surfaces, _ = _surfaces(scene, np.inf)
+    area = sum(0.5 * np.linalg.norm(np.cross(g[1:-1] - g[0], g[2:] - g[0]).sum(0))
+               for k, g, *_ in surfaces if k == "polygon")
     return float(np.sqrt(area / max(count, 1)))

@@ -1,0 +1,150 @@
+"""The registered ``radiosity`` method: patches -> form factors -> solve -> Gouraud display.
+
+Only what is needed: no emitters, no radiosity (``NotApplicable``); progressive refinement
+with hemicube form factors draws one hemicube per shooting patch and never builds the matrix.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...core.errors import NotApplicable
+from ...scene import features as ft
+from ...scene.model import Scene
+from ..base import Knob, Option, RenderResult
+from . import solvers
+from .formfactors import FormFactors, compute
+from .patches import PatchSet, patches_from_scene, scene_extent
+
+#: features radiosity builds, and why it leaves out each of the others
+HANDLED = {ft.EMITTERS, ft.AREA_LIGHTS, ft.POLYGONS, ft.PLANES, ft.BOXES, ft.MESHES, ft.SPHERES,
+           ft.QUADRICS, ft.CSG, ft.TRANSFORMS, ft.SHADOWS}
+REASONS = {
+    ft.POINT_LIGHTS: "radiosity only knows emitting surfaces (area lights, emissive materials)",
+    ft.DIRECTIONAL_LIGHTS: "radiosity only knows emitting surfaces (area lights, emissive materials)",
+    ft.SPECULAR: "diffuse interreflection only (the hybrid method adds specular effects)",
+    ft.REFLECTION: "diffuse interreflection only (use the hybrid method for mirrors)",
+    ft.REFRACTION: "diffuse interreflection only (use the hybrid method for glass)",
+    ft.ABSORPTION: "no transmission in radiosity",
+    ft.TEXTURES: "a patch has one reflectance, the material's kd * color",
+    ft.SOLID_TEXTURES: "a patch has one reflectance, the material's kd * color",
+    ft.IMAGE_TEXTURES: "a patch has one reflectance, the material's kd * color",
+    ft.BUMP: "patches are flat",
+    ft.OPACITY: "patches are opaque",
+    ft.ENVIRONMENT: "radiosity has no environment light",
+}
+
+
+def common_options() -> dict[str, Option]:
+    """Options shared by ``radiosity`` and ``hybrid``."""
+    return {
+        "patch_size": Option(float, 0.05, "largest patch edge as a fraction of the scene's "
+                             "bounding-box diagonal (the quality knob)"),
+        "hemicube_resolution": Option(int, 128, "hemicube pixels across the top face (even)"),
+        "hemicube_rotate": Option(bool, False, "random rotation of each hemicube about the "
+                                  "normal (against aliasing)"),
+        "solver": Option(str, "direct", "linear solver", solvers.METHODS),
+        "form_factors": Option(str, "hemicube", "form-factor method", ("hemicube", "raycast")),
+        "rays": Option(int, 1024, "raycast form factors: rays per patch"),
+        "tol": Option(float, 1e-3, "bound on the true relative error of the solution"),
+        "max_iterations": Option(int, 0, "iteration / shot cap (0: what the error bound needs)"),
+        "ambient": Option(bool, True, "progressive refinement: show Cohen et al.'s ambient term"),
+    }
+
+
+@dataclass
+class Solution:
+    """Radiosity of a scene's patches and the report of how it was obtained."""
+
+    patches: PatchSet
+    radiance: np.ndarray         # (P, 3) what each patch shows
+    stats: dict
+    timings: dict
+    left_out: list
+    features_used: list
+
+
+def _row_provider(hc, stats: dict):
+    """Hemicube rows for progressive refinement, tracking their row sums."""
+    def rows(idx):
+        r = hc.rows(idx)
+        s = r.sum(1)
+        stats["row_sum_min"] = min(stats.get("row_sum_min", np.inf), float(s.min()))
+        stats["row_sum_max"] = max(stats.get("row_sum_max", -np.inf), float(s.max()))
+        return r
+    return rows
+
+
+def solve_scene(scene: Scene, opts: dict, method: str) -> Solution:
+    """Patches, form factors and solution of ``scene`` with the ``common_options``."""
+    timings: dict = {"compile": 0.0}
+    t0 = time.perf_counter()
+    extent = scene_extent(scene)
+    patches, left_out = patches_from_scene(scene, opts["patch_size"] * extent)
+    timings["patches"] = time.perf_counter() - t0
+    needs = scene.needs()
+    left_out = left_out + [f"{f}: {REASONS.get(f, 'not used by radiosity')}"
+                           for f in sorted(needs - HANDLED)]
+    if len(patches) == 0 or not (patches.emission > 0).any():
+        raise NotApplicable(f"{method}: the scene has no emitters (no area light and no emissive "
+                            "material): radiosity has nothing to distribute")
+    stats = {"patches": len(patches), "solver": opts["solver"], "form_factor_method": opts["form_factors"],
+             "patch_size_world": opts["patch_size"] * extent}
+    geom = patches.geometry()
+    E, R = patches.emission, patches.reflectance
+    tol = opts["tol"]
+    cap = opts["max_iterations"] or None
+    if opts["solver"] == "progressive" and opts["form_factors"] == "hemicube":
+        from .hemicube import Hemicube
+        t1 = time.perf_counter()
+        hc = Hemicube(geom, opts["hemicube_resolution"], rotate=opts["hemicube_rotate"])
+        timings["compile"] += time.perf_counter() - t1
+        q = float(R.max()) * max(1.0, hc.info()["weight_sum"])
+        res = solvers.progressive_rows(_row_provider(hc, stats), geom.areas, E, R, tol=tol,
+                                       max_shots=cap, q=q, ambient=opts["ambient"])
+        info = hc.info()
+        hc.release()
+        timings["form_factors"] = res.seconds   # hemicubes and shots interleave
+        timings["solve"] = 0.0
+        stats.update({"hemicubes_drawn": info["hemicubes_drawn"], "matrix_stored": False,
+                      "gl_renderer": info["gl_renderer"], "hemicube_weight_sum": info["weight_sum"],
+                      "reciprocity_error": None})
+    else:
+        ff: FormFactors = compute(geom, opts["form_factors"], opts["hemicube_resolution"],
+                                  rotate=opts["hemicube_rotate"], rays=opts["rays"])
+        timings["form_factors"] = ff.seconds
+        rep = ff.report()
+        stats.update({"row_sum_min": rep["row_sum_min"], "row_sum_max": rep["row_sum_max"],
+                      "reciprocity_error": rep["reciprocity_error"],
+                      "reciprocity_max": rep["reciprocity_max"], "matrix_stored": True})
+        if "gl_renderer" in rep:
+            stats.update({"gl_renderer": rep["gl_renderer"], "hemicube_weight_sum": rep["weight_sum"]})
+        res = solvers.solve(ff.F, E, R, opts["solver"], tol=tol, max_iterations=cap,
+                            ambient=opts["ambient"], areas=geom.areas)
+        timings["solve"] = res.seconds
+    stats.update({"iterations": res.iterations, "converged": res.converged,
+                  "solver_message": res.message, "error_bound": res.error_bound,
+                  "residual_history": [float(x) for x in res.residuals[-50:]]})
+    used = sorted((needs & HANDLED) | {ft.EMITTERS})
+    return Solution(patches, np.asarray(res.display), stats, timings, left_out, used)
+
+
+class RadiosityRenderer:
+    """Radiosity with hemicube (or ray-cast) form factors, shown with Gouraud shading."""
+
+    name = "radiosity"
+    knob = Knob("patch_size", (0.2, 0.1, 0.05, 0.035, 0.025), 0.05,
+                "largest patch edge / scene diagonal")
+    options = common_options()
+
+    def render(self, scene: Scene, width: int, height: int, **opts) -> RenderResult:
+        from .display import draw
+        from .. import gl
+        sol = solve_scene(scene, opts, self.name)
+        img, t = draw(sol.patches, sol.radiance, scene.camera, scene.background)
+        sol.timings["compile"] += t["compile"]
+        sol.timings["display"] = t["display"]
+        sol.stats.setdefault("gl_renderer", gl.renderer_name())
+        return RenderResult(self.name, img, sol.timings, sol.stats, sol.features_used, sol.left_out)
