@@ -110,7 +110,10 @@ def solve_scene(scene: Scene, opts: dict, method: str) -> Solution:
         timings["solve"] = 0.0
         stats.update({"hemicubes_drawn": info["hemicubes_drawn"], "matrix_stored": False,
                       "gl_renderer": info["gl_renderer"], "hemicube_weight_sum": info["weight_sum"],
-                      "reciprocity_error": None})
+                      "reciprocity_error": None,
+                      "note": "shooting takes F_ji = F_ij A_i / A_j from the shooter's hemicube; "
+                              "the error bound is for that system, which differs from gathering "
+                              "by the hemicube's reciprocity error (proximity, errata 6)"})
     else:
         ff: FormFactors = compute(geom, opts["form_factors"], opts["hemicube_resolution"],
                                   rotate=opts["hemicube_rotate"], rays=opts["rays"])
