@@ -46,7 +46,6 @@ import os
 import subprocess
 import sys
 import time
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -58,7 +57,7 @@ from . import gl
 from . import texturing as tx
 from .base import Knob, Option, RenderResult
 
-_EXECUTOR: ThreadPoolExecutor | None = None
+_WORKER = None
 _RENDERERS: dict = {}
 
 
@@ -195,10 +194,11 @@ def _render_here(scene: Scene, width: int, height: int, level: int, frames: int 
     pc = pyrender.PerspectiveCamera(yfov=np.radians(cam.fov_y), aspectRatio=width / height, znear=near, zfar=far)
     ps.add(pc, pose=np.linalg.inv(cam.camera_from_world()))
     t_build = time.perf_counter() - t0
-    key = (width, height)
-    if key not in _RENDERERS:
-        _RENDERERS[key] = gl.pyrender_offscreen(width, height)
-    r = _RENDERERS[key]
+    # one offscreen renderer, resized (deleting one of several would end their shared EGL display)
+    r = _RENDERERS.get("r")
+    if r is None:
+        r = _RENDERERS["r"] = gl.pyrender_offscreen(width, height)
+    r.viewport_width, r.viewport_height = width, height
     flags = pyrender.RenderFlags.SKIP_CULL_FACES
     t0 = time.perf_counter()
     color, depth = r.render(ps, flags=flags)  # first frame: shader compile and upload
@@ -225,12 +225,58 @@ def _must_isolate() -> bool:
     return plat is not None and plat not in ("egl", "osmesa")
 
 
+class _Worker:
+    """One daemon thread owning pyrender's EGL context; jobs run there in order.  At exit the
+    offscreen renderers are deleted in that thread (before the interpreter tears down)."""
+
+    def __init__(self):
+        import atexit
+        import queue
+        import threading
+        self.jobs: queue.Queue = queue.Queue()
+        self.thread = threading.Thread(target=self._loop, name="pyrender", daemon=True)
+        self.thread.start()
+        atexit.register(self.stop)
+
+    def _loop(self):
+        while True:
+            job = self.jobs.get()
+            if job is None:
+                for r in _RENDERERS.values():
+                    try:
+                        r.delete()
+                    except Exception:  # the EGL display may already be gone at exit: nothing to free
+                        pass
+                _RENDERERS.clear()
+                return
+            fn, args, box, done = job
+            try:
+                box.append((True, fn(*args)))
+            except BaseException as e:  # handed back to the caller's thread
+                box.append((False, e))
+            done.set()
+
+    def run(self, fn, *args):
+        import threading
+        box, done = [], threading.Event()
+        self.jobs.put((fn, args, box, done))
+        done.wait()
+        ok, value = box[0]
+        if not ok:
+            raise value
+        return value
+
+    def stop(self):
+        self.jobs.put(None)
+        self.thread.join(timeout=10)
+
+
 def _in_worker(fn, *args):
-    global _EXECUTOR
-    if _EXECUTOR is None:
+    global _WORKER
+    if _WORKER is None:
         gl.pyrender_platform()
-        _EXECUTOR = ThreadPoolExecutor(max_workers=1, thread_name_prefix="pyrender")
-    return _EXECUTOR.submit(fn, *args).result()
+        _WORKER = _Worker()
+    return _WORKER.run(fn, *args)
 
 
 def _child(scene_source: str, width: int, height: int, level: int, frames: int) -> dict:
