@@ -28,7 +28,7 @@ def sphere_scene(width=48, height=36, shininess=20.0):
 
 class Facets:
     name = "facets"
-    knob = Knob("n", (2, 4, 8, 16, 32), 8, "latitude bands")
+    knob = Knob("n", (4, 8, 16, 32, 64), 8, "latitude bands")
     options = {"n": Option(int, 8, "latitude bands")}
 
     def render(self, scene, width, height, n=8):

@@ -1,8 +1,22 @@
 """``workbench study SCENE --out DIR``: error against run time along each method's quality knob."""
 from __future__ import annotations
 
+import argparse
+
 from .cmd_compare import methods_list
 from .cmd_render import _size
+
+
+def _sweep(text: str) -> tuple[str, tuple[str, list[str]]]:
+    try:
+        method, rest = text.split(":", 1)
+        option, values = rest.split("=", 1)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected METHOD:OPTION=V1,V2,..., got {text!r}") from None
+    vals = [v.strip() for v in values.split(",") if v.strip()]
+    if not vals:
+        raise argparse.ArgumentTypeError(f"no values in {text!r}")
+    return method.strip(), (option.strip(), vals)
 
 
 def add_parser(sub):
@@ -14,6 +28,9 @@ def add_parser(sub):
     p.add_argument("--quick", action="store_true", help="small sweep: at most 4 knob values, 2 warm runs, 160 px wide")
     p.add_argument("--repeat", type=int, help="warm runs per point (default 2 quick, 5 otherwise)")
     p.add_argument("--reference", help="force the reference method (default: the documented rule)")
+    p.add_argument("--sweep", type=_sweep, action="append", default=[], metavar="METHOD:OPTION=V1,V2,...",
+                   help="sweep this option instead of the method's knob (repeatable), e.g. "
+                        "radiosity:hemicube_resolution=16,32,64,128")
     p.add_argument("--jobs", type=int, default=1,
                    help="worker processes for the error evaluation, run after all timing (default 1)")
     p.set_defaults(run=run)
@@ -30,7 +47,7 @@ def run(args) -> int:
         raise WorkbenchError(f"--jobs must be >= 1, got {args.jobs}")
     scene = load_scene(args.scene)
     res = study(scene, args.out, methods=args.methods, size=args.size, quick=args.quick, repeat=args.repeat,
-                reference=args.reference, jobs=args.jobs, progress=sys.stderr.isatty(),
+                reference=args.reference, sweeps=dict(args.sweep), jobs=args.jobs, progress=sys.stderr.isatty(),
                 command=" ".join(["workbench"] + sys.argv[1:]))
     ref = res["reference"]
     print(f"{scene.name} {res['size'][0]}x{res['size'][1]}: reference {ref['method']} {ref['options']}")

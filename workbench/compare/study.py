@@ -1,7 +1,8 @@
 """``workbench study``: error against run time along each method's quality knob.
 
 For every method and every value of its knob (``get_renderer(m).knob.values``, cheapest to most
-accurate; ``--quick`` keeps at most 4 of them, evenly spread and including both ends), the
+accurate, or another option given with ``--sweep``; ``--quick`` keeps at most 4 of them, evenly
+spread and including both ends), the
 point is rendered once cold (shader / JIT compile time reported apart) and ``repeat`` times warm;
 its run time is the median of the warm wall times.  Its error against the scene's reference
 (RMSE, PSNR, FLIP; :mod:`workbench.compare.metrics`) is measured on the last image.
@@ -80,7 +81,8 @@ def evaluate(images: list[np.ndarray], reference: np.ndarray, jobs: int) -> list
 def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
           size: tuple[int, int] | None = None, quick: bool = False, repeat: int | None = None,
           reference: str | None = None, reference_image: tuple[np.ndarray, str] | None = None,
-          jobs: int = 1, progress: bool = True, command: str = "") -> dict:
+          sweeps: dict[str, tuple[str, list]] | None = None, jobs: int = 1, progress: bool = True,
+          command: str = "") -> dict:
     """Sweep each method's knob, time it and measure its error; write the study files.
 
     Parameters
@@ -92,6 +94,8 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
     reference : force the reference method (rule of :mod:`.reference` otherwise).
     reference_image : ``(image (H, W, 3), description)`` to use as the reference instead of a
         render (e.g. an analytic image); its size sets the study's size.
+    sweeps : ``{method: (option, values)}`` to sweep another option than the method's knob
+        (e.g. radiosity's ``hemicube_resolution``), values cheapest first.
     jobs : worker processes for the error evaluation (after all timing is done).
     """
     names = list(available()) if not methods else list(methods)
@@ -115,13 +119,15 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
     load = machine_info()
 
     plan = []
+    sweeps = sweeps or {}
     for m in names:
         try:
             knob = get_renderer(m).knob
         except ImportError as e:
             plan.append((m, None, None, f"cannot be loaded ({e})"))
             continue
-        plan += [(m, knob.name, v, "") for v in sweep_values(knob.values, quick)]
+        option, values = sweeps.get(m, (knob.name, knob.values))
+        plan += [(m, option, v, "") for v in sweep_values(tuple(values), quick)]
     points, images = [], []
     from tqdm import tqdm
     bar = tqdm(total=len(plan) * (repeat + 1), desc=f"study {scene.name}", unit="render",
