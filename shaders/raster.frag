@@ -47,7 +47,7 @@ void main() {
     // shading normal: interpolated (or the polygon's, flat); a cancelled one falls back to
     // the triangle's geometric normal
     vec3 Ng = cross(dFdx(v_world), dFdy(v_world));  // outside any branch (derivatives)
-    vec3 N = safe_normalize(length(v_normal) < NORMAL_CANCEL ? Ng : v_normal);
+    vec3 N = safe_normalize(length(v_normal) < TOL_NORMAL_CANCEL ? Ng : v_normal);
 #ifdef BUMP_KIND
     N = bump_normal(v_obj, N);
 #endif

@@ -1,6 +1,6 @@
 // Texture evaluation, GLSL mirror of workbench/renderers/texturing.py (read its docstring for
 // the formulas; tests compare the two at a few pixels).  Object-space inputs.
-// Needs: TOL_ZERO, BUMP_STEP, HAS_UV_ATTR (const bool) and v_uv (the mesh uv, when a bump map
+// Needs: TOL_ZERO, TOL_BUMP_STEP, HAS_UV_ATTR (const bool) and v_uv (the mesh uv, when a bump map
 // uses the uv projection); the *_KIND / *_PROJ defines of the maps in use.
 #include "common.glsl"
 
@@ -226,7 +226,7 @@ float bump_height(vec3 P) {
 
 // Perturbed unit world normal (texturing.bump_normal): N' = normalize(N - tangential grad d).
 vec3 bump_normal(vec3 P, vec3 Nw) {
-    float delta = BUMP_STEP / u_bump.scale;
+    float delta = TOL_BUMP_STEP / u_bump.scale;
     vec3 g;
     for (int k = 0; k < 3; ++k) {
         vec3 e = vec3(0.0);

@@ -83,8 +83,8 @@ def _mapping_defines(prefix: str, m) -> dict[str, object]:
 
 def base_defines() -> dict[str, object]:
     """Constants every program gets (tolerances from the one ``tol`` object)."""
-    return {"TOL_ZERO": f"{tol.zero:.6e}", "NORMAL_CANCEL": f"{tol.normal_cancel:.6e}",
-            "BUMP_STEP": f"{tol.bump_step:.6e}"}
+    return {"TOL_ZERO": f"{tol.zero:.6e}", "TOL_NORMAL_CANCEL": f"{tol.normal_cancel:.6e}",
+            "TOL_BUMP_STEP": f"{tol.bump_step:.6e}"}
 
 
 def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: int,
