@@ -132,3 +132,35 @@ def test_gl_projection_matches_camera_project(gl_ctx):
     assert abs(cols.mean() + 0.5 - xy[0, 0]) < 0.5 and abs(rows.mean() + 0.5 - xy[0, 1]) < 0.5
     finite = r.depth[lit]
     assert np.allclose(finite, depth[0], rtol=1e-2)  # the square spans +-0.05 in depth
+
+
+def test_image_texture_and_image_environment_match_numpy(gl_ctx):
+    from workbench.scene.library import SCENES_DIR
+    earth = str(SCENES_DIR / "assets" / "earth_latlong.png")
+    sky = str(SCENES_DIR / "assets" / "sky_latlong.png")
+    mat = {"ks": 0.2, "kr": 0.4, "environment": True,
+           "texture": {"type": "image", "path": earth, "projection": "planar", "pole": [0, 0, 1], "scale": 0.3}}
+    scene = _plane_scene(mat, environment={"type": "image", "path": sky})
+    r = workbench.render(scene, "phong")
+    got = r.image[tuple(PIXELS.T)]
+    want = _expected(scene, PIXELS)
+    # GL_LINEAR on llvmpipe weights texels with 8-bit fractions: about 1 % of a texel step
+    assert np.allclose(got, want, rtol=2e-2, atol=2e-2 * np.abs(want).max()), (got, want)
+
+
+def test_opacity_grid_cut_out_matches_numpy_alpha(gl_ctx):
+    mat = {"color": [1, 1, 1], "ka": 1.0, "kd": 0.0,
+           "opacity": {"type": "grid", "projection": "planar", "pole": [0, 0, 1], "scale": 2.0, "width": 0.3}}
+    scene = _plane_scene(mat)
+    r = workbench.render(scene, "phong")
+    o, d = scene.camera.rays()
+    P = (o - (o[..., 2] / d[..., 2])[..., None] * d).reshape(-1, 3)
+    a = tx.alpha(scene.materials["m"], P, None).reshape(H, W)
+    drawn = r.depth < np.inf
+    # away from the grid lines' edges (a pixel's footprint), GL keeps exactly the alpha >= 0.5 part
+    s = P[:, :2].reshape(H, W, 2) * 2.0
+    f = s - np.floor(s)
+    edge = (np.abs(f - 0.3) < 0.05) | (f < 0.05) | (f > 0.95)
+    clear = ~edge.any(-1)
+    assert clear.sum() > 500
+    assert np.array_equal(drawn[clear], (a >= 0.5)[clear])
