@@ -34,3 +34,11 @@ def test_pyrender_matches_phong_silhouette_and_lambert(gl_ctx):
     # the moderngl path still works after pyrender ran in this process
     again = workbench.render(scene, "phong", tessellation=8)
     assert np.array_equal(again.image, ph.image)
+
+
+def test_pyrender_in_a_child_process_gives_the_same_image(gl_ctx):
+    scene = workbench.load_scene("whitted")
+    here = workbench.render(scene, "pyrender", width=48, height=36)
+    child = workbench.render(scene, "pyrender", width=48, height=36, isolate=True)
+    assert child.stats["isolated"]
+    assert np.abs(child.image - here.image).max() < 2e-2  # same driver, same 8-bit output

@@ -280,35 +280,39 @@ def _in_worker(fn, *args):
 
 
 def _child(scene_source: str, width: int, height: int, level: int, frames: int) -> dict:
-    """Run :func:`_child_main` in a fresh interpreter; the scene is reloaded from its file."""
+    """Run :func:`_child_main` in a fresh interpreter; the scene is reloaded from its file and
+    the results come back through files in a temporary folder."""
+    import tempfile
     if not scene_source or not os.path.isfile(scene_source):
         raise WorkbenchError("pyrender in a child process needs a scene loaded from a file")
     env = dict(os.environ)
     env["PYOPENGL_PLATFORM"] = "egl"
-    code = ("import sys, json; from workbench.renderers.reference import _child_main; "
-            "_child_main(sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4]), int(sys.argv[5]))")
-    out = subprocess.run([sys.executable, "-c", code, scene_source, str(width), str(height), str(level), str(frames)],
-                         capture_output=True, env=env, timeout=600)
-    if out.returncode != 0:
-        raise WorkbenchError(f"pyrender child process failed: {out.stderr.decode()[-2000:]}")
-    res = json.loads(out.stdout.decode().splitlines()[-1])
-    res["image"] = np.load(res.pop("image_path"))
-    res["depth"] = np.load(res.pop("depth_path"))
+    code = ("import sys; from workbench.renderers.reference import _child_main; "
+            "_child_main(sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4]), int(sys.argv[5]), sys.argv[6])")
+    with tempfile.TemporaryDirectory(prefix="pyrender-") as d:
+        out = subprocess.run([sys.executable, "-c", code, scene_source, str(width), str(height), str(level),
+                              str(frames), d], capture_output=True, env=env, timeout=600)
+        if out.returncode != 0 or not os.path.isfile(os.path.join(d, "result.json")):
+            raise WorkbenchError(f"pyrender child process failed: {out.stderr.decode()[-2000:]}")
+        with open(os.path.join(d, "result.json"), encoding="utf-8") as f:
+            res = json.load(f)
+        res["image"] = np.load(os.path.join(d, "image.npy"))
+        res["depth"] = np.load(os.path.join(d, "depth.npy"))
     return res
 
 
-def _child_main(source: str, width: int, height: int, level: int, frames: int) -> None:
-    import tempfile
-
+def _child_main(source: str, width: int, height: int, level: int, frames: int, out_dir: str) -> None:
     from ..scene.io import load_scene
     scene = load_scene(source)
     scene = scene.with_camera(scene.camera.with_resolution(width, height))
     res = _render_here(scene, width, height, level, frames)
-    d = tempfile.mkdtemp(prefix="pyrender-")
-    np.save(f"{d}/image.npy", res.pop("image"))
-    np.save(f"{d}/depth.npy", res.pop("depth"))
-    res["image_path"], res["depth_path"] = f"{d}/image.npy", f"{d}/depth.npy"
-    print(json.dumps(res))
+    np.save(os.path.join(out_dir, "image.npy"), res.pop("image"))
+    np.save(os.path.join(out_dir, "depth.npy"), res.pop("depth"))
+    with open(os.path.join(out_dir, "result.json"), "w", encoding="utf-8") as f:
+        json.dump(res, f)
+    for r in _RENDERERS.values():
+        r.delete()
+    _RENDERERS.clear()
 
 
 def frame_time_in_child(scene_name: str, width: int, height: int, frames: int = 10) -> dict:
