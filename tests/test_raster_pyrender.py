@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import workbench
 from workbench.scene.io import scene_from_dict
@@ -36,6 +37,7 @@ def test_pyrender_matches_phong_silhouette_and_lambert(gl_ctx):
     assert np.array_equal(again.image, ph.image)
 
 
+@pytest.mark.slow  # a fresh interpreter imports pyrender and trimesh: several seconds
 def test_pyrender_in_a_child_process_gives_the_same_image(gl_ctx):
     scene = workbench.load_scene("whitted")
     here = workbench.render(scene, "pyrender", width=48, height=36)
