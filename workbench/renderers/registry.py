@@ -12,4 +12,5 @@ BUILTIN: dict[str, str] = {
     "raycast": "workbench.renderers.raytrace.whitted:RaycastRenderer",
     "raytrace": "workbench.renderers.raytrace.whitted:RaytraceRenderer",
     "radiosity": "workbench.renderers.radiosity.method:RadiosityRenderer",
+    "hybrid": "workbench.renderers.radiosity.hybrid:HybridRenderer",
 }

@@ -1,0 +1,96 @@
+"""The registered ``hybrid`` method: radiosity for diffuse interreflection, ray tracing from the
+eye for mirrors and glass (the two-pass method; Wallace, Cohen & Greenberg 1987, in the
+simple form the course sketches: view-independent diffuse pass, view-dependent specular pass).
+
+Pass 1 solves radiosity on every surface (a specular surface takes part with its diffuse
+reflectance kd * color: it occludes and reflects diffusely, but light it mirrors onto diffuse
+surfaces is not transported, no caustics).  Pass 2 builds a derived scene in which each
+diffuse object (kr == kt == 0) is a Mesh of its patches whose ``vertex_emission`` is the
+radiosity interpolated to vertices and whose material has ka = kd = 0 and no emission (the
+solution already holds both; ks is kept for highlights), keeps specular objects as they are,
+and renders it with the registered ``raytrace`` method: a primary ray that hits a diffuse
+surface returns its radiosity, one that hits a mirror or glass follows the ray tracer's
+recursion until it lands on a diffuse surface (or the light, or the background).
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ...scene import features as ft
+from ...scene import model as m
+from ..base import Knob, Option, RenderResult
+from ..base import render as render_method
+from .method import common_options, solve_scene
+
+RAYTRACE_OPTIONS = ("max_depth", "threshold", "spp", "fresnel")
+
+
+def is_diffuse(mat: m.Material) -> bool:
+    return mat.kr == 0 and mat.kt == 0
+
+
+def derived_scene(scene: m.Scene, patches, radiance: np.ndarray) -> tuple[m.Scene, int]:
+    """The scene with every diffuse object replaced by its radiosity-emitting patch mesh.
+
+    Returns the scene and the number of objects replaced."""
+    vrad = patches.vertex_values(radiance)
+    by_object: dict[int, list[int]] = {}
+    for s, obj in enumerate(patches.surface_objects):
+        by_object.setdefault(id(obj), []).append(s)
+    objects, materials, replaced = [], dict(scene.materials), 0
+    for obj in scene.objects:
+        mat = scene.material_of(obj)
+        surfaces = by_object.get(id(obj))
+        if not is_diffuse(mat) or not surfaces:
+            objects.append(obj)
+            continue
+        sel = np.isin(patches.surface, surfaces)
+        ids = patches.vertex_ids[sel]
+        tris = np.concatenate([ids[:, [0, 1, 2]], ids[:, [0, 2, 3]]])
+        tris = tris[(tris[:, 0] != tris[:, 1]) & (tris[:, 1] != tris[:, 2]) & (tris[:, 0] != tris[:, 2])]
+        used, faces = np.unique(tris, return_inverse=True)
+        name = f"{mat.name}__radiosity"
+        materials[name] = replace(mat, name=name, ka=0.0, kd=0.0, emission=(0.0, 0.0, 0.0),
+                                  texture=None, bump=None)
+        objects.append(m.Mesh(material=name, name=obj.name, vertices=m._ro(patches.vertices[used]),
+                              faces=faces.reshape(-1, 3).astype(np.int64), source="radiosity patches",
+                              vertex_emission=m._ro(vrad[used])))
+        replaced += 1
+    return replace(scene, objects=tuple(objects), materials=materials, ambient=(0.0, 0.0, 0.0)), replaced
+
+
+class HybridRenderer:
+    """Radiosity (diffuse) + ray tracing from the eye (specular), two passes."""
+
+    name = "hybrid"
+    knob = Knob("patch_size", (0.2, 0.1, 0.05, 0.035, 0.025), 0.05,
+                "largest patch edge / scene diagonal")
+    options = {**common_options(),
+               "max_depth": Option(int, 5, "ray tracer: maximum ray generations per path"),
+               "threshold": Option(float, 1e-3, "ray tracer: weight below which a child ray is not traced"),
+               "spp": Option(int, 1, "ray tracer: samples per pixel"),
+               "fresnel": Option(str, "none", "ray tracer: reflection/transmission split",
+                                 ("none", "schlick", "exact"))}
+
+    def render(self, scene: m.Scene, width: int, height: int, **opts) -> RenderResult:
+        sol = solve_scene(scene, opts, self.name)
+        derived, replaced = derived_scene(scene, sol.patches, sol.radiance)
+        rt = render_method(derived, "raytrace", width=width, height=height,
+                           **{k: opts[k] for k in RAYTRACE_OPTIONS})
+        timings = dict(sol.timings)
+        timings["compile"] += rt.timings.get("compile", 0.0)
+        timings["raytrace"] = rt.timings["total"]
+        stats = dict(sol.stats)
+        stats["objects_as_radiosity_meshes"] = replaced
+        stats.update({f"raytrace_{k}": v for k, v in rt.stats.items()})
+        needs = scene.needs()
+        specular_ok = {ft.REFLECTION, ft.REFRACTION, ft.ABSORPTION, ft.SPECULAR}
+        used = sorted(set(sol.features_used) | (needs & specular_ok))
+        left_out = [e for e in sol.left_out if e.split(":")[0] not in specular_ok]
+        if needs & {ft.REFLECTION, ft.REFRACTION}:
+            left_out.append("caustics: light mirrored or refracted onto diffuse surfaces is not "
+                            "transported by the radiosity pass")
+        return RenderResult(self.name, rt.image, timings, stats, used, left_out, depth=rt.depth)
+
