@@ -42,6 +42,8 @@ from .raster_shaders import ProgramCache, base_defines, material_defines
 #: automatically (keeps 24-bit depth resolution usable when the camera is inside the bounds).
 NEAR_FAR_RATIO = 1e-3
 DEPTH_CHOICES = (16, 24, 32)
+#: Object kinds tessellated as closed, outward-wound surfaces.
+CLOSED_KINDS = ("sphere", "box", "csg")
 #: Texture units of the image samplers.
 UNITS = {"u_tex_image": 0, "u_bump_image": 1, "u_op_image": 2, "u_env_image": 3}
 #: Shader features and why they may be left out.
@@ -368,37 +370,53 @@ class RasterSession:
         bg = tuple(float(x) for x in self.scene.background)
         fbo.clear(*bg, 0.0, depth=1.0, viewport=(0, 0, fbo.width, fbo.height))
         ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
-        if self.background is not None:
-            bg_draw = self.background
-            ctx.disable(moderngl.DEPTH_TEST)
-            bg_draw.uniforms.apply()
-            _write(bg_draw.prog, "u_world_from_clip", np.linalg.inv(clip).T)
-            for name, tex in bg_draw.images.items():
-                tex.use(UNITS[name])
-            bg_draw.vao.render(moderngl.TRIANGLES, vertices=3)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
         cam_pos = np.asarray(camera.position)
-        # opaque front to back (early depth rejection), blended back to front
+        # opaque front to back (early depth rejection), then the environment where nothing is,
+        # then blended surfaces back to front without depth writes
         opaque = sorted((d for d in self.draws if not d.blended),
                         key=lambda d: float(np.linalg.norm(d.centre - cam_pos)))
         blended = sorted((d for d in self.draws if d.blended),
                          key=lambda d: -float(np.linalg.norm(d.centre - cam_pos)))
         clip_bytes = np.ascontiguousarray(clip.T, dtype="f4").tobytes()
-        for i, d in enumerate(opaque + blended):
-            if i == len(opaque):
-                ctx.enable(moderngl.BLEND)
-                ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
-                fbo.depth_mask = False
-            d.uniforms.apply()
-            d.prog["u_clip_from_world"].write(clip_bytes)
-            _set(d.prog, "u_eye", eye)
-            for name, tex in d.images.items():
+        for d in opaque:
+            self._render_draw(d, clip_bytes, eye)
+        if self.background is not None:
+            bg_draw = self.background
+            ctx.depth_func = "<="
+            fbo.depth_mask = False
+            bg_draw.uniforms.apply()
+            _write(bg_draw.prog, "u_world_from_camera", np.linalg.inv(V)[:3, :3].T)
+            th = np.tan(np.radians(camera.fov_y) / 2.0)
+            _set(bg_draw.prog, "u_tan", (float(th * camera.aspect), float(th)))
+            for name, tex in bg_draw.images.items():
                 tex.use(UNITS[name])
-            d.vao.render(moderngl.TRIANGLES)
+            bg_draw.vao.render(moderngl.TRIANGLES, vertices=3)
+            ctx.depth_func = "<"
+        if blended:
+            ctx.enable(moderngl.BLEND)
+            ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+            fbo.depth_mask = False
+            for d in blended:
+                # closed solids: only their front faces (the back ones would blend in twice)
+                if d.part.kind in CLOSED_KINDS:
+                    ctx.enable(moderngl.CULL_FACE)
+                self._render_draw(d, clip_bytes, eye)
+                ctx.disable(moderngl.CULL_FACE)
         fbo.depth_mask = True
         ctx.disable(moderngl.BLEND)
         return near, far
+
+    @staticmethod
+    def _render_draw(d: _Draw, clip_bytes: bytes, eye: tuple) -> None:
+        import moderngl
+        d.uniforms.apply()
+        d.prog["u_clip_from_world"].write(clip_bytes)
+        _set(d.prog, "u_eye", eye)
+        for name, tex in d.images.items():
+            tex.use(UNITS[name])
+        d.vao.render(moderngl.TRIANGLES)
 
     def draw(self, camera: Camera | None = None, *, near: float | None = None,
              far: float | None = None, with_depth: bool = False):
