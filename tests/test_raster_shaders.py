@@ -87,3 +87,15 @@ def test_session_draws_other_cameras_without_rebuilding(gl_ctx):
     r2 = workbench.render(scene, "flat", width=40, height=30)
     assert r2.stats["session_reused"] and r2.timings["compile"] == 0.0
     assert np.array_equal(r1.image, r2.image)
+
+
+def test_evicted_sessions_are_released(gl_ctx):
+    from workbench.renderers import raster
+    scene = workbench.load_scene("whitted")
+    first, _ = raster.session_for(scene, "flat", 1, False, 24)
+    for level in range(2, 2 + raster._MAX_SESSIONS):
+        raster.session_for(scene, "flat", level, False, 24)
+    assert first.draws == [] and first._gl_objects == []
+    # a fresh session for the same key works after the eviction
+    again, created = raster.session_for(scene, "flat", 1, False, 24)
+    assert created and again.draw(scene.camera.with_resolution(16, 12)).shape == (12, 16, 3)

@@ -182,6 +182,7 @@ class RasterSession:
         self.bounds = (pts.min(0), pts.max(0))
         self.lights = scene.point_lights()
         self._gl_images: dict[tuple, object] = {}
+        self._gl_objects: list = []  # vertex arrays and buffers, freed by release()
         self._fbos: OrderedDict = OrderedDict()
         t0 = time.perf_counter()
         self.draws = [self._upload(p, m, blinn) for p, m in pairs]
@@ -223,7 +224,9 @@ class RasterSession:
             u.set("u_env_zenith", env.zenith)
             u.set("u_env_horizon", env.horizon)
             u.set("u_env_ground", env.ground)
-        return _Draw(None, None, prog, self.ctx.vertex_array(prog, []), False, np.zeros(3), images, u)
+        vao = self.ctx.vertex_array(prog, [])
+        self._gl_objects.append(vao)
+        return _Draw(None, None, prog, vao, False, np.zeros(3), images, u)
 
     def _upload(self, part: Part, mat: Material, blinn: bool) -> _Draw:
         ctx = self.ctx
@@ -249,6 +252,7 @@ class RasterSession:
             + (["in_centroid"] if self.mode == "flat" else [])
         vbo = ctx.buffer(np.ascontiguousarray(data, dtype="f4").tobytes())
         vao = ctx.vertex_array(prog, [(vbo, fmt, *names)], index, index_element_size=4, skip_errors=True)
+        self._gl_objects += [vao, vbo] + ([index] if index is not None else [])
         images = {}
         if mat.texture is not None and mat.texture.kind == "image":
             images["u_tex_image"] = self._image_texture(mat.texture.path)
@@ -331,6 +335,16 @@ class RasterSession:
                 left.append(f"{f}: {why}")
         used = sorted(f for f in needs if f not in NOT_RASTER and not (f == ft.BUMP and self.mode != "phong"))
         return left, used
+
+    def release(self) -> None:
+        """Free the session's GL objects (buffers, vertex arrays, programs, textures, FBOs)."""
+        for obj in self._gl_objects + list(self._gl_images.values()) + list(self.programs.programs.values()):
+            obj.release()
+        for _, free in self._fbos.values():
+            free()
+        self._gl_objects, self._gl_images, self._fbos = [], {}, OrderedDict()
+        self.programs.programs.clear()
+        self.draws, self.background = [], None
 
     # ------------------------------------------------------------------ drawing
     def near_far(self, camera: Camera) -> tuple[float, float]:
@@ -469,7 +483,7 @@ def session_for(scene: Scene, mode: str, tessellation: int, blinn: bool, depth_b
     session = RasterSession(scene, mode, tessellation=tessellation, blinn=blinn, depth_bits=depth_bits, ctx=ctx)
     _SESSIONS[key] = (session, scene.objects)
     if len(_SESSIONS) > _MAX_SESSIONS:
-        _SESSIONS.popitem(last=False)
+        _SESSIONS.popitem(last=False)[1][0].release()
     return session, True
 
 
