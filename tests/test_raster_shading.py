@@ -117,3 +117,29 @@ def test_degenerate_triangles_are_harmless(gl_ctx):
         r = workbench.render(scene, method)
         assert r.stats["nonfinite_pixels"] == 0
         assert (r.depth < np.inf).sum() > 50
+
+
+@pytest.mark.parametrize("view", ["pole", "seam"])
+def test_spherical_texture_pole_and_seam_have_no_speckles(gl_ctx, view):
+    """Looking straight at a pole, or at the seam (u = 0 = 1): every sphere pixel is lit and
+    textured (no NaN, no black speckles)."""
+    eye = [0.0, 4.0, 0.0] if view == "pole" else [-4.0, 0.0, 0.0]  # seam: -Se side (u = 0)
+    d = {"scene": {"ambient": [0.3, 0.3, 0.3]},
+         "camera": {"position": eye, "look_at": [0, 0, 0], "up": [0, 0, 1] if view == "pole" else [0, 1, 0],
+                    "fov_y": 40.0, "resolution": [W, H]},
+         "lights": [{"type": "point", "position": [e * 2 for e in eye]}],
+         "materials": {"m": {"ka": 0.5, "kd": 0.5, "ks": 0.3, "texture": {
+             "type": "checker", "projection": "spherical", "scale": 8.0,
+             "colors": [[0.9, 0.2, 0.2], [0.2, 0.2, 0.9]]}}},
+         "objects": [{"type": "sphere", "material": "m", "radius": 1.0}]}
+    scene = scene_from_dict(d)
+    for method in ("flat", "gouraud", "phong"):
+        r = workbench.render(scene, method)
+        assert r.stats["nonfinite_pixels"] == 0
+        on = r.depth < np.inf
+        # darkest possible lit texel: ambient 0.5 * 0.3 * 0.2
+        assert r.image[on].max(-1).min() > 0.5 * 0.3 * 0.2 * 0.99, method
+        # both checker colours show (the projection is not collapsed to one texel)
+        red = on & (r.image[..., 0] > 1.5 * r.image[..., 2])
+        blue = on & (r.image[..., 2] > 1.5 * r.image[..., 0])
+        assert red.sum() > 0.2 * on.sum() and blue.sum() > 0.2 * on.sum(), method
