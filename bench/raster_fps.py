@@ -5,7 +5,10 @@ compile, including llvmpipe's JIT at the first draw, reported apart), 3 warm-up 
 drawn, then frames are timed for at least ``--seconds`` (and at least 10 frames):
 
 * ``fps``: full frames (draw + read the float32 image back to numpy), what ``render()`` does;
-* ``fps_draw``: draw into the FBO and ``ctx.finish()`` without read-back (the UI's case).
+* ``fps_draw``: draw into the FBO and ``ctx.finish()`` without read-back (the UI's case);
+* ``cpu_ms_per_frame`` (and ``_draw``): CPU time of this process per frame, llvmpipe's threads
+  included: on 2 cores shared with other work, the wall-clock rates drop with the load average
+  recorded in the file, the CPU time much less.
 
 pyrender's frame time (its offscreen render + read-back) on the same scene and camera is
 measured beside ours, in a child process (``workbench.renderers.reference``).
@@ -31,14 +34,16 @@ from workbench.scene.library import bundled
 OUT = Path(__file__).resolve().parent / "results" / "raster_fps.json"
 
 
-def _rate(fn, seconds: float) -> float:
+def _rate(fn, seconds: float) -> tuple[float, float]:
+    """Frames per second (wall clock) and CPU seconds per frame (all threads of this process:
+    llvmpipe's rasteriser threads included; less sensitive to other processes' load)."""
     for _ in range(3):
         fn()
-    n, t0 = 0, time.perf_counter()
+    n, t0, c0 = 0, time.perf_counter(), time.process_time()
     while n < 10 or time.perf_counter() - t0 < seconds:
         fn()
         n += 1
-    return n / (time.perf_counter() - t0)
+    return n / (time.perf_counter() - t0), (time.process_time() - c0) / n
 
 
 def bench_scene(name: str, size: int, seconds: float) -> dict:
@@ -56,14 +61,17 @@ def bench_scene(name: str, size: int, seconds: float) -> dict:
             session.draw_to(fbo, cam)
             ctx.finish()
 
+        fps, cpu = _rate(lambda: session.draw(cam), seconds)
+        fps_draw, cpu_draw = _rate(draw_only, seconds)
         row["methods"][mode] = {
             "triangles": session.n_triangles,
             "setup_seconds": round(setup, 4),
             "compile_seconds": round(session.timings["compile"], 4),
             "tessellate_seconds": round(session.timings["tessellate"], 4),
-            "fps": round(_rate(lambda: session.draw(cam), seconds), 1),
-            "fps_draw": round(_rate(draw_only, seconds), 1),
+            "fps": round(fps, 1), "cpu_ms_per_frame": round(1e3 * cpu, 2),
+            "fps_draw": round(fps_draw, 1), "cpu_ms_per_frame_draw": round(1e3 * cpu_draw, 2),
         }
+        session.release()
         print(name, mode, row["methods"][mode], flush=True)
     try:
         from workbench.renderers.reference import frame_time_in_child

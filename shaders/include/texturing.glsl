@@ -224,15 +224,14 @@ float bump_height(vec3 P) {
 #endif
 }
 
-// Perturbed unit world normal (texturing.bump_normal): N' = normalize(N - tangential grad d).
+// Perturbed unit world normal (texturing.bump_normal): N' = normalize(N - tangential grad d),
+// grad d by forward differences along the object axes.
 vec3 bump_normal(vec3 P, vec3 Nw) {
     float delta = TOL_BUMP_STEP / u_bump.scale;
-    vec3 g;
-    for (int k = 0; k < 3; ++k) {
-        vec3 e = vec3(0.0);
-        e[k] = delta;
-        g[k] = (bump_height(P + e) - bump_height(P - e)) / (2.0 * delta);
-    }
+    float h0 = bump_height(P);
+    vec3 g = vec3(bump_height(P + vec3(delta, 0.0, 0.0)), bump_height(P + vec3(0.0, delta, 0.0)),
+                  bump_height(P + vec3(0.0, 0.0, delta)));
+    g = (g - h0) / delta;
     g *= u_bump_strength / u_bump.scale;
     vec3 gw = u_grad_from_object * g;
     vec3 gt = gw - dot(gw, Nw) * Nw;

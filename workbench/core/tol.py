@@ -38,7 +38,7 @@ class Tolerances:
         surfaces closer than this to a patch centre are not seen (the Cornell light hangs
         0.8 mm = 1.1e-3 extents below the ceiling, hence far less).
     bump_step : float
-        Central-difference step of a bump map's height gradient, as a fraction of one pattern
+        Finite-difference step of a bump map's height gradient, as a fraction of one pattern
         period (the step in object units is ``bump_step / scale``).
     """
 

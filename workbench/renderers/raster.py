@@ -89,11 +89,6 @@ class _Uniforms:
                 u.value = v
 
 
-def _frame(m) -> tuple:
-    sp, se, w = tx.frame(m.pole, m.equator)
-    return sp, se, w
-
-
 @dataclass
 class _Draw:
     """One part on the GPU: program, vertex array, material and what to bind (part and
@@ -109,7 +104,7 @@ class _Draw:
     uniforms: _Uniforms
 
 
-def _area_light_parts(scene: Scene, level: int) -> list[tuple[Part, Material]]:
+def _area_light_parts(scene: Scene) -> list[tuple[Part, Material]]:
     """Area lights as emissive polygons of radiance ``color * intensity``."""
     from ..scene.model import Polygon
     from ..scene.tessellate import tessellate_object
@@ -175,7 +170,7 @@ class RasterSession:
         self.timings: dict[str, float] = {}
         t0 = time.perf_counter()
         pairs = [(p, scene.materials[p.material]) for p in _parts(scene, tessellation)]
-        pairs += _area_light_parts(scene, tessellation)
+        pairs += _area_light_parts(scene)
         self.timings["tessellate"] = time.perf_counter() - t0
         self.n_triangles = sum(p.n_triangles for p, _ in pairs)
         pts = np.vstack([p.positions for p, _ in pairs])
@@ -279,11 +274,11 @@ class RasterSession:
         for prefix, m in (("u_tex", mat.texture), ("u_bump", mat.bump), ("u_op", mat.opacity)):
             if m is None:
                 continue
-            sp, se, w = _frame(m)
+            sp, se, w = tx.frame(m.pole, m.equator)
             for name, v in (("center", m.center), ("sp", sp), ("se", se), ("w", w)):
                 u.set(f"{prefix}.{name}", tuple(float(x) for x in v))
             u.set(f"{prefix}.scale", float(m.scale))
-            width = getattr(m, "width", None) if prefix == "u_op" else m.mortar
+            width = m.width if prefix == "u_op" else m.mortar
             u.set(f"{prefix}.width", float(width))
         if mat.texture is not None:
             u.set("u_tex_color0", tuple(mat.texture.colors[0]))

@@ -295,14 +295,17 @@ def height(bump, P: np.ndarray, uv: np.ndarray | None = None) -> np.ndarray:
 
 def height_gradient(bump, P: np.ndarray, uv: np.ndarray | None = None) -> np.ndarray:
     """Object-space gradient of the displacement ``d = strength * h / scale`` (object units),
-    by central differences of step ``tol.bump_step / scale`` along the object axes. (N, 3)"""
+    by forward differences of step ``tol.bump_step / scale`` along the object axes (4 height
+    evaluations per point instead of 6 for central ones; the step is a thousandth of a
+    pattern period, so the O(step) error is far below what shading shows). (N, 3)"""
     P = np.asarray(P, dtype=np.float64)
     delta = tol.bump_step / bump.scale
+    h0 = height(bump, P, uv)
     g = np.empty_like(P)
     for k in range(3):
         e = np.zeros(3)
         e[k] = delta
-        g[:, k] = (height(bump, P + e, uv) - height(bump, P - e, uv)) / (2.0 * delta)
+        g[:, k] = (height(bump, P + e, uv) - h0) / delta
     return g * (bump.strength / bump.scale)
 
 
