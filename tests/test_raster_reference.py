@@ -164,3 +164,30 @@ def test_opacity_grid_cut_out_matches_numpy_alpha(gl_ctx):
     clear = ~edge.any(-1)
     assert clear.sum() > 500
     assert np.array_equal(drawn[clear], (a >= 0.5)[clear])
+
+
+def test_mesh_uvs_drive_uv_projection(gl_ctx):
+    """A quad mesh with uvs = affine function of position: the GLSL's interpolated uvs (and the
+    uv-projected bump, constant along object offsets) agree with numpy given the same uvs."""
+    from dataclasses import replace as dc_replace
+    scene = _plane_scene({"ks": 0.3, "texture": {"type": "checker", "projection": "uv", "scale": 3.0,
+                                                  "colors": [[0.9, 0.8, 0.1], [0.1, 0.3, 0.8]]}})
+    V = np.array([[-3.0, -3.0, 0.0], [3.0, -3.0, 0.0], [3.0, 3.0, 0.0], [-3.0, 3.0, 0.0]])
+    uv_of = lambda P: (P[:, :2] + 3.0) / 6.0
+    from workbench.scene.model import Mesh
+    mesh = Mesh("m", vertices=V, faces=np.array([[0, 1, 2], [0, 2, 3]]), normals=np.tile([0.0, 0.0, 1.0], (4, 1)),
+                uvs=uv_of(V))
+    scene = dc_replace(scene, objects=(mesh,))
+    r = workbench.render(scene, "phong")
+    o, d = scene.camera.rays()
+    P = (o - (o[..., 2] / d[..., 2])[..., None] * d).reshape(-1, 3)
+    mat = scene.materials["m"]
+    N = np.tile([0.0, 0.0, 1.0], (len(P), 1))
+    C = tx.surface_color(mat, P, N, uv_of(P))
+    S = normalize(np.asarray(scene.camera.position) - P)
+    want = lm.shade(P, N, S, C, mat, scene.point_lights(), scene.ambient).reshape(H, W, 3)
+    s = uv_of(P).reshape(H, W, 2) * 3.0
+    f = s - np.floor(s)
+    clear = ((f > 0.05) & (f < 0.95)).all(-1)  # away from checker edges
+    assert clear.sum() > 500
+    assert np.allclose(r.image[clear], want[clear], rtol=RTOL, atol=RTOL)
