@@ -3,13 +3,19 @@
 // I = E + C * diffuse + specular (local model, lighting.glsl), + kr * environment(reflected)
 // for environment-mapped materials; opacity maps cut out (alpha < 0.5) or blend.
 // Output: linear RGB and alpha into a float32 colour attachment.
+#include "varyings.glsl"
+#ifdef NEEDS_SURFACE
 in vec3 v_world;
 in vec3 v_normal;
+#endif
+#ifdef NEEDS_OBJ
 in vec3 v_obj;
-in vec2 v_uv;
+#endif
 #ifdef HAS_UV
+in vec2 v_uv;
 const bool HAS_UV_ATTR = true;
 #else
+const vec2 v_uv = vec2(0.0);
 const bool HAS_UV_ATTR = false;
 #endif
 
@@ -43,6 +49,7 @@ void main() {
 #ifdef TEX_KIND
     C *= texture_color(v_obj, v_uv);
 #endif
+#ifdef NEEDS_SURFACE
     vec3 S = safe_normalize(u_eye - v_world);
     // shading normal: interpolated (or the polygon's, flat); a cancelled one falls back to
     // the triangle's geometric normal
@@ -52,6 +59,7 @@ void main() {
     N = bump_normal(v_obj, N);
 #endif
     N = face_viewer(N, S);
+#endif
 #ifdef MODE_PHONG
     vec3 diffuse, specular;
     local_terms(v_world, N, S, diffuse, specular);

@@ -5,6 +5,7 @@
 // with its normal (the buffer is unwelded: every vertex of a triangle carries the polygon's
 // normal and centroid).  Gouraud: lighting at the vertex with the averaged normal.
 #include "lighting.glsl"
+#include "varyings.glsl"
 
 in vec3 in_position;
 in vec3 in_normal;
@@ -19,10 +20,16 @@ in vec3 in_centroid;
 uniform mat4 u_clip_from_world;
 uniform vec3 u_eye;
 
+#ifdef NEEDS_SURFACE
 out vec3 v_world;
 out vec3 v_normal;
+#endif
+#ifdef NEEDS_OBJ
 out vec3 v_obj;
+#endif
+#ifdef HAS_UV
 out vec2 v_uv;
+#endif
 #if defined(MODE_FLAT)
 flat out vec3 v_diffuse;
 flat out vec3 v_specular;
@@ -32,13 +39,15 @@ out vec3 v_specular;
 #endif
 
 void main() {
+#ifdef NEEDS_SURFACE
     v_world = in_position;
     v_normal = in_normal;
+#endif
+#ifdef NEEDS_OBJ
     v_obj = in_obj_position;
+#endif
 #ifdef HAS_UV
     v_uv = in_uv;
-#else
-    v_uv = vec2(0.0);
 #endif
 #if defined(MODE_FLAT) || defined(MODE_GOURAUD)
 #ifdef MODE_FLAT
