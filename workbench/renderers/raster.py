@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.errors import WorkbenchError
+from ..core.tol import tol
 from ..scene import features as ft
 from ..scene.model import AreaLight, Camera, DirectionalLight, Environment, Material, Scene
 from ..scene.tessellate import DEFAULT_LEVEL, Part, tessellate_scene
@@ -139,7 +140,7 @@ def auto_near_far(camera: Camera, points: np.ndarray) -> tuple[float, float]:
     lo, hi = points.min(0), points.max(0)
     corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
     depth = camera.project(corners)[1]
-    far = camera.far or float(max(depth.max(), 0.0) * 1.01 + 1e-9 * np.linalg.norm(hi - lo))
+    far = camera.far or float(max(depth.max(), tol.zero) * 1.01)
     near = camera.near or float(max(depth.min() * 0.99, far * NEAR_FAR_RATIO))
     if far <= near:
         far = near / NEAR_FAR_RATIO

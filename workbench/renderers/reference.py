@@ -50,6 +50,7 @@ import time
 import numpy as np
 
 from ..core.errors import WorkbenchError
+from ..core.tol import tol
 from ..scene import features as ft
 from ..scene.model import AreaLight, DirectionalLight, Scene
 from ..scene.tessellate import DEFAULT_LEVEL, tessellate_scene
@@ -74,8 +75,8 @@ def build_scene(scene: Scene, level: int):
     left_out = []
     mats = scene.materials
     kas = [m.ka for m in mats.values()]
-    kds = [max(m.kd, 1e-3) for m in mats.values()]
-    ambient = np.asarray(scene.ambient) * (np.mean(kas) / np.mean(kds))
+    kds = [m.kd for m in mats.values()]
+    ambient = np.asarray(scene.ambient) * (np.mean(kas) / max(np.mean(kds), tol.zero))
     # pyrender clears with its colour as is and we decode its output with a 2.2 power
     bg = tuple(float(c) ** (1.0 / 2.2) for c in scene.background)
     ps = pyrender.Scene(ambient_light=ambient, bg_color=(*bg, 1.0))
@@ -132,6 +133,8 @@ def build_scene(scene: Scene, level: int):
 
 
 BAKE_SIZE = 1024
+#: Automatic near plane never closer than this fraction of the far plane (as the raster methods).
+NEAR_FAR_RATIO = 1e-3
 
 
 def _baked_texture(tex, part):
@@ -141,7 +144,7 @@ def _baked_texture(tex, part):
     import pyrender
     s = tx.project(tex, part.obj_positions, part.uvs) * tex.scale
     lo, hi = s.min(0), s.max(0)
-    span = np.maximum(hi - lo, 1e-9)
+    span = np.maximum(hi - lo, tol.zero)
     g = (np.arange(BAKE_SIZE) + 0.5) / BAKE_SIZE
     U, V = np.meshgrid(lo[0] + g * span[0], lo[1] + g[::-1] * span[1])  # row 0 = top = v max
     grid = np.stack([U.ravel(), V.ravel()], -1)
@@ -179,8 +182,8 @@ def _near_far(scene: Scene, ps) -> tuple[float, float]:
     lo, hi = ps.bounds
     corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
     d = cam.project(corners)[1]
-    far = cam.far or float(max(d.max(), 1e-6) * 1.01)
-    near = cam.near or float(max(d.min() * 0.99, far * 1e-3))
+    far = cam.far or float(max(d.max(), tol.zero) * 1.01)
+    near = cam.near or float(max(d.min() * 0.99, far * NEAR_FAR_RATIO))
     return near, far
 
 
