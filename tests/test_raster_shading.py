@@ -143,3 +143,15 @@ def test_spherical_texture_pole_and_seam_have_no_speckles(gl_ctx, view):
         red = on & (r.image[..., 0] > 1.5 * r.image[..., 2])
         blue = on & (r.image[..., 2] > 1.5 * r.image[..., 0])
         assert red.sum() > 0.2 * on.sum() and blue.sum() > 0.2 * on.sum(), method
+
+
+def test_area_light_is_drawn_with_its_radiance(gl_ctx):
+    """Cornell: the emitter is a polygon of radiance color * intensity = (17, 12, 4) in every
+    mode (emission adds; the local model's other terms are zero for it)."""
+    scene = workbench.load_scene("cornell")
+    light = scene.lights[0]
+    xy, _ = scene.camera.with_resolution(64, 64).project(light.vertices.mean(0)[None])
+    j, i = int(xy[0, 0]), int(xy[0, 1])
+    for method in ("flat", "gouraud", "phong"):
+        img = workbench.render(scene, method, width=64, height=64).image
+        assert np.allclose(img[i, j], light.radiance, rtol=1e-5), method
