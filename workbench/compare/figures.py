@@ -13,7 +13,7 @@ import numpy as np
 from ..core.imageio import to_srgb8
 
 PAD = 6
-LINE = 14
+LINE = 14  # heat-map label line height (px)
 BG = (255, 255, 255)
 FG = (20, 20, 20)
 MUTED = (120, 120, 120)
@@ -44,7 +44,7 @@ def _text_width(draw, text: str, f) -> int:
 
 def _wrap(draw, text: str, f, width: int) -> list[str]:
     """Greedy wrap to a pixel width (character-based first guess, then shortened)."""
-    chars = max(8, width // 6)
+    chars = max(8, int(width / max(1, _text_width(draw, "abcdefghij", f) / 10)))
     lines = []
     for para in text.split("\n"):
         for line in textwrap.wrap(para, chars) or [""]:
@@ -54,46 +54,46 @@ def _wrap(draw, text: str, f, width: int) -> list[str]:
     return lines
 
 
-def grid(tiles: list[dict], columns: int | None = None) -> np.ndarray:
+def grid(tiles: list[dict], columns: int | None = None, notes: list[str] = ()) -> np.ndarray:
     """Side-by-side grid of labelled images.
 
     Parameters
     ----------
-    tiles : list of ``{"title": str, "lines": [str, ...], "image": (H, W, 3) linear float or
-        None}``; a tile without image (a method that does not apply or failed) is drawn as a
-        grey box holding its lines (the reason).  All images have the same size.
+    tiles : list of ``{"title": str, "lines": [str, ...], "image": (H, W, 3) linear float}``,
+        all images of the same size; title and lines are written under the image.
     columns : tiles per row (default: up to 4).
+    notes : lines written under the grid (methods that do not apply or failed, with why).
 
     Returns
     -------
     (H, W, 3) uint8 sRGB.
     """
     from PIL import Image, ImageDraw
-    sizes = [t["image"].shape[:2] for t in tiles if t.get("image") is not None]
-    h, w = sizes[0] if sizes else (120, 160)
-    tw = max(w, 150)
+    h, w = tiles[0]["image"].shape[:2]
+    fs = max(11, round(w / 34))
+    line = fs + 4
+    f, fb = font(fs), font(fs + 2)
+    tw = max(w, 15 * fs)
     ncol = columns or min(4, len(tiles))
     nrow = -(-len(tiles) // ncol)
-    f, fb = font(11), font(12)
     nlines = max(len(t["lines"]) for t in tiles) + 1
-    cell_h = h + PAD + LINE * (nlines + 1)
-    canvas = Image.new("RGB", (ncol * (tw + PAD) + PAD, nrow * (cell_h + PAD) + PAD), BG)
+    cell_h = h + PAD + line * nlines + PAD
+    width = ncol * (tw + PAD) + PAD
+    probe = ImageDraw.Draw(Image.new("RGB", (1, 1)))
+    note_lines = [x for n in notes for x in _wrap(probe, n, f, width - 2 * PAD)]
+    canvas = Image.new("RGB", (width, nrow * (cell_h + PAD) + PAD + line * len(note_lines)), BG)
     draw = ImageDraw.Draw(canvas)
     for k, t in enumerate(tiles):
         x0 = PAD + (k % ncol) * (tw + PAD)
         y0 = PAD + (k // ncol) * (cell_h + PAD)
-        if t.get("image") is not None:
-            canvas.paste(Image.fromarray(to_srgb8(t["image"])), (x0, y0))
-            body = t["lines"]
-        else:
-            draw.rectangle([x0, y0, x0 + w - 1, y0 + h - 1], fill=(215, 215, 215))
-            for i, line in enumerate(_wrap(draw, "\n".join(t["lines"]), f, w - 8)[: h // LINE]):
-                draw.text((x0 + 4, y0 + 4 + i * LINE), line, fill=FG, font=f)
-            body = []
+        canvas.paste(Image.fromarray(to_srgb8(t["image"])), (x0, y0))
         y = y0 + h + PAD // 2
         draw.text((x0, y), t["title"], fill=FG, font=fb)
-        for i, line in enumerate(body):
-            draw.text((x0, y + LINE * (i + 1)), _wrap(draw, line, f, tw)[0], fill=FG, font=f)
+        for i, text in enumerate(t["lines"]):
+            draw.text((x0, y + line * (i + 1)), _wrap(draw, text, f, tw)[0], fill=FG, font=f)
+    y = nrow * (cell_h + PAD)
+    for i, text in enumerate(note_lines):
+        draw.text((PAD, y + i * line), text, fill=MUTED, font=f)
     return np.asarray(canvas)
 
 

@@ -3,7 +3,8 @@ times and errors against the scene's reference (:mod:`workbench.compare.referenc
 
 Output folder (written all-or-nothing, see :func:`workbench.compare.outputs.staged`)::
 
-    grid.png                 labelled side-by-side grid (reference first)
+    grid.png                 labelled side-by-side grid (reference first; methods that do not
+                             apply or failed listed under it with the reason)
     images/<m>.png|.npy      each method's image (sRGB PNG, linear float32 .npy); reference.*
     heat/<m>_flip.png        FLIP map against the reference, fixed scale [0, 1]
     heat/<m>_abs.png         mean |linear error| over RGB, scale shared by all methods
@@ -121,10 +122,10 @@ def compare(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
         tiles = [{"title": f"reference: {ref.method}",
                   "lines": [_fmt_opts(ref.options) or "default options", f"time {ref.run.time:.3g} s",
                             "error 0 by definition"], "image": ref_img}]
+        notes = []
         for r, e in zip(runs, entries):
             if r.status != "ok":
-                tiles.append({"title": r.method, "lines": [f"{r.status.replace('_', ' ')}: {r.reason}"],
-                              "image": None})
+                notes.append(f"{r.method}: {r.status.replace('_', ' ')}: {r.reason}")
                 continue
             files = {"png": f"images/{r.method}.png", "npy": f"images/{r.method}.npy",
                      "heat_flip": f"heat/{r.method}_flip.png", "heat_abs": f"heat/{r.method}_abs.png"}
@@ -139,7 +140,7 @@ def compare(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
                 f"{r.time:.3g} s; compile {r.compile:.2g} s",
                 f"RMSE {mt['rmse']:.3g}  PSNR {mt['psnr']:.3g} dB", f"FLIP {mt['flip']:.3g}"],
                 "image": r.image})
-        save_png8(stage / "grid.png", figures.grid(tiles))
+        save_png8(stage / "grid.png", figures.grid(tiles, notes=notes))
         (stage / "report.json").write_text(dumps(report))
         (stage / "report.html").write_text(render_html(report, stage, Path(out_dir)))
     return json.loads(dumps(report))
