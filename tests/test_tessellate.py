@@ -141,3 +141,16 @@ def test_every_bundled_scene_tessellates():
     for path in bundled():
         parts = tessellate_scene(workbench.load_scene(path), 2)
         assert parts and all(np.isfinite(p.positions).all() and np.isfinite(p.normals).all() for p in parts)
+
+
+def test_csg_with_closed_quadric_leaves():
+    Q, _ = quadric_matrix("cylinder", (0.35, 1.0, 0.35))
+    cyl = m.Quadric("a", Q=Q, bounds_min=(-0.4, 0.0, -0.4), bounds_max=(0.4, 1.2, 0.4), shape="cylinder")
+    capsule = m.CSG("a", op="union", left=cyl, right=m.Sphere("a", center=(0, 1.2, 0), radius=0.35))
+    parts = tessellate_object(capsule, 12)
+    want = np.pi * 0.35 ** 2 * 1.2 + 2 / 3 * np.pi * 0.35 ** 3
+    assert _volume(parts) == pytest.approx(want, rel=1e-2)
+    Qe, nat = quadric_matrix("ellipsoid", (1.0, 0.5, 0.8))
+    ell = m.Quadric("a", Q=Qe, bounds_min=nat[0], bounds_max=nat[1], shape="ellipsoid")
+    half = m.CSG("a", op="difference", left=ell, right=m.Box("a", min=(-2, 0, -2), max=(2, 2, 2)))
+    assert _volume(tessellate_object(half, 12)) == pytest.approx(2 / 3 * np.pi * 1.0 * 0.5 * 0.8, rel=1e-2)

@@ -28,7 +28,9 @@ mesh        as given (the level does not apply); its normals, or the face normal
 csg         leaves tessellated as closed solids (quadrics capped by their bounds), then
             real mesh booleans by manifold3d; normals from each leaf (analytic for spheres
             and quadrics, faces for boxes and meshes), flipped where a leaf's surface
-            bounds the result from the other side (the inside of a difference)
+            bounds the result from the other side (the inside of a difference).  Closed
+            quadric leaves: ellipsoids (scaled UV sphere) and cylinders whose x/z bounds
+            do not cut them (tube + caps) directly, other quadrics by the level set
 =========== =====================================================================
 
 Triangles are counter-clockwise seen from the side their normal points to.  Shading normals

@@ -13,7 +13,8 @@ import numpy as np
 from ..core import transform as tf
 from ..core.errors import WorkbenchError
 from . import model as m
-from .tessellate import Part, _box_faces, _quadric_gradient, _quadric_solid, _sphere, triangle_normals
+from .tessellate import (Part, _box_faces, _named_radii, _quadric_gradient, _quadric_solid, _sphere,
+                         triangle_normals)
 
 
 def _leaf_manifold(leaf: m.SceneObject, M: np.ndarray, level: int, leaf_id: int):
@@ -30,9 +31,12 @@ def _leaf_manifold(leaf: m.SceneObject, M: np.ndarray, level: int, leaf_id: int)
             F += [(ids[0], ids[1], ids[2]), (ids[0], ids[2], ids[3])]
         F = np.array(F, dtype=np.int64)
     elif isinstance(leaf, m.Quadric):
-        mesh = _quadric_solid(leaf, level).to_mesh()
-        P = np.asarray(mesh.vert_properties, dtype=np.float64)[:, :3]
-        F = np.asarray(mesh.tri_verts, dtype=np.int64)
+        closed = _closed_named_quadric(leaf, level)
+        if closed is None:
+            mesh = _quadric_solid(leaf, level).to_mesh()
+            closed = (np.asarray(mesh.vert_properties, dtype=np.float64)[:, :3],
+                      np.asarray(mesh.tri_verts, dtype=np.int64))
+        P, F = closed
     elif isinstance(leaf, m.Mesh):
         import trimesh
         tm = trimesh.Trimesh(np.asarray(leaf.vertices), np.asarray(leaf.faces), process=True)
@@ -51,6 +55,39 @@ def _leaf_manifold(leaf: m.SceneObject, M: np.ndarray, level: int, leaf_id: int)
     if man.status() != manifold3d.Error.NoError:
         raise WorkbenchError(f"CSG leaf {leaf.name or leaf.kind!r} is not a closed manifold ({man.status()})")
     return man
+
+
+def _closed_named_quadric(q: m.Quadric, level: int):
+    """Closed welded mesh (points, faces) of an ellipsoid inside its bounds, or of a cylinder
+    whose x/z bounds do not cut it (a tube and two cap fans); None for the other cases (the
+    level set handles them)."""
+    ra, rb, rc = _named_radii(q)
+    lo, hi = np.asarray(q.bounds_min), np.asarray(q.bounds_max)
+    if q.shape == "ellipsoid" and np.all(lo <= [-ra, -rb, -rc]) and np.all(hi >= [ra, rb, rc]):
+        P, _, F, _, _ = _sphere(m.Sphere(q.material), level)
+        return P * [ra, rb, rc], F
+    if q.shape == "cylinder" and np.all(lo[[0, 2]] <= [-ra, -rc]) and np.all(hi[[0, 2]] >= [ra, rc]):
+        n_phi, n_y = 8 * level, 2 * level
+        phi = np.arange(n_phi) * (2 * np.pi / n_phi)
+        ring = np.stack([ra * np.cos(phi), np.zeros(n_phi), -rc * np.sin(phi)], -1)
+        ys = np.linspace(lo[1], hi[1], n_y + 1)
+        P = np.vstack([ring + [0.0, y, 0.0] for y in ys] + [[[0.0, lo[1], 0.0]], [[0.0, hi[1], 0.0]]])
+        j = np.arange(n_phi)
+        F = []
+        for i in range(n_y):
+            a, b = i * n_phi + j, i * n_phi + (j + 1) % n_phi
+            F += [np.stack([a, b, b + n_phi], -1), np.stack([a, b + n_phi, a + n_phi], -1)]
+        bottom, top, last = len(P) - 2, len(P) - 1, n_y * n_phi
+        F += [np.stack([np.full(n_phi, bottom), (j + 1) % n_phi, j], -1),
+              np.stack([np.full(n_phi, top), last + j, last + (j + 1) % n_phi], -1)]
+        F = np.vstack(F).astype(np.int64)
+        # outward winding (the tube's by the quadric gradient)
+        fn = np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]])
+        centroid_dir = P[F].mean(1) - P.mean(0)
+        if np.sum(fn * centroid_dir) < 0:
+            F = F[:, ::-1]
+        return P, F
+    return None
 
 
 def _build(node: m.SceneObject, M: np.ndarray, level: int, leaves: list):
