@@ -154,3 +154,14 @@ def test_csg_with_closed_quadric_leaves():
     ell = m.Quadric("a", Q=Qe, bounds_min=nat[0], bounds_max=nat[1], shape="ellipsoid")
     half = m.CSG("a", op="difference", left=ell, right=m.Box("a", min=(-2, 0, -2), max=(2, 2, 2)))
     assert _volume(tessellate_object(half, 12)) == pytest.approx(2 / 3 * np.pi * 1.0 * 0.5 * 0.8, rel=1e-2)
+
+
+def test_csg_quadric_caps_have_flat_normals():
+    Q, _ = quadric_matrix("cylinder", (0.5, 1.0, 0.5))
+    cyl = m.Quadric("a", Q=Q, bounds_min=(-1, 0.0, -1), bounds_max=(1, 1.0, 1), shape="cylinder")
+    parts = tessellate_object(m.CSG("a", op="union", left=cyl, right=m.Sphere("a", center=(3, 0, 0), radius=0.5)), 6)
+    p = next(q for q in parts if np.allclose(q.positions[:, 0].mean(), 0.0, atol=0.1))
+    top = np.abs(p.positions[:, 1] - 1.0) < 1e-9
+    tri_top = top[p.faces].all(1)
+    assert tri_top.any()
+    assert np.allclose(p.normals[p.faces[tri_top]].reshape(-1, 3), [0, 1, 0])

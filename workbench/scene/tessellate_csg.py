@@ -12,6 +12,7 @@ import numpy as np
 
 from ..core import transform as tf
 from ..core.errors import WorkbenchError
+from ..core.tol import tol
 from . import model as m
 from .tessellate import (Part, _box_faces, _named_radii, _quadric_gradient, _quadric_solid, _sphere,
                          triangle_normals)
@@ -102,22 +103,32 @@ def _build(node: m.SceneObject, M: np.ndarray, level: int, leaves: list):
 
 
 def _leaf_normals(leaf: m.SceneObject, M: np.ndarray, Pw: np.ndarray, tri_n: np.ndarray) -> np.ndarray:
-    """Shading normals (3T, 3) for the unwelded triangles (T, 3, 3) ``Pw`` of one leaf."""
+    """Shading normals (3T, 3) for the unwelded triangles (T, 3, 3) ``Pw`` of one leaf:
+    analytic on spheres and quadric surfaces, the triangle's own on boxes, meshes and the caps
+    that close a quadric at its bounds."""
     flat = np.repeat(tri_n, 3, axis=0)
     P = Pw.reshape(-1, 3)
-    if isinstance(leaf, (m.Sphere, m.Quadric)):
-        P_obj = tf.transform_points(np.linalg.inv(M), P)
-        if isinstance(leaf, m.Sphere):
-            n_obj = P_obj - np.asarray(leaf.center)
-        else:
-            n_obj = _quadric_gradient(np.asarray(leaf.Q), P_obj)
-        N = tf.transform_normals(M, n_obj)
-        # a leaf seen from its inside (subtracted): flip by the area-weighted majority
-        if np.sum(N * flat) < 0:
-            N = -N
-        ok = np.linalg.norm(N, axis=-1) > 0.5
-        return np.where(ok[:, None], N, flat)
-    return flat
+    if not isinstance(leaf, (m.Sphere, m.Quadric)):
+        return flat
+    P_obj = tf.transform_points(np.linalg.inv(M), P)
+    if isinstance(leaf, m.Sphere):
+        n_obj = P_obj - np.asarray(leaf.center)
+        cap = np.zeros(len(P), dtype=bool)
+    else:
+        n_obj = _quadric_gradient(np.asarray(leaf.Q), P_obj)
+        lo, hi = np.asarray(leaf.bounds_min), np.asarray(leaf.bounds_max)
+        T = P_obj.reshape(-1, 3, 3)
+        on = np.zeros(len(T), dtype=bool)
+        for axis in range(3):
+            for plane in (lo[axis], hi[axis]):
+                on |= (np.abs(T[:, :, axis] - plane) <= tol.planar * (hi[axis] - lo[axis])).all(1)
+        cap = np.repeat(on, 3)
+    N = tf.transform_normals(M, n_obj)
+    # a leaf seen from its inside (subtracted): flip by the area-weighted majority
+    if np.sum(N[~cap] * flat[~cap]) < 0:
+        N = -N
+    ok = (np.linalg.norm(N, axis=-1) > 0.5) & ~cap
+    return np.where(ok[:, None], N, flat)
 
 
 def csg_parts(node: m.CSG, level: int, parent: np.ndarray) -> list[Part]:
