@@ -19,7 +19,15 @@ Interactive use (the UI calls this every frame)::
 
 A session keeps its programs, vertex buffers and FBOs; ``render()`` reuses sessions for the
 same scene content (objects, materials, lights), so repeated renders neither re-tessellate nor
-re-upload.
+re-upload.  A UI that owns a window context calls ``gl.use_context(ui_ctx)`` before creating
+the session; ``draw_to`` needs an FBO with a depth attachment.  ``session.release()`` frees
+the GL objects.
+
+Z-buffer: ``depth_bits`` 24 is moderngl's fixed-point depth texture; 32 a float
+``GL_DEPTH_COMPONENT32F`` attachment (:mod:`.raster_depth`); 16 is emulated by quantising
+``gl_FragDepth`` to 2^16 - 1 levels (exactly the comparisons of a 16-bit buffer; it disables
+early depth rejection).  ``RenderResult.depth`` is the camera-space depth recovered from the
+buffer, so its quantisation shows; ``view = "depth"`` shows it as grey levels.
 """
 from __future__ import annotations
 
