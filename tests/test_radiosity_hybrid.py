@@ -1,6 +1,9 @@
 """The hybrid method: the diffuse surfaces show the radiosity solution (the ray tracer returns
 the patch mesh's vertex emission, interpolated as Gouraud does), the mirror and glass spheres
-show the room through the ray tracer's recursion."""
+show the room through the ray tracer's recursion.
+
+The image tests are marked slow: they JIT-compile the ray tracer (about 100 s on this loaded
+machine whenever its numba cache is stale); run them with ``-m slow``."""
 from __future__ import annotations
 
 import numpy as np
@@ -17,6 +20,7 @@ def pair():
     return (workbench.render(scene, "radiosity", **kw), workbench.render(scene, "hybrid", **kw))
 
 
+@pytest.mark.slow
 def test_hybrid_diffuse_pixels_are_the_radiosity(gl_ctx, pair):
     rad, hyb = pair
     assert hyb.stats["nonfinite_pixels"] == 0 and hyb.stats["objects_as_radiosity_meshes"] == 5
@@ -26,6 +30,7 @@ def test_hybrid_diffuse_pixels_are_the_radiosity(gl_ctx, pair):
     assert close.mean() > 0.9          # edges of polygons may fall on either side of a pixel
 
 
+@pytest.mark.slow
 def test_hybrid_spheres_reflect_the_room(pair):
     rad, hyb = pair
     # the spheres stand on the floor in the lower half: black occluders for radiosity (kd = 0),

@@ -211,6 +211,20 @@ def analytic(geom: Geometry, order: int = 8) -> np.ndarray:
     return np.divide(F, area[:, None], out=np.zeros_like(F), where=area[:, None] > 0)
 
 
+def analytic_pairs(geom: Geometry, I, J, order: int = 8) -> np.ndarray:
+    """F_ij (K,) of the listed pairs only, as :func:`analytic` computes them."""
+    pts, w, owner = gauss_points(geom, order)
+    out = np.zeros(len(I))
+    for k, (i, j) in enumerate(zip(I, J)):
+        if i == j or geom.areas[i] <= 0:
+            continue
+        sel = owner == i
+        P = pts[sel].reshape(-1, 3)
+        ff = point_polygon(P, np.broadcast_to(geom.normals[i], P.shape), geom.polygons[j])
+        out[k] = (w[sel].ravel() * ff).sum() / geom.areas[i]
+    return out
+
+
 # --------------------------------------------------------------------------- dispatcher
 def compute(geom: Geometry, method: str = "hemicube", resolution: int = 128, *,
             rotate: bool = False, rays: int = 4096, order: int = 8, seed: int = 0) -> FormFactors:

@@ -1,5 +1,11 @@
 """Patches: every surface of a scene cut into planar pieces no larger than ``patch_size``.
 
+Planar surfaces (polygons, plane rectangles, box faces, area lights) are cut directly (quads
+into bilinear grids, other polygons into fans of subdivided triangles); curved ones (spheres,
+quadrics, CSG) are tessellated by :mod:`workbench.scene.tessellate` at the level whose
+triangles are about ``patch_size`` long, one patch per triangle; meshes keep their triangles
+(cut further if longer than ``patch_size``).
+
 A patch is a planar quadrilateral or triangle (a triangle is stored as a quad whose last vertex
 repeats its third, so that every patch has four corners).  Each surface (one polygon, one face
 of a box, one triangle of a mesh, one area light) is cut into a grid of patches that share

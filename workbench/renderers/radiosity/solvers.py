@@ -94,10 +94,14 @@ def _stop_level(q: float, tol: float) -> float:
     return tol * (1 - q) / q if 0 < q < 1 else (tol if q == 0 else 0.0)
 
 
-def _finish(B, display, method, it, hist, q, tol, reached, cap, t0, scalar, info=None):
+def _finish(B, display, method, it, hist, q, tol, reached, cap, t0, scalar, info=None,
+            timed_out=False):
     last = hist[-1] if len(hist) else 0.0
     bound = q / (1 - q) * last if 0 <= q < 1 else np.inf
-    if q >= 1:
+    if timed_out and not reached:
+        conv, msg = False, (f"NOT converged: time limit reached after {it} iterations; true "
+                            f"relative error <= {bound:.3g} > tol {tol:.3g}")
+    elif q >= 1:
         conv, msg = False, (f"no error bound: ||rho F||_inf = {q:.6g} >= 1 (form-factor rows "
                             f"sum to more than 1/rho); stopped after {it} iterations with update "
                             f"{last:.3g}")
@@ -106,7 +110,8 @@ def _finish(B, display, method, it, hist, q, tol, reached, cap, t0, scalar, info
     else:
         conv, msg = False, (f"NOT converged: iteration cap {cap} reached; true relative error "
                             f"<= {bound:.3g} > tol {tol:.3g} (rho close to 1 needs about "
-                            f"{_auto_iterations(q, tol) // 10} iterations)")
+                            f"{_auto_iterations(q, tol, 1 if method != 'progressive' else len(B)) // 10}"
+                            f" {'shots' if method == 'progressive' else 'iterations'})")
     sh = (lambda a: a[:, 0]) if scalar else (lambda a: a)
     return SolveResult(sh(B), sh(display), method, int(it), np.asarray(hist), float(bound),
                        float(q), conv, msg, time.perf_counter() - t0, info or {})
@@ -257,7 +262,7 @@ def progressive_rows(row: Callable[[np.ndarray], np.ndarray], areas, emission, r
     cap = max_shots if max_shots is not None else _auto_iterations(q, tol, n)
     B, dB = E.copy(), E.copy()
     hist: list[float] = []
-    shots, reached = 0, False
+    shots, reached, timed_out = 0, False, False
     live = A > 0
     invA = np.divide(1.0, A, out=np.zeros_like(A), where=live)
     while shots < cap:
@@ -285,7 +290,11 @@ def progressive_rows(row: Callable[[np.ndarray], np.ndarray], areas, emission, r
                 break
         if on_batch is not None:
             on_batch(B, dB, shots)
-        if reached or (time_limit is not None and time.perf_counter() - t0 > time_limit):
+        if reached:
+            break
+        if time_limit is not None and time.perf_counter() - t0 > time_limit:
+            timed_out = True
             break
     disp = B + R * _ambient(dB, R, A) if ambient else B
-    return _finish(B, disp, "progressive", shots, hist, q, tol, reached and q < 1, cap, t0, scalar)
+    return _finish(B, disp, "progressive", shots, hist, q, tol, reached and q < 1, cap, t0, scalar,
+                   timed_out=timed_out)
