@@ -28,7 +28,7 @@ def cast(sc, O, D):
 def test_sphere_away_from_origin_t4_and_t6():
     """DESIGN errata 1: origin 0, direction +z, centre (0, 0, 5), r = 1 -> t = 4 and 6."""
     assert [t for t, _ in shapes.sphere((0, 0, 5), 1.0, np.zeros(3), np.array([0, 0, 1.0]))] == pytest.approx([4, 6])
-    ok, t0, t1 = kernels.sphere_roots(np.array([0, 0, 5, 1.0]), 0, 0, 0, 0, 0, 1.0)
+    ok, t0, t1 = kernels.sphere_roots(np.array([[0, 0, 5, 1.0]]), 0, 0, 0, 0, 0, 0, 1.0)
     assert ok and (t0, t1) == pytest.approx((4, 6))
     sc = scene([{"type": "sphere", "center": [0, 0, 5], "radius": 1.0}])
     t, n, obj = cast(sc, [[0, 0, 0], [0, 0, 5]], [[0, 0, 1], [0, 0, 1]])

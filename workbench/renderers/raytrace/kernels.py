@@ -33,11 +33,10 @@ BOX_GAMMA = 1.0 + 2.0 * 3.0 * 2.0 ** -53 / (1.0 - 3.0 * 2.0 ** -53)
 # ----------------------------------------------------------------------------- small helpers
 @nb.njit(cache=True, inline="always")
 def _to_object(xf, k, ox, oy, oz, dx, dy, dz):
-    a = xf[k]
-    return (a[0] * ox + a[1] * oy + a[2] * oz + a[3], a[4] * ox + a[5] * oy + a[6] * oz + a[7],
-            a[8] * ox + a[9] * oy + a[10] * oz + a[11],
-            a[0] * dx + a[1] * dy + a[2] * dz, a[4] * dx + a[5] * dy + a[6] * dz,
-            a[8] * dx + a[9] * dy + a[10] * dz)
+    return (xf[k, 0] * ox + xf[k, 1] * oy + xf[k, 2] * oz + xf[k, 3], xf[k, 4] * ox + xf[k, 5] * oy + xf[k, 6] * oz + xf[k, 7],
+            xf[k, 8] * ox + xf[k, 9] * oy + xf[k, 10] * oz + xf[k, 11],
+            xf[k, 0] * dx + xf[k, 1] * dy + xf[k, 2] * dz, xf[k, 4] * dx + xf[k, 5] * dy + xf[k, 6] * dz,
+            xf[k, 8] * dx + xf[k, 9] * dy + xf[k, 10] * dz)
 
 
 @nb.njit(cache=True)
@@ -63,33 +62,38 @@ def solve_quadratic(A, B, C, zero):
     return 2, t0, t1
 
 
-@nb.njit(cache=True)
-def sphere_roots(par, ox, oy, oz, dx, dy, dz):
+@nb.njit(cache=True, inline="always")
+def sphere_roots(par, k, ox, oy, oz, dx, dy, dz):
     """Roots of the ray / sphere equation in object space.
 
     Errata 1 (B uses O - C) and the cancellation-free discriminant of Haines et al.,
     "Precision improvements for ray/sphere intersection" (Ray Tracing Gems, 2019):
-    ``disc = r^2 - |f - (f.d) d|^2`` with ``f = O - C`` and ``d`` the unit direction."""
-    fx, fy, fz = ox - par[0], oy - par[1], oz - par[2]
-    r = par[3]
-    s = math.sqrt(dx * dx + dy * dy + dz * dz)
-    ux, uy, uz = dx / s, dy / s, dz / s
+    ``disc = r^2 - |f - (f.d) d|^2`` with ``f = O - C`` and ``d`` the unit direction.  A sphere
+    entirely behind the origin reports no roots (no ray or CSG query needs ``t < 0``)."""
+    fx, fy, fz = ox - par[k, 0], oy - par[k, 1], oz - par[k, 2]
+    r = par[k, 3]
+    inv_s = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
+    ux, uy, uz = dx * inv_s, dy * inv_s, dz * inv_s
     b = fx * ux + fy * uy + fz * uz
+    ff = fx * fx + fy * fy + fz * fz
+    if b > 0.0 and ff > r * r:  # outside and moving away: both roots behind the origin
+        return False, 0.0, 0.0
     px, py, pz = fx - b * ux, fy - b * uy, fz - b * uz
     disc = r * r - (px * px + py * py + pz * pz)
     if not disc > 0.0:
         return False, 0.0, 0.0
     sq = math.sqrt(disc)
     q = -b - sq if b >= 0.0 else -b + sq
-    c = (math.sqrt(fx * fx + fy * fy + fz * fz) - r) * (math.sqrt(fx * fx + fy * fy + fz * fz) + r)
+    nf = math.sqrt(ff)
+    c = (nf - r) * (nf + r)
     t0 = c / q if q != 0.0 else -sq
     t1 = q
     if t0 > t1:
         t0, t1 = t1, t0
-    return True, t0 / s, t1 / s
+    return True, t0 * inv_s, t1 * inv_s
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def slab(lo0, lo1, lo2, hi0, hi1, hi2, ox, oy, oz, dx, dy, dz):
     """Ray / axis-aligned box (Kay & Kajiya slabs).  Returns ``(ok, t_near, face_near, t_far,
     face_far)``; faces are ``1 + 2 axis + side`` (side 1 = max face)."""
@@ -121,12 +125,12 @@ def slab(lo0, lo1, lo2, hi0, hi1, hi2, ox, oy, oz, dx, dy, dz):
     return True, tn, fn, tf, ff
 
 
-@nb.njit(cache=True)
-def quadric_coeffs(par, ox, oy, oz, dx, dy, dz):
+@nb.njit(cache=True, inline="always")
+def quadric_coeffs(par, k, ox, oy, oz, dx, dy, dz):
     """``A = D^T Q D``, ``B = 2 D^T Q P0``, ``C = P0^T Q P0`` with D lifted with w = 0 and P0
     with w = 1 (errata 2: the cross terms of C carry their factor 2)."""
-    q00, q01, q02, q03, q11, q12, q13, q22, q23, q33 = (par[0], par[1], par[2], par[3], par[4],
-                                                         par[5], par[6], par[7], par[8], par[9])
+    q00, q01, q02, q03, q11, q12, q13, q22, q23, q33 = (par[k, 0], par[k, 1], par[k, 2], par[k, 3], par[k, 4],
+                                                         par[k, 5], par[k, 6], par[k, 7], par[k, 8], par[k, 9])
     # Q P0 and Q D (first three rows)
     qp0 = q00 * ox + q01 * oy + q02 * oz + q03
     qp1 = q01 * ox + q11 * oy + q12 * oz + q13
@@ -141,21 +145,20 @@ def quadric_coeffs(par, ox, oy, oz, dx, dy, dz):
     return A, B, C
 
 
-@nb.njit(cache=True)
-def _in_bounds(par, x, y, z, slack):
-    return (par[10] - slack <= x <= par[13] + slack and par[11] - slack <= y <= par[14] + slack
-            and par[12] - slack <= z <= par[15] + slack)
+@nb.njit(cache=True, inline="always")
+def _in_bounds(par, k, x, y, z, slack):
+    return (par[k, 10] - slack <= x <= par[k, 13] + slack and par[k, 11] - slack <= y <= par[k, 14] + slack
+            and par[k, 12] - slack <= z <= par[k, 15] + slack)
 
 
 # ----------------------------------------------------------------------------- primitives
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def prim_hit(k, ptype, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
     """Closest hit ``tmin < t < tmax`` of analytic primitive ``k`` (object-space ray).
     Returns ``(t, face)``, ``t = inf`` on a miss."""
-    p = par[k]
     kind = ptype[k]
     if kind == SPHERE:
-        ok, t0, t1 = sphere_roots(p, ox, oy, oz, dx, dy, dz)
+        ok, t0, t1 = sphere_roots(par, k, ox, oy, oz, dx, dy, dz)
         if ok:
             if tmin < t0 < tmax:
                 return t0, 0
@@ -163,19 +166,19 @@ def prim_hit(k, ptype, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
                 return t1, 0
         return np.inf, 0
     if kind == RECT:
-        nx, ny, nz = p[9], p[10], p[11]
+        nx, ny, nz = par[k, 9], par[k, 10], par[k, 11]
         den = nx * dx + ny * dy + nz * dz
         if den == 0.0:
             return np.inf, 0
-        t = ((p[0] - ox) * nx + (p[1] - oy) * ny + (p[2] - oz) * nz) / den
+        t = ((par[k, 0] - ox) * nx + (par[k, 1] - oy) * ny + (par[k, 2] - oz) * nz) / den
         if not (tmin < t < tmax):
             return np.inf, 0
-        qx, qy, qz = ox + t * dx - p[0], oy + t * dy - p[1], oz + t * dz - p[2]
-        if abs(qx * p[3] + qy * p[4] + qz * p[5]) <= p[12] and abs(qx * p[6] + qy * p[7] + qz * p[8]) <= p[13]:
+        qx, qy, qz = ox + t * dx - par[k, 0], oy + t * dy - par[k, 1], oz + t * dz - par[k, 2]
+        if abs(qx * par[k, 3] + qy * par[k, 4] + qz * par[k, 5]) <= par[k, 12] and abs(qx * par[k, 6] + qy * par[k, 7] + qz * par[k, 8]) <= par[k, 13]:
             return t, 0
         return np.inf, 0
     if kind == BOX:
-        ok, tn, fn, tf, ff = slab(p[0], p[1], p[2], p[3], p[4], p[5], ox, oy, oz, dx, dy, dz)
+        ok, tn, fn, tf, ff = slab(par[k, 0], par[k, 1], par[k, 2], par[k, 3], par[k, 4], par[k, 5], ox, oy, oz, dx, dy, dz)
         if ok:
             if tmin < tn < tmax:
                 return tn, fn
@@ -183,15 +186,15 @@ def prim_hit(k, ptype, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
                 return tf, ff
         return np.inf, 0
     if kind == POLYGON:
-        nx, ny, nz = p[0], p[1], p[2]
+        nx, ny, nz = par[k, 0], par[k, 1], par[k, 2]
         den = nx * dx + ny * dy + nz * dz
         if den == 0.0:
             return np.inf, 0
-        t = (p[3] - (nx * ox + ny * oy + nz * oz)) / den
+        t = (par[k, 3] - (nx * ox + ny * oy + nz * oz)) / den
         if not (tmin < t < tmax):
             return np.inf, 0
         qx, qy, qz = ox + t * dx, oy + t * dy, oz + t * dz
-        s, n = int(p[4]), int(p[5])
+        s, n = int(par[k, 4]), int(par[k, 5])
         for i in range(n):
             j = s + (i + 1) % n
             ax, ay, az = poly_v[s + i, 0], poly_v[s + i, 1], poly_v[s + i, 2]
@@ -202,11 +205,11 @@ def prim_hit(k, ptype, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
                 return np.inf, 0
         return t, 0
     if kind == QUADRIC:
-        A, B, C = quadric_coeffs(p, ox, oy, oz, dx, dy, dz)
+        A, B, C = quadric_coeffs(par, k, ox, oy, oz, dx, dy, dz)
         n, t0, t1 = solve_quadratic(A, B, C, zero)
         for r in range(n):
             t = t0 if r == 0 else t1
-            if tmin < t < tmax and _in_bounds(p, ox + t * dx, oy + t * dy, oz + t * dz, 0.0):
+            if tmin < t < tmax and _in_bounds(par, k, ox + t * dx, oy + t * dy, oz + t * dz, 0.0):
                 return t, 0
         return np.inf, 0
     return np.inf, 0
@@ -217,10 +220,9 @@ def leaf_events(k, ptype, par, ox, oy, oz, dx, dy, dz, zero, et, ep, ef):
     """Interval list (entering / leaving events along the whole line) of solid leaf ``k``:
     sphere, box, or quadric inside ``P^T Q P < 0`` intersected with its bounds box.
     Writes ``et`` (t), ``ep`` (signed primitive code ``k + 1``), ``ef`` (face); returns the count."""
-    p = par[k]
     kind = ptype[k]
     if kind == SPHERE:
-        ok, t0, t1 = sphere_roots(p, ox, oy, oz, dx, dy, dz)
+        ok, t0, t1 = sphere_roots(par, k, ox, oy, oz, dx, dy, dz)
         if not ok:
             return 0
         et[0], et[1] = t0, t1
@@ -228,7 +230,7 @@ def leaf_events(k, ptype, par, ox, oy, oz, dx, dy, dz, zero, et, ep, ef):
         ef[0], ef[1] = 0, 0
         return 2
     if kind == BOX:
-        ok, tn, fn, tf, ff = slab(p[0], p[1], p[2], p[3], p[4], p[5], ox, oy, oz, dx, dy, dz)
+        ok, tn, fn, tf, ff = slab(par[k, 0], par[k, 1], par[k, 2], par[k, 3], par[k, 4], par[k, 5], ox, oy, oz, dx, dy, dz)
         if not ok or not tn < tf:
             return 0
         et[0], et[1] = tn, tf
@@ -236,10 +238,10 @@ def leaf_events(k, ptype, par, ox, oy, oz, dx, dy, dz, zero, et, ep, ef):
         ef[0], ef[1] = fn, ff
         return 2
     if kind == QUADRIC:
-        ok, sn, sfn, sf, sff = slab(p[10], p[11], p[12], p[13], p[14], p[15], ox, oy, oz, dx, dy, dz)
+        ok, sn, sfn, sf, sff = slab(par[k, 10], par[k, 11], par[k, 12], par[k, 13], par[k, 14], par[k, 15], ox, oy, oz, dx, dy, dz)
         if not ok or not sn < sf:
             return 0
-        A, B, C = quadric_coeffs(p, ox, oy, oz, dx, dy, dz)
+        A, B, C = quadric_coeffs(par, k, ox, oy, oz, dx, dy, dz)
         n, r0, r1 = solve_quadratic(A, B, C, zero)
         # the inside {t : A t^2 + B t + C < 0} as up to two intervals (a, b)
         cnt = 0
@@ -279,7 +281,7 @@ def leaf_events(k, ptype, par, ox, oy, oz, dx, dy, dz, zero, et, ep, ef):
     return 0
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def _op(op, a, b):
     if op == CSG_UNION:
         return a or b
@@ -360,7 +362,7 @@ def csg_hit(start, length, prog, ptype, xf, par, ox, oy, oz, dx, dy, dz, tmin, t
     return np.inf, 0, 0
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def tri_hit(tv, i, ox, oy, oz, kx, ky, kz, sx, sy, sz, tmin, tmax):
     """Watertight ray / triangle test (Woop, Benthin & Wald, JCGT 2013).  Returns
     ``(t, b1, b2)`` with barycentric weights of vertices 1 and 2, ``t = inf`` on a miss."""
@@ -451,7 +453,7 @@ def bvh_hit(tv, box, meta, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     return best, btri, bb1, bb2
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
             st, sp_, sf, sn):
     """Nearest hit of a world ray over all primitives (linear loop over analytic primitives,
@@ -487,28 +489,27 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
     return best, bp, bf, btri, bb1, bb2
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def object_normal(k, face, ptype, par, x, y, z):
     """Outward normal (unnormalised) of primitive ``k`` at object-space point, by face."""
-    p = par[k]
     kind = ptype[k]
     if face >= 1 and (kind == BOX or kind == QUADRIC):
         a = (face - 1) // 2
         s = 1.0 if (face - 1) % 2 == 1 else -1.0
         return (s if a == 0 else 0.0), (s if a == 1 else 0.0), (s if a == 2 else 0.0)
     if kind == SPHERE:
-        return x - p[0], y - p[1], z - p[2]
+        return x - par[k, 0], y - par[k, 1], z - par[k, 2]
     if kind == RECT:
-        return p[9], p[10], p[11]
+        return par[k, 9], par[k, 10], par[k, 11]
     if kind == POLYGON:
-        return p[0], p[1], p[2]
+        return par[k, 0], par[k, 1], par[k, 2]
     if kind == QUADRIC:  # gradient of P^T Q P (halved)
-        return (p[0] * x + p[1] * y + p[2] * z + p[3], p[1] * x + p[4] * y + p[5] * z + p[6],
-                p[2] * x + p[5] * y + p[7] * z + p[8])
+        return (par[k, 0] * x + par[k, 1] * y + par[k, 2] * z + par[k, 3], par[k, 1] * x + par[k, 4] * y + par[k, 5] * z + par[k, 6],
+                par[k, 2] * x + par[k, 5] * y + par[k, 7] * z + par[k, 8])
     return 0.0, 1.0, 0.0
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def _normalize(x, y, z):
     n = math.sqrt(x * x + y * y + z * z)
     if n > 0.0:
@@ -523,44 +524,38 @@ def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_
     to row ``i`` of the output arrays."""
     (ptype, top, xf, nm, par, solid, shadow, poly_v, prog, tri_v, tri_n, tri_uv, tri_e,
      tri_prim, bvh_box, bvh_meta) = geo
-    a = xf[k]
-    x = a[0] * px + a[1] * py + a[2] * pz + a[3]
-    y = a[4] * px + a[5] * py + a[6] * pz + a[7]
-    z = a[8] * px + a[9] * py + a[10] * pz + a[11]
+    x = xf[k, 0] * px + xf[k, 1] * py + xf[k, 2] * pz + xf[k, 3]
+    y = xf[k, 4] * px + xf[k, 5] * py + xf[k, 6] * pz + xf[k, 7]
+    z = xf[k, 8] * px + xf[k, 9] * py + xf[k, 10] * pz + xf[k, 11]
     out_po[i, 0], out_po[i, 1], out_po[i, 2] = x, y, z
     out_uv[i, 0], out_uv[i, 1] = 0.0, 0.0
     out_e[i, 0], out_e[i, 1], out_e[i, 2] = 0.0, 0.0, 0.0
     if tri >= 0:
-        v = tri_v[tri]
-        e1x, e1y, e1z = v[3] - v[0], v[4] - v[1], v[5] - v[2]
-        e2x, e2y, e2z = v[6] - v[0], v[7] - v[1], v[8] - v[2]
+        e1x, e1y, e1z = tri_v[tri, 3] - tri_v[tri, 0], tri_v[tri, 4] - tri_v[tri, 1], tri_v[tri, 5] - tri_v[tri, 2]
+        e2x, e2y, e2z = tri_v[tri, 6] - tri_v[tri, 0], tri_v[tri, 7] - tri_v[tri, 1], tri_v[tri, 8] - tri_v[tri, 2]
         gx, gy, gz = _normalize(e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x)
         b0 = 1.0 - b1 - b2
-        nn = tri_n[tri]
-        sx = b0 * nn[0] + b1 * nn[3] + b2 * nn[6]
-        sy = b0 * nn[1] + b1 * nn[4] + b2 * nn[7]
-        sz = b0 * nn[2] + b1 * nn[5] + b2 * nn[8]
+        sx = b0 * tri_n[tri, 0] + b1 * tri_n[tri, 3] + b2 * tri_n[tri, 6]
+        sy = b0 * tri_n[tri, 1] + b1 * tri_n[tri, 4] + b2 * tri_n[tri, 7]
+        sz = b0 * tri_n[tri, 2] + b1 * tri_n[tri, 5] + b2 * tri_n[tri, 8]
         ln = math.sqrt(sx * sx + sy * sy + sz * sz)
         if ln > ncancel:  # a cancelled interpolated normal falls back to Ng
             sx, sy, sz = sx / ln, sy / ln, sz / ln
         else:
             sx, sy, sz = gx, gy, gz
-        uv = tri_uv[tri]
-        out_uv[i, 0] = b0 * uv[0] + b1 * uv[2] + b2 * uv[4]
-        out_uv[i, 1] = b0 * uv[1] + b1 * uv[3] + b2 * uv[5]
-        e = tri_e[tri]
+        out_uv[i, 0] = b0 * tri_uv[tri, 0] + b1 * tri_uv[tri, 2] + b2 * tri_uv[tri, 4]
+        out_uv[i, 1] = b0 * tri_uv[tri, 1] + b1 * tri_uv[tri, 3] + b2 * tri_uv[tri, 5]
         for c in range(3):
-            out_e[i, c] = b0 * e[c] + b1 * e[3 + c] + b2 * e[6 + c]
+            out_e[i, c] = b0 * tri_e[tri, c] + b1 * tri_e[tri, 3 + c] + b2 * tri_e[tri, 6 + c]
         out_ng[i, 0], out_ng[i, 1], out_ng[i, 2] = gx, gy, gz
         out_ns[i, 0], out_ns[i, 1], out_ns[i, 2] = sx, sy, sz
         return
     f = face - 16 if face >= 16 else face
     sgn = -1.0 if face >= 16 else 1.0
     ux, uy, uz = object_normal(k, f, ptype, par, x, y, z)
-    m = nm[k]
-    wx = sgn * (m[0] * ux + m[1] * uy + m[2] * uz)
-    wy = sgn * (m[3] * ux + m[4] * uy + m[5] * uz)
-    wz = sgn * (m[6] * ux + m[7] * uy + m[8] * uz)
+    wx = sgn * (nm[k, 0] * ux + nm[k, 1] * uy + nm[k, 2] * uz)
+    wy = sgn * (nm[k, 3] * ux + nm[k, 4] * uy + nm[k, 5] * uz)
+    wz = sgn * (nm[k, 6] * ux + nm[k, 7] * uy + nm[k, 8] * uz)
     gx, gy, gz = _normalize(wx, wy, wz)
     out_ng[i, 0], out_ng[i, 1], out_ng[i, 2] = gx, gy, gz
     out_ns[i, 0], out_ns[i, 1], out_ns[i, 2] = gx, gy, gz
@@ -614,32 +609,45 @@ def _transmittance(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmin, tmax, tra
 
 
 @nb.njit(cache=True)
+def accumulate(acc, pix, contrib):
+    """``acc[pix[i]] += contrib[i]`` (serial: several rays may share a pixel)."""
+    for i in range(pix.shape[0]):
+        for c in range(3):
+            acc[pix[i], c] += contrib[i, c]
+
+
+@nb.njit(cache=True, inline="always")
 def _pow(base, n):
     if n == 0.0:
         return 1.0
     return base ** n
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def _ior(mat_tab, stk, ns_):
     return mat_tab[stk[ns_ - 1], 9] if ns_ > 0 else 1.0
 
 
 @nb.njit(cache=True, parallel=True)
-def shade_batch(geo, mat_of, mat_tab, lights, ambient, O, D, t, prim, ng, nsh, col, ev, w, depth,
-                stk, nstk, opts, contrib, out_o, out_d, out_w, out_stk, out_nstk, out_kind, counts):
+def shade_batch(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim, ng, nsh, col, ev,
+                w, depth, stk, nstk, pix, opts, contrib, out_o, out_d, out_w, out_stk, out_nstk,
+                out_kind, out_tmin, out_pix, out_gen, counts):
     """Local model with shadow feelers at each hit, then the reflected and refracted children.
 
     ``opts``: max_depth, threshold, fresnel (0 none, 1 Schlick, 2 exact), transmissive shadows,
     blinn, shadows on, reflection on, refraction on, tol.ray_offset, tol.t_min, tol.zero,
-    extent.  Child slots: ``2 i`` (reflection), ``2 i + 1`` (refraction); ``out_kind`` 0 = none.
-    ``counts[i]``: shadow rays, ended by depth, ended by threshold, total internal reflections.
+    extent, misses see ``background`` (else they contribute nothing here: an environment map
+    is evaluated by the caller).  Child slots: ``2 i`` (reflection), ``2 i + 1`` (refraction);
+    ``out_kind`` 0 = none, with their ``tmin``, pixel and generation.  ``counts[i]``: shadow
+    rays, ended by depth, ended by threshold, total internal reflections, reflected and
+    refracted children, escaped (missed everything).
     """
     n = O.shape[0]
     max_depth, threshold, fres = int(opts[0]), opts[1], int(opts[2])
     transmissive, blinn = opts[3] > 0.5, opts[4] > 0.5
     do_shadow, do_refl, do_refr = opts[5] > 0.5, opts[6] > 0.5, opts[7] > 0.5
     ray_off, t_min, zero, extent = opts[8], opts[9], opts[10], opts[11]
+    add_bg = opts[12] > 0.5
     nl = lights.shape[0]
     solid = geo[5]
     nchunks = (n + CHUNK - 1) // CHUNK
@@ -651,20 +659,24 @@ def shade_batch(geo, mat_of, mat_tab, lights, ambient, O, D, t, prim, ng, nsh, c
         sn = np.empty(CSG_DEPTH, dtype=np.int64)
         for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
             out_kind[2 * i], out_kind[2 * i + 1] = 0, 0
-            for q in range(4):
+            for q in range(7):
                 counts[i, q] = 0
             k = prim[i]
+            if k < 0:
+                counts[i, 6] = 1
+                for q in range(3):
+                    contrib[i, q] = w[i, q] * background[q] if add_bg else 0.0
+                continue
             mi = mat_of[k]
-            mt = mat_tab[mi]
             dx, dy, dz = D[i, 0], D[i, 1], D[i, 2]
             px, py, pz = O[i, 0] + t[i] * dx, O[i, 1] + t[i] * dy, O[i, 2] + t[i] * dz
             # Beer-Lambert absorption by the medium the ray travelled through
             w0, w1, w2 = w[i, 0], w[i, 1], w[i, 2]
             if nstk[i] > 0:
-                am = mat_tab[stk[i, nstk[i] - 1]]
-                w0 *= math.exp(-am[10] * t[i])
-                w1 *= math.exp(-am[11] * t[i])
-                w2 *= math.exp(-am[12] * t[i])
+                ma = stk[i, nstk[i] - 1]
+                w0 *= math.exp(-mat_tab[ma, 10] * t[i])
+                w1 *= math.exp(-mat_tab[ma, 11] * t[i])
+                w2 *= math.exp(-mat_tab[ma, 12] * t[i])
             sx, sy, sz = -dx, -dy, -dz
             gx, gy, gz = ng[i, 0], ng[i, 1], ng[i, 2]
             nx, ny, nz = nsh[i, 0], nsh[i, 1], nsh[i, 2]
@@ -673,11 +685,14 @@ def shade_batch(geo, mat_of, mat_tab, lights, ambient, O, D, t, prim, ng, nsh, c
             front = gx * sx + gy * sy + gz * sz > 0.0
             # side of the surface the ray came from
             fx, fy, fz = (gx, gy, gz) if front else (-gx, -gy, -gz)
-            cr, cg, cb = col[i, 0], col[i, 1], col[i, 2]
-            ka, kd, ks, shin = mt[3], mt[4], mt[5], mt[6]
+            if mat_tab[mi, 17] > 0.5:  # textured: the caller's colour
+                cr, cg, cb = col[i, 0], col[i, 1], col[i, 2]
+            else:
+                cr, cg, cb = mat_tab[mi, 0], mat_tab[mi, 1], mat_tab[mi, 2]
+            ka, kd, ks, shin = mat_tab[mi, 3], mat_tab[mi, 4], mat_tab[mi, 5], mat_tab[mi, 6]
             er, eg, eb = ev[i, 0], ev[i, 1], ev[i, 2]
-            if mt[16] < 0.5 or front:
-                er, eg, eb = er + mt[13], eg + mt[14], eb + mt[15]
+            if mat_tab[mi, 16] < 0.5 or front:
+                er, eg, eb = er + mat_tab[mi, 13], eg + mat_tab[mi, 14], eb + mat_tab[mi, 15]
             lr = ka * cr * ambient[0] + er
             lg = ka * cg * ambient[1] + eg
             lb = ka * cb * ambient[2] + eb
@@ -686,20 +701,19 @@ def shade_batch(geo, mat_of, mat_tab, lights, ambient, O, D, t, prim, ng, nsh, c
             eps = off
             nshadow = 0
             for li in range(nl):
-                L = lights[li]
-                if L[0] > 0.5:
-                    lx, ly, lz = -L[1], -L[2], -L[3]
+                if lights[li, 0] > 0.5:
+                    lx, ly, lz = -lights[li, 1], -lights[li, 2], -lights[li, 3]
                     dist = np.inf
                     scale = 1.0
                 else:
-                    vx, vy, vz = L[1] - px, L[2] - py, L[3] - pz
+                    vx, vy, vz = lights[li, 1] - px, lights[li, 2] - py, lights[li, 3] - pz
                     dist = math.sqrt(vx * vx + vy * vy + vz * vz)
                     lx, ly, lz = _normalize(vx, vy, vz)
                     scale = 1.0
-                    if L[7] > 0.5:
+                    if lights[li, 7] > 0.5:
                         scale = 1.0 / max(dist * dist, 1e-300)
-                    if L[8] > 0.5:
-                        scale *= max(0.0, -(lx * L[9] + ly * L[10] + lz * L[11]))
+                    if lights[li, 8] > 0.5:
+                        scale *= max(0.0, -(lx * lights[li, 9] + ly * lights[li, 10] + lz * lights[li, 11]))
                 ndl = nx * lx + ny * ly + nz * lz
                 if ndl <= 0.0 or scale == 0.0:
                     continue
@@ -725,13 +739,13 @@ def shade_batch(geo, mat_of, mat_tab, lights, ambient, O, D, t, prim, ng, nsh, c
                     base = min(1.0, max(0.0, base))
                     spec = ks * _pow(base, shin)
                 f = vis * scale
-                lr += L[4] * f * (kd * cr * ndl + spec)
-                lg += L[5] * f * (kd * cg * ndl + spec)
-                lb += L[6] * f * (kd * cb * ndl + spec)
+                lr += lights[li, 4] * f * (kd * cr * ndl + spec)
+                lg += lights[li, 5] * f * (kd * cg * ndl + spec)
+                lb += lights[li, 6] * f * (kd * cb * ndl + spec)
             contrib[i, 0], contrib[i, 1], contrib[i, 2] = w0 * lr, w1 * lg, w2 * lb
             counts[i, 0] = nshadow
             # ---- reflection / transmission weights (Whitted 1980; Fresnel optional)
-            kr, kt = mt[7], mt[8]
+            kr, kt = mat_tab[mi, 7], mat_tab[mi, 8]
             if not do_refl:
                 kr = 0.0
             if not do_refr:
@@ -748,9 +762,9 @@ def shade_batch(geo, mat_of, mat_tab, lights, ambient, O, D, t, prim, ng, nsh, c
                 # media on both sides (nested dielectrics: a small stack of materials)
                 if front:
                     n1 = _ior(mat_tab, stk[i], ns_)
-                    n2 = mt[9]
+                    n2 = mat_tab[mi, 9]
                 else:
-                    n1 = mt[9]
+                    n1 = mat_tab[mi, 9]
                     # the medium beyond: the stack without its topmost entry of this material
                     j = ns_ - 1
                     while j >= 0 and stk[i, j] != mi:
@@ -814,6 +828,7 @@ def shade_batch(geo, mat_of, mat_tab, lights, ambient, O, D, t, prim, ng, nsh, c
                         out_stk[s, q] = stk[i, q]
                     out_nstk[s] = ns_
                     out_kind[s] = 1
+                    counts[i, 4] += 1
                 else:
                     out_o[s, 0], out_o[s, 1], out_o[s, 2] = px - off * fx, py - off * fy, pz - off * fz
                     out_d[s, 0], out_d[s, 1], out_d[s, 2] = tx, ty, tz
@@ -837,4 +852,8 @@ def shade_batch(geo, mat_of, mat_tab, lights, ambient, O, D, t, prim, ng, nsh, c
                                     q2 += 1
                             out_nstk[s] = ns_ - 1
                     out_kind[s] = 2
+                    counts[i, 5] += 1
                 out_w[s, 0], out_w[s, 1], out_w[s, 2] = b0, b1_, b2_
+                out_tmin[s] = t_min * max(max(abs(out_o[s, 0]), abs(out_o[s, 1]), abs(out_o[s, 2])), extent)
+                out_pix[s] = pix[i]
+                out_gen[s] = depth[i] + 1

@@ -53,25 +53,26 @@ def camera_rays(camera, width: int, height: int, spp: int, seed: int):
     """
     th = np.tan(np.radians(camera.fov_y) / 2.0)
     aspect = width / height
-    jj, ii = np.meshgrid(np.arange(width), np.arange(height))
     if spp == 1:
-        ox = np.full((height, width, 1), 0.5)
-        oy = np.full((height, width, 1), 0.5)
+        ox = np.full((1, 1, 1), 0.5)
+        oy = ox
     else:
         m = int(np.ceil(np.sqrt(spp)))
         m2 = int(np.ceil(spp / m))
         s = np.arange(spp)
-        rng = np.random.default_rng(seed)
-        jit = rng.random((height, width, spp, 2))
+        jit = np.random.default_rng(seed).random((height, width, spp, 2))
         ox = ((s % m)[None, None, :] + jit[..., 0]) / m
         oy = ((s // m)[None, None, :] + jit[..., 1]) / m2
-    x = ((jj[..., None] + ox) / width * 2.0 - 1.0) * th * aspect
-    y = (1.0 - (ii[..., None] + oy) / height * 2.0) * th
-    d_cam = np.stack([x, y, -np.ones_like(x)], -1).reshape(-1, 3)
-    world_from_camera = np.linalg.inv(camera.camera_from_world())
-    d = d_cam @ world_from_camera[:3, :3].T
-    d /= np.linalg.norm(d, axis=1, keepdims=True)
-    o = np.broadcast_to(np.asarray(camera.position, dtype=np.float64), d.shape).copy()
+    x = ((np.arange(width)[None, :, None] + ox) / width * 2.0 - 1.0) * th * aspect
+    y = (1.0 - (np.arange(height)[:, None, None] + oy) / height * 2.0) * th
+    R = np.linalg.inv(camera.camera_from_world())[:3, :3]  # world_from_camera: columns r, u, -f
+    d = np.empty((height, width, spp, 3))
+    for c in range(3):
+        d[..., c] = x * R[c, 0] + y * R[c, 1] - R[c, 2]
+    d = d.reshape(-1, 3)
+    d /= np.sqrt(np.einsum("ij,ij->i", d, d))[:, None]
+    o = np.empty_like(d)
+    o[:] = camera.position
     pix = np.repeat(np.arange(height * width), spp)
     return o, d, pix
 
@@ -100,18 +101,18 @@ class _Colorizer:
         """(material, selection, uv or None, world_from_object) for hits whose material has
         ``attr`` (texture, bump, opacity), split by primitive (each has its own transform)."""
         sd = self.sd
-        mat = sd.mat[prim]
-        for k in np.unique(prim):
+        for k in np.flatnonzero(np.bincount(prim[prim >= 0], minlength=len(sd.mat))):
             m = sd.materials[sd.mat[k]]
             if getattr(m, attr) is None:
                 continue
             yield m, prim == k, bool(sd.has_uv[k]), sd.wfo[k]
 
     def colors(self, prim, P_obj, Ns, uv):
-        """(n, 3) colours ``C`` and (n, 3) shading normals (bumped where a material asks)."""
-        C = self.base[self.sd.mat[prim]].copy()
+        """(n, 3) colours ``C`` (set for textured materials only: shade_batch reads the others
+        from the material table) and (n, 3) shading normals (bumped where a material asks)."""
         if self.tex is None:
-            return C, Ns
+            return self.base[self.sd.mat[np.maximum(prim, 0)]], Ns
+        C = np.empty((len(prim), 3))
         for m, sel, has_uv, W in self._groups(prim, "texture"):
             n_obj = Ns[sel] @ W[:3, :3]
             C[sel] = self.tex.surface_color(m, P_obj[sel], n_obj, uv[sel] if has_uv else None)
@@ -145,7 +146,7 @@ def ensure_compiled(sd: SceneData) -> float:
     Returns the seconds spent (0 if already compiled in this process)."""
     k = _kernels()
     from .bvh import _build
-    if k.trace_batch.signatures and k.shade_batch.signatures and _build.signatures:
+    if k.trace_batch.signatures and k.shade_batch.signatures and _build.signatures and k.accumulate.signatures:
         return 0.0
     t0 = time.perf_counter()
     _build(np.array([[0.0, 0, 0, 1, 0, 0, 0, 1, 0]]))
@@ -157,23 +158,33 @@ def ensure_compiled(sd: SceneData) -> float:
                   tol.normal_cancel, arr["t"], arr["prim"], arr["ng"], arr["ns"], arr["uv"],
                   arr["po"], arr["ev"])
     ch = _alloc_children(1)
-    k.shade_batch(geo, sd.mat, sd.mat_tab, sd.lights, np.zeros(3), O, D, np.ones(1),
+    k.shade_batch(geo, sd.mat, sd.mat_tab, sd.lights, np.zeros(3), np.zeros(3), O, D, np.ones(1),
                   np.zeros(1, np.int64), D.copy(), D.copy(), np.ones((1, 3)), np.zeros((1, 3)),
                   np.ones((1, 3)), np.zeros(1, np.int64), np.zeros((1, 4), np.int64),
-                  np.zeros(1, np.int64), np.zeros(12), np.zeros((1, 3)), ch["o"], ch["d"], ch["w"],
-                  ch["stk"], ch["nstk"], ch["kind"], np.zeros((1, 4), np.int64))
+                  np.zeros(1, np.int64), np.zeros(1, np.int64), np.zeros(13), np.zeros((1, 3)),
+                  ch["o"], ch["d"], ch["w"], ch["stk"], ch["nstk"], ch["kind"], ch["tmin"], ch["pix"],
+                  ch["gen"], np.zeros((1, 7), np.int64))
+    k.accumulate(np.zeros((1, 3)), np.zeros(1, np.int64), np.zeros((1, 3)))
     return time.perf_counter() - t0
 
 
 def _alloc(n):
-    return dict(t=np.empty(n), prim=np.empty(n, np.int64), ng=np.zeros((n, 3)),
-                ns=np.zeros((n, 3)), uv=np.zeros((n, 2)), po=np.zeros((n, 3)), ev=np.zeros((n, 3)))
+    """Hit records of n rays (rows of missed rays are left unset)."""
+    return dict(t=np.empty(n), prim=np.empty(n, np.int64), ng=np.empty((n, 3)),
+                ns=np.empty((n, 3)), uv=np.empty((n, 2)), po=np.empty((n, 3)), ev=np.empty((n, 3)))
 
 
 def _alloc_children(n):
+    """Child ray slots (2 per parent: reflection, refraction), written by shade_batch."""
     return dict(o=np.empty((2 * n, 3)), d=np.empty((2 * n, 3)), w=np.empty((2 * n, 3)),
-                stk=np.zeros((2 * n, 4), np.int64), nstk=np.zeros(2 * n, np.int64),
-                kind=np.zeros(2 * n, np.int64))
+                stk=np.empty((2 * n, 4), np.int64), nstk=np.empty(2 * n, np.int64),
+                kind=np.empty(2 * n, np.int64), tmin=np.empty(2 * n), pix=np.empty(2 * n, np.int64),
+                gen=np.empty(2 * n, np.int64))
+
+
+# the columns of shade_batch's counts
+_COUNTS = ("shadow_rays", "ended_by_depth", "ended_by_threshold", "total_internal_reflections",
+           "reflected_rays", "refracted_rays", "escaped_rays")
 
 
 class _Tracer:
@@ -188,10 +199,11 @@ class _Tracer:
         refr = recursive and any(m.kt > 0 for m in sd.materials)
         self.do_refl, self.do_refr = refl, refr
         fres = {"none": 0, "schlick": 1, "exact": 2}[opts["fresnel"]]
+        self.env = scene.environment is not None and self.col.tex is not None
         self.kopts = np.array([opts["max_depth"] if recursive else 1, opts.get("threshold", 0.0), fres,
                                float(opts["transmissive_shadows"]), float(opts["blinn"]),
                                float(self.do_shadow), float(refl), float(refr), tol.ray_offset,
-                               tol.t_min, tol.zero, sd.extent])
+                               tol.t_min, tol.zero, sd.extent, float(not self.env)])
         self.ambient = np.asarray(scene.ambient, dtype=np.float64)
         self.geo = sd.kernel_args()
         self.stats = dict(primary_rays=0, shadow_rays=0, reflected_rays=0, refracted_rays=0,
@@ -216,55 +228,38 @@ class _Tracer:
         first = True
         while n > 0:
             h = self._hits(O, D, tmin)
-            hit = h["prim"] >= 0
+            prim = h["prim"]
             if first:
-                dd = h["t"] * (D @ fwd)
-                sel = hit & (np.arange(n) % spp == 0)
-                depth_map[pix[sel]] = dd[sel]
+                sel = np.flatnonzero((prim >= 0) & (np.arange(n) % spp == 0))
+                depth_map[pix[sel]] = h["t"][sel] * (D[sel] @ fwd)
                 first = False
-            miss = ~hit
-            if miss.any():
-                self.stats["escaped_rays"] += int(miss.sum())
+            if self.env:
+                miss = np.flatnonzero(prim < 0)
                 _accumulate(acc, pix[miss], w[miss] * self.col.background(D[miss]))
-            if not hit.any():
-                break
-            idx = np.nonzero(hit)[0]
-            O, D, pix, w, gen, stk, nstk = (a[idx] for a in (O, D, pix, w, gen, stk, nstk))
-            t, prim = h["t"][idx], h["prim"][idx]
-            # opacity map: alpha blends the surface with the straight continuation of the ray
-            alpha = h["alpha"][idx]
-            part = np.nonzero(alpha < 1.0)[0]
-            cont = (O[part], D[part], pix[part], w[part] * (1.0 - alpha[part, None]), gen[part],
-                    stk[part], nstk[part], self._past(O[part], D[part], t[part]))
-            w = w * alpha[:, None]
-            ng, ns = h["ng"][idx], h["ns"][idx]
-            C, ns = self.col.colors(prim, h["po"][idx], ns, h["uv"][idx])
-            m = len(idx)
-            contrib = np.zeros((m, 3))
-            ch = _alloc_children(m)
-            counts = np.zeros((m, 4), np.int64)
-            k.shade_batch(self.geo, sd.mat, sd.mat_tab, sd.lights, self.ambient, O, D, t, prim,
-                          ng, np.ascontiguousarray(ns), np.ascontiguousarray(C), h["ev"][idx], w,
-                          gen, stk, nstk, self.kopts, contrib, ch["o"], ch["d"], ch["w"],
-                          ch["stk"], ch["nstk"], ch["kind"], counts)
+            C, ns = self.col.colors(prim, h["po"], h["ns"], h["uv"])
+            cont = None
+            if self.has_opacity:  # alpha blends the surface with the ray's straight continuation
+                alpha = h["alpha"]
+                part = np.flatnonzero((prim >= 0) & (alpha < 1.0))
+                cont = (O[part], D[part], w[part] * (1.0 - alpha[part, None]), stk[part], nstk[part],
+                        self._past(O[part], D[part], h["t"][part]), pix[part], gen[part])
+                w = w * alpha[:, None]
+            contrib = np.empty((n, 3))
+            ch = _alloc_children(n)
+            counts = np.empty((n, 7), np.int64)
+            k.shade_batch(self.geo, sd.mat, sd.mat_tab, sd.lights, self.ambient, self.col.bg, O, D,
+                          h["t"], prim, h["ng"], ns, C, h["ev"], w, gen, stk, nstk, pix, self.kopts,
+                          contrib, ch["o"], ch["d"], ch["w"], ch["stk"], ch["nstk"], ch["kind"],
+                          ch["tmin"], ch["pix"], ch["gen"], counts)
             _accumulate(acc, pix, contrib)
-            cs = counts.sum(0)
-            self.stats["shadow_rays"] += int(cs[0])
-            self.stats["ended_by_depth"] += int(cs[1])
-            self.stats["ended_by_threshold"] += int(cs[2])
-            self.stats["total_internal_reflections"] += int(cs[3])
-            kind = ch["kind"]
-            self.stats["reflected_rays"] += int((kind == 1).sum())
-            self.stats["refracted_rays"] += int((kind == 2).sum())
-            live = np.nonzero(kind > 0)[0]
-            parent = live // 2
-            O, D, w = ch["o"][live], ch["d"][live], ch["w"][live]
-            stk, nstk = ch["stk"][live], ch["nstk"][live]
-            pix, gen = pix[parent], gen[parent] + 1
-            tmin = tol.t_min * np.maximum(np.abs(O).max(1), sd.extent)
-            if len(part):
-                O, D, pix, w, gen, stk, nstk, tmin = (np.concatenate([x, y]) for x, y in
-                                                      zip((O, D, pix, w, gen, stk, nstk, tmin), cont))
+            for key, v in zip(_COUNTS, counts.sum(0)):
+                self.stats[key] += int(v)
+            live = np.flatnonzero(ch["kind"])
+            O, D, w, stk, nstk, tmin, pix, gen = (ch[x][live] for x in
+                                                   ("o", "d", "w", "stk", "nstk", "tmin", "pix", "gen"))
+            if cont is not None and len(cont[0]):
+                O, D, w, stk, nstk, tmin, pix, gen = (np.concatenate([x, y]) for x, y in
+                                                      zip((O, D, w, stk, nstk, tmin, pix, gen), cont))
             n = len(O)
         return acc / spp, depth_map
 
@@ -305,8 +300,7 @@ class _Tracer:
 
 
 def _accumulate(acc, pix, values):
-    for c in range(3):
-        acc[:, c] += np.bincount(pix, weights=values[:, c], minlength=len(acc))
+    _kernels().accumulate(acc, pix, np.ascontiguousarray(values))
 
 
 class _WhittedBase:
