@@ -187,6 +187,7 @@ class SceneRun:
     def __init__(self, cat: Catalogue, case: dict, method: str):
         self.cat, self.case, self.method = cat, case, method
         self.nonfinite = 0
+        self.stats: dict = {}
 
     def options(self, method: str, table_: dict | None = None) -> dict:
         t = self.case.get("options", {}) if table_ is None else table_
@@ -196,6 +197,8 @@ class SceneRun:
         m = method or self.method
         res = render(scene, m, **(self.options(m) if options is None else options))
         self.nonfinite += int(res.stats.get("nonfinite_pixels", 0))
+        if not self.stats:
+            self.stats = res.stats  # of the case's own (first) render
         return res.image
 
 
@@ -485,7 +488,10 @@ def run_case(cat: Catalogue, case: dict, method: str) -> Row:
             if method not in available():
                 row.verdict = f"unavailable: method {method} not registered"
                 return row
-            out = SCENE_CHECKS[case["check"]](SceneRun(cat, case, method))
+            run = SceneRun(cat, case, method)
+            out = SCENE_CHECKS[case["check"]](run)
+            shown = [f"{k} = {run.stats[k]}" for k in case.get("note_stats", []) if k in run.stats]
+            out.note = "; ".join(([out.note] if out.note else []) + shown)
         else:
             try:
                 fn = resolve_callable(case["call"])
