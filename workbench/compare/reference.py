@@ -13,6 +13,11 @@ its quality knob, ``knob.values[-1]``):
 4. ``phong`` at its finest tessellation (per-pixel local model);
 5. otherwise the first registered method that applies, at its finest setting.
 
+The reference is point-sampled at pixel centres (the workbench's definition of an image; only
+the knob is raised, other options keep their defaults, e.g. ``spp = 1``).  Supersampling
+(``spp > 1``) converges to the box-filtered image instead, so its error against this
+reference does not fall with ``spp``: :data:`SAMPLING_NOTE` says so in the reports.
+
 ``--reference METHOD`` overrides the rule.  Methods that leave out features the reference
 builds (e.g. Phong has no reflection, refraction or shadows) differ *physically* from it, not
 only by discretisation: :func:`physical_differences` says which, and the report shows it.
@@ -26,6 +31,11 @@ from ..renderers.base import available, get_renderer
 from ..scene import features as F
 from ..scene.model import Scene
 from .runs import MethodRun, timed_run
+
+
+SAMPLING_NOTE = ("The reference samples each pixel at its centre (1 sample); supersampled images "
+                 "(spp > 1) converge to the pixel-averaged image instead, so their error against this "
+                 "reference measures antialiasing, not convergence.")
 
 
 @dataclass

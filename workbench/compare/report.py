@@ -206,6 +206,7 @@ def _study_section(out_dir: Path) -> str:
     rows = [[p["method"], f"{p['knob']}={p['value']}", p["time_s"], p["rmse"], p["flip"]]
             for p in study["points"] if p.get("pareto")]
     return ("<h2>Error against run time</h2>" + img_tag(png, "study") +
+            "".join(f"<p>{esc(n)}</p>" for n in study.get("notes", [])) +
             f"<p>Study of {esc(study['scene']['name'])} at {study['size'][0]}x{study['size'][1]} "
             f"(reference {esc(study['reference']['method'])}); Pareto front:</p>"
             + table(["method", "setting", "time (s)", "RMSE", "FLIP"], rows, numeric={2, 3, 4}))

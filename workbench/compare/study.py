@@ -33,7 +33,7 @@ from ..scene.model import Scene
 from .html import esc, img_tag, page, table
 from .metrics import metrics
 from .outputs import dumps, machine_info, staged
-from .reference import choose_reference
+from .reference import SAMPLING_NOTE, choose_reference
 from .runs import timed_run
 
 CSV_FIELDS = ["method", "knob", "value", "status", "reason", "time_s", "cold_s", "compile_s", "rmse",
@@ -171,6 +171,7 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
                            "sequential in one process; time_s = median of warm wall times; error "
                            f"evaluation afterwards ({'in %d worker processes' % jobs if jobs > 1 else 'in-process'})",
         "points": points, "machine": load,
+        "notes": [SAMPLING_NOTE] if any(p["knob"] == "spp" for p in points) else [],
     }
     with staged(out_dir, last=("study.json", "study.html")) as stage:
         plot(points, stage / "study.png", f"{scene.name} {w}x{h}: error against warm run time "
@@ -240,6 +241,7 @@ def render_html(result: dict, stage: Path) -> str:
             f"<p>Reference: {esc(ref['method'])} {esc(ref['options'])}: {esc(ref['reason'])}</p>",
             img_tag(stage / "study.png", "study"),
             f"<p class='muted'>{esc(result['timing_protocol'])}</p>",
+            "".join(f"<p>{esc(n)}</p>" for n in result["notes"]),
             table(["method", "setting", "status", "time (s, warm median)", "compile (s)", "RMSE",
                    "PSNR (dB)", "FLIP", "Pareto (RMSE)"], rows, numeric={3, 4, 5, 6, 7}),
             "<h2>Machine</h2>", table(["key", "value"], [[k, v] for k, v in result["machine"].items()])]
