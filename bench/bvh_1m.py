@@ -1,0 +1,81 @@
+"""BVH build time and peak memory for a mesh of about 1M triangles (target: a few seconds,
+under 1 GB).
+
+The mesh is the procedural blob at 8 subdivisions (20 * 4^8 = 1,310,720 triangles).  The
+build (binned SAH, :mod:`workbench.renderers.raytrace.bvh`) runs in a child process that
+first loads the triangles and compiles (or loads from the numba cache) the builder on a tiny
+input, so that its peak resident memory before the build is the baseline; the peak after the
+build minus that baseline is the build's own peak memory.  Also traces 640 x 480 primary rays
+against it (closest hit through the BVH) for a rays/s figure.
+
+Writes ``bench/results/bvh_1m.json`` and prints it.  Run: ``.venv/bin/python bench/bvh_1m.py``.
+"""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+RESULTS = ROOT / "bench" / "results"
+
+CHILD = r"""
+import json, resource, sys, time
+import numpy as np
+from workbench.renderers.raytrace.bvh import build_bvh
+tri = np.load(sys.argv[1])
+build_bvh(tri[:64])  # JIT or cache load, outside the measurement
+base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+t0 = time.perf_counter()
+order, box, meta = build_bvh(tri)
+dt = time.perf_counter() - t0
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+print(json.dumps(dict(build_s=dt, baseline_rss_mb=base / 1024, peak_rss_mb=peak / 1024,
+                      build_peak_extra_mb=(peak - base) / 1024, nodes=int(len(box)),
+                      bvh_bytes_mb=(box.nbytes + meta.nbytes + order.nbytes) / 2**20,
+                      triangles_mb=tri.nbytes / 2**20)))
+"""
+
+
+def main() -> dict:
+    import time
+
+    import workbench
+    from workbench.scene.generate import generate_mesh
+    from workbench.scene.io import scene_from_dict
+    t0 = time.perf_counter()
+    mesh = generate_mesh("blob", subdivisions=8)
+    gen_s = time.perf_counter() - t0
+    V, F = np.asarray(mesh.vertices), np.asarray(mesh.faces)
+    tri = np.ascontiguousarray(V[F].reshape(-1, 9))
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "tri.npy"
+        np.save(path, tri)
+        p = subprocess.run([sys.executable, "-c", CHILD, str(path)], capture_output=True, text=True, cwd=ROOT)
+        if p.returncode != 0:
+            raise RuntimeError(p.stderr[-3000:])
+        res = json.loads(p.stdout.strip().splitlines()[-1])
+    res.update(triangles=int(len(F)), mesh_generation_s=gen_s)
+    # primary rays against the 1.3M-triangle mesh (BVH built inside the render: timings)
+    from workbench.scene import model as m
+    sc = scene_from_dict({"camera": {"position": [0, 0.5, -3.5], "look_at": [0, 0, 0], "resolution": [640, 480]},
+                          "materials": {"clay": {"color": [0.75, 0.55, 0.4]}},
+                          "objects": [{"type": "sphere", "radius": 0.01, "material": "clay"}]})
+    from dataclasses import replace
+    blob = m.Mesh("clay", vertices=V, faces=F, normals=np.asarray(mesh.vertex_normals))
+    sc = replace(sc, objects=(blob,))
+    r = workbench.render(sc, "raycast")
+    res["render_640x480_primary"] = dict(trace_s=r.timings["trace"], bvh_build_in_render_s=r.timings["bvh_build"],
+                                         mrays_per_s=r.stats["mrays_per_s"], rays=r.stats["total_rays"])
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    (RESULTS / "bvh_1m.json").write_text(json.dumps(res, indent=2))
+    print(json.dumps(res, indent=2))
+    return res
+
+
+if __name__ == "__main__":
+    main()
