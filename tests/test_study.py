@@ -98,3 +98,26 @@ def test_radiosity_error_falls_with_hemicube_resolution_on_parallel_squares(tmp_
                 sweeps={"radiosity": ("hemicube_resolution", [4, 8, 16, 32])}, progress=False)
     _, rmse = _errors(res, "radiosity")
     assert all(b < a for a, b in zip(rmse, rmse[1:])), rmse
+
+
+def test_parallel_error_evaluation_gives_the_same_numbers():
+    from workbench.compare.study import evaluate
+    rng = np.random.default_rng(1)
+    ref = rng.random((24, 32, 3)).astype(np.float32)
+    images = [np.clip(ref + s * rng.standard_normal(ref.shape), 0, 1).astype(np.float32) for s in (0.01, 0.1, 0.3)]
+    assert evaluate(images, ref, jobs=2) == evaluate(images, ref, jobs=1)
+
+
+def test_reference_rule_order():
+    """Emitters first go to radiosity (or hybrid with mirrors/glass), otherwise the ray tracer."""
+    from workbench.compare.reference import candidates
+    from workbench.scene.io import load_scene
+    regs = set(available())
+    cornell = [m for m, _ in candidates(load_scene("cornell"))]
+    whitted = [m for m, _ in candidates(load_scene("whitted"))]
+    assert "hybrid" not in cornell[:1]  # cornell has no mirror/glass
+    if "radiosity" in regs:
+        assert cornell[0] == "radiosity"
+    if "raytrace" in regs:
+        assert whitted[0] == "raytrace"
+    assert sorted(whitted) == sorted(regs) and sorted(cornell) == sorted(regs)

@@ -74,7 +74,9 @@ def evaluate(images: list[np.ndarray], reference: np.ndarray, jobs: int) -> list
     """Metrics of every image against the reference, in ``jobs`` worker processes if > 1."""
     if jobs <= 1 or len(images) < 2:
         return [metrics(im, reference) for im in images]
-    with ProcessPoolExecutor(max_workers=jobs) as pool:
+    import multiprocessing
+    # "spawn": fresh workers, not forks of a process holding GL contexts and numba threads
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("spawn")) as pool:
         return list(pool.map(_metrics_job, [(im, reference) for im in images]))
 
 
