@@ -7,7 +7,8 @@ Output folder (written all-or-nothing, see :func:`workbench.compare.outputs.stag
                              apply or failed listed under it with the reason)
     images/<m>.png|.npy      each method's image (sRGB PNG, linear float32 .npy); reference.*
     heat/<m>_flip.png        FLIP map against the reference, fixed scale [0, 1]
-    heat/<m>_abs.png         mean |linear error| over RGB, scale shared by all methods
+    heat/<m>_abs.png         mean |linear error| over RGB, scale shared by all methods (median of
+                             their 99.5th percentiles, at most 1; larger errors saturate)
     report.json              every number (metrics, timings with compile apart, stats,
                              features used / left out, reference and why, machine, GL_RENDERER)
     report.html              all of it in one self-contained page (images embedded)
@@ -97,7 +98,9 @@ def compare(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
         if r.status == "ok":
             e["metrics"] = metrics(r.image, ref_img)
             maps[r.method] = (error_map(r.image, ref_img, "flip"), error_map(r.image, ref_img, "abs"))
-    abs_max = max([float(np.percentile(a, 99.5)) for _, a in maps.values()] + [1e-6])
+    # shared scale: the median over methods of their 99.5th percentile, at most display white
+    # (1.0); larger errors saturate, so one far-off method does not blacken every other map
+    abs_max = max(min(1.0, float(np.median([np.percentile(a, 99.5) for _, a in maps.values()] or [1.0]))), 1e-6)
 
     report = {
         "kind": "compare", "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
@@ -182,7 +185,8 @@ def render_html(report: dict, stage: Path, out_dir: Path) -> str:
           "out; its error then measures the missing effect, not only discretisation.</p>",
           "<h2>Error heat maps against the reference</h2>",
           "<p>FLIP (perceptual, scale 0..1) and mean |linear error| over RGB "
-          f"(scale 0..{report['heatmap_scales']['abs'][1]:.3g}, shared by all methods).</p>"]
+          f"(scale 0..{report['heatmap_scales']['abs'][1]:.3g}, shared by all methods: the median of their "
+          "99.5th percentiles, at most 1; larger errors saturate).</p>"]
     for e in report["methods"]:
         if e["status"] == "ok":
             b.append("<div>" + "".join(f"<figure>{img_tag(stage / e['files'][k], k)}<figcaption>"
