@@ -504,6 +504,8 @@ def run_case(cat: Catalogue, case: dict, method: str) -> Row:
         row.verdict = _verdict(row, out)
     except NotApplicable as e:
         row.verdict = f"unavailable: {method} does not apply: {e}"
+    except ImportError as e:  # registered, but its module has not landed or does not import
+        row.verdict = f"unavailable: method {method} cannot be loaded ({e})"
     except WorkbenchError as e:
         row.verdict = (f"ok: rejected with a clear error: {e}" if case.get("accept_error")
                        else f"breaks: {type(e).__name__}: {e}")
