@@ -1,0 +1,180 @@
+"""The ray tracer against POV-Ray 3.7 on the same scenes, same machine, same run.
+
+1. Whitted scene (``scenes/whitted.toml`` / ``bench/whitted.pov``), 640 x 480, no
+   antialiasing, maximum trace level 5, adaptive depth control 1/255 (POV-Ray's default
+   ``adc_bailout``; our ``threshold``), 2 threads for both.
+2. A mesh of 81,920 triangles (``scenes/mesh.toml``: the procedural blob, exported to POV-Ray
+   as a ``mesh2`` with its vertex normals, in a temporary directory).
+
+Rays per second: POV-Ray's "Rays" (eye + reflected + refracted) plus its "Shadow Ray Tests",
+over its "Trace Time" (which excludes its start-up and parsing); ours: primary + shadow +
+reflected + refracted rays over our trace phase (``timings["trace"]``, warm JIT cache, best of
+3).  Whole commands: POV-Ray's process wall time against ``workbench render ...`` as a process
+(Python start-up, imports, scene loading, warm numba cache, PNG writing).  Cold compile: the
+same render in a fresh process with an empty numba cache directory.
+
+Writes ``bench/results/povray_whitted.json`` and prints it.  Run:
+``.venv/bin/python bench/povray_whitted.py``.
+"""
+from __future__ import annotations
+
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+RESULTS = ROOT / "bench" / "results"
+W, H = 640, 480
+THRESHOLD = 1.0 / 255.0
+PY = sys.executable
+
+
+def povray(pov: Path, out: Path) -> dict:
+    """Run POV-Ray; parse its statistics."""
+    cmd = ["povray", f"+W{W}", f"+H{H}", "-A", "+MV3.7", "Work_Threads=2", "-D", f"+O{out}", f"+I{pov}"]
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, capture_output=True, text=True, cwd=pov.parent)
+    wall = time.perf_counter() - t0
+    log = p.stdout + p.stderr
+    if p.returncode != 0:
+        raise RuntimeError(f"povray failed:\n{log[-2000:]}")
+
+    def num(pattern):
+        m = re.search(pattern, log)
+        return float(m.group(1)) if m else 0.0
+    rays = num(r"Rays:\s+(\d+)")
+    shadow = num(r"Shadow Ray Tests:\s+(\d+)")
+    trace = num(r"Trace Time:.*\(([\d.]+) seconds\)")
+    return dict(command=" ".join(cmd), wall_s=wall, trace_s=trace, rays=rays, shadow_rays=shadow,
+                reflected=num(r"Reflected Rays:\s+(\d+)"), refracted=num(r"Refracted Rays:\s+(\d+)"),
+                total_rays=rays + shadow, mrays_per_s=(rays + shadow) / max(trace, 1e-9) / 1e6)
+
+
+def ours_in_process(scene_name: str, repeats: int = 3) -> dict:
+    import numba
+
+    import workbench
+    numba.set_num_threads(2)
+    scene = workbench.load_scene(scene_name)
+    workbench.render(scene, "raytrace", width=32, height=24)  # JIT (or cache load)
+    best = None
+    for _ in range(repeats):
+        r = workbench.render(scene, "raytrace", width=W, height=H, threshold=THRESHOLD, max_depth=5)
+        if best is None or r.timings["trace"] < best.timings["trace"]:
+            best = r
+    st = best.stats
+    return dict(trace_s=best.timings["trace"], total_s=best.timings["total"],
+                bvh_build_s=best.timings.get("bvh_build", 0.0), total_rays=st["total_rays"],
+                primary=st["primary_rays"], shadow_rays=st["shadow_rays"],
+                reflected=st["reflected_rays"], refracted=st["refracted_rays"],
+                mrays_per_s=st["total_rays"] / best.timings["trace"] / 1e6)
+
+
+def ours_command(scene: str, cache_dir: str, out: Path) -> dict:
+    """``workbench render`` as a separate process; returns wall time and its timings."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache_dir, NUMBA_NUM_THREADS="2")
+    js = out.with_suffix(".json")
+    cmd = [str(Path(PY).parent / "workbench"), "render", scene, "-m", "raytrace", "-o", str(out),
+           "--size", f"{W}x{H}", "--set", f"threshold={THRESHOLD}", "--set", "max_depth=5",
+           "--set", "progress=false", "--json", str(js)]
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=ROOT)
+    wall = time.perf_counter() - t0
+    if p.returncode != 0:
+        raise RuntimeError(f"workbench render failed:\n{p.stdout[-2000:]}{p.stderr[-2000:]}")
+    t = json.loads(js.read_text())["timings"]
+    return dict(command=" ".join(cmd[1:]), wall_s=wall, compile_s=t["compile"], trace_s=t["trace"])
+
+
+def export_mesh_pov(path: Path) -> None:
+    """``scenes/mesh.toml`` as a POV-Ray scene (mesh2 with normals, same camera and lights)."""
+    import workbench
+    from workbench.scene import model as m
+    sc = workbench.load_scene("mesh")
+    cam = sc.camera
+    hfov = np.degrees(2 * np.arctan(np.tan(np.radians(cam.fov_y) / 2) * W / H))
+    v3 = lambda v: "<{:.9g}, {:.9g}, {:.9g}>".format(*v)  # noqa: E731
+    out = ["#version 3.7;", f"global_settings {{ assumed_gamma 1.0 max_trace_level 5 adc_bailout 1/255 "
+           f"ambient_light rgb {v3(sc.ambient)} }}", f"background {{ color rgb {v3(sc.background)} }}",
+           f"camera {{ perspective location {v3(cam.position)} up y right -x*image_width/image_height "
+           f"angle {hfov:.9g} look_at {v3(cam.look_at)} }}"]
+    for lt in sc.lights:
+        if isinstance(lt, m.DirectionalLight):  # a parallel light far away
+            pos = -np.asarray(lt.direction) * 1e5
+            out.append(f"light_source {{ {v3(pos)} color rgb {v3(np.asarray(lt.color) * lt.intensity)} "
+                       f"parallel point_at <0, 0, 0> }}")
+        else:
+            out.append(f"light_source {{ {v3(lt.position)} color rgb {v3(np.asarray(lt.color) * lt.intensity)} }}")
+
+    def finish(mt):
+        s = f"finish {{ ambient {mt.ka} diffuse {mt.kd}"
+        if mt.ks > 0:
+            s += f" phong {mt.ks} phong_size {mt.shininess}"
+        return s + " }"
+    for o in sc.objects:
+        mt = sc.materials[o.material]
+        tex = f"pigment {{ color rgb {v3(mt.color)} }} {finish(mt)}"
+        if isinstance(o, m.Mesh):
+            Wm = np.asarray(o.world_from_object)
+            V = np.asarray(o.vertices) @ Wm[:3, :3].T + Wm[:3, 3]
+            N = np.asarray(o.normals) @ np.linalg.inv(Wm[:3, :3])
+            N /= np.linalg.norm(N, axis=1, keepdims=True)
+            F = np.asarray(o.faces)
+            out.append("mesh2 {")
+            out.append(f"vertex_vectors {{ {len(V)}, " + ", ".join(v3(v) for v in V) + " }")
+            out.append(f"normal_vectors {{ {len(N)}, " + ", ".join(v3(v) for v in N) + " }")
+            out.append(f"face_indices {{ {len(F)}, " + ", ".join("<%d, %d, %d>" % tuple(f) for f in F) + " }")
+            out.append(f"texture {{ {tex} }} }}")
+        elif isinstance(o, m.Plane):
+            c = o.corners()
+            out.append("polygon { 5, " + ", ".join(v3(p) for p in [*c, c[0]]) + f" texture {{ {tex} }} }}")
+        else:
+            raise NotImplementedError(o.kind)
+    path.write_text("\n".join(out) + "\n")
+
+
+def main() -> dict:
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    res: dict = {"machine": f"{os.cpu_count()} CPUs (shared), both renderers on 2 threads",
+                 "size": f"{W}x{H}", "threshold_adc_bailout": THRESHOLD, "max_depth": 5}
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        # --- Whitted
+        pov = povray(ROOT / "bench" / "whitted.pov", tmp / "pov.png")
+        cold = ours_command("whitted", str(tmp / "cold_cache"), tmp / "cold.png")
+        warm_cache = str(ROOT / ".numba_cache")
+        ours_command("whitted", warm_cache, tmp / "w0.png")  # make sure the cache is warm
+        warm = min((ours_command("whitted", warm_cache, tmp / f"w{i}.png") for i in range(1, 3)),
+                   key=lambda d: d["wall_s"])
+        inproc = ours_in_process("whitted")
+        res["whitted"] = dict(
+            povray=pov, ours_trace=inproc, ours_command_warm=warm, ours_command_cold=cold,
+            numba_cold_compile_s=cold["compile_s"],
+            rays_per_s_ratio=inproc["mrays_per_s"] / pov["mrays_per_s"],
+            command_ratio_pov_over_ours=pov["wall_s"] / warm["wall_s"],
+            targets={"rays_per_s_ratio >= 2": inproc["mrays_per_s"] / pov["mrays_per_s"] >= 2,
+                     "warm command no slower than POV-Ray": warm["wall_s"] <= pov["wall_s"]})
+        # --- mesh
+        mesh_pov = tmp / "mesh_blob.pov"
+        export_mesh_pov(mesh_pov)
+        povm = povray(mesh_pov, tmp / "povm.png")
+        oursm = ours_in_process("mesh")
+        warm_m = ours_command("mesh", warm_cache, tmp / "m.png")
+        res["mesh"] = dict(
+            triangles=81920, povray=povm, ours_trace=oursm, ours_command_warm=warm_m,
+            rays_per_s_ratio=oursm["mrays_per_s"] / povm["mrays_per_s"],
+            targets={"rays_per_s_ratio >= 3": oursm["mrays_per_s"] / povm["mrays_per_s"] >= 3})
+    (RESULTS / "povray_whitted.json").write_text(json.dumps(res, indent=2))
+    print(json.dumps(res, indent=2))
+    return res
+
+
+if __name__ == "__main__":
+    main()
