@@ -7,9 +7,10 @@
    as a ``mesh2`` with its vertex normals, in a temporary directory).
 
 Rays per second: POV-Ray's "Rays" (eye + reflected + refracted) plus its "Shadow Ray Tests",
-over its "Trace Time" (which excludes its start-up and parsing); ours: primary + shadow +
-reflected + refracted rays over our trace phase (``timings["trace"]``, warm JIT cache, best of
-3).  Whole commands: POV-Ray's process wall time against ``workbench render ...`` as a process
+over its "Trace Time" (which excludes its start-up and parsing) and over the CPU-seconds it
+reports for the trace (a fairer measure on a shared, loaded machine); ours: primary + shadow +
+reflected + refracted rays over our trace phase (``timings["trace"]`` and its CPU seconds
+``timings["trace_cpu"]``, warm JIT cache, best of 3).  Whole commands: POV-Ray's process wall time against ``workbench render ...`` as a process
 (Python start-up, imports, scene loading, warm numba cache, PNG writing).  Cold compile: the
 same render in a fresh process with an empty numba cache directory.
 
@@ -52,9 +53,11 @@ def povray(pov: Path, out: Path) -> dict:
     rays = num(r"Rays:\s+(\d+)")
     shadow = num(r"Shadow Ray Tests:\s+(\d+)")
     trace = num(r"Trace Time:.*\(([\d.]+) seconds\)")
-    return dict(command=" ".join(cmd), wall_s=wall, trace_s=trace, rays=rays, shadow_rays=shadow,
+    cpu = num(r"Trace Time:.*\n.*with ([\d.]+) CPU-seconds")
+    return dict(command=" ".join(cmd), wall_s=wall, trace_s=trace, trace_cpu_s=cpu, rays=rays, shadow_rays=shadow,
                 reflected=num(r"Reflected Rays:\s+(\d+)"), refracted=num(r"Refracted Rays:\s+(\d+)"),
-                total_rays=rays + shadow, mrays_per_s=(rays + shadow) / max(trace, 1e-9) / 1e6)
+                total_rays=rays + shadow, mrays_per_s=(rays + shadow) / max(trace, 1e-9) / 1e6,
+                mrays_per_cpu_s=(rays + shadow) / max(cpu, 1e-9) / 1e6)
 
 
 def ours_in_process(scene_name: str, repeats: int = 3) -> dict:
@@ -70,11 +73,12 @@ def ours_in_process(scene_name: str, repeats: int = 3) -> dict:
         if best is None or r.timings["trace"] < best.timings["trace"]:
             best = r
     st = best.stats
-    return dict(trace_s=best.timings["trace"], total_s=best.timings["total"],
+    return dict(trace_s=best.timings["trace"], trace_cpu_s=best.timings["trace_cpu"], total_s=best.timings["total"],
                 bvh_build_s=best.timings.get("bvh_build", 0.0), total_rays=st["total_rays"],
                 primary=st["primary_rays"], shadow_rays=st["shadow_rays"],
                 reflected=st["reflected_rays"], refracted=st["refracted_rays"],
-                mrays_per_s=st["total_rays"] / best.timings["trace"] / 1e6)
+                mrays_per_s=st["total_rays"] / best.timings["trace"] / 1e6,
+                mrays_per_cpu_s=st["total_rays"] / best.timings["trace_cpu"] / 1e6)
 
 
 def ours_command(scene: str, cache_dir: str, out: Path) -> dict:
@@ -158,6 +162,7 @@ def main() -> dict:
             povray=pov, ours_trace=inproc, ours_command_warm=warm, ours_command_cold=cold,
             numba_cold_compile_s=cold["compile_s"],
             rays_per_s_ratio=inproc["mrays_per_s"] / pov["mrays_per_s"],
+            rays_per_cpu_s_ratio=inproc["mrays_per_cpu_s"] / pov["mrays_per_cpu_s"],
             command_ratio_pov_over_ours=pov["wall_s"] / warm["wall_s"],
             targets={"rays_per_s_ratio >= 2": inproc["mrays_per_s"] / pov["mrays_per_s"] >= 2,
                      "warm command no slower than POV-Ray": warm["wall_s"] <= pov["wall_s"]})
@@ -170,6 +175,7 @@ def main() -> dict:
         res["mesh"] = dict(
             triangles=81920, povray=povm, ours_trace=oursm, ours_command_warm=warm_m,
             rays_per_s_ratio=oursm["mrays_per_s"] / povm["mrays_per_s"],
+            rays_per_cpu_s_ratio=oursm["mrays_per_cpu_s"] / povm["mrays_per_cpu_s"],
             targets={"rays_per_s_ratio >= 3": oursm["mrays_per_s"] / povm["mrays_per_s"] >= 3})
     (RESULTS / "povray_whitted.json").write_text(json.dumps(res, indent=2))
     print(json.dumps(res, indent=2))

@@ -329,7 +329,7 @@ class _WhittedBase:
         if opts["progress"]:
             from tqdm import tqdm
             bar = tqdm(total=height, unit="row", desc=self.name)
-        t1 = time.perf_counter()
+        t1, c1 = time.perf_counter(), time.process_time()
         for y0 in bands:
             y1 = min(height, y0 + rows)
             a, b = y0 * width * spp, y1 * width * spp
@@ -343,6 +343,7 @@ class _WhittedBase:
         if bar is not None:
             bar.close()
         timings["trace"] = time.perf_counter() - t1
+        timings["trace_cpu"] = time.process_time() - c1  # CPU seconds, all threads
         st = tr.stats
         total = st["primary_rays"] + st["shadow_rays"] + st["reflected_rays"] + st["refracted_rays"]
         st["total_rays"] = total
