@@ -170,7 +170,12 @@ class Catalogue:
         d = self.scene_dict(case, variant)
         if factor is not None:
             d = scale_scene_dict(d, factor)
-        return scene_from_dict(d, source=f"{self.path.name}:{case['id']}", base_dir=self.path.parent)
+        if case["scene"] in self.scenes:
+            base_dir = self.path.parent
+        else:  # a bundled scene: its relative asset paths are relative to its own file
+            from ..scene.library import resolve
+            base_dir = resolve(case["scene"]).parent
+        return scene_from_dict(d, source=f"{self.path.name}:{case['id']}", base_dir=base_dir)
 
 
 def per_method(case: dict, key: str, method: str, default):
