@@ -1,9 +1,39 @@
-"""CPU ray caster and Whitted ray tracer (``raycast``, ``raytrace``) and the public
-``intersect`` (``workbench.raytrace.intersect``).
+"""CPU ray caster and Whitted ray tracer (``raycast``, ``raytrace``), the public
+``intersect`` (``workbench.raytrace.intersect``) and ``ray_tree``.
 
-Modules: :mod:`.flatten` (scene -> arrays), :mod:`.bvh` (SAH BVH), :mod:`.kernels` (numba),
-:mod:`.csg` and :mod:`.shapes` + :mod:`.reference` (readable reference, ray tree),
-:mod:`.whitted` (the renderers).
+Modules: :mod:`.flatten` (scene -> arrays), :mod:`.bvh` (binned SAH BVH), :mod:`.kernels`
+(numba: intersection, shading with shadow feelers, child rays), :mod:`.whitted` (the two
+renderers, wavefront loop, textures through :mod:`workbench.renderers.texturing`), and the
+readable reference :mod:`.shapes` + :mod:`.csg` + :mod:`.reference` (one ray at a time, the
+course's trace / shade / intersect structure; tested against the kernels).
+
+Options of both methods (``workbench methods`` lists them): ``spp`` and ``seed`` (stratified
+jitter), ``shadows``, ``transmissive_shadows`` (an occluder with k_t attenuates a shadow
+feeler by k_t instead of blocking it), ``blinn``, ``fresnel`` (``none``: constant k_r, k_t;
+``schlick``; ``exact`` dielectric: reflection ``k_r + k_t F``, transmission ``k_t (1 - F)``),
+``progress`` (tqdm bar on stderr) and ``on_tile``; ``raytrace`` adds ``max_depth`` (its quality
+knob: the maximum number of ray generations in a path, primary = 1, as the course's
+``recurs_max`` and POV-Ray's ``max_trace_level``) and ``threshold`` (the course's perceptual
+threshold: a child whose accumulated RGB weight, max component, is at most this is not traced).
+
+For a UI: ``on_tile(y0, y1, x0, x1, tile)`` is called in the rendering thread after each band
+of rows with the finished (y1 - y0, x1 - x0, 3) float32 linear tile (full width bands of about
+65k rays); ``ray_tree(scene, i, j, **options)`` returns the tree of pixel (i, j).
+
+Stats: ``primary_rays``, ``shadow_rays``, ``reflected_rays``, ``refracted_rays``,
+``ended_by_depth``, ``ended_by_threshold``, ``escaped_rays``, ``total_internal_reflections``,
+``total_rays``, ``mrays_per_s``; timings ``build`` (scene arrays and BVH), ``bvh_build``,
+``compile`` (first-call JIT or numba disk-cache load), ``trace`` and ``trace_cpu``;
+``RenderResult.depth`` is the camera-space depth of the primary hit.
+
+Conventions: normals from the intersection are outward; the shading normal is turned towards
+the viewer (two-sided surfaces).  Rectangles and polygons are thin sheets (transmission goes
+straight through); spheres, boxes, quadrics, meshes and CSG solids are media (refraction with
+a small stack of nested media, Beer-Lambert absorption inside).  A top-level quadric is its
+surface cut to its bounds (open); inside a CSG tree it is the solid ``P^T Q P < 0`` within its
+bounds box (capped).  Meshes inside CSG trees are not supported.  Area lights are point-light
+stand-ins for shading and emissive front-facing polygons (radiance colour x intensity) that
+cast no shadow.  Mesh ``vertex_emission`` is interpolated and added as emission.
 """
 from __future__ import annotations
 

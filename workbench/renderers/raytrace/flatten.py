@@ -22,7 +22,7 @@ sheet (transmission goes straight through).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -65,7 +65,6 @@ class SceneData:
     lights: np.ndarray          # (L, 14) light table (see _light_rows)
     extent: float               # diagonal of the scene's bounds
     n_objects: int
-    features: dict = field(default_factory=dict)
     bvh_build_time: float = 0.0
 
     def kernel_args(self) -> tuple:

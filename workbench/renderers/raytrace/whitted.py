@@ -25,6 +25,7 @@ import time
 
 import numpy as np
 
+from ...core.errors import WorkbenchError
 from ...core.tol import tol
 from ...scene import features as F
 from ...scene.model import Scene
@@ -209,7 +210,6 @@ class _Tracer:
         self.stats = dict(primary_rays=0, shadow_rays=0, reflected_rays=0, refracted_rays=0,
                           ended_by_depth=0, ended_by_threshold=0, escaped_rays=0,
                           total_internal_reflections=0)
-        self.needs = needs
         self.has_opacity = F.OPACITY in needs and self.col.tex is not None
 
     def trace(self, O, D, pix, n_pixels, spp, fwd):
@@ -307,6 +307,8 @@ class _WhittedBase:
     recursive = True
 
     def render(self, scene: Scene, width: int, height: int, **o) -> RenderResult:
+        if not 1 <= o["spp"] <= 4096:
+            raise WorkbenchError(f"method {self.name!r}: option 'spp' must be within 1..4096, got {o['spp']}")
         timings = {}
         t0 = time.perf_counter()
         sd = flatten(scene)
@@ -406,7 +408,6 @@ class RaytraceRenderer(_WhittedBase):
                "threshold": Option(float, 1e-3, "perceptual threshold: a child ray whose accumulated weight (max RGB) is at most this is not traced")}
 
     def render(self, scene, width, height, **o):
-        from ...core.errors import WorkbenchError
         if o["max_depth"] < 1:
             raise WorkbenchError(f"method 'raytrace': option 'max_depth' must be >= 1, got {o['max_depth']}")
         return super().render(scene, width, height, **o)
