@@ -45,7 +45,8 @@ def test_fake_facets_error_falls_with_n_and_files_agree(tmp_path, monkeypatch):
     from PIL import Image
     with Image.open(out / "study.png") as im:
         assert im.size[0] > 400
-    assert "data:image/png;base64," in (out / "study.html").read_text()
+    html = (out / "study.html").read_text()
+    assert "data:image/png;base64," in html and "shadows: not computed by this fake" in html
 
 
 @settings(max_examples=60, deadline=None)

@@ -28,7 +28,7 @@ import io
 import json
 import time
 import tomllib
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Callable
 
@@ -59,6 +59,8 @@ class Row:
     time_s: float = 0.0
     verdict: str = ""
     note: str = ""
+    features_used: list = field(default_factory=list)
+    left_out: list = field(default_factory=list)
 
 
 @dataclass
@@ -193,6 +195,8 @@ class SceneRun:
         self.cat, self.case, self.method = cat, case, method
         self.nonfinite = 0
         self.stats: dict = {}
+        self.features_used: list[str] = []
+        self.left_out: list[str] = []
 
     def options(self, method: str, table_: dict | None = None) -> dict:
         t = self.case.get("options", {}) if table_ is None else table_
@@ -202,8 +206,8 @@ class SceneRun:
         m = method or self.method
         res = render(scene, m, **(self.options(m) if options is None else options))
         self.nonfinite += int(res.stats.get("nonfinite_pixels", 0))
-        if not self.stats:
-            self.stats = res.stats  # of the case's own (first) render
+        if not self.stats:  # of the case's own (first) render
+            self.stats, self.features_used, self.left_out = res.stats, res.features_used, res.left_out
         return res.image
 
 
@@ -497,6 +501,7 @@ def run_case(cat: Catalogue, case: dict, method: str) -> Row:
             out = SCENE_CHECKS[case["check"]](run)
             shown = [f"{k} = {run.stats[k]}" for k in case.get("note_stats", []) if k in run.stats]
             out.note = "; ".join(([out.note] if out.note else []) + shown)
+            row.features_used, row.left_out = run.features_used, run.left_out
         else:
             try:
                 fn = resolve_callable(case["call"])

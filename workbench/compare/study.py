@@ -246,5 +246,17 @@ def render_html(result: dict, stage: Path) -> str:
             "".join(f"<p>{esc(n)}</p>" for n in result["notes"]),
             table(["method", "setting", "status", "time (s, warm median)", "compile (s)", "RMSE",
                    "PSNR (dB)", "FLIP", "Pareto (RMSE)"], rows, numeric={3, 4, 5, 6, 7}),
+            "<h2>Features per method</h2>",
+            table(["method", "features used", "left out"], _features(result["points"])),
             "<h2>Machine</h2>", table(["key", "value"], [[k, v] for k, v in result["machine"].items()])]
     return page(f"{result['scene']['name']} study", "\n".join(body))
+
+
+def _features(points: list[dict]) -> list[list[str]]:
+    """One row per method: what it built of the scene and what it left out (first rendered point)."""
+    seen, rows = set(), []
+    for p in points:
+        if p["status"] == "ok" and p["method"] not in seen:
+            seen.add(p["method"])
+            rows.append([p["method"], ", ".join(p["features_used"]), "; ".join(p["left_out"]) or "none"])
+    return rows
