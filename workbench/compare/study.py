@@ -104,6 +104,13 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
     unknown = [m for m in names if m not in available()]
     if unknown:
         raise WorkbenchError(f"unknown method(s) {', '.join(unknown)} (available: {', '.join(available())})")
+    sweeps = sweeps or {}
+    for m, (option, values) in sweeps.items():
+        if m not in names:
+            raise WorkbenchError(f"--sweep {m}:{option}: method {m!r} is not among the studied methods")
+        if option not in get_renderer(m).options:
+            raise WorkbenchError(f"--sweep {m}:{option}: {m} has no option {option!r} "
+                                 f"(accepted: {', '.join(sorted(get_renderer(m).options))})")
     repeat = (2 if quick else 5) if repeat is None else int(repeat)
     if repeat < 1:
         raise WorkbenchError(f"a study needs at least one warm run per point, got repeat={repeat}")
@@ -121,7 +128,6 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
     load = machine_info()
 
     plan = []
-    sweeps = sweeps or {}
     for m in names:
         try:
             knob = get_renderer(m).knob
