@@ -176,6 +176,7 @@ def part_pvf(count: int, res: int, pairs: int) -> dict:
     t0 = time.perf_counter()
     ref = np.array([pvf.compute_viewfactor(cells[j], cells[i]) for i, j in zip(I, J)])
     t_pvf = time.perf_counter() - t0
+    analytic_pairs(g, I[:1], J[:1], order=8)                  # JIT warm-up, apart
     t0 = time.perf_counter()
     an = analytic_pairs(g, I, J, order=8)
     t_an = time.perf_counter() - t0
@@ -186,6 +187,7 @@ def part_pvf(count: int, res: int, pairs: int) -> dict:
     def stats(x, ref=ref):
         d = x - ref
         return {"mean_abs": float(np.abs(d).mean()), "max_abs": float(np.abs(d).max()),
+                "mean_rel_signed_F>1e-4": float(np.mean(d[big] / ref[big])),
                 "median_rel_F>1e-4": float(np.median(np.abs(d[big]) / ref[big])),
                 "p95_rel_F>1e-4": float(np.percentile(np.abs(d[big]) / ref[big], 95))}
     return {"room_patches": n, "pairs": int(len(I)), "pyviewfactor_version": pvf.__version__,
@@ -225,6 +227,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--part", choices=("full", "pvf", "big"))
     ap.add_argument("--quick", action="store_true", help="small sizes (smoke test)")
+    ap.add_argument("--parts", default="full,pvf,big",
+                    help="comma-separated parts to run; others are kept from the last results file")
     a = ap.parse_args()
     q = a.quick
     if a.part:
@@ -233,9 +237,12 @@ def main():
               "big": lambda: part_big(1000 if q else 10000, 64 if q else 128, 10.0 if q else 120.0)}[a.part]
         print(json.dumps(fn()))
         return
-    results = {"date": time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()),
-               "machine": f"{os.cpu_count()} CPUs (shared), llvmpipe", "quick": q}
-    for part in ("full", "pvf", "big"):
+    parts = a.parts.split(",")
+    results = json.loads(OUT.read_text()) if OUT.exists() and len(parts) < 3 else {}
+    results.update({"machine": f"{os.cpu_count()} CPUs (shared), llvmpipe", "quick": q})
+    for part in parts:
+        results[f"{part}_date"] = time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime())
+        results[f"{part}_load_average_1min_before"] = os.getloadavg()[0]
         cmd = [sys.executable, __file__, "--part", part] + (["--quick"] if q else [])
         r = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
         if r.returncode:

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...core.tol import tol
 from ...scene.model import Camera
 from .. import gl
 from .patches import PatchSet
@@ -21,7 +22,7 @@ def clip_planes(camera: Camera, points: np.ndarray) -> tuple[float, float]:
     if camera.near is not None and camera.far is not None:
         return camera.near, camera.far
     _, depth = camera.project(points)
-    far = float(max(depth.max(), 1e-300)) * 1.01 if len(depth) else 1.0
+    far = float(max(depth.max(), tol.zero)) * 1.01 if len(depth) else 1.0
     near = max(float(depth[depth > 0].min()) * 0.5 if (depth > 0).any() else far, far * NEAR_FRACTION)
     return (camera.near or min(near, far * 0.5)), (camera.far or far)
 

@@ -26,6 +26,9 @@ from ...core.errors import WorkbenchError
 from ...core.tol import tol
 
 METHODS = ("hemicube", "raycast", "analytic")
+#: pairs exchanging less than this fraction of the largest exchange are left out of the
+#: worst-pair reciprocity error (their relative error is noise)
+RECIPROCITY_FLOOR = 1e-3
 
 
 @dataclass(frozen=True)
@@ -101,7 +104,7 @@ class FormFactors:
         over all pairs (0 for exact form factors).
     reciprocity_max : float, the largest relative pair error
         ``|A_i F_ij - A_j F_ji| / (A_i F_ij + A_j F_ji)`` over pairs exchanging at least
-        ``1e-3`` of the largest exchange (smaller ones are noise-dominated).
+        ``RECIPROCITY_FLOOR`` of the largest exchange (smaller ones are noise-dominated).
     method, seconds, info : how it was made (resolution, rays, hemicube weight sum, ...).
     """
 
@@ -145,7 +148,7 @@ def reciprocity(F: np.ndarray, areas: np.ndarray) -> tuple[float, float]:
     tot = AF + AF.T
     s = float(tot.sum())
     agg = float(diff.sum() / s) if s > 0 else 0.0
-    big = tot > 1e-3 * tot.max() if tot.size and tot.max() > 0 else np.zeros_like(tot, bool)
+    big = tot > RECIPROCITY_FLOOR * tot.max() if tot.size and tot.max() > 0 else np.zeros_like(tot, bool)
     worst = float((diff[big] / tot[big]).max()) if big.any() else 0.0
     return agg, worst
 

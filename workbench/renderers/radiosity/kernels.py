@@ -189,7 +189,8 @@ def raycast_rows(tris, tri_patch, first_tri, normals, rays, seed, t_min, offset)
             k = t0
             while k < t1 - 1 and cdf[k - t0 + 1] < a:
                 k += 1
-            a = (a - cdf[k - t0]) / max(cdf[k - t0 + 1] - cdf[k - t0], 1e-300)
+            w = cdf[k - t0 + 1] - cdf[k - t0]
+            a = (a - cdf[k - t0]) / w if w > 0.0 else 0.0
             sa = np.sqrt(min(max(a, 0.0), 1.0))
             w0, w1, w2 = 1.0 - sa, sa * (1.0 - b), sa * b
             for c in range(3):

@@ -22,6 +22,7 @@ from typing import Callable
 import numpy as np
 
 from ...core.errors import WorkbenchError
+from ...core.tol import tol as TOL
 
 METHODS = ("direct", "jacobi", "gauss_seidel", "progressive")
 MAX_AUTO_ITERATIONS = 1_000_000
@@ -170,12 +171,12 @@ def _direct(F, E, R, q, t0, scalar) -> SolveResult:
         res.converged, res.message = False, ("direct solve failed: I - rho F is singular (a closed "
                                              "room with rho = 1 has no unique solution)")
         return res
-    r = np.abs(B - R * (F @ B) - E).max(0) / np.maximum(np.abs(B).max(0), 1e-300)
+    r = np.abs(B - R * (F @ B) - E).max(0) / np.maximum(np.abs(B).max(0), TOL.zero)
     res = _finish(B, B, "direct", 1, [float(r.max())], q, 0, True, 1, t0, scalar)
     if q < 1:
         res.error_bound = float(r.max() / (1 - q))  # ||e|| <= ||(I-K)^-1|| ||residual||
         res.message = f"direct LU solve; relative residual {r.max():.3g}"
-    if not np.isfinite(B).all() or (B < -1e-9 * np.abs(B).max()).any():
+    if not np.isfinite(B).all() or (B < -TOL.zero * np.abs(B).max()).any():
         res.converged = False
         res.message = "direct solve gave non-finite or negative radiosity: the system is ill-posed"
     return res
@@ -219,9 +220,9 @@ def _sweeps(F, E, R, q, tol, cap, method, t0, scalar) -> SolveResult:
 
 def _ambient(dB, R, areas) -> np.ndarray:
     """Cohen et al. 1988 ambient radiosity (C,): 1/(1 - rho_avg) * area-mean unshot radiosity."""
-    A = areas / max(areas.sum(), 1e-300)
+    A = areas / max(areas.sum(), TOL.zero)
     rho_avg = (A[:, None] * R).sum(0)
-    return (A[:, None] * dB).sum(0) / np.maximum(1 - rho_avg, 1e-12)
+    return (A[:, None] * dB).sum(0) / np.maximum(1 - rho_avg, TOL.zero)
 
 
 def _progressive_matrix(F, E, R, areas, q, tol, cap, ambient, t0, scalar) -> SolveResult:
