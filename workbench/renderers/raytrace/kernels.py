@@ -393,9 +393,29 @@ def tri_hit(tv, i, ox, oy, oz, kx, ky, kz, sx, sy, sz, tmin, tmax):
     return t, V / det, W / det
 
 
+@nb.njit(cache=True, inline="always")
+def _box_entry(box, nd, ox, oy, oz, ix, iy, iz, tmin, best):
+    """Entry distance of the ray into node ``nd``'s box (slabs), ``inf`` if it misses it or
+    enters beyond ``best``; exits are enlarged by ``BOX_GAMMA`` (Ize, JCGT 2013)."""
+    t0 = (box[nd, 0] - ox) * ix
+    t1 = (box[nd, 3] - ox) * ix
+    tn, tf = min(t0, t1), max(t0, t1)
+    t0 = (box[nd, 1] - oy) * iy
+    t1 = (box[nd, 4] - oy) * iy
+    tn, tf = max(tn, min(t0, t1)), min(tf, max(t0, t1))
+    t0 = (box[nd, 2] - oz) * iz
+    t1 = (box[nd, 5] - oz) * iz
+    tn, tf = max(tn, min(t0, t1)), min(tf, max(t0, t1))
+    if tn > tf * BOX_GAMMA or tf < tmin or tn > best:
+        return np.inf
+    return tn
+
+
 @nb.njit(cache=True)
 def bvh_hit(tv, box, meta, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
-    """Closest (or any) triangle hit through the BVH.  Returns ``(t, tri, b1, b2)``."""
+    """Closest (or any) triangle hit through the BVH, near child first (both children's boxes
+    are tested at their parent; the farther one waits on ``stack``).  Returns
+    ``(t, tri, b1, b2)``."""
     ax0, ax1, ax2 = abs(dx), abs(dy), abs(dz)
     kz = 0
     if ax1 > ax0 and ax1 >= ax2:
@@ -413,24 +433,10 @@ def bvh_hit(tv, box, meta, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     iy = 1.0 / dy if dy != 0.0 else (big if dy >= 0.0 else -big)
     iz = 1.0 / dz if dz != 0.0 else (big if dz >= 0.0 else -big)
     best, btri, bb1, bb2 = tmax, -1, 0.0, 0.0
-    sp = 0
-    stack[0] = 0
-    sp = 1
-    while sp > 0:
-        sp -= 1
-        nd = stack[sp]
-        t0 = (box[nd, 0] - ox) * ix
-        t1 = (box[nd, 3] - ox) * ix
-        tn, tf = min(t0, t1), max(t0, t1)
-        t0 = (box[nd, 1] - oy) * iy
-        t1 = (box[nd, 4] - oy) * iy
-        tn, tf = max(tn, min(t0, t1)), min(tf, max(t0, t1))
-        t0 = (box[nd, 2] - oz) * iz
-        t1 = (box[nd, 5] - oz) * iz
-        tn, tf = max(tn, min(t0, t1)), min(tf, max(t0, t1))
-        # conservative by a few ulps (Ize, "Robust BVH ray traversal", JCGT 2013)
-        if tn > tf * BOX_GAMMA or tf < tmin or tn > best:
-            continue
+    if _box_entry(box, 0, ox, oy, oz, ix, iy, iz, tmin, best) == np.inf:
+        return np.inf, -1, 0.0, 0.0
+    nd, sp = 0, 0
+    while True:
         if meta[nd, 1] > 0:
             first, cnt = meta[nd, 0], meta[nd, 1]
             for i in range(first, first + cnt):
@@ -439,15 +445,30 @@ def bvh_hit(tv, box, meta, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
                     best, btri, bb1, bb2 = t, i, b1, b2
                     if any_hit:
                         return best, btri, bb1, bb2
-        elif sp + 2 <= stack.shape[0]:
-            axis = meta[nd, 2]
-            if d[axis] < 0.0:  # visit the far (right) side first when going backwards
-                stack[sp] = nd + 1
-                stack[sp + 1] = meta[nd, 0]
+            nd = -1
+        else:
+            # test both children, descend into the nearer, keep the farther for later
+            left, right = nd + 1, meta[nd, 0]
+            tl = _box_entry(box, left, ox, oy, oz, ix, iy, iz, tmin, best)
+            tr = _box_entry(box, right, ox, oy, oz, ix, iy, iz, tmin, best)
+            if tl == np.inf and tr == np.inf:
+                nd = -1
+            elif tr == np.inf:
+                nd = left
+            elif tl == np.inf:
+                nd = right
             else:
-                stack[sp] = meta[nd, 0]
-                stack[sp + 1] = nd + 1
-            sp += 2
+                near, far = (left, right) if tl <= tr else (right, left)
+                if sp < stack.shape[0]:
+                    stack[sp] = far
+                    sp += 1
+                nd = near
+        while nd < 0 and sp > 0:  # pop, culling nodes now beyond the best hit
+            sp -= 1
+            if _box_entry(box, stack[sp], ox, oy, oz, ix, iy, iz, tmin, best) < np.inf:
+                nd = stack[sp]
+        if nd < 0:
+            break
     if btri < 0:
         return np.inf, -1, 0.0, 0.0
     return best, btri, bb1, bb2
