@@ -93,8 +93,14 @@ def test_patch_size_is_the_knob():
 
 def test_progressive_does_not_build_the_matrix(gl_ctx):
     scene = workbench.load_scene("cornell")
-    sol = solve_scene(scene, _opts(patch_size=0.2, solver="progressive", tol=1e-2,
-                                   hemicube_resolution=32), "radiosity")
-    assert sol.stats["matrix_stored"] is False
+    kw = dict(patch_size=0.2, solver="progressive", tol=1e-3, hemicube_resolution=32)
+    plain = solve_scene(scene, _opts(row_cache_mb=0.0, **kw), "radiosity")
+    assert plain.stats["matrix_stored"] is False and plain.stats["rows_cached"] == 0
     # one hemicube per shot, drawn 16 at a time (the last batch may not all shoot)
-    assert 0 < sol.stats["iterations"] <= sol.stats["hemicubes_drawn"] < sol.stats["iterations"] + 16
+    it = plain.stats["iterations"]
+    assert 0 < it <= plain.stats["hemicubes_drawn"] < it + 16
+    # rows of patches that shoot again kept: fewer hemicubes, same answer (float32 rows)
+    cached = solve_scene(scene, _opts(**kw), "radiosity")
+    n = cached.stats["patches"]
+    assert cached.stats["hemicubes_drawn"] < min(it, n + 16) and cached.stats["row_cache_hits"] > 0
+    assert np.abs(cached.radiance - plain.radiance).max() <= 1e-5 * plain.radiance.max()

@@ -51,6 +51,8 @@ def common_options() -> dict[str, Option]:
         "tol": Option(float, 1e-3, "bound on the true relative error of the solution"),
         "max_iterations": Option(int, 0, "iteration / shot cap (0: what the error bound needs)"),
         "ambient": Option(bool, True, "progressive refinement: show Cohen et al.'s ambient term"),
+        "row_cache_mb": Option(float, 128.0, "progressive refinement with hemicubes: memory for "
+                               "rows of patches that shoot again (0: a hemicube every shot)"),
     }
 
 
@@ -102,13 +104,15 @@ def solve_scene(scene: Scene, opts: dict, method: str) -> Solution:
         hc = Hemicube(geom, opts["hemicube_resolution"], rotate=opts["hemicube_rotate"])
         timings["compile"] += time.perf_counter() - t1
         q = float(R.max()) * max(1.0, hc.info()["weight_sum"])
-        res = solvers.progressive_rows(_row_provider(hc, stats), geom.areas, E, R, tol=tol,
+        rows = solvers.RowCache(_row_provider(hc, stats), opts["row_cache_mb"])
+        res = solvers.progressive_rows(rows, geom.areas, E, R, tol=tol,
                                        max_shots=cap, q=q, ambient=opts["ambient"])
         info = hc.info()
         hc.release()
         timings["form_factors"] = res.seconds   # hemicubes and shots interleave
         timings["solve"] = 0.0
         stats.update({"hemicubes_drawn": info["hemicubes_drawn"], "matrix_stored": False,
+                      "rows_cached": len(rows.rows), "row_cache_hits": rows.hits,
                       "gl_renderer": info["gl_renderer"], "hemicube_weight_sum": info["weight_sum"],
                       "reciprocity_error": None,
                       "note": "shooting takes F_ji = F_ij A_i / A_j from the shooter's hemicube; "

@@ -238,6 +238,33 @@ def _progressive_matrix(F, E, R, areas, q, tol, cap, ambient, t0, scalar) -> Sol
     return _finish(B, disp, "progressive", shots, hist, q, tol, reached and q < 1, cap, t0, scalar)
 
 
+class RowCache:
+    """Rows F[i, :] kept (float32) for patches that shoot again, up to ``budget_mb``;
+    the oldest are dropped first.  ``row(indices) -> (k, P)`` computes the missing ones.
+    With ``budget_mb = 0`` every shot draws its hemicube."""
+
+    def __init__(self, row: Callable[[np.ndarray], np.ndarray], budget_mb: float = 128.0):
+        self.row, self.budget = row, int(budget_mb * 2 ** 20)
+        self.rows: dict[int, np.ndarray] = {}
+        self.hits = self.computed = 0
+
+    def __call__(self, idx) -> np.ndarray:
+        idx = [int(i) for i in np.asarray(idx).ravel()]
+        missing = [i for i in idx if i not in self.rows]
+        fresh = dict(zip(missing, self.row(np.array(missing)))) if missing else {}
+        self.computed += len(missing)
+        self.hits += len(idx) - len(missing)
+        out = np.array([fresh[i] if i in fresh else self.rows[i] for i in idx], dtype=np.float64)
+        for i, r in fresh.items():
+            if (len(self.rows) + 1) * r.size * 4 > self.budget:
+                if not self.rows:
+                    break
+                self.rows.pop(next(iter(self.rows)))
+            if (len(self.rows) + 1) * r.size * 4 <= self.budget:
+                self.rows[i] = r.astype(np.float32)
+        return out
+
+
 def progressive_rows(row: Callable[[np.ndarray], np.ndarray], areas, emission, reflectance, *,
                      tol: float = 1e-3, max_shots: int | None = None, batch: int = 16,
                      ambient: bool = True, q: float | None = None, time_limit: float | None = None,
