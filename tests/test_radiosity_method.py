@@ -75,6 +75,12 @@ def test_bad_options():
         workbench.render(scene, "radiosity", width=8, height=8, solver="magic")
     with pytest.raises(WorkbenchError, match="resolution"):
         workbench.render(scene, "radiosity", width=8, height=8, hemicube_resolution=7)
+    with pytest.raises(WorkbenchError, match="tol"):
+        workbench.render(scene, "radiosity", width=8, height=8, tol=0.0)
+    with pytest.raises(WorkbenchError, match="max_iterations"):
+        workbench.render(scene, "radiosity", width=8, height=8, max_iterations=-1)
+    with pytest.raises(WorkbenchError, match="patch_size"):
+        workbench.render(scene, "radiosity", width=8, height=8, patch_size=0.0)
 
 
 def test_patch_size_is_the_knob():

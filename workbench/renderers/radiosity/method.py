@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...core.errors import NotApplicable
+from ...core.errors import NotApplicable, WorkbenchError
 from ...scene import features as ft
 from ...scene.model import Scene
 from ..base import Knob, Option, RenderResult
@@ -81,6 +81,10 @@ def _row_provider(hc, stats: dict):
 
 def solve_scene(scene: Scene, opts: dict, method: str) -> Solution:
     """Patches, form factors and solution of ``scene`` with the ``common_options``."""
+    if opts["max_iterations"] < 0:
+        raise WorkbenchError(f"{method}: max_iterations must be >= 0 (0: automatic), got {opts['max_iterations']}")
+    if opts["row_cache_mb"] < 0:
+        raise WorkbenchError(f"{method}: row_cache_mb must be >= 0, got {opts['row_cache_mb']}")
     timings: dict = {"compile": 0.0}
     t0 = time.perf_counter()
     extent = scene_extent(scene)

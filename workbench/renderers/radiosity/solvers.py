@@ -281,6 +281,8 @@ def progressive_rows(row: Callable[[np.ndarray], np.ndarray], areas, emission, r
     the hemicube's rows can exceed 1 by O(1/res^2), pass it in).  ``on_batch(B, dB, shots)`` is
     called after each round (the benchmark records convergence with it).
     """
+    if not (0 < tol < 1):
+        raise WorkbenchError(f"progressive refinement: tol must be in (0, 1), got {tol!r}")
     t0 = time.perf_counter()
     A = np.asarray(areas, dtype=np.float64)
     E, R, scalar = _prepare(emission, reflectance, len(A))
