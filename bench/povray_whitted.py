@@ -7,7 +7,7 @@
    as a ``mesh2`` with its vertex normals, in a temporary directory).
 
 Rays per second: POV-Ray's "Rays" (eye + reflected + refracted) plus its "Shadow Ray Tests",
-over its "Trace Time" (which excludes its start-up and parsing) and over the CPU-seconds it
+over its "Trace Time" (which excludes its start-up and parsing; best of 3 runs) and over the CPU-seconds it
 reports for the trace (a fairer measure on a shared, loaded machine); ours: primary + shadow +
 reflected + refracted rays over our trace phase (``timings["trace"]`` and its CPU seconds
 ``timings["trace_cpu"]``, warm JIT cache, best of 3).  Whole commands: POV-Ray's process wall time against ``workbench render ...`` as a process
@@ -37,8 +37,13 @@ THRESHOLD = 1.0 / 255.0
 PY = sys.executable
 
 
-def povray(pov: Path, out: Path) -> dict:
-    """Run POV-Ray; parse its statistics."""
+def povray(pov: Path, out: Path, repeats: int = 3) -> dict:
+    """POV-Ray's statistics, best trace time of ``repeats`` runs (as for ours)."""
+    return min((_povray_once(pov, out) for _ in range(repeats)), key=lambda d: d["trace_s"])
+
+
+def _povray_once(pov: Path, out: Path) -> dict:
+    """Run POV-Ray once; parse its statistics."""
     cmd = ["povray", f"+W{W}", f"+H{H}", "-A", "+MV3.7", "Work_Threads=2", "-D", f"+O{out}", f"+I{pov}"]
     t0 = time.perf_counter()
     p = subprocess.run(cmd, capture_output=True, text=True, cwd=pov.parent)
