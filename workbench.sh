@@ -38,8 +38,8 @@ if [ "$what" = test ]; then
   exec .venv/bin/python -m pytest -q
 fi
 
-echo "== main job: the default scene (whitted) and the Cornell box"
-mkdir -p out
-.venv/bin/workbench render whitted --method phong -o out/whitted_phong.png
-.venv/bin/workbench render cornell --method phong -o out/cornell_phong.png
-echo "== images written to $PWD/out"
+echo "== main job: quick error-vs-time study and side-by-side comparison of every method on the default scene (whitted)"
+echo "   (the first run also compiles the ray tracer's numba kernels, about 80 s; later runs load them from .numba_cache)"
+.venv/bin/workbench study whitted --quick --out out/report
+.venv/bin/workbench compare whitted --out out/report
+echo "== report: $PWD/out/report/report.html"
