@@ -19,15 +19,17 @@ def _opts(**kw):
 
 @pytest.mark.parametrize("solver", ["direct", "jacobi", "gauss_seidel"])
 def test_furnace_scene_image_is_exact(gl_ctx, solver):
-    """Closed cube, E = 0.25, rho = 0.8: every pixel shows B = E / (1 - rho) = 1.25, up to the
-    hemicube's row-sum excess (errata 6: 1 + 3.3e-5 at resolution 128)."""
+    """Closed cube, E = 0.25, rho = 0.8: every pixel shows B = E / (1 - rho) = 1.25 (delta form
+    factors normalised); with the raw ones, rows sum to 1 + 3.3e-5 at resolution 128 (errata 6)
+    and B = E / (1 - rho (1 + 3.3e-5))."""
     scene = workbench.load_scene("furnace")
-    r = workbench.render(scene, "radiosity", width=32, height=32, solver=solver, patch_size=0.15,
-                         tol=1e-6)
-    assert r.stats["converged"] and r.stats["nonfinite_pixels"] == 0
-    excess = r.stats["hemicube_weight_sum"] - 1.0
-    expect = 0.25 / (1 - 0.8 * (1 + excess))
-    assert np.abs(r.image - expect).max() < 1e-4
+    for normalize in (True, False):
+        r = workbench.render(scene, "radiosity", width=32, height=32, solver=solver,
+                             patch_size=0.15, tol=1e-6, hemicube_normalize=normalize)
+        assert r.stats["converged"] and r.stats["nonfinite_pixels"] == 0
+        excess = r.stats["hemicube_weight_sum"] - 1.0
+        assert (excess == pytest.approx(0, abs=1e-12)) if normalize else (0 < excess < 1e-4)
+        assert np.abs(r.image - 0.25 / (1 - 0.8 * (1 + excess))).max() < 1e-5
 
 
 def test_furnace_progressive_shows_the_hemicube_reciprocity_error(gl_ctx):

@@ -23,7 +23,7 @@ __all__ = ["form_factors", "solve", "FormFactors", "SolveResult"]
 
 def form_factors(polygons, method: str = "hemicube", resolution: int = 128, *,
                  rotate: bool = False, rays: int = 4096, order: int = 8,
-                 seed: int = 0) -> FormFactors:
+                 seed: int = 0, normalize: bool = True) -> FormFactors:
     """Form-factor matrix of planar convex polygons.
 
     Parameters
@@ -34,11 +34,13 @@ def form_factors(polygons, method: str = "hemicube", resolution: int = 128, *,
         (Malley's rays, with occlusion) or ``analytic`` (exact, unoccluded, Gauss-Legendre
         over the emitter).
     resolution : hemicube pixels across the top face.
-    rotate, rays, order, seed : see :func:`workbench.renderers.radiosity.formfactors.compute`.
+    rotate, rays, order, seed, normalize : see
+        :func:`workbench.renderers.radiosity.formfactors.compute` (``normalize``: hemicube
+        delta form factors scaled to sum to exactly 1; their raw sum is 1 + O(1/res^2)).
 
     Returns
     -------
     FormFactors : ``F`` (P, P) (``ff[i, j]`` indexes it), ``row_sums``, ``reciprocity_error``.
     """
     return _compute(geometry_from_polygons(polygons), method, resolution, rotate=rotate,
-                    rays=rays, order=order, seed=seed)
+                    rays=rays, order=order, seed=seed, normalize=normalize)

@@ -230,13 +230,15 @@ def analytic_pairs(geom: Geometry, I, J, order: int = 8) -> np.ndarray:
 
 # --------------------------------------------------------------------------- dispatcher
 def compute(geom: Geometry, method: str = "hemicube", resolution: int = 128, *,
-            rotate: bool = False, rays: int = 4096, order: int = 8, seed: int = 0) -> FormFactors:
+            rotate: bool = False, rays: int = 4096, order: int = 8, seed: int = 0,
+            normalize: bool = True) -> FormFactors:
     """Form-factor matrix of ``geom`` by ``method`` (see the module docstring).
 
     Parameters
     ----------
     resolution : hemicube resolution (pixels across the top face, even).
     rotate : hemicube: rotate each hemicube by a random angle about the normal (aliasing).
+    normalize : hemicube: scale the delta form factors to sum to exactly 1 (errata 6).
     rays : raycast: rays per patch.
     order : analytic: Gauss-Legendre order per triangle edge.
     """
@@ -246,7 +248,7 @@ def compute(geom: Geometry, method: str = "hemicube", resolution: int = 128, *,
     info: dict = {}
     if method == "hemicube":
         from .hemicube import Hemicube
-        hc = Hemicube(geom, resolution, rotate=rotate, seed=seed)
+        hc = Hemicube(geom, resolution, rotate=rotate, seed=seed, normalize=normalize)
         F = hc.matrix()
         info = hc.info()
     elif method == "raycast":

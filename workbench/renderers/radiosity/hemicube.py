@@ -8,8 +8,10 @@ adds its delta form factor to the patch it shows:
     top:   dF = dA / (pi (x^2 + y^2 + 1)^2)          (x, y in [-1, 1])
     sides: dF = z dA / (pi (y^2 + z^2 + 1)^2)        (y in [-1, 1], z in [0, 1])
 
-with dA = (2/res)^2.  Their sum is 1 + O(1/res^2) (DESIGN errata 6), reported as
-``weight_sum``.  Aliasing (small or distant patches falling between pixel centres) and
+with dA = (2/res)^2.  Their sum is 1 + O(1/res^2) (DESIGN errata 6: the midpoint rule on
+the pixels), reported as ``weight_sum_raw``; by default they are scaled to sum to exactly 1
+(``normalize``), so that a closed scene's rows sum to 1 and a furnace with rho near 1 is not
+biased by 1 / (1 - rho (1 + O(1/res^2))).  Aliasing (small or distant patches falling between pixel centres) and
 proximity (the hemicube sees from the centre only) are inherent errors.
 
 Speed on llvmpipe (whose vertex/primitive front end is single-threaded, ~2.5 M triangles/s):
@@ -79,10 +81,11 @@ class Hemicube:
     rotate : turn each hemicube by a random angle about the normal (against aliasing).
     seed : seed of those angles.
     batch : patches per draw call and read-back (<= 16).
+    normalize : scale the delta form factors to sum to exactly 1.
     """
 
     def __init__(self, geom: Geometry, resolution: int = 128, *, rotate: bool = False,
-                 seed: int = 0, batch: int = 16):
+                 seed: int = 0, batch: int = 16, normalize: bool = True):
         if resolution < 2 or resolution % 2:
             raise WorkbenchError(f"hemicube resolution must be an even number >= 2, got {resolution}")
         if resolution > 2048:
@@ -92,6 +95,9 @@ class Hemicube:
         self.rng = np.random.default_rng(seed)
         self.rotate = rotate
         self.weights = delta_form_factors(self.res)
+        self.weight_sum_raw = float(self.weights.sum())
+        if normalize:
+            self.weights /= self.weight_sum_raw
         self.P = len(geom)
         self.extent = ext = geom.extent
         self.origin = geom.tris.reshape(-1, 3).mean(0) if len(geom.tris) else np.zeros(3)
@@ -253,6 +259,7 @@ class Hemicube:
 
     def info(self) -> dict:
         return {"hemicube_resolution": self.res, "weight_sum": float(self.weights.sum()),
+                "weight_sum_raw": self.weight_sum_raw,
                 "rotate": self.rotate, "gl_renderer": gl.renderer_name(self.ctx),
                 "hemicubes_drawn": self.drawn}
 

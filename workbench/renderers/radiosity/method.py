@@ -45,6 +45,8 @@ def common_options() -> dict[str, Option]:
         "hemicube_resolution": Option(int, 128, "hemicube pixels across the top face (even)"),
         "hemicube_rotate": Option(bool, False, "random rotation of each hemicube about the "
                                   "normal (against aliasing)"),
+        "hemicube_normalize": Option(bool, True, "scale the delta form factors to sum to 1 "
+                                     "(their raw sum is 1 + O(1/res^2), errata 6)"),
         "solver": Option(str, "direct", "linear solver", solvers.METHODS),
         "form_factors": Option(str, "hemicube", "form-factor method", ("hemicube", "raycast")),
         "rays": Option(int, 1024, "raycast form factors: rays per patch"),
@@ -105,7 +107,8 @@ def solve_scene(scene: Scene, opts: dict, method: str) -> Solution:
     if opts["solver"] == "progressive" and opts["form_factors"] == "hemicube":
         from .hemicube import Hemicube
         t1 = time.perf_counter()
-        hc = Hemicube(geom, opts["hemicube_resolution"], rotate=opts["hemicube_rotate"])
+        hc = Hemicube(geom, opts["hemicube_resolution"], rotate=opts["hemicube_rotate"],
+                      normalize=opts["hemicube_normalize"])
         timings["compile"] += time.perf_counter() - t1
         q = float(R.max()) * max(1.0, hc.info()["weight_sum"])
         rows = solvers.RowCache(_row_provider(hc, stats), opts["row_cache_mb"])
@@ -118,20 +121,22 @@ def solve_scene(scene: Scene, opts: dict, method: str) -> Solution:
         stats.update({"hemicubes_drawn": info["hemicubes_drawn"], "matrix_stored": False,
                       "rows_cached": len(rows.rows), "row_cache_hits": rows.hits,
                       "gl_renderer": info["gl_renderer"], "hemicube_weight_sum": info["weight_sum"],
-                      "reciprocity_error": None,
+                      "hemicube_weight_sum_raw": info["weight_sum_raw"], "reciprocity_error": None,
                       "note": "shooting takes F_ji = F_ij A_i / A_j from the shooter's hemicube; "
                               "the error bound is for that system, which differs from gathering "
                               "by the hemicube's reciprocity error (proximity, errata 6)"})
     else:
         ff: FormFactors = compute(geom, opts["form_factors"], opts["hemicube_resolution"],
-                                  rotate=opts["hemicube_rotate"], rays=opts["rays"])
+                                  rotate=opts["hemicube_rotate"], rays=opts["rays"],
+                                  normalize=opts["hemicube_normalize"])
         timings["form_factors"] = ff.seconds
         rep = ff.report()
         stats.update({"row_sum_min": rep["row_sum_min"], "row_sum_max": rep["row_sum_max"],
                       "reciprocity_error": rep["reciprocity_error"],
                       "reciprocity_max": rep["reciprocity_max"], "matrix_stored": True})
         if "gl_renderer" in rep:
-            stats.update({"gl_renderer": rep["gl_renderer"], "hemicube_weight_sum": rep["weight_sum"]})
+            stats.update({"gl_renderer": rep["gl_renderer"], "hemicube_weight_sum": rep["weight_sum"],
+                          "hemicube_weight_sum_raw": rep["weight_sum_raw"]})
         res = solvers.solve(ff.F, E, R, opts["solver"], tol=tol, max_iterations=cap,
                             ambient=opts["ambient"], areas=geom.areas)
         timings["solve"] = res.seconds
