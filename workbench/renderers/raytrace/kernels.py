@@ -4,7 +4,9 @@ shaded, then its reflected and refracted children form the next generation).
 
 Everything is scalar code over flat arrays (:mod:`.flatten`); the batch kernels are
 ``parallel=True`` over chunks of ``CHUNK`` rays (``prange``), each chunk with its own scratch
-arrays (BVH stack, CSG interval stacks).  ``cache=True``: compiled code is kept on disk
+arrays (BVH stack, CSG interval stacks).  ``error_model="numpy"``: float divisions follow IEEE
+(no zero-divisor check and exception path on every division; the results are the same wherever
+the default Python model would not raise).  ``cache=True``: compiled code is kept on disk
 (``NUMBA_CACHE_DIR``), so a warm cache compiles nothing.
 
 The readable version of the same algorithm is :mod:`.reference`; the two are tested against
@@ -22,6 +24,11 @@ from .flatten import (BOX, CSG_DIFFERENCE, CSG_INTERSECTION, CSG_UNION, CSGNODE,
                       QUADRIC, RECT, SPHERE)
 
 CHUNK = 64
+# Chunks handed to a thread at a time: the callers run the batch kernels inside
+# ``numba.parallel_chunksize(SCHED)`` (dynamic scheduling: the cost of a ray varies a lot across
+# the image, and numba's default static split leaves one thread idle; set from Python because
+# setting it inside a kernel defeats numba's disk cache).
+SCHED = 4
 BVH_STACK = 128
 CSG_DEPTH = 16
 CSG_EVENTS = 32
@@ -31,7 +38,7 @@ BOX_GAMMA = 1.0 + 2.0 * 3.0 * 2.0 ** -53 / (1.0 - 3.0 * 2.0 ** -53)
 
 
 # ----------------------------------------------------------------------------- small helpers
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def _to_object(xf, k, ox, oy, oz, dx, dy, dz):
     return (xf[k, 0] * ox + xf[k, 1] * oy + xf[k, 2] * oz + xf[k, 3], xf[k, 4] * ox + xf[k, 5] * oy + xf[k, 6] * oz + xf[k, 7],
             xf[k, 8] * ox + xf[k, 9] * oy + xf[k, 10] * oz + xf[k, 11],
@@ -39,7 +46,7 @@ def _to_object(xf, k, ox, oy, oz, dx, dy, dz):
             xf[k, 8] * dx + xf[k, 9] * dy + xf[k, 10] * dz)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def solve_quadratic(A, B, C, zero):
     """Real roots of ``A t^2 + B t + C`` sorted (DESIGN errata 7: ``q = -(B + sign(B) sqrt(disc))/2``,
     roots ``q/A`` and ``C/q``); ``A = 0`` (relative to ``zero``) gives the linear root ``-C/B``.
@@ -62,7 +69,7 @@ def solve_quadratic(A, B, C, zero):
     return 2, t0, t1
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def sphere_roots(par, k, ox, oy, oz, dx, dy, dz):
     """Roots of the ray / sphere equation in object space.
 
@@ -93,7 +100,7 @@ def sphere_roots(par, k, ox, oy, oz, dx, dy, dz):
     return True, t0 * inv_s, t1 * inv_s
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def slab(lo0, lo1, lo2, hi0, hi1, hi2, ox, oy, oz, dx, dy, dz):
     """Ray / axis-aligned box (Kay & Kajiya slabs).  Returns ``(ok, t_near, face_near, t_far,
     face_far)``; faces are ``1 + 2 axis + side`` (side 1 = max face)."""
@@ -125,7 +132,7 @@ def slab(lo0, lo1, lo2, hi0, hi1, hi2, ox, oy, oz, dx, dy, dz):
     return True, tn, fn, tf, ff
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def quadric_coeffs(par, k, ox, oy, oz, dx, dy, dz):
     """``A = D^T Q D``, ``B = 2 D^T Q P0``, ``C = P0^T Q P0`` with D lifted with w = 0 and P0
     with w = 1 (errata 2: the cross terms of C carry their factor 2)."""
@@ -145,14 +152,14 @@ def quadric_coeffs(par, k, ox, oy, oz, dx, dy, dz):
     return A, B, C
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def _in_bounds(par, k, x, y, z, slack):
     return (par[k, 10] - slack <= x <= par[k, 13] + slack and par[k, 11] - slack <= y <= par[k, 14] + slack
             and par[k, 12] - slack <= z <= par[k, 15] + slack)
 
 
 # ----------------------------------------------------------------------------- primitives
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def prim_hit(k, ptype, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
     """Closest hit ``tmin < t < tmax`` of analytic primitive ``k`` (object-space ray).
     Returns ``(t, face)``, ``t = inf`` on a miss."""
@@ -215,7 +222,7 @@ def prim_hit(k, ptype, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
     return np.inf, 0
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def leaf_events(k, ptype, par, ox, oy, oz, dx, dy, dz, zero, et, ep, ef):
     """Interval list (entering / leaving events along the whole line) of solid leaf ``k``:
     sphere, box, or quadric inside ``P^T Q P < 0`` intersected with its bounds box.
@@ -281,7 +288,7 @@ def leaf_events(k, ptype, par, ox, oy, oz, dx, dy, dz, zero, et, ep, ef):
     return 0
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def _op(op, a, b):
     if op == CSG_UNION:
         return a or b
@@ -290,7 +297,7 @@ def _op(op, a, b):
     return a and not b
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def combine(op, ta, pa, fa, na, tb, pb, fb, nb_, to, po, fo, eps):
     """Combine two interval lists by a boolean ``op`` (the course's ``composite_intersect``):
     sweep the events of both lists in order, grouping events closer than ``eps`` (coincident
@@ -332,7 +339,7 @@ def combine(op, ta, pa, fa, na, tb, pb, fb, nb_, to, po, fo, eps):
     return m
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def csg_hit(start, length, prog, ptype, xf, par, ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps,
             st, sp_, sf, sn):
     """Evaluate a CSG postfix program along a ray (the course's recursive ``intersect``, made
@@ -362,7 +369,7 @@ def csg_hit(start, length, prog, ptype, xf, par, ox, oy, oz, dx, dy, dz, tmin, t
     return np.inf, 0, 0
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def tri_hit(tv, i, ox, oy, oz, kx, ky, kz, sx, sy, sz, tmin, tmax):
     """Watertight ray / triangle test (Woop, Benthin & Wald, JCGT 2013).  Returns
     ``(t, b1, b2)`` with barycentric weights of vertices 1 and 2, ``t = inf`` on a miss."""
@@ -393,7 +400,7 @@ def tri_hit(tv, i, ox, oy, oz, kx, ky, kz, sx, sy, sz, tmin, tmax):
     return t, V / det, W / det
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def _box_entry(box, nd, ox, oy, oz, ix, iy, iz, tmin, best):
     """Entry distance of the ray into node ``nd``'s box (slabs), ``inf`` if it misses it or
     enters beyond ``best``; exits are enlarged by ``BOX_GAMMA`` (Ize, JCGT 2013)."""
@@ -411,7 +418,7 @@ def _box_entry(box, nd, ox, oy, oz, ix, iy, iz, tmin, best):
     return tn
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def bvh_hit(tv, box, meta, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     """Closest (or any) triangle hit through the BVH, near child first (both children's boxes
     are tested at their parent; the farther one waits on ``stack``).  Returns
@@ -474,7 +481,7 @@ def bvh_hit(tv, box, meta, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     return best, btri, bb1, bb2
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
             st, sp_, sf, sn):
     """Nearest hit of a world ray over all primitives (linear loop over analytic primitives,
@@ -510,7 +517,7 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
     return best, bp, bf, btri, bb1, bb2
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def object_normal(k, face, ptype, par, x, y, z):
     """Outward normal (unnormalised) of primitive ``k`` at object-space point, by face."""
     kind = ptype[k]
@@ -530,7 +537,7 @@ def object_normal(k, face, ptype, par, x, y, z):
     return 0.0, 1.0, 0.0
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def _normalize(x, y, z):
     n = math.sqrt(x * x + y * y + z * z)
     if n > 0.0:
@@ -538,7 +545,7 @@ def _normalize(x, y, z):
     return 0.0, 0.0, 0.0
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_uv, out_po, out_e, i):
     """Geometric (outward) normal, shading normal, uv (meshes; analytic primitives leave the
     mapping to the texturing module), object-space point and vertex emission at a hit, written
@@ -583,7 +590,7 @@ def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_
 
 
 # ----------------------------------------------------------------------------- batch kernels
-@nb.njit(cache=True, parallel=True)
+@nb.njit(cache=True, error_model="numpy", parallel=True)
 def trace_batch(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel,
                 t_out, prim_out, ng, ns, uv, po, ev):
     """Closest hits of N rays and their surface data (``prim_out = -1``, ``t = inf`` on a miss)."""
@@ -606,7 +613,7 @@ def trace_batch(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel,
                         oz + t * D[i, 2], ncancel, ng, ns, uv, po, ev, i)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def _transmittance(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmin, tmax, transmissive, zero,
                    eps, stack, st, sp_, sf, sn):
     """Shadow feeler: 1 if nothing blocks the segment, 0 if blocked; with ``transmissive``, the
@@ -629,7 +636,7 @@ def _transmittance(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmin, tmax, tra
     return v
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def accumulate(acc, pix, contrib):
     """``acc[pix[i]] += contrib[i]`` (serial: several rays may share a pixel)."""
     for i in range(pix.shape[0]):
@@ -637,19 +644,19 @@ def accumulate(acc, pix, contrib):
             acc[pix[i], c] += contrib[i, c]
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def _pow(base, n):
     if n == 0.0:
         return 1.0
     return base ** n
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def _ior(mat_tab, stk, ns_):
     return mat_tab[stk[ns_ - 1], 9] if ns_ > 0 else 1.0
 
 
-@nb.njit(cache=True, parallel=True)
+@nb.njit(cache=True, error_model="numpy", parallel=True)
 def shade_batch(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim, ng, nsh, col, ev,
                 w, depth, stk, nstk, pix, opts, contrib, out_o, out_d, out_w, out_stk, out_nstk,
                 out_kind, out_tmin, out_pix, out_gen, counts):
@@ -878,3 +885,38 @@ def shade_batch(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim
                 out_tmin[s] = t_min * max(max(abs(out_o[s, 0]), abs(out_o[s, 1]), abs(out_o[s, 2])), extent)
                 out_pix[s] = pix[i]
                 out_gen[s] = depth[i] + 1
+
+
+@nb.njit(cache=True, error_model="numpy")
+def compact(kind, o, d, w, stk, nstk, tmin, pix, gen):
+    """The child rays that exist (``kind != 0``), in slot order, as new contiguous arrays
+    (the next generation): ``(o, d, w, stk, nstk, tmin, pix, gen)``."""
+    m = 0
+    for s in range(kind.shape[0]):
+        if kind[s] != 0:
+            m += 1
+    O, D, W = np.empty((m, 3)), np.empty((m, 3)), np.empty((m, 3))
+    STK = np.empty((m, stk.shape[1]), np.int64)
+    NSTK, TMIN = np.empty(m, np.int64), np.empty(m)
+    PIX, GEN = np.empty(m, np.int64), np.empty(m, np.int64)
+    j = 0
+    for s in range(kind.shape[0]):
+        if kind[s] == 0:
+            continue
+        for c in range(3):
+            O[j, c], D[j, c], W[j, c] = o[s, c], d[s, c], w[s, c]
+        for c in range(stk.shape[1]):
+            STK[j, c] = stk[s, c]
+        NSTK[j], TMIN[j], PIX[j], GEN[j] = nstk[s], tmin[s], pix[s], gen[s]
+        j += 1
+    return O, D, W, STK, NSTK, TMIN, PIX, GEN
+
+
+@nb.njit(cache=True, error_model="numpy")
+def column_sums(counts):
+    """``counts.sum(0)`` of an (n, m) int64 array, row by row."""
+    out = np.zeros(counts.shape[1], np.int64)
+    for i in range(counts.shape[0]):
+        for q in range(counts.shape[1]):
+            out[q] += counts[i, q]
+    return out

@@ -147,7 +147,7 @@ def ensure_compiled(sd: SceneData) -> float:
     Returns the seconds spent (0 if already compiled in this process)."""
     k = _kernels()
     from .bvh import _build
-    if k.trace_batch.signatures and k.shade_batch.signatures and _build.signatures and k.accumulate.signatures:
+    if all(f.signatures for f in (k.trace_batch, k.shade_batch, _build, k.accumulate, k.compact, k.column_sums)):
         return 0.0
     t0 = time.perf_counter()
     _build(np.array([[0.0, 0, 0, 1, 0, 0, 0, 1, 0]]))
@@ -166,6 +166,9 @@ def ensure_compiled(sd: SceneData) -> float:
                   ch["o"], ch["d"], ch["w"], ch["stk"], ch["nstk"], ch["kind"], ch["tmin"], ch["pix"],
                   ch["gen"], np.zeros((1, 7), np.int64))
     k.accumulate(np.zeros((1, 3)), np.zeros(1, np.int64), np.zeros((1, 3)))
+    k.compact(ch["kind"], ch["o"], ch["d"], ch["w"], ch["stk"], ch["nstk"], ch["tmin"], ch["pix"],
+              ch["gen"])
+    k.column_sums(np.zeros((1, 7), np.int64))
     return time.perf_counter() - t0
 
 
@@ -252,11 +255,10 @@ class _Tracer:
                           contrib, ch["o"], ch["d"], ch["w"], ch["stk"], ch["nstk"], ch["kind"],
                           ch["tmin"], ch["pix"], ch["gen"], counts)
             _accumulate(acc, pix, contrib)
-            for key, v in zip(_COUNTS, counts.sum(0)):
+            for key, v in zip(_COUNTS, k.column_sums(counts)):
                 self.stats[key] += int(v)
-            live = np.flatnonzero(ch["kind"])
-            O, D, w, stk, nstk, tmin, pix, gen = (ch[x][live] for x in
-                                                   ("o", "d", "w", "stk", "nstk", "tmin", "pix", "gen"))
+            O, D, w, stk, nstk, tmin, pix, gen = k.compact(*(ch[x] for x in (
+                "kind", "o", "d", "w", "stk", "nstk", "tmin", "pix", "gen")))
             if cont is not None and len(cont[0]):
                 O, D, w, stk, nstk, tmin, pix, gen = (np.concatenate([x, y]) for x, y in
                                                       zip((O, D, w, stk, nstk, tmin, pix, gen), cont))
@@ -307,6 +309,7 @@ class _WhittedBase:
     recursive = True
 
     def render(self, scene: Scene, width: int, height: int, **o) -> RenderResult:
+        import numba
         if not 1 <= o["spp"] <= 4096:
             raise WorkbenchError(f"method {self.name!r}: option 'spp' must be within 1..4096, got {o['spp']}")
         timings = {}
@@ -335,7 +338,8 @@ class _WhittedBase:
         for y0 in bands:
             y1 = min(height, y0 + rows)
             a, b = y0 * width * spp, y1 * width * spp
-            img, dep = tr.trace(O[a:b], D[a:b], pix[a:b] - y0 * width, (y1 - y0) * width, spp, fwd)
+            with numba.parallel_chunksize(_kernels().SCHED):
+                img, dep = tr.trace(O[a:b], D[a:b], pix[a:b] - y0 * width, (y1 - y0) * width, spp, fwd)
             image[y0 * width:y1 * width] = img
             depth[y0 * width:y1 * width] = dep
             if opts["on_tile"] is not None:
