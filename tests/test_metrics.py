@@ -13,7 +13,16 @@ def test_rmse_psnr_of_a_known_offset():
     m = workbench.compare.metrics(ref + 0.1, ref)
     assert m["rmse"] == pytest.approx(0.1, rel=1e-6)
     assert m["psnr"] == pytest.approx(20.0, rel=1e-5)
-    assert workbench.compare.metrics(ref, ref) == {"rmse": 0.0, "psnr": float("inf"), "flip": 0.0}
+    assert workbench.compare.metrics(ref, ref) == {"rmse": 0.0, "psnr": float("inf"), "flip": 0.0, "rmse_hdr": 0.0}
+
+
+def test_rmse_is_taken_in_the_display_range():
+    ref = np.full((10, 10, 3), 0.5, dtype=np.float32)
+    ref[0, 0] = 20.0                      # an emitter pixel
+    img = ref.copy()
+    img[0, 0] = 5.0                       # another method's emitter edge: both show white
+    m = workbench.compare.metrics(img, ref)
+    assert m["rmse"] == 0.0 and m["rmse_hdr"] == pytest.approx(15.0 / 10.0)
 
 
 def test_flip_grows_with_the_error():

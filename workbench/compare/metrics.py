@@ -1,6 +1,8 @@
 """Image error metrics on linear images (same size, (H, W, 3) float).
 
-* RMSE on linear RGB values.
+* RMSE on linear RGB values clipped to the display range [0, 1].  Unclipped, a few pixels on
+  the edge of an emitter (radiance ~20 in the Cornell box) that two methods sample differently
+  outweigh every other pixel of the image; the unclipped value is kept as ``rmse_hdr``.
 * PSNR = 20 log10(peak / RMSE) with ``peak = 1`` (display white in linear units); an exact
   match gives ``inf`` in the dictionary (JSON writers turn it into a string).
 * FLIP (Andersson et al. 2020, "FLIP: A Difference Evaluator for Alternating Images"), LDR, via
@@ -39,18 +41,22 @@ def flip(image, reference) -> tuple[float, np.ndarray]:
 
 
 def metrics(image, reference) -> dict[str, float]:
-    """``{"rmse", "psnr", "flip"}`` of ``image`` against ``reference`` (linear (H, W, 3))."""
+    """``{"rmse", "psnr", "flip", "rmse_hdr"}`` of ``image`` against ``reference`` (linear
+    (H, W, 3)): RMSE and PSNR in the display range [0, 1], FLIP (LDR), and the RMSE of the
+    unclipped values."""
     a, b = _check_pair(image, reference)
-    rmse = float(np.sqrt(np.mean((a - b) ** 2)))
+    rmse = float(np.sqrt(np.mean((np.clip(a, 0.0, 1.0) - np.clip(b, 0.0, 1.0)) ** 2)))
     psnr = float("inf") if rmse == 0.0 else float(20.0 * np.log10(1.0 / rmse))
-    return {"rmse": rmse, "psnr": psnr, "flip": flip(a, b)[0]}
+    return {"rmse": rmse, "psnr": psnr, "flip": flip(a, b)[0],
+            "rmse_hdr": float(np.sqrt(np.mean((a - b) ** 2)))}
 
 
 def error_map(image, reference, kind: str = "abs") -> np.ndarray:
-    """Per-pixel error (H, W): ``"abs"`` (mean absolute difference over RGB, linear) or ``"flip"``."""
+    """Per-pixel error (H, W): ``"abs"`` (mean absolute difference over RGB of the linear values
+    clipped to [0, 1], as RMSE) or ``"flip"``."""
     a, b = _check_pair(image, reference)
     if kind == "abs":
-        return np.abs(a - b).mean(-1)
+        return np.abs(np.clip(a, 0.0, 1.0) - np.clip(b, 0.0, 1.0)).mean(-1)
     if kind == "flip":
         return flip(a, b)[1]
     raise WorkbenchError(f"unknown error map kind {kind!r} (expected 'abs' or 'flip')")
