@@ -74,12 +74,9 @@ def intersect(scene, origins, directions):
     sd = flatten(scene)
     n = len(O)
     h = _alloc(n)
-    import numba
-    k = _kernels()
-    with numba.parallel_chunksize(k.SCHED):
-        k.trace_batch(sd.kernel_args(), O, D, np.zeros(n), np.full(n, np.inf), tol.zero,
-                      tol.ray_offset, sd.extent, tol.normal_cancel, h["t"], h["prim"], h["ng"],
-                      h["ns"], h["uv"], h["po"], h["ev"])
+    _kernels().trace_batch(sd.kernel_args(), O, D, np.zeros(n), np.full(n, np.inf), tol.zero,
+                           tol.ray_offset, sd.extent, tol.normal_cancel, h["t"], h["prim"], h["ng"],
+                           h["ns"], h["uv"], h["po"], h["ev"])
     hit = h["prim"] >= 0
     obj = np.where(hit, sd.obj[np.maximum(h["prim"], 0)], -1)
     normal = np.where(hit[:, None], h["ng"], 0.0)

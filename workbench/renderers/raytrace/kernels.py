@@ -24,11 +24,6 @@ from .flatten import (BOX, CSG_DIFFERENCE, CSG_INTERSECTION, CSG_UNION, CSGNODE,
                       QUADRIC, RECT, SPHERE)
 
 CHUNK = 64
-# Chunks handed to a thread at a time: the callers run the batch kernels inside
-# ``numba.parallel_chunksize(SCHED)`` (dynamic scheduling: the cost of a ray varies a lot across
-# the image, and numba's default static split leaves one thread idle; set from Python because
-# setting it inside a kernel defeats numba's disk cache).
-SCHED = 4
 BVH_STACK = 128
 CSG_DEPTH = 16
 CSG_EVENTS = 32

@@ -309,7 +309,6 @@ class _WhittedBase:
     recursive = True
 
     def render(self, scene: Scene, width: int, height: int, **o) -> RenderResult:
-        import numba
         if not 1 <= o["spp"] <= 4096:
             raise WorkbenchError(f"method {self.name!r}: option 'spp' must be within 1..4096, got {o['spp']}")
         timings = {}
@@ -338,8 +337,7 @@ class _WhittedBase:
         for y0 in bands:
             y1 = min(height, y0 + rows)
             a, b = y0 * width * spp, y1 * width * spp
-            with numba.parallel_chunksize(_kernels().SCHED):
-                img, dep = tr.trace(O[a:b], D[a:b], pix[a:b] - y0 * width, (y1 - y0) * width, spp, fwd)
+            img, dep = tr.trace(O[a:b], D[a:b], pix[a:b] - y0 * width, (y1 - y0) * width, spp, fwd)
             image[y0 * width:y1 * width] = img
             depth[y0 * width:y1 * width] = dep
             if opts["on_tile"] is not None:
