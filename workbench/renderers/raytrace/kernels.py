@@ -154,6 +154,43 @@ def _in_bounds(par, k, x, y, z, slack):
 
 
 # ----------------------------------------------------------------------------- primitives
+@nb.njit(cache=True, error_model="numpy")
+def _polygon_hit(k, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax):
+    """Planar convex polygon ``k``: plane hit inside every edge.  Not inlined (a rarely used
+    path: one compiled copy instead of one per call site of :func:`closest`)."""
+    nx, ny, nz = par[k, 0], par[k, 1], par[k, 2]
+    den = nx * dx + ny * dy + nz * dz
+    if den == 0.0:
+        return np.inf, 0
+    t = (par[k, 3] - (nx * ox + ny * oy + nz * oz)) / den
+    if not (tmin < t < tmax):
+        return np.inf, 0
+    qx, qy, qz = ox + t * dx, oy + t * dy, oz + t * dz
+    s, n = int(par[k, 4]), int(par[k, 5])
+    for i in range(n):
+        j = s + (i + 1) % n
+        ax, ay, az = poly_v[s + i, 0], poly_v[s + i, 1], poly_v[s + i, 2]
+        ex, ey, ez = poly_v[j, 0] - ax, poly_v[j, 1] - ay, poly_v[j, 2] - az
+        wx, wy, wz = qx - ax, qy - ay, qz - az
+        cx, cy, cz = ey * wz - ez * wy, ez * wx - ex * wz, ex * wy - ey * wx
+        if cx * nx + cy * ny + cz * nz < 0.0:
+            return np.inf, 0
+    return t, 0
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _quadric_hit(k, par, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
+    """General quadric ``k`` cut to its bounds: first root in ``(tmin, tmax)`` inside them.
+    Not inlined (see :func:`_polygon_hit`)."""
+    A, B, C = quadric_coeffs(par, k, ox, oy, oz, dx, dy, dz)
+    n, t0, t1 = solve_quadratic(A, B, C, zero)
+    for r in range(n):
+        t = t0 if r == 0 else t1
+        if tmin < t < tmax and _in_bounds(par, k, ox + t * dx, oy + t * dy, oz + t * dz, 0.0):
+            return t, 0
+    return np.inf, 0
+
+
 @nb.njit(cache=True, error_model="numpy", inline="always")
 def prim_hit(k, ptype, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
     """Closest hit ``tmin < t < tmax`` of analytic primitive ``k`` (object-space ray).
@@ -188,32 +225,9 @@ def prim_hit(k, ptype, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
                 return tf, ff
         return np.inf, 0
     if kind == POLYGON:
-        nx, ny, nz = par[k, 0], par[k, 1], par[k, 2]
-        den = nx * dx + ny * dy + nz * dz
-        if den == 0.0:
-            return np.inf, 0
-        t = (par[k, 3] - (nx * ox + ny * oy + nz * oz)) / den
-        if not (tmin < t < tmax):
-            return np.inf, 0
-        qx, qy, qz = ox + t * dx, oy + t * dy, oz + t * dz
-        s, n = int(par[k, 4]), int(par[k, 5])
-        for i in range(n):
-            j = s + (i + 1) % n
-            ax, ay, az = poly_v[s + i, 0], poly_v[s + i, 1], poly_v[s + i, 2]
-            ex, ey, ez = poly_v[j, 0] - ax, poly_v[j, 1] - ay, poly_v[j, 2] - az
-            wx, wy, wz = qx - ax, qy - ay, qz - az
-            cx, cy, cz = ey * wz - ez * wy, ez * wx - ex * wz, ex * wy - ey * wx
-            if cx * nx + cy * ny + cz * nz < 0.0:
-                return np.inf, 0
-        return t, 0
+        return _polygon_hit(k, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax)
     if kind == QUADRIC:
-        A, B, C = quadric_coeffs(par, k, ox, oy, oz, dx, dy, dz)
-        n, t0, t1 = solve_quadratic(A, B, C, zero)
-        for r in range(n):
-            t = t0 if r == 0 else t1
-            if tmin < t < tmax and _in_bounds(par, k, ox + t * dx, oy + t * dy, oz + t * dz, 0.0):
-                return t, 0
-        return np.inf, 0
+        return _quadric_hit(k, par, ox, oy, oz, dx, dy, dz, tmin, tmax, zero)
     return np.inf, 0
 
 
