@@ -1,0 +1,111 @@
+"""CPU methods (ray casting, ray tracing, radiosity, hybrid) in background threads.
+
+A :class:`Job` renders one (scene, camera, method, options) request with
+:func:`workbench.renderers.base.render`; methods that accept ``on_tile`` fill ``partial`` band
+by band, so the UI shows the image as it comes.  A job whose request is superseded is
+*cancelled*: its next ``on_tile`` raises :class:`Cancelled`, which ends the render early in its
+own thread (methods without ``on_tile`` finish in the background and their result is dropped).
+The UI thread never waits on a job except at exit (:func:`join_all`).
+"""
+from __future__ import annotations
+
+import threading
+import time
+from dataclasses import replace
+
+import numpy as np
+
+
+class Cancelled(Exception):
+    """Raised inside a superseded job's ``on_tile`` to stop its render."""
+
+
+class Job:
+    """One background render.
+
+    Attributes
+    ----------
+    partial : (H, W, 3) float32, the image so far (zeros where not rendered yet).
+    image : (H, W, 3) float32 or None, the finished image.
+    seconds : wall time of the finished render, or None.
+    error : message of a failed render, or None.
+    """
+
+    def __init__(self, scene, camera, method: str, options: dict, tiled: bool):
+        self.key = (id(scene), camera, method, tuple(sorted(options.items())))
+        self.partial = np.zeros((camera.height, camera.width, 3), np.float32)
+        self.image = None
+        self.seconds = None
+        self.error = None
+        self.rows_done = 0
+        self.cancelled = threading.Event()
+        self.lock = threading.Lock()
+        opts = dict(options)
+        if tiled:
+            opts["on_tile"] = self._on_tile
+        self.thread = threading.Thread(
+            target=self._run, args=(replace(scene, camera=camera), method, opts),
+            name=f"ui-job-{method}", daemon=False)
+        self.thread.start()
+
+    def _on_tile(self, y0, y1, x0, x1, tile):
+        if self.cancelled.is_set():
+            raise Cancelled
+        with self.lock:
+            self.partial[y0:y1, x0:x1] = tile
+            self.rows_done = max(self.rows_done, y1)
+
+    def _run(self, scene, method, opts):
+        from ...renderers.base import render
+        t0 = time.perf_counter()
+        try:
+            res = render(scene, method, width=scene.camera.width, height=scene.camera.height, **opts)
+        except Cancelled:
+            return
+        except Exception as e:  # shown in the panel, never kills the UI
+            self.error = f"{type(e).__name__}: {e}"
+            return
+        with self.lock:
+            self.image = np.asarray(res.image, np.float32)
+            self.seconds = time.perf_counter() - t0
+
+    def snapshot(self) -> np.ndarray:
+        """The finished image, else a copy of the partial one."""
+        with self.lock:
+            return self.image if self.image is not None else self.partial.copy()
+
+    @property
+    def done(self) -> bool:
+        return self.image is not None or self.error is not None
+
+
+class JobBoard:
+    """The current job of each CPU method plus every thread ever started (joined at exit)."""
+
+    def __init__(self):
+        self.current: dict[str, Job] = {}
+        self.started: list[Job] = []
+
+    def request(self, scene, camera, method: str, options: dict, tiled: bool) -> Job:
+        """The job for this request: the current one if its key matches, else a new one (the
+        old one is cancelled)."""
+        key = (id(scene), camera, method, tuple(sorted(options.items())))
+        job = self.current.get(method)
+        if job is not None and job.key == key:
+            return job
+        if job is not None:
+            job.cancelled.set()
+        job = Job(scene, camera, method, options, tiled)
+        self.current[method] = job
+        self.started.append(job)
+        return job
+
+    def busy(self) -> bool:
+        return any(not j.done for j in self.current.values())
+
+    def join_all(self, timeout: float | None = None) -> None:
+        """Cancel everything and join every thread started."""
+        for j in self.started:
+            j.cancelled.set()
+        for j in self.started:
+            j.thread.join(timeout)

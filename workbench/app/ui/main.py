@@ -1,0 +1,104 @@
+"""The window loop (hello_imgui through ``immapp.run``).
+
+``python -m workbench.app.ui.main [SCENE] --test-script check --out DIR`` runs a scripted
+session (see :mod:`.scripts`) and writes the panel images, ``summary.json`` (frames, GL
+renderer, threads alive after exit) and ``ui.png`` (the last frame) into DIR.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import threading
+import time
+from pathlib import Path
+
+from .state import AppState, new_state
+
+WINDOW_SIZE = (1280, 760)
+
+
+def run(state: AppState, max_frames: int | None = None, script=None) -> None:
+    """Open the window and loop until it is closed, ``max_frames`` frames were shown or the
+    script sets ``state.quit``.  Background jobs are joined before returning."""
+    import moderngl
+    from imgui_bundle import hello_imgui, immapp
+
+    from ...renderers import gl
+    from .frames import release_gl, update_images
+    from .panels import gui, status_bar
+    clock = {"t": None}
+
+    def post_init():
+        state.ctx = moderngl.create_context()  # the window's current GLFW context
+        gl.use_context(state.ctx)
+        state.gl_renderer = gl.renderer_name(state.ctx)
+
+    def show_gui():
+        now = time.perf_counter()
+        if clock["t"] is not None:
+            state.frame_seconds = now - clock["t"]
+        clock["t"] = now
+        update_images(state)
+        if script is not None:
+            script(state)
+        gui(state)
+        state.frame += 1
+        if state.quit or (max_frames is not None and state.frame >= max_frames):
+            hello_imgui.get_runner_params().app_shall_exit = True
+
+    def before_exit():
+        state.jobs.join_all()
+        release_gl(state)
+
+    params = hello_imgui.RunnerParams()
+    params.app_window_params.window_title = f"workbench ui: {state.scene_path.stem}"
+    params.app_window_params.window_geometry.size = WINDOW_SIZE
+    params.fps_idling.enable_idling = False
+    params.imgui_window_params.show_status_bar = True
+    params.ini_filename = ""
+    params.callbacks.post_init = post_init
+    params.callbacks.show_gui = show_gui
+    params.callbacks.show_status = lambda: status_bar(state)
+    params.callbacks.before_exit = before_exit
+    immapp.run(params)
+    state.jobs.join_all()
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m workbench.app.ui.main")
+    p.add_argument("scene", nargs="?", default="whitted")
+    p.add_argument("--methods", default="", help="comma-separated, 1 to 6")
+    p.add_argument("--size", type=int, default=256, help="panel width and height in pixels")
+    p.add_argument("--frames", type=int, default=None, help="stop after this many frames")
+    p.add_argument("--test-script", default=None, help="check or fps (see scripts.py)")
+    p.add_argument("--out", type=Path, default=None, help="folder for the script's outputs")
+    args = p.parse_args(argv)
+    from .scripts import SCRIPTS
+    state = new_state(args.scene, [m for m in args.methods.split(",") if m] or None,
+                      (args.size, args.size))
+    script = None
+    if args.test_script:
+        args.out = args.out or Path("out/ui")
+        args.out.mkdir(parents=True, exist_ok=True)
+        script = SCRIPTS[args.test_script](args.out)
+    t0 = time.perf_counter()
+    run(state, args.frames, script)
+    if args.out is not None:
+        from imgui_bundle import hello_imgui
+        from PIL import Image
+        shot = hello_imgui.final_app_window_screenshot()
+        if shot is not None and shot.size:
+            Image.fromarray(shot[..., :3]).save(args.out / "ui.png")
+        summary = {"frames": state.frame, "seconds": time.perf_counter() - t0,
+                   "gl_renderer": state.gl_renderer, "methods": state.methods,
+                   "scene": state.scene_path.stem, "panel_size": list(state.panel_size),
+                   "timings": state.timings,
+                   "threads": [t.name for t in threading.enumerate()],
+                   "script": getattr(script, "log", {})}
+        (args.out / "summary.json").write_text(json.dumps(summary, indent=1, default=str))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,174 @@
+"""GUI functions: each takes the :class:`~.state.AppState` and draws one part of the window."""
+from __future__ import annotations
+
+import numpy as np
+from imgui_bundle import imgui
+
+from . import camera as cam
+from .frames import upload, upload_linear
+from .state import (LEFT_OUT, MATERIAL_FIELDS, MAX_PANELS, AppState,
+                    choosable_methods, set_material_value, set_option, set_scene)
+
+ORBIT_SPEED = 0.01
+"""Radians of orbit per pixel of mouse drag."""
+ZOOM_STEP = 0.9
+"""Distance factor per notch of the mouse wheel."""
+MATERIAL_RANGES = {"ka": (0.0, 1.0), "kd": (0.0, 1.0), "ks": (0.0, 1.0),
+                   "shininess": (1.0, 500.0), "kr": (0.0, 1.0), "kt": (0.0, 1.0),
+                   "ior": (1.0, 2.5)}
+HOT = np.array([[0, 0, 0], [0.5, 0, 0], [1, 0.3, 0], [1, 0.9, 0], [1, 1, 1]], np.float32)
+"""Colour scale of the difference panel, from 0 (black) to the maximum (white)."""
+
+
+def colour_scale(values: np.ndarray, vmax: float) -> np.ndarray:
+    """(H, W) values in [0, vmax] -> (H, W, 3) uint8 colours of :data:`HOT` (display space)."""
+    t = np.clip(values / vmax, 0.0, 1.0) * (len(HOT) - 1) if vmax > 0 else np.zeros_like(values)
+    i = np.minimum(t.astype(int), len(HOT) - 2)
+    f = (t - i)[..., None]
+    return ((HOT[i] * (1 - f) + HOT[i + 1] * f) * 255 + 0.5).astype(np.uint8)
+
+
+def scene_picker(state: AppState) -> None:
+    """Combo over the bundled scenes."""
+    from ...scene.library import bundled
+    names = [p.stem for p in bundled()]
+    cur = names.index(state.scene_path.stem) if state.scene_path.stem in names else 0
+    changed, idx = imgui.combo("scene", cur, names)
+    if changed and names[idx] != state.scene_path.stem:
+        set_scene(state, names[idx])
+    if imgui.button("reset camera"):
+        state.camera = cam.reset(state.scene, state.camera)
+
+
+def method_list(state: AppState) -> None:
+    """Checkboxes over the methods (1 to 6 selected)."""
+    imgui.separator_text("methods")
+    for m in choosable_methods():
+        on = m in state.methods
+        changed, on = imgui.checkbox(m, on)
+        if changed:
+            if on and len(state.methods) < MAX_PANELS:
+                state.methods.append(m)
+            elif not on and len(state.methods) > 1:
+                state.methods.remove(m)
+    for m, why in LEFT_OUT.items():
+        imgui.text_disabled(f"{m}: {why}")
+
+
+def parameters(state: AppState) -> None:
+    """Sliders: the chosen material's coefficients and each selected method's quality knob."""
+    from ...renderers.base import get_renderer
+    imgui.separator_text("material")
+    names = list(state.scene.materials)
+    changed, idx = imgui.combo("material", names.index(state.material), names)
+    if changed:
+        state.material = names[idx]
+    mat = state.scene.materials[state.material]
+    for f in MATERIAL_FIELDS:
+        lo, hi = MATERIAL_RANGES[f]
+        changed, v = imgui.slider_float(f, float(getattr(mat, f)), lo, hi)
+        if changed:
+            set_material_value(state, state.material, f, v)
+    imgui.separator_text("quality")
+    for m in state.methods:
+        knob = get_renderer(m).knob
+        values = list(knob.values)
+        cur = state.options[m][knob.name]
+        idx = values.index(cur) if cur in values else 0
+        changed, idx = imgui.slider_int(f"{m} {knob.name}", idx, 0, len(values) - 1,
+                                        format=str(values[idx]))
+        if changed:
+            set_option(state, m, knob.name, values[idx])
+
+
+def handle_mouse(state: AppState) -> None:
+    """Mouse over the last drawn image panel: left drag orbits, right drag pans, wheel zooms.
+    Every panel shares ``state.camera``."""
+    if not imgui.is_item_hovered():
+        return
+    io = imgui.get_io()
+    dx, dy = io.mouse_delta.x, io.mouse_delta.y
+    if imgui.is_mouse_dragging(imgui.MouseButton_.left) and (dx or dy):
+        state.camera = cam.orbit(state.camera, -dx * ORBIT_SPEED, dy * ORBIT_SPEED)
+    elif imgui.is_mouse_dragging(imgui.MouseButton_.right) and (dx or dy):
+        h = state.camera.height
+        state.camera = cam.pan(state.camera, -dx / h, dy / h)
+    if io.mouse_wheel:
+        state.camera = cam.zoom(state.camera, ZOOM_STEP ** io.mouse_wheel)
+
+
+def image_panels(state: AppState) -> None:
+    """One image per selected method, side by side, wrapping to the available width."""
+    w, h = state.camera.width, state.camera.height
+    avail = imgui.get_content_region_avail().x
+    per_row = max(1, int(avail // (w + 8)))
+    for k, m in enumerate(state.methods):
+        if k % per_row:
+            imgui.same_line()
+        imgui.begin_group()
+        t = state.timings.get(m)
+        imgui.text(f"{m}  {'' if t is None else f'{t * 1e3:.1f} ms'}")
+        if m in state.images:
+            tex = upload_linear(state, m, state.images[m])
+            imgui.image(imgui.ImTextureRef(tex.glo), imgui.ImVec2(w, h))
+            handle_mouse(state)
+        imgui.text_disabled(state.status.get(m, "")[:40])
+        imgui.end_group()
+
+
+def difference_panel(state: AppState) -> None:
+    """Error map between two chosen methods with its colour scale."""
+    from ...compare.metrics import error_map
+    imgui.separator_text("difference")
+    ms = state.methods
+    a, b = (x if x in ms else ms[0] for x in state.diff_pair)
+    kinds = ["abs", "flip"]
+    imgui.set_next_item_width(120)
+    _, ia = imgui.combo("A", ms.index(a), ms)
+    imgui.same_line()
+    imgui.set_next_item_width(120)
+    _, ib = imgui.combo("B", ms.index(b), ms)
+    imgui.same_line()
+    imgui.set_next_item_width(80)
+    _, ik = imgui.combo("kind", kinds.index(state.diff_kind), kinds)
+    state.diff_pair, state.diff_kind = (ms[ia], ms[ib]), kinds[ik]
+    if state.diff_pair[0] not in state.images or state.diff_pair[1] not in state.images:
+        return
+    err = error_map(state.images[state.diff_pair[0]], state.images[state.diff_pair[1]],
+                    state.diff_kind)
+    vmax = max(float(err.max()), 1e-6)
+    state.images["difference"] = err
+    tex = upload(state, "difference", colour_scale(err, vmax))
+    size = imgui.ImVec2(state.camera.width, state.camera.height)
+    imgui.image(imgui.ImTextureRef(tex.glo), size)
+    bar = colour_scale(np.tile(np.linspace(0, 1, 128, dtype=np.float32), (8, 1)), 1.0)
+    tb = upload(state, "colour_scale", bar)
+    imgui.text("0")
+    imgui.same_line()
+    imgui.image(imgui.ImTextureRef(tb.glo), imgui.ImVec2(size.x - 60, 10))
+    imgui.same_line()
+    imgui.text(f"{vmax:.3g}")
+    imgui.text(f"mean {float(err.mean()):.4f}")
+
+
+def status_bar(state: AppState) -> None:
+    """GL_RENDERER, frame time and per-method timings."""
+    parts = [f"{m} {state.timings[m] * 1e3:.0f} ms" for m in state.methods if m in state.timings]
+    imgui.text(f"{state.gl_renderer} | frame {state.frame_seconds * 1e3:.1f} ms | "
+               + " | ".join(parts))
+
+
+def gui(state: AppState) -> None:
+    """The whole window: controls on the left, panels on the right."""
+    imgui.begin_child("controls", imgui.ImVec2(300, 0))
+    scene_picker(state)
+    method_list(state)
+    parameters(state)
+    imgui.end_child()
+    imgui.same_line()
+    imgui.begin_child("panels")
+    image_panels(state)
+    imgui.begin_child("difference", imgui.ImVec2(state.camera.width + 300, 0))
+    difference_panel(state)
+    imgui.end_child()
+    imgui.end_child()

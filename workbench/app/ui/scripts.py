@@ -1,0 +1,82 @@
+"""Scripted sessions for tests and benchmarks: called once per frame after the panels' images
+are updated, they act on the state through the same functions the mouse and sliders call, and
+record images into ``out``."""
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import camera as cam
+from .state import RASTER, AppState, set_material_value, set_option
+
+CPU_WAIT_SECONDS = 120.0
+"""How long the check script waits for background jobs before giving up."""
+
+
+def _record(state: AppState, out: Path, phase: str) -> None:
+    for m in state.methods:
+        np.save(out / f"{phase}_{m}.npy", np.asarray(state.images[m], np.float32))
+
+
+def _spec_material(state: AppState) -> str:
+    """The material of the first sphere (else first object): the one whose ks is changed."""
+    from ...scene.model import Sphere
+    objs = [o for o in state.scene.objects if isinstance(o, Sphere)] or list(state.scene.objects)
+    return objs[0].material
+
+
+class Check:
+    """before -> orbit -> flat knob change -> ks change -> wait for CPU jobs -> quit."""
+
+    def __init__(self, out: Path):
+        self.out, self.log, self.t_wait = out, {}, None
+
+    def __call__(self, state: AppState) -> None:
+        f, out = state.frame, self.out
+        if f == 2:
+            _record(state, out, "before")
+            state.camera = cam.orbit(state.camera, 0.4, 0.15)
+        elif f == 3:
+            _record(state, out, "orbit")
+            knob = state.options["flat"]["tessellation"]
+            set_option(state, "flat", "tessellation", 2 if knob != 2 else 3)
+        elif f == 4:
+            _record(state, out, "knob")
+            mat = _spec_material(state)
+            ks = state.scene.materials[mat].ks
+            set_material_value(state, mat, "ks", 1.0 if ks < 0.5 else 0.0)
+            self.log.update(material=mat, ks_before=ks)
+        elif f == 5:
+            _record(state, out, "ks")
+            self.t_wait = time.perf_counter()
+        elif f > 5 and (not state.jobs.busy()
+                        or time.perf_counter() - self.t_wait > CPU_WAIT_SECONDS):
+            _record(state, out, "final")
+            self.log["cpu_done"] = not state.jobs.busy()
+            state.quit = True
+
+
+class Fps:
+    """Count frames for ``seconds`` after a warm-up while the CPU jobs run (benchmark)."""
+
+    def __init__(self, out: Path, seconds: float = 10.0, warmup: int = 10):
+        self.out, self.seconds, self.warmup, self.log = out, seconds, warmup, {}
+        self.t0 = None
+
+    def __call__(self, state: AppState) -> None:
+        if state.frame == self.warmup:
+            self.t0, self.busy_frames = time.perf_counter(), 0
+        elif self.t0 is not None:
+            self.busy_frames += state.jobs.busy()
+            dt = time.perf_counter() - self.t0
+            if dt >= self.seconds:
+                n = state.frame - self.warmup
+                self.log.update(frames=n, seconds=dt, fps=n / dt, frames_with_cpu_job_running=
+                                self.busy_frames, raster_ms={m: state.timings.get(m, 0) * 1e3
+                                                             for m in state.methods if m in RASTER})
+                state.quit = True
+
+
+SCRIPTS = {"check": Check, "fps": Fps}
