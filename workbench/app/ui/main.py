@@ -56,7 +56,7 @@ def run(state: AppState, max_frames: int | None = None, script=None) -> None:
     params.app_window_params.window_geometry.size = WINDOW_SIZE
     params.fps_idling.enable_idling = False
     params.imgui_window_params.show_status_bar = True
-    params.ini_filename = ""
+    params.ini_disable = True  # no settings file written into the working folder
     params.callbacks.post_init = post_init
     params.callbacks.show_gui = show_gui
     params.callbacks.show_status = lambda: status_bar(state)

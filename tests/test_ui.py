@@ -1,0 +1,139 @@
+"""The UI under Xvfb: a scripted session (``workbench.app.ui.scripts.Check``) runs in a
+subprocess (GLFW and GL state never enter the pytest process) and writes each panel's image
+per phase plus ``summary.json``; the assertions are here."""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from workbench.app.ui import camera as cam
+from workbench.scene.io import load_scene
+
+pytestmark = pytest.mark.gl
+ROOT = Path(__file__).resolve().parents[1]
+METHODS = ("flat", "gouraud", "phong", "raycast")
+RASTER = ("flat", "gouraud", "phong")
+
+
+def _free_display() -> int:
+    for n in range(90, 200):
+        if not Path(f"/tmp/.X11-unix/X{n}").exists() and not Path(f"/tmp/.X{n}-lock").exists():
+            return n
+    raise RuntimeError("no free X display number")
+
+
+@pytest.fixture(scope="module")
+def xvfb():
+    if shutil.which("Xvfb") is None:
+        pytest.skip("Xvfb not installed")
+    n = _free_display()
+    proc = subprocess.Popen(["Xvfb", f":{n}", "-screen", "0", "1280x800x24", "-nolisten", "tcp"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    for _ in range(100):
+        if Path(f"/tmp/.X11-unix/X{n}").exists():
+            break
+        time.sleep(0.05)
+    yield f":{n}"
+    proc.terminate()
+    proc.wait(10)
+
+
+@pytest.fixture(scope="module")
+def session(xvfb, tmp_path_factory):
+    """Run the check script once; returns (out folder, summary, completed process)."""
+    out = tmp_path_factory.mktemp("ui")
+    env = {**os.environ, "DISPLAY": xvfb}
+    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", "whitted",
+                        "--methods", ",".join(METHODS), "--size", "128",
+                        "--test-script", "check", "--out", str(out), "--frames", "2000"],
+                       cwd=ROOT, env=env, capture_output=True, text=True, timeout=400)
+    summary = json.loads((out / "summary.json").read_text()) if (out / "summary.json").exists() else None
+    shot = out / "ui.png"
+    if shot.exists():
+        (ROOT / "docs" / "images").mkdir(parents=True, exist_ok=True)
+        shutil.copy(shot, ROOT / "docs" / "images" / "ui.png")
+    return out, summary, p
+
+
+def _img(out: Path, phase: str, m: str) -> np.ndarray:
+    return np.load(out / f"{phase}_{m}.npy")
+
+
+def _coverage(img: np.ndarray, background) -> np.ndarray:
+    """Pixels that are not the background colour (objects drawn)."""
+    return np.abs(img - np.asarray(background, np.float32)).max(-1) > 1e-3
+
+
+def test_window_opens_exits_cleanly_no_threads(session):
+    out, summary, p = session
+    assert p.returncode == 0, p.stderr[-2000:]
+    assert summary["frames"] >= 6
+    assert summary["gl_renderer"].strip()
+    assert summary["threads"] == ["MainThread"]
+    assert summary["script"]["cpu_done"]
+
+
+def test_every_panel_non_empty(session):
+    out, summary, _ = session
+    for m in METHODS:
+        img = _img(out, "final", m)
+        assert img.shape == (128, 128, 3) and np.isfinite(img).all()
+        assert img.std() > 0.01, m  # not a flat colour
+    shot = np.asarray(__import__("PIL.Image", fromlist=["Image"]).open(out / "ui.png"))
+    assert shot.shape[0] > 100 and shot.std() > 10
+
+
+def test_orbit_changes_all_raster_panels_consistently(session):
+    out, _, _ = session
+    bg = load_scene("whitted").background
+    masks = {}
+    for m in RASTER:
+        before, after = _img(out, "before", m), _img(out, "orbit", m)
+        assert np.abs(before - after).mean() > 0.01, m
+        masks[m] = _coverage(after, bg)
+    # silhouettes agree between the three shadings (tessellation edges aside)
+    for m in ("flat", "gouraud"):
+        assert (masks[m] != masks["phong"]).mean() < 0.02, m
+
+
+def test_cpu_panel_follows_the_shared_camera(session):
+    """The ray-cast panel (finished after the orbit) has the raster panels' silhouette."""
+    out, _, _ = session
+    bg = load_scene("whitted").background
+    rc = _coverage(_img(out, "final", "raycast"), bg)
+    ph = _coverage(_img(out, "final", "phong"), bg)
+    assert (rc != ph).mean() < 0.03
+
+
+def test_parameters_change_affected_panels_only(session):
+    out, summary, _ = session
+    # flat's tessellation knob: flat changes, gouraud and phong are bit-identical
+    assert np.abs(_img(out, "orbit", "flat") - _img(out, "knob", "flat")).max() > 0.01
+    for m in ("gouraud", "phong"):
+        assert np.array_equal(_img(out, "orbit", m), _img(out, "knob", m)), m
+    # ks of one material: phong changes, only where objects are (never the background)
+    bg = load_scene("whitted").background
+    k, s = _img(out, "knob", "phong"), _img(out, "ks", "phong")
+    changed = np.abs(k - s).max(-1) > 1e-4
+    assert changed.any()
+    assert not (changed & ~_coverage(k, bg)).any()
+
+
+def test_camera_functions_are_consistent():
+    c = load_scene("whitted").camera
+    back = cam.orbit(cam.orbit(c, 0.3, 0.2), -0.3, -0.2)
+    assert np.allclose(back.position, c.position, atol=1e-9)
+    _, _, _, d = cam.orbit_parameters(c)
+    assert np.isclose(cam.orbit_parameters(cam.orbit(c, 1.0, 0.5))[3], d)
+    assert np.isclose(cam.orbit_parameters(cam.zoom(c, 0.5))[3], d / 2)
+    p = cam.pan(c, 0.1, -0.2)
+    assert np.allclose(np.subtract(p.position, c.position), np.subtract(p.look_at, c.look_at))
+    assert cam.orbit_parameters(cam.orbit(c, 0.0, 10.0))[2] <= cam.PITCH_LIMIT + 1e-12
