@@ -137,3 +137,11 @@ def test_camera_functions_are_consistent():
     p = cam.pan(c, 0.1, -0.2)
     assert np.allclose(np.subtract(p.position, c.position), np.subtract(p.look_at, c.look_at))
     assert cam.orbit_parameters(cam.orbit(c, 0.0, 10.0))[2] <= cam.PITCH_LIMIT + 1e-12
+
+
+def test_display_table_matches_srgb_encode():
+    from workbench.app.ui.frames import srgb_lut, to_display
+    from workbench.core.imageio import to_srgb8
+    rng = np.random.default_rng(1)
+    img = (rng.random((64, 64, 3)) ** 3 * 1.2).astype(np.float32)
+    assert np.abs(to_display(srgb_lut(), img).astype(int) - to_srgb8(img)).max() <= 1

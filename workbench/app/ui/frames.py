@@ -16,6 +16,21 @@ from .state import RASTER, AppState
 
 TILED = ("raycast", "raytrace")
 """CPU methods that accept ``on_tile`` (partial images)."""
+SRGB_LUT_SIZE = 1 << 14
+"""Entries of the display table linear [0, 1] -> sRGB 8 bit (at most 1 level from
+:func:`~workbench.core.imageio.to_srgb8`; about 3x faster per frame)."""
+
+
+def srgb_lut() -> np.ndarray:
+    """(SRGB_LUT_SIZE,) uint8 table of :func:`~workbench.core.imageio.to_srgb8` on a uniform
+    grid of [0, 1]."""
+    return to_srgb8(np.linspace(0.0, 1.0, SRGB_LUT_SIZE))
+
+
+def to_display(lut: np.ndarray, image: np.ndarray) -> np.ndarray:
+    """(H, W, 3) finite linear float -> (H, W, 3) uint8 sRGB through ``lut``."""
+    idx = (np.clip(image, 0.0, 1.0) * (len(lut) - 1) + 0.5).astype(np.intp)
+    return lut[idx]
 
 
 def raster_image(state: AppState, method: str) -> np.ndarray:
@@ -72,8 +87,10 @@ def upload(state: AppState, key: str, rgb8: np.ndarray):
 
 
 def upload_linear(state: AppState, key: str, image: np.ndarray):
-    """sRGB-encode a linear image and upload it."""
-    return upload(state, key, to_srgb8(image))
+    """sRGB-encode a linear image (table :func:`srgb_lut`) and upload it."""
+    if state.srgb_lut is None:
+        state.srgb_lut = srgb_lut()
+    return upload(state, key, to_display(state.srgb_lut, image))
 
 
 def release_gl(state: AppState) -> None:

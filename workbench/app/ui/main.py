@@ -43,6 +43,7 @@ def run(state: AppState, max_frames: int | None = None, script=None) -> None:
         if script is not None:
             script(state)
         gui(state)
+        state.gui_seconds = time.perf_counter() - now
         state.frame += 1
         if state.quit or (max_frames is not None and state.frame >= max_frames):
             hello_imgui.get_runner_params().app_shall_exit = True

@@ -59,21 +59,25 @@ class Check:
 
 
 class Fps:
-    """Count frames for ``seconds`` after a warm-up while the CPU jobs run (benchmark)."""
+    """Count frames for ``seconds`` after a warm-up while the camera turns by ``step`` radians
+    per frame (a steady mouse drag: every panel changes every frame and the CPU jobs restart)."""
 
-    def __init__(self, out: Path, seconds: float = 10.0, warmup: int = 10):
-        self.out, self.seconds, self.warmup, self.log = out, seconds, warmup, {}
+    def __init__(self, out: Path, seconds: float = 10.0, warmup: int = 10, step: float = 0.002):
+        self.out, self.seconds, self.warmup, self.step, self.log = out, seconds, warmup, step, {}
         self.t0 = None
 
     def __call__(self, state: AppState) -> None:
+        state.camera = cam.orbit(state.camera, self.step, 0.0)
         if state.frame == self.warmup:
-            self.t0, self.busy_frames = time.perf_counter(), 0
+            self.t0, self.busy_frames, self.gui = time.perf_counter(), 0, 0.0
         elif self.t0 is not None:
             self.busy_frames += state.jobs.busy()
+            self.gui += state.gui_seconds
             dt = time.perf_counter() - self.t0
             if dt >= self.seconds:
                 n = state.frame - self.warmup
-                self.log.update(frames=n, seconds=dt, fps=n / dt, frames_with_cpu_job_running=
+                self.log.update(frames=n, seconds=dt, fps=n / dt, gui_ms_mean=self.gui / n * 1e3,
+                                frames_with_cpu_job_running=
                                 self.busy_frames, raster_ms={m: state.timings.get(m, 0) * 1e3
                                                              for m in state.methods if m in RASTER})
                 state.quit = True

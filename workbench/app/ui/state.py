@@ -43,12 +43,14 @@ class AppState:
     status: dict[str, str] = field(default_factory=dict)
     frame: int = 0
     frame_seconds: float = 0.0
+    gui_seconds: float = 0.0
     diff_pair: tuple[str, str] = ("flat", "phong")
     diff_kind: str = "abs"
     gl_renderer: str = ""
     ctx: object = None
     sessions: dict = field(default_factory=dict)
     jobs: object = None
+    srgb_lut: object = None
     quit: bool = False
 
 
