@@ -56,7 +56,9 @@ def cpu_image(state: AppState, method: str) -> np.ndarray:
     """The current background job's image (finished, or its tiles so far)."""
     job = state.jobs.request(state.scene, state.camera, method, state.options[method],
                              tiled=method in TILED)
-    if job.error:
+    if job.cancelled.is_set():
+        state.status[method] = "restarting (stale image)"
+    elif job.error:
         state.status[method] = job.error
     elif job.done:
         state.timings[method] = job.seconds

@@ -5,10 +5,13 @@ A :class:`Job` renders one (scene, camera, method, options) request with
 by band, so the UI shows the image as it comes.  A job whose request is superseded is
 *cancelled*: its next ``on_tile`` raises :class:`Cancelled`, which ends the render early in its
 own thread (methods without ``on_tile`` finish in the background and their result is dropped).
-The UI thread never waits on a job except at exit (:func:`join_all`).
+The UI thread never waits on a job except at exit (:func:`join_all`).  Jobs use one core fewer
+than the machine has for numba's parallel loops (``numba.set_num_threads`` is per calling
+thread), so the window keeps a core.
 """
 from __future__ import annotations
 
+import os
 import threading
 import time
 from dataclasses import replace
@@ -56,7 +59,10 @@ class Job:
             self.rows_done = max(self.rows_done, y1)
 
     def _run(self, scene, method, opts):
+        import numba
+
         from ...renderers.base import render
+        numba.set_num_threads(max(1, min(numba.config.NUMBA_NUM_THREADS, (os.cpu_count() or 1) - 1)))
         t0 = time.perf_counter()
         try:
             res = render(scene, method, width=scene.camera.width, height=scene.camera.height, **opts)
@@ -87,21 +93,25 @@ class JobBoard:
         self.started: list[Job] = []
 
     def request(self, scene, camera, method: str, options: dict, tiled: bool) -> Job:
-        """The job for this request: the current one if its key matches, else a new one (the
-        old one is cancelled)."""
+        """The job for this request: the current one if its key matches; else the old one is
+        cancelled and, once its thread has ended, a new one starts (at most one thread per
+        method, so a mouse drag does not pile up renders: meanwhile the old image shows)."""
         key = (id(scene), camera, method, tuple(sorted(options.items())))
         job = self.current.get(method)
         if job is not None and job.key == key:
             return job
         if job is not None:
             job.cancelled.set()
+            if job.thread.is_alive():
+                return job
         job = Job(scene, camera, method, options, tiled)
         self.current[method] = job
         self.started.append(job)
         return job
 
     def busy(self) -> bool:
-        return any(not j.done for j in self.current.values())
+        """A job is running or its result is stale (a restart is pending)."""
+        return any(j.thread.is_alive() or j.cancelled.is_set() for j in self.current.values())
 
     def join_all(self, timeout: float | None = None) -> None:
         """Cancel everything and join every thread started."""
