@@ -19,7 +19,7 @@ from workbench.scene.io import load_scene
 
 pytestmark = pytest.mark.gl
 ROOT = Path(__file__).resolve().parents[1]
-METHODS = ("flat", "gouraud", "phong", "raycast")
+METHODS = ("flat", "gouraud", "phong", "raycast", "raytrace")
 RASTER = ("flat", "gouraud", "phong")
 
 
@@ -125,6 +125,31 @@ def test_parameters_change_affected_panels_only(session):
     changed = np.abs(k - s).max(-1) > 1e-4
     assert changed.any()
     assert not (changed & ~_coverage(k, bg)).any()
+
+
+def test_ray_tree_of_a_pixel_matches_the_raytrace_panel(session):
+    """The ray tree (reference Python tracer) of a pixel gives the wavefront panel's value."""
+    out, summary, _ = session
+    rt = summary["script"]["ray_tree"]
+    i, j = rt["pixel"]
+    assert np.allclose(rt["color"], _img(out, "final", "raytrace")[i, j], atol=2e-3)
+    assert rt["n_children"] >= 1
+
+
+def test_export_writes_panels_and_settings(session):
+    from PIL import Image
+
+    from workbench.core.imageio import to_srgb8
+    out, summary, _ = session
+    exp = out / "export"
+    settings = json.loads((exp / "settings.json").read_text())
+    assert settings["methods"] == list(METHODS)
+    assert settings["material_overrides"] == {summary["script"]["material"]: {
+        "ks": 1.0 if summary["script"]["ks_before"] < 0.5 else 0.0}}
+    for m in METHODS:
+        png = np.asarray(Image.open(exp / f"{m}.png"))
+        assert np.array_equal(png, to_srgb8(_img(out, "final", m)))
+    assert (exp / "difference.png").exists()
 
 
 def test_camera_functions_are_consistent():

@@ -6,6 +6,7 @@ from imgui_bundle import imgui
 
 from . import camera as cam
 from .frames import upload, upload_linear
+from .inspect import export, pixel_under_mouse, probe_tooltip, ray_tree_view, select_ray_tree
 from .state import (LEFT_OUT, MATERIAL_FIELDS, MAX_PANELS, AppState,
                     choosable_methods, set_material_value, set_option, set_scene)
 
@@ -45,6 +46,12 @@ def scene_picker(state: AppState) -> None:
         set_scene(state, names[idx])
     if imgui.button("reset camera"):
         state.camera = cam.reset(state.scene, state.camera)
+    imgui.same_line()
+    if imgui.button("export"):
+        folder = state.export_dir / f"{state.scene_path.stem}_{state.frame:06d}"
+        state.status["export"] = f"saved {len(export(state, folder))} files to {folder}"
+    if "export" in state.status:
+        imgui.text_disabled(state.status["export"])
 
 
 def method_list(state: AppState) -> None:
@@ -95,6 +102,8 @@ def handle_mouse(state: AppState) -> None:
         return
     io = imgui.get_io()
     dx, dy = io.mouse_delta.x, io.mouse_delta.y
+    if imgui.get_io().key_ctrl:  # Ctrl+click selects a pixel, no camera move
+        return
     if imgui.is_mouse_dragging(imgui.MouseButton_.left) and (dx or dy):
         state.camera = cam.orbit(state.camera, -dx * ORBIT_SPEED, dy * ORBIT_SPEED)
     elif imgui.is_mouse_dragging(imgui.MouseButton_.right) and (dx or dy):
@@ -119,6 +128,12 @@ def image_panels(state: AppState) -> None:
             tex = upload_linear(state, m, state.images[m])
             imgui.image(imgui.ImTextureRef(tex.glo), imgui.ImVec2(w, h))
             handle_mouse(state)
+            ij = pixel_under_mouse(state)
+            if ij is not None:
+                probe_tooltip(state, ij)
+                if (m == "raytrace" and imgui.get_io().key_ctrl
+                        and imgui.is_mouse_clicked(imgui.MouseButton_.left)):
+                    select_ray_tree(state, *ij)
         imgui.text_disabled(state.status.get(m, "")[:40])
         imgui.end_group()
 
@@ -177,5 +192,9 @@ def gui(state: AppState) -> None:
     image_panels(state)
     imgui.begin_child("difference", imgui.ImVec2(state.camera.width + 300, 0))
     difference_panel(state)
+    imgui.end_child()
+    imgui.same_line()
+    imgui.begin_child("ray tree")
+    ray_tree_view(state)
     imgui.end_child()
     imgui.end_child()

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from . import camera as cam
+from .inspect import export, select_ray_tree
 from .state import RASTER, AppState, set_material_value, set_option
 
 CPU_WAIT_SECONDS = 120.0
@@ -55,6 +56,13 @@ class Check:
                         or time.perf_counter() - self.t_wait > CPU_WAIT_SECONDS):
             _record(state, out, "final")
             self.log["cpu_done"] = not state.jobs.busy()
+            self.log["exported"] = [p.name for p in export(state, out / "export")]
+            if "raytrace" in state.methods:
+                i, j = state.camera.height // 2, state.camera.width // 3
+                tree = select_ray_tree(state, i, j)["tree"]
+                self.log["ray_tree"] = {"pixel": [i, j], "color": tree["color"],
+                                        "depth": tree.get("depth"),
+                                        "n_children": len(tree.get("children", []))}
             state.quit = True
 
 

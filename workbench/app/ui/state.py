@@ -51,6 +51,8 @@ class AppState:
     sessions: dict = field(default_factory=dict)
     jobs: object = None
     srgb_lut: object = None
+    ray_tree: dict | None = None
+    export_dir: Path = Path("out/ui_export")
     quit: bool = False
 
 

@@ -1,0 +1,99 @@
+"""Looking closely: the pixel probe, the ray tree of a clicked pixel and the export of the
+comparison (panels, difference view and settings)."""
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, replace
+from pathlib import Path
+
+import numpy as np
+from imgui_bundle import imgui
+
+from .state import AppState
+
+
+def pixel_under_mouse(state: AppState) -> tuple[int, int] | None:
+    """(row, column) of the last drawn image panel under the mouse, or None."""
+    if not imgui.is_item_hovered():
+        return None
+    lo, mouse = imgui.get_item_rect_min(), imgui.get_mouse_pos()
+    i, j = int(mouse.y - lo.y), int(mouse.x - lo.x)
+    if 0 <= i < state.camera.height and 0 <= j < state.camera.width:
+        return i, j
+    return None
+
+
+def probe_tooltip(state: AppState, ij: tuple[int, int]) -> None:
+    """Tooltip with every panel's linear value at pixel ``ij`` (and the difference value)."""
+    i, j = ij
+    lines = [f"pixel row {i}, column {j}"]
+    for m in [*state.methods, "difference"]:
+        img = state.images.get(m)
+        if img is not None and img.shape[:2] == (state.camera.height, state.camera.width):
+            v = np.atleast_1d(img[i, j])
+            lines.append(f"{m:>10}: " + " ".join(f"{x:.4f}" for x in v))
+    imgui.set_tooltip("\n".join(lines))
+
+
+def select_ray_tree(state: AppState, i: int, j: int) -> dict:
+    """Compute the ray tree of pixel (i, j) with the shared camera and the ``raytrace``
+    options (:func:`workbench.renderers.raytrace.ray_tree`); kept in ``state.ray_tree``."""
+    from ...renderers.raytrace import ray_tree
+    scene = replace(state.scene, camera=state.camera)
+    state.ray_tree = {"pixel": [i, j], "tree": ray_tree(scene, i, j, **state.options["raytrace"])}
+    return state.ray_tree
+
+
+def _show_node(label: str, node) -> None:
+    if isinstance(node, dict):
+        if imgui.tree_node(f"{label}##{id(node)}"):
+            for k, v in node.items():
+                _show_node(str(k), v)
+            imgui.tree_pop()
+    elif isinstance(node, list) and node and isinstance(node[0], (dict, list)):
+        if imgui.tree_node(f"{label} [{len(node)}]##{id(node)}"):
+            for k, v in enumerate(node):
+                _show_node(f"{label}[{k}]", v)
+            imgui.tree_pop()
+    else:
+        if isinstance(node, (list, tuple)):
+            node = "(" + ", ".join(f"{x:.4g}" if isinstance(x, float) else str(x) for x in node) + ")"
+        elif isinstance(node, float):
+            node = f"{node:.4g}"
+        imgui.bullet_text(f"{label}: {node}")
+
+
+def ray_tree_view(state: AppState) -> None:
+    """The selected pixel's ray tree as nested tree nodes (Ctrl+click in the raytrace panel)."""
+    imgui.separator_text("ray tree (Ctrl+click the raytrace panel)")
+    if state.ray_tree is not None:
+        i, j = state.ray_tree["pixel"]
+        imgui.set_next_item_open(True, imgui.Cond_.once)
+        _show_node(f"pixel ({i}, {j})", state.ray_tree["tree"])
+
+
+def settings(state: AppState) -> dict:
+    """The comparison's settings (scene, camera, methods and their options, material overrides,
+    difference view)."""
+    return {"scene": str(state.scene_path), "camera": asdict(state.camera),
+            "methods": list(state.methods),
+            "options": {m: state.options[m] for m in state.methods},
+            "material_overrides": state.overrides,
+            "difference": {"a": state.diff_pair[0], "b": state.diff_pair[1],
+                           "kind": state.diff_kind}}
+
+
+def export(state: AppState, folder: Path) -> list[Path]:
+    """Write every panel (sRGB PNG), the difference view (colour scale PNG) and
+    ``settings.json`` into ``folder``; returns the files written."""
+    from ...core.imageio import save_png, save_png8
+    from .panels import colour_scale
+    folder = Path(folder)
+    written = [save_png(folder / f"{m}.png", state.images[m])
+               for m in state.methods if m in state.images]
+    err = state.images.get("difference")
+    if err is not None:
+        written.append(save_png8(folder / "difference.png", colour_scale(err, float(err.max()))))
+    path = folder / "settings.json"
+    path.write_text(json.dumps(settings(state), indent=1, default=str))
+    return [*written, path]
