@@ -63,3 +63,10 @@ def test_look_at_is_orthonormal_and_maps_eye_to_origin():
     m = tf.look_at([1, 2, 3], [4, 0, -1], [0, 1, 0])
     assert np.allclose(m[:3, :3] @ m[:3, :3].T, np.eye(3))
     assert np.allclose(tf.transform_points(m, np.array([[1, 2, 3.0]])), 0)
+
+
+def test_normalize_keeps_the_direction_of_tiny_vectors():
+    # a face normal at scene scale 1e-6: cross product of 1e-7 edges is 1e-14 long
+    e1, e2 = np.array([1e-7, 0, 0]), np.array([0, 1e-7, 0])
+    assert np.allclose(tf.normalize(np.cross(e1, e2)), [0, 0, 1])
+    assert np.array_equal(tf.normalize(np.zeros(3)), np.zeros(3))

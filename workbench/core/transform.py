@@ -6,14 +6,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from .tol import tol
 
 
 def normalize(v: np.ndarray, axis: int = -1) -> np.ndarray:
-    """Unit vectors along ``axis``; zero vectors stay zero (never NaN)."""
+    """Unit vectors along ``axis``; zero vectors stay zero (never NaN).
+
+    Any non-zero finite vector has a direction, however short: a cross product of two 1e-7
+    edges (a scene at scale 1e-6) is 1e-14 long and must not be taken for zero, so there is
+    no absolute threshold here (callers that need one, e.g. cancelled normals, test the length
+    against ``tol`` themselves)."""
     v = np.asarray(v, dtype=np.float64)
     n = np.linalg.norm(v, axis=axis, keepdims=True)
-    return np.divide(v, n, out=np.zeros_like(v), where=n > tol.zero)
+    return np.divide(v, n, out=np.zeros_like(v), where=(n > 0.0) & np.isfinite(n))
 
 
 def translate(t) -> np.ndarray:
