@@ -300,13 +300,14 @@ def _expected_ff(formula: dict, polygons) -> float:
 
 def api_ff_pair(fn, p: dict) -> Outcome:
     """``F[0, 1]`` of two polygons against a closed form (relative error); also reports the
-    reciprocity error ``|A0 F01 - A1 F10| / (A0 F01)``."""
+    reciprocity error ``|A0 F01 - A1 F10| / max(A0 F01, A1 F10)`` (1 when one side is 0)."""
     polys = [np.asarray(q, dtype=np.float64) for q in p["polygons"]]
     exp = _expected_ff(p["formula"], polys)
     ff = fn(polys, **p.get("args", {}))
     F = np.asarray(ff)
     A = [0.5 * np.linalg.norm(np.cross(q[1:-1] - q[0], q[2:] - q[0]).sum(0)) for q in polys]
-    recip = abs(A[0] * F[0, 1] - A[1] * F[1, 0]) / max(A[0] * F[0, 1], 1e-300)
+    a01, a10 = A[0] * F[0, 1], A[1] * F[1, 0]
+    recip = abs(a01 - a10) / max(a01, a10) if max(a01, a10) > 0 else 0.0
     return Outcome(f"F01 = {exp:.6g} ({p['formula']['name']})",
                    f"F01 = {F[0, 1]:.6g}, F10 = {F[1, 0]:.6g}, reciprocity error {recip:.3g}",
                    abs(F[0, 1] - exp) / exp, _nonfinite(F))
