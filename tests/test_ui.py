@@ -170,3 +170,14 @@ def test_display_table_matches_srgb_encode():
     rng = np.random.default_rng(1)
     img = (rng.random((64, 64, 3)) ** 3 * 1.2).astype(np.float32)
     assert np.abs(to_display(srgb_lut(), img).astype(int) - to_srgb8(img)).max() <= 1
+
+
+def test_linked_view_zoom_keeps_the_point_under_the_mouse():
+    v = cam.zoom_view((1.0, 0.5, 0.5), 4.0, (0.3, 0.6))
+    (u0, v0), (u1, v1) = cam.view_window(v)
+    assert np.isclose(u1 - u0, 0.25) and np.isclose((0.3 - u0) / (u1 - u0), 0.3)
+    assert np.isclose((0.6 - v0) / (v1 - v0), 0.6)
+    back = cam.pan_view(cam.pan_view(v, 0.1, -0.05), -0.1, 0.05)
+    assert np.allclose(cam.view_window(back), cam.view_window(v))
+    assert np.allclose(cam.view_window((2.0, 0.0, 1.0)), ((0.0, 0.5), (0.5, 1.0)))  # kept inside
+    assert cam.zoom_view(v, 1e-3, (0.5, 0.5))[0] == 1.0

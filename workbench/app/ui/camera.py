@@ -80,3 +80,31 @@ def zoom(cam: Camera, factor: float) -> Camera:
 def reset(scene: Scene, cam: Camera) -> Camera:
     """The scene's camera at ``cam``'s resolution."""
     return scene.camera.with_resolution(cam.width, cam.height)
+
+
+# ---------------------------------------------------------------- linked image view (2D zoom)
+MAX_VIEW_ZOOM = 32.0
+
+
+def view_window(view: tuple[float, float, float]) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Texture window (uv0, uv1) of the shared 2D view ``(zoom, cu, cv)``: a square of side
+    ``1 / zoom`` centred on (cu, cv), u to the right and v down, kept inside [0, 1]^2."""
+    z, cu, cv = view
+    h = 0.5 / z
+    cu, cv = min(max(cu, h), 1.0 - h), min(max(cv, h), 1.0 - h)
+    return (cu - h, cv - h), (cu + h, cv + h)
+
+
+def zoom_view(view: tuple[float, float, float], factor: float, at: tuple[float, float]):
+    """Zoom the 2D view by ``factor`` keeping the image point ``at`` (uv) under the mouse."""
+    (u0, v0), _ = view_window(view)
+    z = min(max(view[0] * factor, 1.0), MAX_VIEW_ZOOM)
+    fx, fy = (at[0] - u0) * view[0], (at[1] - v0) * view[0]  # mouse position in the panel [0, 1]
+    return (z, at[0] - fx / z + 0.5 / z, at[1] - fy / z + 0.5 / z)
+
+
+def pan_view(view: tuple[float, float, float], du: float, dv: float):
+    """Slide the 2D view by (du, dv) fractions of the panel (the image follows the mouse)."""
+    (u0, v0), (u1, v1) = view_window(view)
+    z = view[0]
+    return (z, (u0 + u1) / 2 - du / z, (v0 + v1) / 2 - dv / z)

@@ -13,11 +13,16 @@ from .state import AppState
 
 
 def pixel_under_mouse(state: AppState) -> tuple[int, int] | None:
-    """(row, column) of the last drawn image panel under the mouse, or None."""
+    """(row, column) of the image pixel under the mouse in the last drawn panel (through the
+    linked 2D view), or None."""
     if not imgui.is_item_hovered():
         return None
+    from .camera import view_window
     lo, mouse = imgui.get_item_rect_min(), imgui.get_mouse_pos()
-    i, j = int(mouse.y - lo.y), int(mouse.x - lo.x)
+    (u0, v0), (u1, v1) = view_window(state.view)
+    fx, fy = (mouse.x - lo.x) / state.camera.width, (mouse.y - lo.y) / state.camera.height
+    i = int((v0 + fy * (v1 - v0)) * state.camera.height)
+    j = int((u0 + fx * (u1 - u0)) * state.camera.width)
     if 0 <= i < state.camera.height and 0 <= j < state.camera.width:
         return i, j
     return None

@@ -47,6 +47,9 @@ def scene_picker(state: AppState) -> None:
     if imgui.button("reset camera"):
         state.camera = cam.reset(state.scene, state.camera)
     imgui.same_line()
+    if imgui.button("reset zoom"):
+        state.view = (1.0, 0.5, 0.5)
+    imgui.same_line()
     if imgui.button("export"):
         folder = state.export_dir / f"{state.scene_path.stem}_{state.frame:06d}"
         state.status["export"] = f"saved {len(export(state, folder))} files to {folder}"
@@ -96,13 +99,25 @@ def parameters(state: AppState) -> None:
 
 
 def handle_mouse(state: AppState) -> None:
-    """Mouse over the last drawn image panel: left drag orbits, right drag pans, wheel zooms.
-    Every panel shares ``state.camera``."""
+    """Mouse over the last drawn image panel: left drag orbits, right drag pans, wheel zooms
+    (every panel shares ``state.camera``); with Shift, the wheel and left drag zoom and pan the
+    linked 2D view of all panels instead."""
     if not imgui.is_item_hovered():
         return
     io = imgui.get_io()
     dx, dy = io.mouse_delta.x, io.mouse_delta.y
-    if imgui.get_io().key_ctrl:  # Ctrl+click selects a pixel, no camera move
+    if io.key_ctrl:  # Ctrl+click selects a pixel, no camera move
+        return
+    if io.key_shift:  # Shift: linked 2D zoom (wheel) and pan (left drag) of all panels
+        lo, mouse = imgui.get_item_rect_min(), imgui.get_mouse_pos()
+        (u0, v0), (u1, v1) = cam.view_window(state.view)
+        fx, fy = (mouse.x - lo.x) / state.camera.width, (mouse.y - lo.y) / state.camera.height
+        if io.mouse_wheel:
+            at = (u0 + fx * (u1 - u0), v0 + fy * (v1 - v0))
+            state.view = cam.zoom_view(state.view, 1.25 ** io.mouse_wheel, at)
+        if imgui.is_mouse_dragging(imgui.MouseButton_.left) and (dx or dy):
+            state.view = cam.pan_view(state.view, dx / state.camera.width,
+                                      dy / state.camera.height)
         return
     if imgui.is_mouse_dragging(imgui.MouseButton_.left) and (dx or dy):
         state.camera = cam.orbit(state.camera, -dx * ORBIT_SPEED, dy * ORBIT_SPEED)
@@ -126,7 +141,7 @@ def image_panels(state: AppState) -> None:
         imgui.text(f"{m}  {'' if t is None else f'{t * 1e3:.1f} ms'}")
         if m in state.images:
             tex = upload_linear(state, m, state.images[m])
-            imgui.image(imgui.ImTextureRef(tex.glo), imgui.ImVec2(w, h))
+            imgui.image(imgui.ImTextureRef(tex.glo), imgui.ImVec2(w, h), *cam.view_window(state.view))
             handle_mouse(state)
             ij = pixel_under_mouse(state)
             if ij is not None:
@@ -162,7 +177,7 @@ def difference_panel(state: AppState) -> None:
     state.images["difference"] = err
     tex = upload(state, "difference", colour_scale(err, vmax))
     size = imgui.ImVec2(state.camera.width, state.camera.height)
-    imgui.image(imgui.ImTextureRef(tex.glo), size)
+    imgui.image(imgui.ImTextureRef(tex.glo), size, *cam.view_window(state.view))
     bar = colour_scale(np.tile(np.linspace(0, 1, 128, dtype=np.float32), (8, 1)), 1.0)
     tb = upload(state, "colour_scale", bar)
     imgui.text("0")

@@ -23,7 +23,8 @@ class AppState:
 
     ``scene`` is the loaded scene with the material overrides applied; ``scene_version`` grows
     with every change of it (cache keys of GL sessions and background jobs).  ``camera`` is the
-    shared camera of all panels at the panel resolution.  ``images`` holds each panel's last
+    shared camera of all panels at the panel resolution; ``view`` (zoom, centre u, centre v)
+    the linked 2D zoom of every image panel.  ``images`` holds each panel's last
     linear (H, W, 3) float32 image, ``timings`` its last render time in seconds.
     """
 
@@ -52,6 +53,7 @@ class AppState:
     jobs: object = None
     srgb_lut: object = None
     ray_tree: dict | None = None
+    view: tuple[float, float, float] = (1.0, 0.5, 0.5)
     export_dir: Path = Path("out/ui_export")
     quit: bool = False
 
