@@ -181,3 +181,23 @@ def test_linked_view_zoom_keeps_the_point_under_the_mouse():
     assert np.allclose(cam.view_window(back), cam.view_window(v))
     assert np.allclose(cam.view_window((2.0, 0.0, 1.0)), ((0.0, 0.5), (0.5, 1.0)))  # kept inside
     assert cam.zoom_view(v, 1e-3, (0.5, 0.5))[0] == 1.0
+
+
+@pytest.mark.slow
+def test_radiosity_panels_in_the_window(xvfb, tmp_path):
+    """Radiosity and hybrid (no tiles: they finish in the background) restart with each change
+    and end with non-empty images; no thread left."""
+    env = {**os.environ, "DISPLAY": xvfb}
+    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", "cornell",
+                        "--methods", "phong,radiosity,hybrid", "--size", "64",
+                        "--test-script", "check", "--out", str(tmp_path)],
+                       cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stderr[-2000:]
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["threads"] == ["MainThread"] and summary["script"]["cpu_done"]
+    ph, ph_before = _img(tmp_path, "final", "phong"), _img(tmp_path, "before", "phong")
+    for m in ("radiosity", "hybrid"):
+        img = np.clip(_img(tmp_path, "final", m), 0, 1)
+        assert img.std() > 0.01
+        # rendered with the orbited camera: closer to phong after the orbit than before it
+        assert np.abs(img - np.clip(ph, 0, 1)).mean() < np.abs(img - np.clip(ph_before, 0, 1)).mean()
