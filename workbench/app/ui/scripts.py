@@ -68,13 +68,17 @@ class Check:
 
 class Fps:
     """Count frames for ``seconds`` after a warm-up while the camera turns by ``step`` radians
-    per frame (a steady mouse drag: every panel changes every frame and the CPU jobs restart)."""
+    per frame (a steady mouse drag: every panel changes every frame and the CPU jobs restart).
+    ``raytrace_spp`` sets the ray tracer's samples per pixel (a longer background job)."""
 
-    def __init__(self, out: Path, seconds: float = 10.0, warmup: int = 10, step: float = 0.002):
+    def __init__(self, out: Path, seconds: float = 10.0, warmup: int = 10, step: float = 0.002,
+                 raytrace_spp: int | None = None):
         self.out, self.seconds, self.warmup, self.step, self.log = out, seconds, warmup, step, {}
-        self.t0 = None
+        self.spp, self.t0 = raytrace_spp, None
 
     def __call__(self, state: AppState) -> None:
+        if state.frame == 0 and self.spp is not None:
+            set_option(state, "raytrace", "spp", self.spp)
         state.camera = cam.orbit(state.camera, self.step, 0.0)
         if state.frame == self.warmup:
             self.t0, self.busy_frames, self.gui = time.perf_counter(), 0, 0.0
@@ -91,4 +95,5 @@ class Fps:
                 state.quit = True
 
 
-SCRIPTS = {"check": Check, "fps": Fps}
+SCRIPTS = {"check": Check, "fps": Fps,
+           "fps_static": lambda out: Fps(out, step=0.0, raytrace_spp=16)}
