@@ -152,6 +152,12 @@ def test_export_writes_panels_and_settings(session):
     assert (exp / "difference.png").exists()
 
 
+def test_panel_display_mode_quantises_only_what_is_shown(session):
+    _, summary, _ = session
+    d = summary["script"]["display"]
+    assert d["colours"] <= 2 < d["image_colours"]
+
+
 def test_camera_functions_are_consistent():
     c = load_scene("whitted").camera
     back = cam.orbit(cam.orbit(c, 0.3, 0.2), -0.3, -0.2)

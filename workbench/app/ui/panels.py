@@ -7,8 +7,9 @@ from imgui_bundle import imgui
 from . import camera as cam
 from .frames import upload, upload_linear
 from .inspect import export, pixel_under_mouse, probe_tooltip, ray_tree_view, select_ray_tree
-from .state import (LEFT_OUT, MATERIAL_FIELDS, MAX_PANELS, AppState,
-                    choosable_methods, set_material_value, set_option, set_scene)
+from .state import (DISPLAY_MODES, HARMONIES, LEFT_OUT, MATERIAL_FIELDS, MAX_PANELS, AppState,
+                    choosable_methods, set_display, set_material_value, set_option, set_scene,
+                    shown_image)
 
 ORBIT_SPEED = 0.01
 """Radians of orbit per pixel of mouse drag."""
@@ -140,7 +141,7 @@ def image_panels(state: AppState) -> None:
         t = state.timings.get(m)
         imgui.text(f"{m}  {'' if t is None else f'{t * 1e3:.1f} ms'}")
         if m in state.images:
-            tex = upload_linear(state, m, state.images[m])
+            tex = upload_linear(state, m, shown_image(state, m))
             imgui.image(imgui.ImTextureRef(tex.glo), imgui.ImVec2(w, h), *cam.view_window(state.view))
             handle_mouse(state)
             ij = pixel_under_mouse(state)
@@ -150,6 +151,12 @@ def image_panels(state: AppState) -> None:
                         and imgui.is_mouse_clicked(imgui.MouseButton_.left)):
                     select_ray_tree(state, *ij)
         imgui.text_disabled(state.status.get(m, "")[:40])
+        mode = state.display.get(m, "direct24")
+        modes = list(DISPLAY_MODES) if mode in DISPLAY_MODES else [mode, *DISPLAY_MODES]
+        imgui.set_next_item_width(w)
+        changed, k_mode = imgui.combo(f"##display {m}", modes.index(mode), modes)
+        if changed:
+            set_display(state, m, modes[k_mode])
         imgui.end_group()
 
 
@@ -188,6 +195,22 @@ def difference_panel(state: AppState) -> None:
     imgui.text(f"mean {float(err.mean()):.4f}")
 
 
+def colour_wheel(state: AppState) -> None:
+    """The chromatic circle with the course's harmonies for a chosen base hue (HSV)."""
+    from ...core.harmony import wheel_image
+    imgui.separator_text("colour wheel")
+    hue, kind = state.wheel
+    _, hue = imgui.slider_float("base hue", hue, 0.0, 360.0)
+    _, k = imgui.combo("harmony", HARMONIES.index(kind), list(HARMONIES))
+    key = f"wheel {hue:.1f} {HARMONIES[k]}"
+    if state.wheel != (hue, HARMONIES[k]) or key not in state.textures:
+        for old in [t for t in state.textures if t.startswith("wheel ")]:
+            state.textures.pop(old).release()
+        state.wheel = (hue, HARMONIES[k])
+        upload_linear(state, key, wheel_image(hue, HARMONIES[k], size=200))
+    imgui.image(imgui.ImTextureRef(state.textures[key].glo), imgui.ImVec2(200, 200))
+
+
 def status_bar(state: AppState) -> None:
     """GL_RENDERER, frame time and per-method timings."""
     parts = [f"{m} {state.timings[m] * 1e3:.0f} ms" for m in state.methods if m in state.timings]
@@ -201,6 +224,7 @@ def gui(state: AppState) -> None:
     scene_picker(state)
     method_list(state)
     parameters(state)
+    colour_wheel(state)
     imgui.end_child()
     imgui.same_line()
     imgui.begin_child("panels")

@@ -10,7 +10,7 @@ import numpy as np
 
 from . import camera as cam
 from .inspect import export, select_ray_tree
-from .state import RASTER, AppState, set_material_value, set_option
+from .state import RASTER, AppState, set_display, set_material_value, set_option, shown_image
 
 CPU_WAIT_SECONDS = 120.0
 """How long the check script waits for background jobs before giving up."""
@@ -56,6 +56,12 @@ class Check:
                         or time.perf_counter() - self.t_wait > CPU_WAIT_SECONDS):
             _record(state, out, "final")
             self.log["cpu_done"] = not state.jobs.busy()
+            m0 = state.methods[0]
+            set_display(state, m0, "indexed2-mediancut")
+            shown = shown_image(state, m0).reshape(-1, 3)
+            self.log["display"] = {"method": m0, "colours": int(len(np.unique(shown, axis=0))),
+                                   "image_colours": int(len(np.unique(
+                                       state.images[m0].reshape(-1, 3), axis=0)))}
             self.log["exported"] = [p.name for p in export(state, out / "export")]
             if "raytrace" in state.methods:
                 i, j = state.camera.height // 2, state.camera.width // 3

@@ -15,6 +15,12 @@ CPU = ("raycast", "raytrace", "radiosity", "hybrid")
 LEFT_OUT = {"pyrender": "needs its own process with PyOpenGL's EGL platform; not in the UI"}
 MAX_PANELS = 6
 MATERIAL_FIELDS = ("ka", "kd", "ks", "shininess", "kr", "kt", "ior")
+DISPLAY_MODES = ("direct24", "direct16-555", "direct16-565", "direct16-565-fs",
+                 "indexed256-mediancut", "indexed16-mediancut", "indexed16-kmeans-fs",
+                 "indexed4-mediancut-bayer", "indexed2-mediancut")
+"""Display modes offered per panel (the colour chapter's 24/16-bit direct and indexed CLUTs);
+``workbench.core.display`` accepts more from the CLI."""
+HARMONIES = ("complementary", "triad", "square", "hexagon")
 
 
 @dataclass
@@ -54,6 +60,8 @@ class AppState:
     srgb_lut: object = None
     ray_tree: dict | None = None
     view: tuple[float, float, float] = (1.0, 0.5, 0.5)
+    display: dict[str, str] = field(default_factory=dict)
+    wheel: tuple[float, str] = (0.0, "triad")
     export_dir: Path = Path("out/ui_export")
     quit: bool = False
 
@@ -120,3 +128,20 @@ def set_material_value(state: AppState, material: str, name: str, value: float) 
 def set_option(state: AppState, method: str, name: str, value) -> None:
     """Set a method's option (its quality knob)."""
     state.options[method] = {**state.options[method], name: value}
+
+
+def set_display(state: AppState, method: str, mode: str) -> None:
+    """Show ``method``'s panel through a display mode (checked by ``display_mode``)."""
+    from ...core.display import display_mode
+    display_mode(mode)  # raises WorkbenchError on a bad mode string
+    state.display[method] = mode
+
+
+def shown_image(state: AppState, method: str) -> np.ndarray:
+    """The panel's linear image as displayed: through its display mode if one is set."""
+    image = state.images[method]
+    mode = state.display.get(method, "direct24")
+    if mode == "direct24":
+        return image
+    from ...core.display import apply_display_mode
+    return apply_display_mode(image, mode)
