@@ -165,3 +165,15 @@ def test_csg_quadric_caps_have_flat_normals():
     tri_top = top[p.faces].all(1)
     assert tri_top.any()
     assert np.allclose(p.normals[p.faces[tri_top]].reshape(-1, 3), [0, 1, 0])
+
+
+def test_mirroring_transform_keeps_triangles_wound_outward():
+    from workbench.core import transform as tf
+    from workbench.scene.model import Sphere
+    from workbench.scene.tessellate import tessellate_object
+    for M in (np.eye(4), tf.scale([-1.0, 1.0, 1.0])):
+        part = tessellate_object(Sphere(material="m", world_from_object=M, radius=1.0), 4)[0]
+        P, F = part.positions, part.faces
+        geo = np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]])
+        outward = np.sum(geo * P[F].mean(1), -1) > 0
+        assert outward.mean() > 0.99

@@ -43,11 +43,14 @@ def run(args) -> int:
     from pathlib import Path
 
     from ..core.errors import WorkbenchError
-    from ..core.imageio import save_npy, save_png
+    from ..core.imageio import atomic_write_text, save_npy, save_png
     from ..renderers.base import render
     from ..scene.io import load_scene
     if not args.output.lower().endswith(".png"):
         raise WorkbenchError(f"output must be a .png file, got {args.output!r}")
+    for opt, target in (("--npy", args.npy), ("--json", args.json)):
+        if target and Path(target).parent.exists() and not Path(target).parent.is_dir():
+            raise WorkbenchError(f"{opt}: {Path(target).parent} is not a folder")
     from ..core.display import apply_display_mode, display_mode
     display_mode(args.display)  # refuse a bad mode before rendering
     scene = load_scene(args.scene)
@@ -74,7 +77,7 @@ def run(args) -> int:
     if result.left_out:
         print(f"  left out: {'; '.join(result.left_out)}")
     if args.json:
-        Path(args.json).write_text(json.dumps({
+        atomic_write_text(args.json, json.dumps({
             "scene": scene.name, "method": result.method, "timings": result.timings,
             "stats": result.stats, "features_used": result.features_used,
             "left_out": result.left_out, "options": {k: str(v) for k, v in result.options.items()}},

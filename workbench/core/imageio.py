@@ -25,14 +25,23 @@ def to_srgb8(linear: np.ndarray) -> np.ndarray:
     return (srgb_encode(linear) * 255.0 + 0.5).astype(np.uint8)
 
 
+def atomic_write_text(path, text: str) -> Path:
+    """Write a text file atomically (same rules as the images)."""
+    _atomic_write(Path(path), lambda t: Path(t).write_text(text))
+    return Path(path)
+
+
 def _atomic_write(path: Path, write):
     """Write through a temporary file in the same folder, then rename: never a half-written file."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".tmp-", suffix=path.suffix)
     os.close(fd)
+    umask = os.umask(0)
+    os.umask(umask)
     try:
         write(tmp)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the file the usual mode
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
@@ -57,7 +66,10 @@ def save_png8(path, rgb8: np.ndarray) -> Path:
 
 def save_npy(path, array: np.ndarray) -> Path:
     """Save linear data (float32) for exact comparison, atomically."""
-    _atomic_write(Path(path), lambda t: np.save(t, np.asarray(array, dtype=np.float32)))
+    def write(tmp):
+        with open(tmp, "wb") as f:  # a file object: np.save would append ".npy" to a name
+            np.save(f, np.asarray(array, dtype=np.float32))
+    _atomic_write(Path(path), write)
     return Path(path)
 
 

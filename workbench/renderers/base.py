@@ -108,6 +108,8 @@ def _convert_options(r: Renderer, options: dict) -> dict:
         except (TypeError, ValueError) as e:
             raise WorkbenchError(f"method {r.name!r}: option {k!r} expects {getattr(o.kind, '__name__', 'a valid value')}"
                                  f" ({o.help}), got {v!r}") from None
+        if isinstance(val, float) and not np.isfinite(val):
+            raise WorkbenchError(f"method {r.name!r}: option {k!r} must be a finite number, got {v!r}")
         if o.choices is not None and val not in o.choices:
             raise WorkbenchError(f"method {r.name!r}: option {k!r} must be one of {', '.join(map(str, o.choices))}, got {v!r}")
         out[k] = val

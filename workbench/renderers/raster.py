@@ -41,7 +41,7 @@ from ..core.errors import WorkbenchError
 from ..core.tol import tol
 from ..scene import features as ft
 from ..scene.model import AreaLight, Camera, DirectionalLight, Environment, Material, Scene
-from ..scene.tessellate import DEFAULT_LEVEL, Part, tessellate_scene
+from ..scene.tessellate import DEFAULT_LEVEL, MAX_LEVEL, Part, tessellate_scene
 from . import gl
 from . import texturing as tx
 from .base import Knob, Option, RenderResult
@@ -367,8 +367,14 @@ class RasterSession:
                 holder = FloatDepthFramebuffer(self.ctx, color)
                 self._fbos[key] = (holder.fbo, holder.release)
             else:
-                fbo = self.ctx.framebuffer([color], self.ctx.depth_texture((width, height)))
-                self._fbos[key] = (fbo, fbo.release)
+                depth = self.ctx.depth_texture((width, height))
+                fbo = self.ctx.framebuffer([color], depth)
+
+                def free(fbo=fbo, color=color, depth=depth):  # releasing an FBO keeps its attachments
+                    fbo.release()
+                    color.release()
+                    depth.release()
+                self._fbos[key] = (fbo, free)
             if len(self._fbos) > 4:
                 self._fbos.popitem(last=False)[1][1]()
         return self._fbos[key][0]
@@ -380,6 +386,8 @@ class RasterSession:
         ctx = self.ctx
         n0, f0 = self.near_far(camera)
         near, far = near or n0, far or f0
+        if not 0.0 < near < far:
+            raise WorkbenchError(f"clip planes need 0 < near < far, got near {near:.6g} and far {far:.6g}")
         V = camera.camera_from_world()
         clip = camera.clip_from_camera(near, far) @ V
         eye = tuple(float(x) for x in camera.position)
@@ -510,8 +518,9 @@ class _RasterRenderer:
     def render(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
                blinn: bool = False, depth_bits: int = 24, view: str = "color", near: float = 0.0,
                far: float = 0.0) -> RenderResult:
-        if tessellation < 1:
-            raise WorkbenchError(f"method {self.name!r}: tessellation must be >= 1, got {tessellation}")
+        if not 1 <= tessellation <= MAX_LEVEL:
+            raise WorkbenchError(f"method {self.name!r}: tessellation must be within 1..{MAX_LEVEL}, "
+                                 f"got {tessellation}")
         if near < 0 or far < 0 or (near and far and far <= near):
             raise WorkbenchError(f"method {self.name!r}: need 0 < near < far, got near={near}, far={far}")
         session, created = session_for(scene, self.name, tessellation, blinn, depth_bits)

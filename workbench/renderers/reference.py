@@ -53,7 +53,7 @@ from ..core.errors import WorkbenchError
 from ..core.tol import tol
 from ..scene import features as ft
 from ..scene.model import AreaLight, DirectionalLight, Scene
-from ..scene.tessellate import DEFAULT_LEVEL, tessellate_scene
+from ..scene.tessellate import DEFAULT_LEVEL, MAX_LEVEL, tessellate_scene
 from . import gl
 from . import texturing as tx
 from .base import Knob, Option, RenderResult
@@ -342,8 +342,8 @@ class PyrenderRenderer:
 
     def render(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
                isolate: bool = False) -> RenderResult:
-        if tessellation < 1:
-            raise WorkbenchError(f"method 'pyrender': tessellation must be >= 1, got {tessellation}")
+        if not 1 <= tessellation <= MAX_LEVEL:
+            raise WorkbenchError(f"method 'pyrender': tessellation must be within 1..{MAX_LEVEL}, got {tessellation}")
         if isolate or _must_isolate():
             res = _child(scene.source, width, height, tessellation, 1)
         else:

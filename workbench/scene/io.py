@@ -200,9 +200,16 @@ def _mapping(ctx, t, w, default_projection):
                 center=_vec(ctx, t, w, "center", (0.0, 0.0, 0.0)), pole=pole, equator=equator)
 
 
+def _image_projection(ctx, t, w, kind):
+    if kind == "image" and t.get("projection") == "solid":
+        ctx.fail(f"{w}.projection", "an image map needs a 2D projection (uv, planar, cylindrical or "
+                                    "spherical), not 'solid'")
+
+
 def _texture(ctx, t, w):
     _check_keys(ctx, t, w, _MAP_KEYS | {"type", "colors", "mortar"}, {"type"})
     kind = _str(ctx, t, w, "type", choices=("checker", "bricks", "marble", "wood", "grid", "image"))
+    _image_projection(ctx, t, w, kind)
     colors = t.get("colors", [[1.0, 1.0, 1.0], [0.0, 0.0, 0.0]])
     if not (isinstance(colors, list) and len(colors) == 2):
         ctx.fail(f"{w}.colors", "expected two colours [[r, g, b], [r, g, b]]")
@@ -215,6 +222,7 @@ def _texture(ctx, t, w):
 def _bump(ctx, t, w):
     _check_keys(ctx, t, w, _MAP_KEYS | {"type", "strength", "mortar"}, {"type"})
     kind = _str(ctx, t, w, "type", choices=("bricks", "noise", "waves", "image"))
+    _image_projection(ctx, t, w, kind)
     return m.Bump(kind, strength=_num(ctx, t, w, "strength", 1.0),
                   path=_path(ctx, t, w, "path", kind == "image"),
                   mortar=_num(ctx, t, w, "mortar", 0.08, lo=0.0, hi=0.5),
@@ -224,6 +232,7 @@ def _bump(ctx, t, w):
 def _opacity(ctx, t, w):
     _check_keys(ctx, t, w, _MAP_KEYS | {"type", "value", "width"}, {"type"})
     kind = _str(ctx, t, w, "type", choices=("constant", "grid", "checker", "image"))
+    _image_projection(ctx, t, w, kind)
     return m.Opacity(kind, value=_num(ctx, t, w, "value", 1.0, lo=0.0, hi=1.0),
                      path=_path(ctx, t, w, "path", kind == "image"),
                      width=_num(ctx, t, w, "width", 0.2, lo=0.0, hi=1.0),

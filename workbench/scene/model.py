@@ -139,8 +139,9 @@ class AreaLight:
 
     @property
     def normal(self) -> np.ndarray:
+        """Unit normal from the summed cross products (robust to collinear leading vertices)."""
         v = self.vertices
-        return tf.normalize(np.cross(v[1] - v[0], v[2] - v[0]))
+        return tf.normalize(np.cross(v[1:-1] - v[0], v[2:] - v[0]).sum(0))
 
     @property
     def area(self) -> float:

@@ -345,19 +345,24 @@ def _quadric(q: m.Quadric, level: int):
 
 
 # --------------------------------------------------------------------------- parts
+MAX_LEVEL = 64
+"""Largest tessellation level accepted (a sphere at 64 has 256 x 512 quads)."""
+
+
 def _level(obj: m.SceneObject, level: int) -> int:
-    if level < 1:
-        raise WorkbenchError(f"tessellation level must be >= 1, got {level}")
+    if not 1 <= level <= MAX_LEVEL:
+        raise WorkbenchError(f"tessellation level must be within 1..{MAX_LEVEL}, got {level}")
     return int(obj.tessellation or level)
 
 
 def _part(obj: m.SceneObject, M: np.ndarray, P, N, F, fn, fc, uvs=None, material=None) -> Part:
     """Object-space arrays -> world-space Part."""
     Pw = tf.transform_points(M, P)
+    if np.linalg.det(np.asarray(M)[:3, :3]) < 0:  # a mirroring transform flips the winding
+        F = np.asarray(F)[:, ::-1]
     Nw = _fix_normals(tf.transform_normals(M, N), Pw, F)
-    tri_n = triangle_normals(Pw, F)
     if fn is None:
-        fn_w, fc_w = tri_n, Pw[F].mean(1)
+        fn_w, fc_w = triangle_normals(Pw, F), Pw[F].mean(1)
     else:
         fn_w, fc_w = tf.transform_normals(M, fn), tf.transform_points(M, fc)
     return Part(obj.name, obj.kind, material or obj.material, np.asarray(M, dtype=np.float64),
