@@ -179,3 +179,15 @@ def test_occlusion_hemicube_and_raycast_agree(gl_ctx):
 def aggregate_to(ff, n_emit, j):
     a = ff.areas[:n_emit]
     return float((a * ff.F[:n_emit, j]).sum() / a.sum())
+
+
+def test_hemicubes_release_their_gl_objects_and_can_be_built_again(gl_ctx):
+    """Every form-factor computation frees its item buffer (GL objects are not garbage-collected)
+    and the next one still works (releasing a bound FBO must not break the next one)."""
+    import workbench
+    sq = lambda z: np.array([[0, 0, z], [1, 0, z], [1, 1, z], [0, 1, z]], float)
+    values = [np.asarray(workbench.radiosity.form_factors([sq(0), sq(1)[::-1]], method="hemicube",
+                                                          resolution=32))[0, 1] for _ in range(3)]
+    assert values[0] == values[1] == values[2] > 0
+    with pytest.raises(workbench.WorkbenchError, match="hemicube resolution"):
+        workbench.radiosity.form_factors([sq(0), sq(1)[::-1]], method="hemicube", resolution=8192)

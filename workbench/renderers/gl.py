@@ -57,6 +57,23 @@ def check_errors(ctx=None) -> None:
         raise RuntimeError(f"OpenGL error: {err}")
 
 
+def release_framebuffer(fbo) -> None:
+    """Release an FBO without leaving it bound.
+
+    moderngl remembers the bound framebuffer: release the bound one and the next FBO, which
+    OpenGL may give the same name, is taken as already bound and never bound (draws then fail
+    with GL_INVALID_OPERATION in a standalone context, which has no default framebuffer).  So
+    a bound FBO is first swapped for a 1x1 parking framebuffer kept for the context's life."""
+    ctx = fbo.ctx
+    if ctx.fbo is fbo:
+        park = getattr(ctx, "_workbench_park", None)
+        if park is None:
+            park = ctx.framebuffer(color_attachments=[ctx.renderbuffer((1, 1))])
+            ctx._workbench_park = park
+        park.use()
+    fbo.release()
+
+
 def pyrender_platform() -> str:
     """Choose PyOpenGL's platform for pyrender before OpenGL is first imported: EGL when
     libEGL loads, else OSMesa.  Returns the platform name."""

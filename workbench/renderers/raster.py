@@ -371,7 +371,7 @@ class RasterSession:
                 fbo = self.ctx.framebuffer([color], depth)
 
                 def free(fbo=fbo, color=color, depth=depth):  # releasing an FBO keeps its attachments
-                    fbo.release()
+                    gl.release_framebuffer(fbo)
                     color.release()
                     depth.release()
                 self._fbos[key] = (fbo, free)

@@ -65,7 +65,8 @@ def draw(patches: PatchSet, radiance: np.ndarray, camera: Camera, background) ->
     finally:
         if previous is not None:
             previous.use()
-        for o in (vao, vbo, ibo, fbo, tex, depth, prog):
+        gl.release_framebuffer(fbo)
+        for o in (vao, vbo, ibo, tex, depth, prog):
             o.release()
     return np.ascontiguousarray(img[::-1, :, :3]), {"compile": t_compile,
                                                   "display": time.perf_counter() - t0 - t_compile}

@@ -249,8 +249,11 @@ def compute(geom: Geometry, method: str = "hemicube", resolution: int = 128, *,
     if method == "hemicube":
         from .hemicube import Hemicube
         hc = Hemicube(geom, resolution, rotate=rotate, seed=seed, normalize=normalize)
-        F = hc.matrix()
-        info = hc.info()
+        try:
+            F = hc.matrix()
+            info = hc.info()
+        finally:  # GL objects are not garbage-collected: free them on every path
+            hc.release()
     elif method == "raycast":
         from .raycast import raycast
         F = raycast(geom, rays, seed)

@@ -91,7 +91,13 @@ class Hemicube:
         if resolution > 2048:
             raise WorkbenchError(f"hemicube resolution must be <= 2048, got {resolution}")
         self.geom, self.res = geom, int(resolution)
-        self.batch = max(1, min(int(batch), MAX_FACES // FACES))
+        self.ctx = ctx = gl.context()
+        max_size = min(ctx.info["GL_MAX_TEXTURE_SIZE"], ctx.info["GL_MAX_RENDERBUFFER_SIZE"])
+        if 3 * self.res > max_size:
+            raise WorkbenchError(f"hemicube resolution {resolution} needs a {3 * self.res}-pixel item "
+                                 f"buffer; this OpenGL allows {max_size} (use <= {max_size // 3})")
+        # patches per read-back: their faces are stacked in one item buffer, within GL's limits
+        self.batch = max(1, min(int(batch), MAX_FACES // FACES, max_size // self.res))
         self.rng = np.random.default_rng(seed)
         self.rotate = rotate
         self.weights = delta_form_factors(self.res)
@@ -103,7 +109,6 @@ class Hemicube:
         self.origin = geom.tris.reshape(-1, 3).mean(0) if len(geom.tris) else np.zeros(3)
         self.near = tol.hemicube_near * ext
         self.far = 2.0 * ext
-        self.ctx = ctx = gl.context()
         src = [(SHADERS / f"radiosity_item_{s}.glsl").read_text() for s in ("vs", "fs")]
         self.prog = ctx.program(vertex_shader=src[0], fragment_shader=src[1])
         # shared vertices + index buffer (each vertex shaded once per face, not per triangle);
@@ -264,6 +269,6 @@ class Hemicube:
                 "hemicubes_drawn": self.drawn}
 
     def release(self) -> None:
-        for o in (self.vao, self.vbo, self.ibo, self.lut, self.fbo, self.item, self.depth,
-                  self.prog):
+        gl.release_framebuffer(self.fbo)
+        for o in (self.vao, self.vbo, self.ibo, self.lut, self.item, self.depth, self.prog):
             o.release()

@@ -110,12 +110,14 @@ def solve_scene(scene: Scene, opts: dict, method: str) -> Solution:
         hc = Hemicube(geom, opts["hemicube_resolution"], rotate=opts["hemicube_rotate"],
                       normalize=opts["hemicube_normalize"])
         timings["compile"] += time.perf_counter() - t1
-        q = float(R.max()) * max(1.0, hc.info()["weight_sum"])
-        rows = solvers.RowCache(_row_provider(hc, stats), opts["row_cache_mb"])
-        res = solvers.progressive_rows(rows, geom.areas, E, R, tol=tol,
-                                       max_shots=cap, q=q, ambient=opts["ambient"])
-        info = hc.info()
-        hc.release()
+        try:
+            q = float(R.max()) * max(1.0, hc.info()["weight_sum"])
+            rows = solvers.RowCache(_row_provider(hc, stats), opts["row_cache_mb"])
+            res = solvers.progressive_rows(rows, geom.areas, E, R, tol=tol,
+                                           max_shots=cap, q=q, ambient=opts["ambient"])
+            info = hc.info()
+        finally:
+            hc.release()
         timings["form_factors"] = res.seconds   # hemicubes and shots interleave
         timings["solve"] = 0.0
         stats.update({"hemicubes_drawn": info["hemicubes_drawn"], "matrix_stored": False,

@@ -97,7 +97,7 @@ def _stop_level(q: float, tol: float) -> float:
 
 def _finish(B, display, method, it, hist, q, tol, reached, cap, t0, scalar, info=None,
             timed_out=False):
-    last = hist[-1] if len(hist) else 0.0
+    last = hist[-1] if len(hist) else np.inf  # no iteration: nothing is bounded
     bound = q / (1 - q) * last if 0 <= q < 1 else np.inf
     if timed_out and not reached:
         conv, msg = False, (f"NOT converged: time limit reached after {it} iterations; true "
@@ -138,6 +138,8 @@ def solve(F, emission, reflectance, method: str = "direct", tol: float = 1e-6,
         raise WorkbenchError(f"solver must be one of {', '.join(METHODS)}, got {method!r}")
     if not (0 < tol < 1):
         raise WorkbenchError(f"solve: tol must be in (0, 1), got {tol!r}")
+    if max_iterations is not None and max_iterations < 1:
+        raise WorkbenchError(f"solve: max_iterations must be >= 1 (or None), got {max_iterations!r}")
     F = np.asarray(F, dtype=np.float64)
     if F.ndim != 2 or F.shape[0] != F.shape[1]:
         raise WorkbenchError(f"solve: F must be a square (P, P) matrix, got shape {F.shape}")
@@ -283,6 +285,9 @@ def progressive_rows(row: Callable[[np.ndarray], np.ndarray], areas, emission, r
     """
     if not (0 < tol < 1):
         raise WorkbenchError(f"progressive refinement: tol must be in (0, 1), got {tol!r}")
+    if (max_shots is not None and max_shots < 1) or batch < 1:
+        raise WorkbenchError(f"progressive refinement: max_shots and batch must be >= 1, got "
+                             f"{max_shots!r} and {batch!r}")
     t0 = time.perf_counter()
     A = np.asarray(areas, dtype=np.float64)
     E, R, scalar = _prepare(emission, reflectance, len(A))

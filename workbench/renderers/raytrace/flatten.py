@@ -26,12 +26,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...core.errors import NotApplicable
+from ...core.errors import NotApplicable, WorkbenchError
 from ...core.tol import tol
 from ...scene import model as m
 
 SPHERE, RECT, BOX, POLYGON, QUADRIC, CSGNODE, MESH = range(7)
 CSG_UNION, CSG_INTERSECTION, CSG_DIFFERENCE = -1, -2, -3
+CSG_DEPTH = 16
+"""Interval lists a CSG program may hold at once (the kernels' scratch stack; numba does not
+check bounds, so deeper trees are refused when the scene is flattened)."""
 _CSG_OPS = {"union": CSG_UNION, "intersection": CSG_INTERSECTION, "difference": CSG_DIFFERENCE}
 NPAR = 20
 
@@ -189,6 +192,13 @@ class _Builder:
         if isinstance(o, m.CSG):
             start = len(self.prog)
             self.csg_program(o, i, np.eye(4))
+            depth = top = 0
+            for code in self.prog[start:]:  # leaves push an interval list, operators pop two
+                top += 1 if code >= 0 else -1
+                depth = max(depth, top)
+            if depth > CSG_DEPTH:
+                raise WorkbenchError(f"CSG object {o.name or i + 1}: its tree needs {depth} interval lists "
+                                     f"at once, the ray tracer holds {CSG_DEPTH} (nest it more evenly)")
             par = np.zeros(NPAR)
             par[:2] = (start, len(self.prog) - start)
             self.add(CSGNODE, i, self.mat_index[o.material], np.eye(4), par, top=True)

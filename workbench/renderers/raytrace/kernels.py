@@ -20,12 +20,11 @@ import numba as nb
 import numpy as np
 from numba import prange
 
-from .flatten import (BOX, CSG_DIFFERENCE, CSG_INTERSECTION, CSG_UNION, CSGNODE, POLYGON,
+from .flatten import (BOX, CSG_DEPTH, CSG_DIFFERENCE, CSG_INTERSECTION, CSG_UNION, CSGNODE, POLYGON,
                       QUADRIC, RECT, SPHERE)
 
 CHUNK = 64
 BVH_STACK = 128
-CSG_DEPTH = 16
 CSG_EVENTS = 32
 # Slab exits are enlarged by 1 + 2 gamma_3 (gamma_n = n u / (1 - n u), u = 2^-53) so that
 # rounding never culls a box the ray touches (Ize, "Robust BVH ray traversal", JCGT 2013).
