@@ -45,6 +45,12 @@ def _callback(v):
     raise ValueError("expected a callable on_tile(y0, y1, x0, x1, tile) or None")
 
 
+_BYTES_PER_PRIMARY_RAY = 96
+"""Origin, direction, jitter and pixel index of one primary ray (all are built up front)."""
+_PRIMARY_RAYS_GIB = 4.0
+"""Largest primary-ray set accepted (the machine has 24 GiB; bands bound everything else)."""
+
+
 def camera_rays(camera, width: int, height: int, spp: int, seed: int):
     """Primary rays, ``spp`` per pixel, stratified jitter on an ``m x ceil(spp/m)`` grid
     (``m = ceil(sqrt(spp))``); one sample per pixel goes through the pixel centre (same rays as
@@ -311,6 +317,10 @@ class _WhittedBase:
     def render(self, scene: Scene, width: int, height: int, **o) -> RenderResult:
         if not 1 <= o["spp"] <= 4096:
             raise WorkbenchError(f"method {self.name!r}: option 'spp' must be within 1..4096, got {o['spp']}")
+        gib = width * height * o["spp"] * _BYTES_PER_PRIMARY_RAY / 2 ** 30
+        if gib > _PRIMARY_RAYS_GIB:
+            raise WorkbenchError(f"method {self.name!r}: {width}x{height} at spp {o['spp']} needs about "
+                                 f"{gib:.1f} GiB of primary rays (limit {_PRIMARY_RAYS_GIB} GiB): lower spp or the size")
         timings = {}
         t0 = time.perf_counter()
         sd = flatten(scene)
