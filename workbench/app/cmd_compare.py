@@ -1,12 +1,7 @@
 """``workbench compare SCENE --out DIR``: every method side by side, timed, against a reference."""
 from __future__ import annotations
 
-from .cmd_render import _size
-
-
-def methods_list(text: str) -> list[str]:
-    """``"phong,raytrace"`` -> ``["phong", "raytrace"]`` (names checked when running)."""
-    return [m.strip() for m in text.split(",") if m.strip()]
+from .args import methods_list, size
 
 
 def add_parser(sub):
@@ -14,7 +9,7 @@ def add_parser(sub):
     p.add_argument("scene", help="scene file or bundled scene name")
     p.add_argument("--out", required=True, help="output folder (report.html, report.json, grid.png, ...)")
     p.add_argument("--methods", type=methods_list, help="comma-separated methods (default: every registered one)")
-    p.add_argument("--size", type=_size, help="WIDTHxHEIGHT (default: the scene camera's)")
+    p.add_argument("--size", type=size, help="WIDTHxHEIGHT (default: the scene camera's)")
     p.add_argument("--reference", help="force the reference method (default: the documented rule)")
     p.add_argument("--repeat", type=int, default=1, help="warm timed runs per method after the cold one (default 1)")
     p.set_defaults(run=run)

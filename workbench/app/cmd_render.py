@@ -1,24 +1,7 @@
 """``workbench render SCENE --method M -o out.png``: one method, one image, its numbers."""
 from __future__ import annotations
 
-import argparse
-
-
-def _size(text: str) -> tuple[int, int]:
-    try:
-        w, h = (int(x) for x in text.lower().split("x"))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT such as 320x240, got {text!r}") from None
-    if not (1 <= w <= 16384 and 1 <= h <= 16384):
-        raise argparse.ArgumentTypeError(f"size must be within 1..16384, got {text!r}")
-    return w, h
-
-
-def _kv(text: str) -> tuple[str, str]:
-    if "=" not in text:
-        raise argparse.ArgumentTypeError(f"expected KEY=VALUE, got {text!r}")
-    k, v = text.split("=", 1)
-    return k.strip(), v.strip()
+from .args import key_value, size
 
 
 def add_parser(sub):
@@ -26,8 +9,8 @@ def add_parser(sub):
     p.add_argument("scene", help="scene file or bundled scene name")
     p.add_argument("--method", "-m", default="phong", help="registered method (see 'workbench methods')")
     p.add_argument("-o", "--output", required=True, help="output PNG (sRGB-encoded)")
-    p.add_argument("--size", type=_size, help="WIDTHxHEIGHT (default: the scene camera's)")
-    p.add_argument("--set", type=_kv, action="append", default=[], metavar="KEY=VALUE",
+    p.add_argument("--size", type=size, help="WIDTHxHEIGHT (default: the scene camera's)")
+    p.add_argument("--set", type=key_value, action="append", default=[], metavar="KEY=VALUE",
                    help="method option, repeatable (see 'workbench methods')")
     p.add_argument("--npy", help="also save the linear float32 image as .npy")
     p.add_argument("--json", help="also save timings, stats and left-out features as JSON")

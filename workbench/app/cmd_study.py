@@ -3,8 +3,7 @@ from __future__ import annotations
 
 import argparse
 
-from .cmd_compare import methods_list
-from .cmd_render import _size
+from .args import methods_list, size
 
 
 def _sweep(text: str) -> tuple[str, tuple[str, list[str]]]:
@@ -24,7 +23,7 @@ def add_parser(sub):
     p.add_argument("scene", help="scene file or bundled scene name")
     p.add_argument("--out", required=True, help="output folder (study.csv, study.json, study.png, study.html)")
     p.add_argument("--methods", type=methods_list, help="comma-separated methods (default: every registered one)")
-    p.add_argument("--size", type=_size, help="WIDTHxHEIGHT (default: 160 wide with --quick, else the camera's)")
+    p.add_argument("--size", type=size, help="WIDTHxHEIGHT (default: 160 wide with --quick, else the camera's)")
     p.add_argument("--quick", action="store_true", help="small sweep: at most 4 knob values, 2 warm runs, 160 px wide")
     p.add_argument("--repeat", type=int, help="warm runs per point (default 2 quick, 5 otherwise)")
     p.add_argument("--reference", help="force the reference method (default: the documented rule)")

@@ -1,0 +1,28 @@
+"""Argument types shared by the ``cmd_*`` modules (argparse ``type=`` converters)."""
+from __future__ import annotations
+
+import argparse
+
+
+def size(text: str) -> tuple[int, int]:
+    """``"320x240"`` -> ``(320, 240)``, each within 1..16384."""
+    try:
+        w, h = (int(x) for x in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT such as 320x240, got {text!r}") from None
+    if not (1 <= w <= 16384 and 1 <= h <= 16384):
+        raise argparse.ArgumentTypeError(f"size must be within 1..16384, got {text!r}")
+    return w, h
+
+
+def key_value(text: str) -> tuple[str, str]:
+    """``"max_depth=8"`` -> ``("max_depth", "8")`` (method options, converted by the method)."""
+    if "=" not in text:
+        raise argparse.ArgumentTypeError(f"expected KEY=VALUE, got {text!r}")
+    k, v = text.split("=", 1)
+    return k.strip(), v.strip()
+
+
+def methods_list(text: str) -> list[str]:
+    """``"phong,raytrace"`` -> ``["phong", "raytrace"]`` (names checked when running)."""
+    return [m.strip() for m in text.split(",") if m.strip()]
