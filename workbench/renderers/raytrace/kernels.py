@@ -598,6 +598,15 @@ def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_
 
 
 # ----------------------------------------------------------------------------- batch kernels
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def scratch():
+    """Per-thread work arrays of :func:`closest`: the BVH traversal stack and the CSG stack of
+    interval lists (times, signed primitive codes, faces, counts)."""
+    return (np.empty(BVH_STACK, dtype=np.int64), np.empty((CSG_DEPTH, CSG_EVENTS)),
+            np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64),
+            np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64), np.empty(CSG_DEPTH, dtype=np.int64))
+
+
 @nb.njit(cache=True, error_model="numpy", parallel=True)
 def trace_batch(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel,
                 t_out, prim_out, ng, ns, uv, po, ev):
@@ -605,11 +614,7 @@ def trace_batch(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel,
     n = O.shape[0]
     nchunks = (n + CHUNK - 1) // CHUNK
     for c in prange(nchunks):
-        stack = np.empty(BVH_STACK, dtype=np.int64)
-        st = np.empty((CSG_DEPTH, CSG_EVENTS))
-        sp_ = np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64)
-        sf = np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64)
-        sn = np.empty(CSG_DEPTH, dtype=np.int64)
+        stack, st, sp_, sf, sn = scratch()
         for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
             ox, oy, oz = O[i, 0], O[i, 1], O[i, 2]
             eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
@@ -688,11 +693,7 @@ def shade_batch(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim
     solid = geo[5]
     nchunks = (n + CHUNK - 1) // CHUNK
     for c in prange(nchunks):
-        stack = np.empty(BVH_STACK, dtype=np.int64)
-        st = np.empty((CSG_DEPTH, CSG_EVENTS))
-        sp_ = np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64)
-        sf = np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64)
-        sn = np.empty(CSG_DEPTH, dtype=np.int64)
+        stack, st, sp_, sf, sn = scratch()
         for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
             out_kind[2 * i], out_kind[2 * i + 1] = 0, 0
             for q in range(7):
