@@ -41,3 +41,15 @@ def test_bad_pairs_are_refused():
     b[0, 0, 0] = np.nan
     with pytest.raises(WorkbenchError, match="finite"):
         workbench.compare.metrics(b, a)
+
+
+def test_metrics_and_maps_agree_with_the_separate_calls():
+    from workbench.compare.metrics import error_map, metrics_and_maps
+    rng = np.random.default_rng(7)
+    ref = rng.random((24, 20, 3)).astype(np.float32)
+    img = np.clip(ref + rng.normal(0.0, 0.08, ref.shape), -0.2, 1.3).astype(np.float32)
+    values, maps = metrics_and_maps(img, ref)
+    assert values == workbench.compare.metrics(img, ref)
+    for kind in ("flip", "abs"):
+        np.testing.assert_allclose(maps[kind], error_map(img, ref, kind), rtol=0, atol=1e-12)
+    assert values["flip"] == pytest.approx(float(maps["flip"].mean()), rel=1e-4)

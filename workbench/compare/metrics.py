@@ -44,11 +44,20 @@ def metrics(image, reference) -> dict[str, float]:
     """``{"rmse", "psnr", "flip", "rmse_hdr"}`` of ``image`` against ``reference`` (linear
     (H, W, 3)): RMSE and PSNR in the display range [0, 1], FLIP (LDR), and the RMSE of the
     unclipped values."""
+    return metrics_and_maps(image, reference)[0]
+
+
+def metrics_and_maps(image, reference) -> tuple[dict[str, float], dict[str, np.ndarray]]:
+    """:func:`metrics` and the (H, W) error maps ``{"flip", "abs"}`` of :func:`error_map`,
+    with FLIP evaluated once for both (it dominates the cost)."""
     a, b = _check_pair(image, reference)
-    rmse = float(np.sqrt(np.mean((np.clip(a, 0.0, 1.0) - np.clip(b, 0.0, 1.0)) ** 2)))
+    ca, cb = np.clip(a, 0.0, 1.0), np.clip(b, 0.0, 1.0)
+    rmse = float(np.sqrt(np.mean((ca - cb) ** 2)))
     psnr = float("inf") if rmse == 0.0 else float(20.0 * np.log10(1.0 / rmse))
-    return {"rmse": rmse, "psnr": psnr, "flip": flip(a, b)[0],
-            "rmse_hdr": float(np.sqrt(np.mean((a - b) ** 2)))}
+    mean_flip, flip_map = flip(a, b)
+    values = {"rmse": rmse, "psnr": psnr, "flip": mean_flip,
+              "rmse_hdr": float(np.sqrt(np.mean((a - b) ** 2)))}
+    return values, {"flip": flip_map, "abs": np.abs(ca - cb).mean(-1)}
 
 
 def error_map(image, reference, kind: str = "abs") -> np.ndarray:

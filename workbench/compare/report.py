@@ -30,7 +30,7 @@ from ..renderers.base import available
 from ..scene.model import Scene
 from . import figures
 from .html import esc, img_tag, page, table
-from .metrics import error_map, metrics
+from .metrics import metrics_and_maps
 from .outputs import dumps, machine_info, staged
 from .reference import choose_reference, physical_differences
 from .runs import MethodRun, timed_run
@@ -96,8 +96,8 @@ def compare(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
     maps = {}
     for r, e in zip(runs, entries):
         if r.status == "ok":
-            e["metrics"] = metrics(r.image, ref_img)
-            maps[r.method] = (error_map(r.image, ref_img, "flip"), error_map(r.image, ref_img, "abs"))
+            e["metrics"], m = metrics_and_maps(r.image, ref_img)
+            maps[r.method] = (m["flip"], m["abs"])
     # shared scale: the median over methods of their 99.5th percentile, at most display white
     # (1.0); larger errors saturate, so one far-off method does not blacken every other map
     abs_max = max(min(1.0, float(np.median([np.percentile(a, 99.5) for _, a in maps.values()] or [1.0]))), 1e-6)
