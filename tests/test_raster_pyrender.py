@@ -44,3 +44,23 @@ def test_pyrender_in_a_child_process_gives_the_same_image(gl_ctx):
     child = workbench.render(scene, "pyrender", width=48, height=36, isolate=True)
     assert child.stats["isolated"]
     assert np.abs(child.image - here.image).max() < 2e-2  # same driver, same 8-bit output
+
+
+def test_unattenuated_point_light_is_scaled_at_the_transformed_scene_centre(gl_ctx):
+    # a sphere moved far from the origin by its transform, lit by a distant point light without
+    # falloff: pyrender's r^2 division is undone at the world centre of the sphere, so its
+    # Lambert shading matches ours within the light's distance ratio across the sphere (+-4 %)
+    scene = scene_from_dict({
+        "scene": {"ambient": [0.0, 0.0, 0.0], "background": [0.0, 0.0, 0.0]},
+        "camera": {"position": [20.0, 0.0, 5.0], "look_at": [20.0, 0.0, 0.0], "fov_y": 30.0,
+                   "resolution": [48, 48]},
+        "lights": [{"type": "point", "position": [20.0, 0.0, 50.0], "intensity": 1.0}],
+        "materials": {"m": {"color": [0.8, 0.8, 0.8], "ka": 0.0, "kd": 0.9, "ks": 0.0}},
+        "objects": [{"type": "sphere", "material": "m", "radius": 1.0,
+                     "transform": {"translate": [20.0, 0.0, 0.0]}}]})
+    ref = workbench.render(scene, "pyrender", tessellation=8)
+    ph = workbench.render(scene, "phong", tessellation=8)
+    both = (ref.depth < np.inf) & (ph.depth < np.inf) & (ph.image[..., 0] > 0.2)
+    assert both.sum() > 200
+    ratio = np.median(ref.image[both] / np.maximum(ph.image[both], 1e-6), axis=0)
+    assert np.allclose(ratio, 1.0, atol=0.08), ratio

@@ -27,7 +27,8 @@ alpha               opacity ``constant`` -> BLEND with base alpha ``value``; oth
                     maps are left out
 point light         pyrender always divides by r^2: intensity ``pi * I`` for inverse-square
                     lights, ``pi * I * r0^2`` for our unattenuated ones (r0: distance from the
-                    light to the scene's centre); the factor pi because pyrender's Lambert lobe
+                    light to the scene's centre: the mean of the world bounding-box
+                    centres of the tessellated objects); the factor pi because pyrender's Lambert lobe
                     is ``c_diff / pi``.  An area light's stand-ins become such point lights
                     (their cosine lobe is dropped) and the emitter is drawn as an emissive polygon
 directional light   intensity ``pi * I``
@@ -80,7 +81,9 @@ def build_scene(scene: Scene, level: int):
     # pyrender clears with its colour as is and we decode its output with a 2.2 power
     bg = tuple(float(c) ** (1.0 / 2.2) for c in scene.background)
     ps = pyrender.Scene(ambient_light=ambient, bg_color=(*bg, 1.0))
+    centres = []  # world bounding-box centre of every tessellated part, (3,) each
     for part in tessellate_scene(scene, level):
+        centres.append(0.5 * (part.positions.min(0) + part.positions.max(0)))
         mat = mats[part.material]
         alpha = 1.0
         if mat.opacity is not None:
@@ -115,7 +118,7 @@ def build_scene(scene: Scene, level: int):
             n = np.tile(light.normal, (len(v), 1))
             ps.add(pyrender.Mesh([pyrender.Primitive(positions=v.astype(np.float32), normals=n.astype(np.float32),
                                                      indices=faces, material=em)]))
-    centre = _scene_centre(scene)
+    centre = np.mean(centres, 0) if centres else np.zeros(3)
     for light in scene.point_lights():
         col = np.asarray(light.color, dtype=np.float64)
         if isinstance(light, DirectionalLight):
@@ -158,11 +161,6 @@ def _baked_texture(tex, part):
     img = to_srgb8(rgb.reshape(BAKE_SIZE, BAKE_SIZE, 3))
     texture = pyrender.Texture(source=img, source_channels="RGB")
     return texture, (s - lo) / span
-
-
-def _scene_centre(scene: Scene) -> np.ndarray:
-    pts = [np.asarray(getattr(o, "center", o.world_from_object[:3, 3])) for o in scene.objects]
-    return np.mean(pts, 0)
 
 
 def _pose_looking(position: np.ndarray, direction: np.ndarray) -> np.ndarray:
