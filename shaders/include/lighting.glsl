@@ -7,7 +7,7 @@
 //
 // It is split as I = E + C * diffuse + specular so that flat and Gouraud shading can light at
 // the polygon / vertex and still modulate by a per-fragment texture colour C.
-// Needs: N_LIGHTS, TOL_ZERO; SPECULAR when ks > 0 (defines).
+// Needs: N_LIGHTS, FOR_EACH_LIGHT, TOL_ZERO; SPECULAR when ks > 0 (defines).
 #include "common.glsl"
 
 uniform vec3 u_ambient;      // the scene's Ia
@@ -16,11 +16,13 @@ uniform float u_kd;
 uniform float u_ks;
 uniform float u_shininess;
 
+#ifndef FOR_EACH_LIGHT
+#define FOR_EACH_LIGHT(X)
+#endif
 #if N_LIGHTS > 0
-uniform vec4 u_light_pos[N_LIGHTS];     // xyz position (w = 1) or direction towards the light (w = 0)
+uniform vec3 u_light_pos[N_LIGHTS];     // position, or direction towards the light
 uniform vec3 u_light_color[N_LIGHTS];   // color * intensity
-uniform float u_light_inv_sq[N_LIGHTS]; // 1: inverse-square falloff
-uniform vec4 u_light_lobe[N_LIGHTS];    // xyz emitter normal of an area light's stand-in, w = 1 if set
+uniform vec3 u_light_lobe[N_LIGHTS];    // emitter normal of an area light's stand-in
 #endif
 
 // x^n with x clamped to [0, 1] and x^0 = 1.
@@ -28,42 +30,46 @@ float spec_pow(float x, float n) {
     return n == 0.0 ? 1.0 : pow(clamp(x, 0.0, 1.0), n);
 }
 
-// Direction to light l and received intensity at P.  Branch-free (llvmpipe runs both sides
-// of a branch it cannot prove uniform): a directional light has w = 0, so d = lp.xyz.
-void light_incidence(int l, vec3 P, out vec3 L, out vec3 I) {
 #if N_LIGHTS > 0
-    vec4 lp = u_light_pos[l];
-    vec3 d = lp.xyz - P * lp.w;
+// Light l's terms at P, specialised at compile time by literal flags (FOR_EACH_LIGHT, built by
+// raster_shaders.light_list): POINT (else directional: u_light_pos[l] points towards it),
+// INV_SQ (1 / r^2 falloff), LOBE (area-light stand-in: max(0, -n_l.L)).  The compiler folds the
+// flags away, so each light costs only its own arithmetic.  With d = (light - P) and
+// L = d / |d|:  N.L = (N.d) / |d|, and for Phong's R = 2 (N.L) N - L,
+// R.S = 2 (N.L) (N.S) - (d.S) / |d|, so L itself is only formed for Blinn's H.  A light at P
+// (d = 0) gives L = 0 as safe_normalize would: no light.
+void add_light(int l, bool POINT, bool INV_SQ, bool LOBE, vec3 P, vec3 N, vec3 S, float NdS,
+               inout vec3 diffuse, inout vec3 specular) {
+    vec3 d = POINT ? u_light_pos[l] - P : u_light_pos[l];
     float r2 = dot(d, d);
-    L = safe_normalize(d);
-    float falloff = mix(1.0, 1.0 / max(r2, TOL_ZERO * TOL_ZERO), u_light_inv_sq[l]);
-    float lobe = mix(1.0, max(0.0, -dot(L, u_light_lobe[l].xyz)), u_light_lobe[l].w);
-    I = u_light_color[l] * (falloff * lobe);
+    float inv_r = r2 > TOL_ZERO * TOL_ZERO ? inversesqrt(r2) : 0.0;
+    float ndl = dot(N, d) * inv_r;
+    float scale = 1.0;
+    if (INV_SQ) scale = 1.0 / max(r2, TOL_ZERO * TOL_ZERO);
+    if (LOBE) scale *= max(0.0, -dot(d, u_light_lobe[l]) * inv_r);
+    diffuse += u_light_color[l] * (scale * u_kd * max(ndl, 0.0));
+#ifdef SPECULAR
+#ifdef BLINN
+    float base = dot(N, safe_normalize(d * inv_r + S));
 #else
-    L = vec3(0.0);
-    I = vec3(0.0);
+    float base = 2.0 * ndl * NdS - dot(d, S) * inv_r;
+#endif
+    specular += u_light_color[l] * (ndl > 0.0 ? scale * u_ks * spec_pow(base, u_shininess) : 0.0);
 #endif
 }
+#endif
 
 // N: unit shading normal (already facing the viewer), S: unit vector to the viewer.
 // diffuse = ka Ia + sum I_l kd max(N.L, 0) (to multiply by C); specular = sum I_l ks spec_l.
+// FOR_EACH_LIGHT(X) expands to X(l, POINT, INV_SQ, LOBE) for each light that can contribute
+// (none for a material with kd = ks = 0).
 void local_terms(vec3 P, vec3 N, vec3 S, out vec3 diffuse, out vec3 specular) {
     diffuse = u_ka * u_ambient;
     specular = vec3(0.0);
-    for (int l = 0; l < N_LIGHTS; ++l) {
-        vec3 L, I;
-        light_incidence(l, P, L, I);
-        float ndl = dot(N, L);
-        diffuse += I * (u_kd * max(ndl, 0.0));
-#ifdef SPECULAR
-#ifdef BLINN
-        float base = dot(N, safe_normalize(L + S));
-#else
-        float base = dot(2.0 * ndl * N - L, S);
-#endif
-        specular += I * (ndl > 0.0 ? u_ks * spec_pow(base, u_shininess) : 0.0);
-#endif
-    }
+    float NdS = dot(N, S);
+#define X(l, POINT, INV_SQ, LOBE) add_light(l, POINT, INV_SQ, LOBE, P, N, S, NdS, diffuse, specular);
+    FOR_EACH_LIGHT(X)
+#undef X
 }
 
 // The shading normal turned towards the viewer (two-sided surfaces).

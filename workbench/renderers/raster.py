@@ -307,23 +307,19 @@ class RasterSession:
             u.set("u_env_ground", tuple(e.ground))
         for name, unit in UNITS.items():
             u.set(name, unit)
-        if self.lights:
-            pos, col, inv_sq, lobe = [], [], [], []
+        if self.lights:  # kinds and falloffs are compiled in (raster_shaders.light_list)
+            pos, col, lobe = [], [], []
             for light in self.lights:
-                c = np.asarray(light.color) * light.intensity
-                col.append(tuple(float(x) for x in c))
+                col.append(np.asarray(light.color, dtype=np.float64) * light.intensity)
                 if isinstance(light, DirectionalLight):
-                    pos.append((*(-float(x) for x in light.direction), 0.0))  # towards the light
-                    inv_sq.append(0.0)
-                    lobe.append((0.0, 0.0, 0.0, 0.0))
+                    pos.append(-np.asarray(light.direction, dtype=np.float64))  # towards the light
+                    lobe.append(np.zeros(3))
                 else:
-                    pos.append((*map(float, light.position), 1.0))
-                    inv_sq.append(1.0 if light.falloff == "inverse_square" else 0.0)
+                    pos.append(np.asarray(light.position, dtype=np.float64))
                     cn = light.cosine_normal
-                    lobe.append((0.0, 0.0, 0.0, 0.0) if cn is None else (*map(float, cn), 1.0))
+                    lobe.append(np.zeros(3) if cn is None else np.asarray(cn, dtype=np.float64))
             u.set("u_light_pos", np.array(pos))
             u.set("u_light_color", np.array(col))
-            u.set("u_light_inv_sq", np.array(inv_sq))
             u.set("u_light_lobe", np.array(lobe))
         if self.depth_bits == 16:
             u.set("u_depth_levels", float(2 ** 16 - 1))

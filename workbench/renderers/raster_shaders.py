@@ -20,7 +20,7 @@ from pathlib import Path
 from ..core.errors import WorkbenchError
 from ..core.tol import tol
 from ..scene import features as ft
-from ..scene.model import Material, Scene
+from ..scene.model import DirectionalLight, Material, Scene
 
 SHADER_DIR = Path(__file__).resolve().parents[2] / "shaders"
 INCLUDE_DIR = SHADER_DIR / "include"
@@ -87,11 +87,29 @@ def base_defines() -> dict[str, object]:
             "TOL_BUMP_STEP": f"{tol.bump_step:.6e}"}
 
 
+def light_list(lights) -> str:
+    """Body of the ``FOR_EACH_LIGHT(X)`` macro: ``X(l, POINT, INV_SQ, LOBE)`` per light, the
+    flags as GLSL literals (``lighting.glsl`` folds them away: each light compiles to its own
+    arithmetic only)."""
+    def flag(b: bool) -> str:
+        return "true" if b else "false"
+    items = []
+    for i, light in enumerate(lights):
+        point = not isinstance(light, DirectionalLight)
+        inv_sq = point and light.falloff == "inverse_square"
+        lobe = point and light.cosine_normal is not None
+        items.append(f"X({i}, {flag(point)}, {flag(inv_sq)}, {flag(lobe)})")
+    return " ".join(items)
+
+
 def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: int,
                      has_uv: bool, blinn: bool, depth_bits: int, allow_bump: bool) -> dict[str, object]:
     """The ``#define``s of one draw: what the scene needs and this material uses, nothing else.
 
-    ``MODE_*`` (flat, gouraud, phong), ``N_LIGHTS``, ``SPECULAR`` for a material with
+    ``MODE_*`` (flat, gouraud, phong), ``N_LIGHTS`` (uniform array size) and
+    ``FOR_EACH_LIGHT(X)`` (:func:`light_list` of the scene's first ``n_lights`` point and
+    directional lights; empty for a material with ``kd = ks = 0``, which no light changes),
+    ``SPECULAR`` for a material with
     ``ks > 0`` (and ``BLINN`` when asked), ``HAS_UV`` (mesh uvs), ``TEX_KIND/TEX_PROJ``, ``BUMP_KIND/BUMP_PROJ``
     (only when ``allow_bump``: per-fragment normals), ``OPACITY_KIND/OPACITY_PROJ``,
     ``ENV_MAP`` + ``ENV_KIND`` for environment-mapped materials, ``DEPTH_LEVELS`` for an
@@ -101,6 +119,8 @@ def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: i
     d = base_defines()
     d[MODES[mode]] = ""
     d["N_LIGHTS"] = n_lights
+    if material.kd > 0 or material.ks > 0:
+        d["FOR_EACH_LIGHT(X)"] = light_list(scene.point_lights()[:n_lights])
     if material.ks > 0:
         d["SPECULAR"] = ""
         if blinn:
