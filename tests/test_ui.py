@@ -207,3 +207,20 @@ def test_radiosity_panels_in_the_window(xvfb, tmp_path):
         assert img.std() > 0.01
         # rendered with the orbited camera: closer to phong after the orbit than before it
         assert np.abs(img - np.clip(ph, 0, 1)).mean() < np.abs(img - np.clip(ph_before, 0, 1)).mean()
+
+
+def test_docking_layout_and_status_bar(session):
+    """Every window is docked; one tab per dock space is in front (the parameters, not the colour
+    wheel sharing their space); the status bar names the GL renderer and each method's time."""
+    _, summary, _ = session
+    win = summary["script"]["windows"]
+    assert all(w["exists"] and w["docked"] for w in win.values()), win
+    for label in ("Scene", "Methods", "Parameters", "Panels", "Difference", "Ray tree"):
+        assert win[label]["drawn"] and min(win[label]["size"]) > 100, label
+    assert not win["Colour wheel"]["drawn"]
+    # the panels window holds the widest part of the window
+    assert win["Panels"]["size"][0] > max(win["Scene"]["size"][0], win["Difference"]["size"][0])
+    status = summary["script"]["status_bar"]
+    assert status.startswith(summary["gl_renderer"])
+    for m in METHODS:
+        assert f"| {m} " in status and status.split(f"| {m} ")[1].split(" ms")[0].isdigit(), m

@@ -26,7 +26,8 @@ def run(state: AppState, max_frames: int | None = None, script=None) -> None:
 
     from ...renderers import gl
     from .frames import release_gl, update_images
-    from .panels import gui, status_bar
+    from .layout import docking_params
+    from .panels import status_bar
     clock = {"t": None}
 
     def post_init():
@@ -42,8 +43,9 @@ def run(state: AppState, max_frames: int | None = None, script=None) -> None:
         update_images(state)
         if script is not None:
             script(state)
-        gui(state)
-        state.gui_seconds = time.perf_counter() - now
+
+    def end_frame():  # after every dockable window's gui, before ImGui renders
+        state.gui_seconds = time.perf_counter() - clock["t"]
         state.frame += 1
         if state.quit or (max_frames is not None and state.frame >= max_frames):
             hello_imgui.get_runner_params().app_shall_exit = True
@@ -57,9 +59,13 @@ def run(state: AppState, max_frames: int | None = None, script=None) -> None:
     params.app_window_params.window_geometry.size = WINDOW_SIZE
     params.fps_idling.enable_idling = False
     params.imgui_window_params.show_status_bar = True
+    params.imgui_window_params.default_imgui_window_type = \
+        hello_imgui.DefaultImGuiWindowType.provide_full_screen_dock_space
+    params.docking_params = docking_params(state)
     params.ini_disable = True  # no settings file written into the working folder
     params.callbacks.post_init = post_init
     params.callbacks.show_gui = show_gui
+    params.callbacks.before_imgui_render = end_frame
     params.callbacks.show_status = lambda: status_bar(state)
     params.callbacks.before_exit = before_exit
     immapp.run(params)

@@ -6,7 +6,8 @@ from imgui_bundle import imgui
 
 from . import camera as cam
 from .frames import upload, upload_linear
-from .inspect import export, pixel_under_mouse, probe_tooltip, ray_tree_view, select_ray_tree
+from .inspect import export, pixel_under_mouse, probe_tooltip, select_ray_tree
+from .layout import focus
 from .state import (DISPLAY_MODES, HARMONIES, LEFT_OUT, MATERIAL_FIELDS, MAX_PANELS, AppState,
                     choosable_methods, set_display, set_material_value, set_option, set_scene,
                     shown_image)
@@ -150,6 +151,7 @@ def image_panels(state: AppState) -> None:
                 if (m == "raytrace" and imgui.get_io().key_ctrl
                         and imgui.is_mouse_clicked(imgui.MouseButton_.left)):
                     select_ray_tree(state, *ij)
+                    focus("Ray tree")
         imgui.text_disabled(state.status.get(m, "")[:40])
         mode = state.display.get(m, "direct24")
         modes = list(DISPLAY_MODES) if mode in DISPLAY_MODES else [mode, *DISPLAY_MODES]
@@ -211,29 +213,14 @@ def colour_wheel(state: AppState) -> None:
     imgui.image(imgui.ImTextureRef(state.textures[key].glo), imgui.ImVec2(200, 200))
 
 
-def status_bar(state: AppState) -> None:
-    """GL_RENDERER, frame time and per-method timings."""
+def status_text(state: AppState) -> str:
+    """GL_RENDERER, frame time (and rate) and each shown method's last run time."""
     parts = [f"{m} {state.timings[m] * 1e3:.0f} ms" for m in state.methods if m in state.timings]
-    imgui.text(f"{state.gl_renderer} | frame {state.frame_seconds * 1e3:.1f} ms | "
-               + " | ".join(parts))
+    fps = 1.0 / state.frame_seconds if state.frame_seconds > 0 else 0.0
+    return " | ".join([state.gl_renderer, f"frame {state.frame_seconds * 1e3:.1f} ms "
+                       f"({fps:.0f} fps)", *parts])
 
 
-def gui(state: AppState) -> None:
-    """The whole window: controls on the left, panels on the right."""
-    imgui.begin_child("controls", imgui.ImVec2(300, 0))
-    scene_picker(state)
-    method_list(state)
-    parameters(state)
-    colour_wheel(state)
-    imgui.end_child()
-    imgui.same_line()
-    imgui.begin_child("panels")
-    image_panels(state)
-    imgui.begin_child("difference", imgui.ImVec2(state.camera.width + 300, 0))
-    difference_panel(state)
-    imgui.end_child()
-    imgui.same_line()
-    imgui.begin_child("ray tree")
-    ray_tree_view(state)
-    imgui.end_child()
-    imgui.end_child()
+def status_bar(state: AppState) -> None:
+    """The status bar line (:func:`status_text`)."""
+    imgui.text(status_text(state))

@@ -10,6 +10,8 @@ import numpy as np
 
 from . import camera as cam
 from .inspect import export, select_ray_tree
+from .layout import window_report
+from .panels import status_text
 from .state import RASTER, AppState, set_display, set_material_value, set_option, shown_image
 
 CPU_WAIT_SECONDS = 120.0
@@ -63,6 +65,8 @@ class Check:
                                    "image_colours": int(len(np.unique(
                                        state.images[m0].reshape(-1, 3), axis=0)))}
             self.log["exported"] = [p.name for p in export(state, out / "export")]
+            self.log["windows"] = window_report()
+            self.log["status_bar"] = status_text(state)
             if "raytrace" in state.methods:
                 i, j = state.camera.height // 2, state.camera.width // 3
                 tree = select_ray_tree(state, i, j)["tree"]
