@@ -6,7 +6,11 @@
 #include "varyings.glsl"
 #ifdef NEEDS_SURFACE
 in vec3 v_world;
+#ifdef MODE_FLAT
+flat in vec3 v_normal;
+#else
 in vec3 v_normal;
+#endif
 #endif
 #ifdef NEEDS_OBJ
 in vec3 v_obj;

@@ -2,8 +2,9 @@
 // Vertex stage of flat, Gouraud and Phong shading (MODE_FLAT | MODE_GOURAUD | MODE_PHONG).
 // Positions and normals arrive in world space (the tessellator transforms them); the object-
 // space point travels along for the textures.  Flat: one lighting per polygon, at its centroid
-// with its normal (the buffer is unwelded: every vertex of a triangle carries the polygon's
-// normal and centroid).  Gouraud: lighting at the vertex with the averaged normal.
+// with its normal (flat varyings: the provoking vertex of each triangle carries the polygon's
+// normal and centroid, tessellate_topology.provoking_layout).  Gouraud: lighting at the vertex
+// with the averaged normal.
 #include "lighting.glsl"
 #include "varyings.glsl"
 
@@ -22,7 +23,11 @@ uniform vec3 u_eye;
 
 #ifdef NEEDS_SURFACE
 out vec3 v_world;
+#ifdef MODE_FLAT
+flat out vec3 v_normal;  // the polygon's (provoking vertex)
+#else
 out vec3 v_normal;
+#endif
 #endif
 #ifdef NEEDS_OBJ
 out vec3 v_obj;

@@ -42,6 +42,7 @@ from ..core.tol import tol
 from ..scene import features as ft
 from ..scene.model import AreaLight, Camera, DirectionalLight, Environment, Material, Scene
 from ..scene.tessellate import DEFAULT_LEVEL, MAX_LEVEL, Part, tessellate_scene
+from ..scene.tessellate_topology import closed_outward, provoking_layout
 from . import gl
 from . import texturing as tx
 from .base import Knob, Option, RenderResult
@@ -111,6 +112,9 @@ class _Draw:
     centre: np.ndarray
     images: dict
     uniforms: _Uniforms
+    #: index into RasterSession.cull_boxes when the part belongs to a closed, outward-wound
+    #: opaque object (its back faces are culled while the camera is outside its box), else -1
+    cull: int = -1
 
 
 def _area_light_parts(scene: Scene) -> list[tuple[Part, Material]]:
@@ -165,10 +169,12 @@ class RasterSession:
     tessellation : level of :func:`workbench.scene.tessellate.tessellate_scene`.
     blinn : Blinn-Phong specular instead of Phong.
     depth_bits : 16 (emulated fixed point), 24 (fixed point) or 32 (float) depth buffer.
+    backface_culling : cull the back faces of closed opaque objects while the camera is
+        outside them (:meth:`_cull_groups`; the image is the same, the triangle work halves).
     """
 
     def __init__(self, scene: Scene, mode: str, *, tessellation: int = DEFAULT_LEVEL,
-                 blinn: bool = False, depth_bits: int = 24, ctx=None):
+                 blinn: bool = False, depth_bits: int = 24, ctx=None, backface_culling: bool = True):
         if mode not in ("flat", "gouraud", "phong"):
             raise WorkbenchError(f"unknown raster mode {mode!r}")
         if depth_bits not in DEPTH_CHOICES:
@@ -190,6 +196,7 @@ class RasterSession:
         self._fbos: OrderedDict = OrderedDict()
         t0 = time.perf_counter()
         self.draws = [self._upload(p, m, blinn) for p, m in pairs]
+        self.cull_boxes = self._cull_groups() if backface_culling else np.zeros((0, 8, 3))
         self.background = None
         if scene.environment is not None:
             self.background = self._background(scene.environment)
@@ -240,23 +247,24 @@ class RasterSession:
                                    allow_bump=self.mode == "phong")
         prog = self.programs.get("raster", defines)
         F = part.faces
-        if self.mode == "flat":  # unwelded: each vertex carries its polygon's normal and centroid
-            cols = [part.positions[F], np.repeat(part.face_normals[:, None], 3, 1), part.obj_positions[F]]
-            if has_uv:
-                cols.append(part.uvs[F])
-            cols.append(np.repeat(part.face_centroids[:, None], 3, 1))
-            data = np.concatenate([c.reshape(len(F) * 3, -1) for c in cols], 1)
-            index = None
+        if self.mode == "flat":
+            # indexed, each triangle with its own provoking (last) vertex carrying the polygon's
+            # normal and centroid (flat varyings take the provoking vertex's values)
+            src, owner, F = provoking_layout(len(part.positions), F)
+            has_owner = (owner >= 0)[:, None]
+            cols = [part.positions[src], np.where(has_owner, part.face_normals[owner], 0.0),
+                    part.obj_positions[src]] + ([part.uvs[src]] if has_uv else [])
+            cols.append(np.where(has_owner, part.face_centroids[owner], 0.0))
         else:
             cols = [part.positions, part.normals, part.obj_positions] + ([part.uvs] if has_uv else [])
-            data = np.concatenate(cols, 1)
-            index = ctx.buffer(np.ascontiguousarray(F, dtype="i4").tobytes())
+        data = np.concatenate(cols, 1)
+        index = ctx.buffer(np.ascontiguousarray(F, dtype="i4").tobytes())
         fmt = "3f 3f 3f" + (" 2f" if has_uv else "") + (" 3f" if self.mode == "flat" else "")
         names = ["in_position", "in_normal", "in_obj_position"] + (["in_uv"] if has_uv else []) \
             + (["in_centroid"] if self.mode == "flat" else [])
         vbo = ctx.buffer(np.ascontiguousarray(data, dtype="f4").tobytes())
         vao = ctx.vertex_array(prog, [(vbo, fmt, *names)], index, index_element_size=4, skip_errors=True)
-        self._gl_objects += [vao, vbo] + ([index] if index is not None else [])
+        self._gl_objects += [vao, vbo, index]
         images = {}
         if mat.texture is not None and mat.texture.kind == "image":
             images["u_tex_image"] = self._image_texture(mat.texture.path)
@@ -324,6 +332,36 @@ class RasterSession:
         if self.depth_bits == 16:
             u.set("u_depth_levels", float(2 ** 16 - 1))
         return u
+
+    def _cull_groups(self) -> np.ndarray:
+        """Mark the draws of objects whose parts together are closed and outward-wound
+        (:func:`closed_outward`; a CSG object's parts are grouped by its name) and have no
+        opacity map (cut-outs show back faces; unnamed parts are tested alone); returns the (G, 8, 3) corners of each group's
+        bounding box, the test of :meth:`_cull_flags`."""
+        groups: dict[object, list[_Draw]] = {}
+        for d in self.draws:
+            if not d.blended and d.material.opacity is None:
+                groups.setdefault(d.part.name or id(d), []).append(d)
+        boxes = []
+        for draws in groups.values():
+            P = np.vstack([d.part.positions for d in draws])
+            offsets = np.cumsum([0] + [len(d.part.positions) for d in draws[:-1]])
+            F = np.vstack([d.part.faces + o for d, o in zip(draws, offsets)])
+            if not closed_outward(P, F):
+                continue
+            lo, hi = P.min(0), P.max(0)
+            boxes.append([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+            for d in draws:
+                d.cull = len(boxes) - 1
+        return np.array(boxes, dtype=np.float64).reshape(-1, 8, 3)
+
+    def _cull_flags(self, camera: Camera, near: float) -> np.ndarray:
+        """Per cull group: True when its whole bounding box lies beyond the near plane (so the
+        camera is outside the solid and no front face is clipped open): back faces hidden."""
+        if len(self.cull_boxes) == 0:
+            return np.zeros(0, dtype=bool)
+        depth = camera.project(self.cull_boxes.reshape(-1, 3))[1].reshape(-1, 8)
+        return (depth > near).all(1)
 
     def _report(self) -> tuple[list[str], list[str]]:
         needs = self.scene.needs()
@@ -402,8 +440,16 @@ class RasterSession:
         blended = sorted((d for d in self.draws if d.blended),
                          key=lambda d: -float(np.linalg.norm(d.centre - cam_pos)))
         clip_bytes = np.ascontiguousarray(clip.T, dtype="f4").tobytes()
+        ctx.provoking_vertex = moderngl.LAST_VERTEX_CONVENTION  # flat: provoking_layout
+        ctx.front_face, ctx.cull_face = "ccw", "back"
+        cull = self._cull_flags(camera, near)
         for d in opaque:
+            culled = d.cull >= 0 and cull[d.cull]
+            if culled:
+                ctx.enable(moderngl.CULL_FACE)
             self._render_draw(d, clip_bytes, eye)
+            if culled:
+                ctx.disable(moderngl.CULL_FACE)
         if self.background is not None:
             bg_draw = self.background
             ctx.depth_func = "<="
