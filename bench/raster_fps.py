@@ -1,17 +1,23 @@
 """Raster throughput: flat, Gouraud and Phong at 512 x 512 on every bundled scene (llvmpipe).
 
 For each scene and method: a :class:`RasterSession` is built (tessellation, upload and shader
-compile, including llvmpipe's JIT at the first draw, reported apart), 3 warm-up frames are
-drawn, then frames are timed for at least ``--seconds`` (and at least 10 frames):
+compile, including llvmpipe's JIT at the first draw: ``setup_seconds`` and
+``compile_seconds``, reported apart), 3 warm-up frames are drawn, then frames are timed for at
+least ``--seconds`` (and at least 10 frames):
 
-* ``fps``: full frames (draw + read the float32 image back to numpy), what ``render()`` does;
-* ``fps_draw``: draw into the FBO and ``ctx.finish()`` without read-back (the UI's case);
-* ``cpu_ms_per_frame`` (and ``_draw``): CPU time of this process per frame, llvmpipe's threads
-  included: on 2 cores shared with other work, the wall-clock rates drop with the load average
-  recorded in the file, the CPU time much less.
+* ``fps`` / ``ms_per_frame``: a frame as a user sees it: ``draw_to`` into the FBO and
+  ``ctx.finish()`` (the UI shows the FBO's texture; nothing is read back);
+* ``cpu_ms_per_frame``: CPU time of this process per frame, llvmpipe's threads included: on 2
+  cores shared with other work, the wall-clock rate drops with the load average recorded in
+  the file, the CPU time much less;
+* ``readback_ms``: reading the finished float32 colour image back to numpy
+  (``RasterSession.read_image``), for images only, timed alone;
+* ``ms_with_readback``: ``draw(camera, with_depth=True)``, what ``render()`` does (colour and
+  depth read back), the number to set beside pyrender's.
 
-pyrender's frame time (its offscreen render + read-back) on the same scene and camera is
-measured beside ours, in a child process (``workbench.renderers.reference``).
+pyrender's frame time (its offscreen render, which always reads colour and depth back) on the
+same scene and camera is measured beside ours, in a child process
+(``workbench.renderers.reference``).
 
     .venv/bin/python bench/raster_fps.py [--seconds 1.0] [--size 512] [--scenes a,b]
 
@@ -36,7 +42,8 @@ OUT = Path(__file__).resolve().parent / "results" / "raster_fps.json"
 
 def _rate(fn, seconds: float) -> tuple[float, float]:
     """Frames per second (wall clock) and CPU seconds per frame (all threads of this process:
-    llvmpipe's rasteriser threads included; less sensitive to other processes' load)."""
+    llvmpipe's rasteriser threads included; less sensitive to other processes' load), after 3
+    warm-up calls."""
     for _ in range(3):
         fn()
     n, t0, c0 = 0, time.perf_counter(), time.process_time()
@@ -57,19 +64,21 @@ def bench_scene(name: str, size: int, seconds: float) -> dict:
         ctx = session.ctx
         fbo = session.framebuffer(size, size)
 
-        def draw_only():
+        def frame():
             session.draw_to(fbo, cam)
             ctx.finish()
 
-        fps, cpu = _rate(lambda: session.draw(cam), seconds)
-        fps_draw, cpu_draw = _rate(draw_only, seconds)
+        fps, cpu = _rate(frame, seconds)
+        read_rate, _ = _rate(lambda: session.read_image(fbo), seconds / 4)
+        full_rate, _ = _rate(lambda: session.draw(cam, with_depth=True), seconds / 2)
         row["methods"][mode] = {
             "triangles": session.n_triangles,
+            "culled_objects": len(session.cull_boxes),
             "setup_seconds": round(setup, 4),
             "compile_seconds": round(session.timings["compile"], 4),
             "tessellate_seconds": round(session.timings["tessellate"], 4),
-            "fps": round(fps, 1), "cpu_ms_per_frame": round(1e3 * cpu, 2),
-            "fps_draw": round(fps_draw, 1), "cpu_ms_per_frame_draw": round(1e3 * cpu_draw, 2),
+            "fps": round(fps, 1), "ms_per_frame": round(1e3 / fps, 2), "cpu_ms_per_frame": round(1e3 * cpu, 2),
+            "readback_ms": round(1e3 / read_rate, 2), "ms_with_readback": round(1e3 / full_rate, 2),
         }
         session.release()
         print(name, mode, row["methods"][mode], flush=True)
@@ -94,7 +103,9 @@ def main():
     result = {"benchmark": "raster_fps", "size": [args.size, args.size], "gl_renderer": gl.renderer_name(),
               "machine": platform.platform(), "cpu_count": os.cpu_count(),
               "load_average_1min": {"before": round(load_before[0], 2), "after": round(os.getloadavg()[0], 2)},
-              "note": "2 shared cores: other processes' load (load_average) lowers these rates",
+              "note": "2 shared cores: other processes' load (load_average) lowers these rates; "
+                      "fps = draw + finish (no read-back); pyrender's frame includes its read-back: "
+                      "compare it with ms_with_readback",
               "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "scenes": rows}
     OUT.parent.mkdir(parents=True, exist_ok=True)
     OUT.write_text(json.dumps(result, indent=2))

@@ -194,6 +194,8 @@ class RasterSession:
         self._gl_images: dict[tuple, object] = {}
         self._gl_objects: list = []  # vertex arrays and buffers, freed by release()
         self._fbos: OrderedDict = OrderedDict()
+        self._uniforms_of: dict[int, _Draw] = {}  # program -> draw whose uniforms it holds
+        self._camera_of: dict[int, bytes] = {}    # program -> clip matrix it holds
         t0 = time.perf_counter()
         self.draws = [self._upload(p, m, blinn) for p, m in pairs]
         self.cull_boxes = self._cull_groups() if backface_culling else np.zeros((0, 8, 3))
@@ -382,6 +384,7 @@ class RasterSession:
             free()
         self._gl_objects, self._gl_images, self._fbos = [], {}, OrderedDict()
         self.programs.programs.clear()
+        self._uniforms_of, self._camera_of = {}, {}
         self.draws, self.background = [], None
 
     # ------------------------------------------------------------------ drawing
@@ -476,12 +479,18 @@ class RasterSession:
         ctx.disable(moderngl.BLEND)
         return near, far
 
-    @staticmethod
-    def _render_draw(d: _Draw, clip_bytes: bytes, eye: tuple) -> None:
+    def _render_draw(self, d: _Draw, clip_bytes: bytes, eye: tuple) -> None:
+        """One draw; a program keeps its uniforms, so a draw's material uniforms are written
+        only when another draw used its program last, and the camera's once per frame."""
         import moderngl
-        d.uniforms.apply()
-        d.prog["u_clip_from_world"].write(clip_bytes)
-        _set(d.prog, "u_eye", eye)
+        key = id(d.prog)
+        if self._uniforms_of.get(key) is not d:
+            d.uniforms.apply()
+            self._uniforms_of[key] = d
+        if self._camera_of.get(key) != clip_bytes:
+            d.prog["u_clip_from_world"].write(clip_bytes)
+            _set(d.prog, "u_eye", eye)
+            self._camera_of[key] = clip_bytes
         for name, tex in d.images.items():
             tex.use(UNITS[name])
         d.vao.render(moderngl.TRIANGLES)
@@ -499,17 +508,24 @@ class RasterSession:
         camera = camera or self.scene.camera
         fbo = self.framebuffer(camera.width, camera.height)
         nf = self.draw_to(fbo, camera, near, far)
-        raw = np.frombuffer(fbo.read(components=4, dtype="f4"), dtype=np.float32)
-        image = raw.reshape(camera.height, camera.width, 4)[::-1, :, :3]
+        image = self.read_image(fbo)
         if not with_depth:
-            return np.ascontiguousarray(image)
+            return image
         d = np.frombuffer(fbo.read(components=1, attachment=-1, dtype="f4"), dtype=np.float32)
         d = d.reshape(camera.height, camera.width)[::-1].astype(np.float64)
         n, f = nf
-        z_ndc = 2.0 * d - 1.0
-        with np.errstate(divide="ignore"):
-            depth = np.where(d >= 1.0, np.inf, 2.0 * n * f / ((f + n) - z_ndc * (f - n)))
-        return np.ascontiguousarray(image), depth.astype(np.float32), nf
+        # window depth d in [0, 1] -> camera depth: z_ndc = 2 d - 1 and
+        # 2 n f / ((f + n) - z_ndc (f - n)) = n f / (f - d (f - n)) (never 0 for 0 < n < f)
+        depth = (n * f) / (f - d * (f - n))
+        depth[d >= 1.0] = np.inf
+        return image, depth.astype(np.float32), nf
+
+    @staticmethod
+    def read_image(fbo) -> np.ndarray:
+        """The colour attachment of ``fbo`` as (H, W, 3) float32, row 0 at the top (reading
+        RGB, not RGBA, halves llvmpipe's read-back time)."""
+        raw = np.frombuffer(fbo.read(components=3, dtype="f4"), dtype=np.float32)
+        return np.ascontiguousarray(raw.reshape(fbo.height, fbo.width, 3)[::-1])
 
 
 def depth_view(depth: np.ndarray, near: float, far: float) -> np.ndarray:
