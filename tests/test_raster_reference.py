@@ -84,6 +84,42 @@ def test_phong_glsl_equals_numpy_reference(gl_ctx, name, blinn):
     assert np.allclose(got, want, rtol=RTOL, atol=RTOL * np.abs(want).max()), (got, want)
 
 
+@pytest.mark.parametrize("blinn", [False, True])
+@pytest.mark.parametrize("method", ["phong", "gouraud"])
+def test_area_light_stand_ins_match_numpy_reference(gl_ctx, blinn, method):
+    """Each light kind is compiled in separately (raster_shaders.light_list): area-light
+    stand-ins (inverse square and emitter lobe) beside a directional and an unattenuated point
+    light.  Phong per pixel; Gouraud (vertex colours of a fine grid, interpolated) loosely."""
+    # the emitter out of the camera's view (its polygon would hide the pixels), facing -z
+    lights = [{"type": "area", "vertices": [[2.5, -0.5, 1.5], [2.5, 0.5, 1.5], [3.5, 0.5, 1.5], [3.5, -0.5, 1.5]],
+               "color": [8.0, 7.0, 6.0], "intensity": 1.0, "stand_in": 2},
+              {"type": "directional", "direction": [-0.3, -0.2, -1.0], "intensity": 0.4},
+              {"type": "point", "position": [-2.0, -1.0, 2.0], "color": [0.2, 0.4, 1.0], "intensity": 0.5}]
+    scene = _plane_scene(MATERIALS["plain"], lights=lights)
+    assert sum(getattr(lt, "cosine_normal", None) is not None for lt in scene.point_lights()) == 4
+    r = workbench.render(scene, method, blinn=blinn, tessellation=16)
+    got = r.image[tuple(PIXELS.T)]
+    want = _expected(scene, PIXELS, blinn)
+    if method == "phong":
+        assert np.allclose(got, want, rtol=RTOL, atol=RTOL * np.abs(want).max()), (got, want)
+    else:  # interpolated vertex colours of a fine grid: close to the per-pixel model
+        assert np.allclose(got, want, rtol=0.1, atol=0.05 * np.abs(want).max()), (got, want)
+
+
+def test_material_no_light_changes_compiles_no_light_terms(gl_ctx):
+    """kd = ks = 0: no light term is compiled; the image is E + ka C Ia exactly as numpy."""
+    from workbench.renderers.raster_shaders import material_defines
+    mat = {"color": [0.8, 0.6, 0.4], "ka": 0.5, "kd": 0.0, "ks": 0.0, "emission": [0.1, 0.0, 0.05]}
+    scene = _plane_scene(mat)
+    kw = dict(n_lights=3, has_uv=False, blinn=False, depth_bits=24, allow_bump=True)
+    assert "FOR_EACH_LIGHT(X)" not in material_defines(scene, scene.materials["m"], "phong", **kw)
+    lit = _plane_scene({**mat, "kd": 0.5})
+    assert material_defines(lit, lit.materials["m"], "phong", **kw)["FOR_EACH_LIGHT(X)"].count("X(") == 3
+    r = workbench.render(scene, "phong")
+    want = _expected(scene, PIXELS)
+    assert np.allclose(r.image[tuple(PIXELS.T)], want, rtol=RTOL)
+
+
 def test_flat_is_the_local_model_at_the_polygon_centroid(gl_ctx):
     scene = _plane_scene(MATERIALS["plain"])
     r = workbench.render(scene, "flat")

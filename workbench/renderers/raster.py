@@ -78,18 +78,22 @@ def _write(prog, name: str, array: np.ndarray) -> None:
 
 
 class _Uniforms:
-    """The uniforms of one draw, recorded once and written before each draw (programs are
-    shared between draws with the same defines)."""
+    """The uniforms of one draw, recorded once and written when the draw's program last
+    served another draw (programs are shared between draws with the same defines)."""
 
     def __init__(self, prog):
         self.prog, self.items = prog, []
 
     def set(self, name: str, value) -> None:
         if name in self.prog:
+            u = self.prog[name]
             if isinstance(value, int):
-                self.items.append((self.prog[name], value, False))
+                self.items.append((u, value, False))
             else:
-                self.items.append((self.prog[name], np.ascontiguousarray(value, dtype="f4").tobytes(), True))
+                # the compiler trims a uniform array after its last element in use (e.g. the
+                # lobes of lights that have none): write only what is left
+                flat = np.ascontiguousarray(value, dtype="f4").reshape(-1)[:u.array_length * u.dimension]
+                self.items.append((u, flat.tobytes(), True))
 
     def apply(self) -> None:
         for u, v, raw in self.items:
@@ -337,9 +341,9 @@ class RasterSession:
 
     def _cull_groups(self) -> np.ndarray:
         """Mark the draws of objects whose parts together are closed and outward-wound
-        (:func:`closed_outward`; a CSG object's parts are grouped by its name) and have no
-        opacity map (cut-outs show back faces; unnamed parts are tested alone); returns the (G, 8, 3) corners of each group's
-        bounding box, the test of :meth:`_cull_flags`."""
+        (:func:`closed_outward`; a CSG object's parts are grouped by its name, unnamed parts
+        are tested alone) and have no opacity map (cut-outs show back faces); returns the
+        (G, 8, 3) corners of each group's bounding box, the test of :meth:`_cull_flags`."""
         groups: dict[object, list[_Draw]] = {}
         for d in self.draws:
             if not d.blended and d.material.opacity is None:
