@@ -102,3 +102,49 @@ def test_bad_input():
         radiosity.solve(np.zeros((2, 3)), [1, 0], 0.5)
     with pytest.raises(WorkbenchError, match="solver"):
         radiosity.solve(np.zeros((2, 2)), [1, 0], 0.5, method="magic")
+
+
+@pytest.mark.parametrize("relax", [1.0, 1.2, 1.6])
+def test_progressive_rows_overshooting_converges(relax):
+    """Matrix-free shooting from rows F[i, :] (receivers take F_ji = F_ij A_i / A_j) inside a
+    sphere (exact reciprocity), plain and overshooting: the true error is within the bound
+    (negative unshot radiosity included), and overshooting by 1.2 needs fewer shots."""
+    from workbench.renderers.radiosity.solvers import progressive_rows
+    rng = np.random.default_rng(5)
+    n = 30
+    A = rng.uniform(0.1, 2.0, n)
+    E = rng.uniform(0, 1, (n, 3)) * (rng.random((n, 1)) < 0.3)
+    E[0] = 1.0
+    R = rng.uniform(0.3, 0.9, (n, 3))
+    F = np.broadcast_to(A / A.sum(), (n, n)).copy()
+    w = A / A.sum()
+    exact = E + R * ((w @ E) / (1 - w @ R))
+    runs = {r: progressive_rows(lambda idx: F[idx], A, E, R, tol=1e-8, relax=r)
+            for r in {1.0, relax}}
+    res = runs[relax]
+    assert res.converged, res.message
+    err = np.abs(res.radiosity - exact).max() / np.abs(res.radiosity).max()
+    assert err <= res.error_bound * (1 + 1e-9) + 1e-15 and res.error_bound <= 1e-8
+    if relax == 1.2:
+        assert res.iterations < runs[1.0].iterations
+
+
+def test_progressive_rows_refuses_divergent_relaxation():
+    from workbench.renderers.radiosity.solvers import progressive_rows
+    with pytest.raises(WorkbenchError, match="relax"):
+        progressive_rows(lambda idx: np.zeros((len(idx), 2)), np.ones(2), [1.0, 0.0], 0.5, relax=2.0)
+
+
+def test_row_cache_drops_the_least_recently_used():
+    from workbench.renderers.radiosity.solvers import RowCache
+    calls = []
+
+    def rows(idx):
+        calls.extend(idx.tolist())
+        return np.ones((len(idx), 1024)) * idx[:, None]
+
+    cache = RowCache(rows, budget_mb=2 * 1024 * 4 / 2 ** 20)     # room for two float32 rows
+    for i in (0, 1, 0, 2, 0, 1):
+        assert cache([i])[0, 0] == i
+    assert calls == [0, 1, 2, 1]          # 0, used last, stayed; 1 was dropped for 2
+    assert cache.hits == 2 and cache.computed == 4

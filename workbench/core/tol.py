@@ -37,6 +37,12 @@ class Tolerances:
         Near-plane distance of a radiosity hemicube, as a fraction of the scene's extent:
         surfaces closer than this to a patch centre are not seen (the Cornell light hangs
         0.8 mm = 1.1e-3 extents below the ceiling, hence far less).
+    hemicube_flat : float
+        Largest distance of a block of radiosity patches, drawn by the hemicube as one quad,
+        from the patches' own triangles, as a fraction of a patch edge (a warped quad such
+        as the Cornell box's red wall is drawn in smaller blocks): seen from the nearest
+        other patch centre, half an edge away, it moves a surface by a fifth of a pixel of a
+        resolution-128 hemicube.
     bump_step : float
         Finite-difference step of a bump map's height gradient, as a fraction of one pattern
         period (the step in object units is ``bump_step / scale``).
@@ -49,6 +55,7 @@ class Tolerances:
     symmetric: float = 1e-9
     normal_cancel: float = 1e-6
     hemicube_near: float = 1e-5
+    hemicube_flat: float = 1e-3
     bump_step: float = 1e-3
 
 

@@ -39,6 +39,8 @@ class Geometry:
     tri_patch : (T,) the patch of each triangle.
     centres, normals : (P, 3); areas : (P,).
     polygons : list of P arrays (k, 3), the patches' outlines (for the contour formula).
+    grids : :class:`~.patches.Grid` surfaces whose patches form bilinear grids (optional: the
+        hemicube draws them as a few large quads, see :mod:`.hemicube`).
     """
 
     tris: np.ndarray
@@ -47,6 +49,7 @@ class Geometry:
     normals: np.ndarray
     areas: np.ndarray
     polygons: list
+    grids: tuple = ()
 
     def __len__(self) -> int:
         return len(self.areas)

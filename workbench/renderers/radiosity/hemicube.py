@@ -23,6 +23,7 @@ it there), read back once.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -36,7 +37,8 @@ from .formfactors import Geometry
 SHADERS = Path(__file__).resolve().parents[3] / "shaders"
 MAX_FACES = 80          # must match MAX_FACES in radiosity_item_vs.glsl
 FACES = 5
-TRI_ROW = 4096          # must match TRI_ROW in radiosity_item_fs.glsl
+TRI_ROW = 4096          # must match TRI_ROW in radiosity_item_vs.glsl and radiosity_item_fs.glsl
+NO_BLOCK = 0xFFFFFFFF   # vertex tag of a patch's own triangle, as in radiosity_item_vs.glsl
 GL_CLIP_DISTANCE0 = 0x3000
 
 
@@ -82,10 +84,13 @@ class Hemicube:
     seed : seed of those angles.
     batch : patches per draw call and read-back (<= 16).
     normalize : scale the delta form factors to sum to exactly 1.
+    regions : draw the bilinear grids of ``geom.grids`` as a few large quads, the patch found
+        per pixel (:func:`grid_regions`); ``False`` draws two triangles per patch (the readable
+        reference it is tested against).
     """
 
     def __init__(self, geom: Geometry, resolution: int = 128, *, rotate: bool = False,
-                 seed: int = 0, batch: int = 16, normalize: bool = True):
+                 seed: int = 0, batch: int = 16, normalize: bool = True, regions: bool = True):
         if resolution < 2 or resolution % 2:
             raise WorkbenchError(f"hemicube resolution must be an even number >= 2, got {resolution}")
         if resolution > 2048:
@@ -111,25 +116,44 @@ class Hemicube:
         self.far = 2.0 * ext
         src = [(SHADERS / f"radiosity_item_{s}.glsl").read_text() for s in ("vs", "fs")]
         self.prog = ctx.program(vertex_shader=src[0], fragment_shader=src[1])
-        # shared vertices + index buffer (each vertex shaded once per face, not per triangle);
-        # the patch comes from gl_PrimitiveID through a texture
-        pos, index = np.unique(geom.tris.reshape(-1, 3), axis=0, return_inverse=True)
+        # vertices: the patches' own triangles share theirs (each shaded once per face); the
+        # bilinear blocks have four each, tagged block * 4 + corner (NO_BLOCK for the others)
+        ptris, ptri_patch, blocks = grid_regions(geom) if regions else \
+            (geom.tris, geom.tri_patch, GridBlocks.empty())
+        self.blocks = len(blocks.cells)
+        pos, index = np.unique(ptris.reshape(-1, 3), axis=0, return_inverse=True)
+        Up = len(pos)
+        pos = np.concatenate([pos, blocks.corners.reshape(-1, 3)])
+        tag = np.concatenate([np.full(Up, NO_BLOCK, dtype="u4"),
+                              np.arange(4 * self.blocks, dtype="u4")])
+        quads = Up + 4 * np.arange(self.blocks)[:, None, None] + np.array([[0, 1, 2], [0, 2, 3]])
+        self.index = np.concatenate([index.reshape(-1, 3), quads.reshape(-1, 3)]).astype("u4")
+        # the patch of each triangle (unused for a block's, whose fragments find theirs), the
+        # block of each triangle and of each patch (-1: none)
+        self.tri_patch = np.concatenate([ptri_patch, np.zeros(2 * self.blocks)]).astype("u4")
+        self.tri_block = np.concatenate([np.full(len(ptri_patch), -1),
+                                         np.repeat(np.arange(self.blocks), 2)])
+        self.patch_block = blocks.patch_block(self.P)
         self.pos_h = np.concatenate([pos - self.origin, np.ones((len(pos), 1))], 1)
-        self.index = index.reshape(-1, 3).astype("u4")
         self.U = U = len(pos)
         slots = FACES * self.batch
-        verts = np.empty((slots, U), dtype=[("p", "f4", 3), ("f", "u4")])
+        verts = np.empty((slots, U), dtype=[("p", "f4", 3), ("f", "u4"), ("t", "u4")])
         verts["p"] = (pos - self.origin).astype("f4")[None]
         verts["f"] = np.arange(slots, dtype="u4")[:, None]
+        verts["t"] = tag[None]
         self.vbo = ctx.buffer(verts.tobytes())
         max_tris = slots * len(self.index)
         self.ibo = ctx.buffer(reserve=max(12, 12 * max_tris))
-        self.vao = ctx.vertex_array(self.prog, [(self.vbo, "3f 1u", "in_pos", "in_face")],
+        self.vao = ctx.vertex_array(self.prog, [(self.vbo, "3f 1u 1u", "in_pos", "in_face", "in_tag")],
                                     self.ibo, index_element_size=4)
         self.lut_rows = max(1, -(-max_tris // TRI_ROW))
         self.lut = ctx.texture((TRI_ROW, self.lut_rows), 1, dtype="u4")
-        self.lut.filter = (ctx.NEAREST, ctx.NEAREST)
-        self.prog["tri_patch"].value = 0
+        self.block_cells = _table(ctx, blocks.cells.astype("u4"), "u4")
+        self.block_map = _table(ctx, blocks.maps.reshape(-1, 4).astype("f4"), "f4")
+        self.textures = (self.lut, self.block_cells, self.block_map)
+        for k, (tex, name) in enumerate(zip(self.textures, ("tri_patch", "block_cells", "block_map"))):
+            tex.filter = (ctx.NEAREST, ctx.NEAREST)
+            self.prog[name].value = k
         W, H = 3 * self.res, self.batch * self.res
         self.item = ctx.texture((W, H), 1, dtype="u4")
         self.depth = ctx.depth_renderbuffer((W, H))
@@ -186,25 +210,55 @@ class Hemicube:
         proj = np.stack([self._proj_top] + [self._proj_side] * 4)   # (5, 4, 4)
         return (proj[None] @ view).reshape(-1, 4, 4)
 
-    def _cull(self, mats: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Triangles each face keeps: those not wholly outside one plane of its clip volume.
+    def _cull(self, mats: np.ndarray, own: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Triangles each face keeps: those not wholly outside one plane of its clip volume,
+        and not of the block holding the face's own patch (that block is (nearly) the
+        patch's plane, which it cannot see; drawn, its deviation from the patches'
+        own triangles could pass above the eye and hide everything).
 
-        mats : (S, 4, 4) clip_from_world of face slots 0..S-1.
+        mats : (S, 4, 4) clip_from_world of face slots 0..S-1; own : (S,) their block, -1.
         Returns the vertex indices (K, 3) into the per-slot vertex buffer, and the patch of
-        each kept triangle (K,)."""
+        each kept triangle (K,) (0 for a block's)."""
         c = self.pos_h @ mats.transpose(0, 2, 1)            # (S, U, 4)
         x, y, z, w = c[..., 0], c[..., 1], c[..., 2], c[..., 3]
         code = ((x < -w).astype(np.uint8) | ((x > w) << 1) | ((y < -w) << 2) | ((y > w) << 3)
                 | ((z < -w) << 4) | ((z > w) << 5)).astype(np.uint8)
         t = code[:, self.index]                              # (S, T, 3)
-        slot, tri = np.nonzero((t[..., 0] & t[..., 1] & t[..., 2]) == 0)
-        return (self.index[tri] + (slot * self.U).astype("u4")[:, None],
-                self.geom.tri_patch[tri].astype("u4"))
+        mine = (self.tri_block[None] == own[:, None]) & (own[:, None] >= 0)
+        keep = ((t[..., 0] & t[..., 1] & t[..., 2]) == 0) & ~mine
+        slot, tri = np.nonzero(keep)
+        return self.index[tri] + (slot * self.U).astype("u4")[:, None], self.tri_patch[tri]
 
-    def rows(self, patches) -> np.ndarray:
-        """Rows F[i, :] (len(patches), P) of the patches listed."""
+    def _draw(self, chunk: np.ndarray) -> np.ndarray:
+        """Item buffers (len(chunk), res, 3 res) of up to ``batch`` patches, one draw call and
+        one read-back; a zero-area patch's is left empty (all 0)."""
+        live = np.nonzero(self.geom.areas[chunk] > 0)[0]
+        if len(live):
+            mats = self._face_matrices(chunk[live])
+            rects = self.rects.reshape(self.batch, FACES, 4)[live].reshape(-1, 4)
+            nf = FACES * len(live)
+            tri_idx, tri_patch = self._cull(mats, np.repeat(self.patch_block[chunk[live]], FACES))
+            # GLSL matrices are column-major
+            pad_m = np.zeros((MAX_FACES, 4, 4), dtype="f4")
+            pad_m[:nf] = mats.transpose(0, 2, 1)
+            pad_r = np.zeros((MAX_FACES, 4), dtype="f4")
+            pad_r[:nf] = rects
+            self.prog["clip_from_world"].write(pad_m.tobytes())
+            self.prog["rect"].write(pad_r.tobytes())
+        self.fbo.clear(depth=1.0)         # the item buffer (integer) to 0 too
+        if len(live) and len(tri_idx):
+            self.ibo.write(tri_idx.tobytes())
+            lut = np.zeros(-(-len(tri_patch) // TRI_ROW) * TRI_ROW, dtype="u4")
+            lut[:len(tri_patch)] = tri_patch
+            self.lut.write(lut.tobytes(), viewport=(0, 0, TRI_ROW, len(lut) // TRI_ROW))
+            self.vao.render(vertices=3 * len(tri_idx))
+        self.drawn += len(live)
+        ids = np.frombuffer(self.fbo.read(components=1, dtype="u4"), dtype="u4")
+        return ids.reshape(self.batch, self.res, 3 * self.res)[:len(chunk)]
+
+    def _each_batch(self, patches):
+        """Draw the item buffers of ``patches`` batch by batch: yields (start, ids)."""
         patches = np.asarray(patches, dtype=np.int64).ravel()
-        out = np.zeros((len(patches), self.P))
         ctx = self.ctx
         ctx.enable(ctx.DEPTH_TEST)
         ctx.disable(ctx.CULL_FACE)
@@ -213,49 +267,36 @@ class Hemicube:
         previous = ctx.fbo     # rebound afterwards: releasing a bound FBO breaks the next one
         try:
             self.fbo.use()
-            self.lut.use(0)
+            for k, tex in enumerate(self.textures):
+                tex.use(k)
             for s in range(0, len(patches), self.batch):
-                chunk = patches[s:s + self.batch]
-                live = np.nonzero(self.geom.areas[chunk] > 0)[0]
-                if len(live) == 0:
-                    continue
-                live_p = chunk[live]
-                mats = self._face_matrices(live_p)
-                rects = self.rects.reshape(self.batch, FACES, 4)[live].reshape(-1, 4)
-                nf = FACES * len(live)
-                tri_idx, tri_patch = self._cull(mats[:nf])
-                if len(tri_idx):
-                    self.ibo.write(tri_idx.astype("u4").tobytes())
-                    lut = np.zeros(-(-len(tri_patch) // TRI_ROW) * TRI_ROW, dtype="u4")
-                    lut[:len(tri_patch)] = tri_patch
-                    self.lut.write(lut.tobytes(), viewport=(0, 0, TRI_ROW, len(lut) // TRI_ROW))
-                # GLSL matrices are column-major
-                pad_m = np.zeros((MAX_FACES, 4, 4), dtype="f4")
-                pad_m[:nf] = mats.transpose(0, 2, 1)
-                pad_r = np.zeros((MAX_FACES, 4), dtype="f4")
-                pad_r[:nf] = rects
-                self.prog["clip_from_world"].write(pad_m.tobytes())
-                self.prog["rect"].write(pad_r.tobytes())
-                self.fbo.clear(depth=1.0)
-                self.item.write(np.zeros(self.item.size[::-1], dtype="u4").tobytes())
-                if len(tri_idx):
-                    self.vao.render(vertices=3 * len(tri_idx))
-                ids = np.frombuffer(self.fbo.read(components=1, dtype="u4"), dtype="u4")
-                ids = ids.reshape(self.batch, self.res, 3 * self.res)[:len(chunk)]
-                shift = (np.arange(len(chunk)) * (self.P + 1))[:, None, None]
-                acc = np.bincount((ids.astype(np.int64) + shift).ravel(),
-                                  weights=np.broadcast_to(self.weights, ids.shape).ravel(),
-                                  minlength=len(chunk) * (self.P + 1))
-                acc = acc.reshape(len(chunk), self.P + 1)[:, 1:]
-                for b in live:
-                    out[s + b] = acc[b]
-                self.drawn += len(live)
+                yield s, self._draw(patches[s:s + self.batch])
         finally:
             for k in range(4):
                 ctx.disable_direct(GL_CLIP_DISTANCE0 + k)
             if previous is not None:
                 previous.use()
-        gl.check_errors(ctx)
+            gl.check_errors(ctx)
+
+    def item_buffers(self, patches) -> np.ndarray:
+        """Item buffers (len(patches), res, 3 res) uint32, laid out as
+        :func:`delta_form_factors` (top face, then the four half sides; rows bottom-up):
+        patch number + 1 of the nearest front face seen by each pixel, 0 for nothing (or a
+        back face)."""
+        patches = np.asarray(patches, dtype=np.int64).ravel()
+        out = np.zeros((len(patches), self.res, 3 * self.res), dtype=np.uint32)
+        for s, ids in self._each_batch(patches):
+            out[s:s + len(ids)] = ids
+        return out
+
+    def rows(self, patches) -> np.ndarray:
+        """Rows F[i, :] (len(patches), P) of the patches listed: each item buffer's delta
+        form factors summed per patch (numba, :func:`.kernels.accumulate_items`)."""
+        from .kernels import accumulate_items
+        patches = np.asarray(patches, dtype=np.int64).ravel()
+        out = np.zeros((len(patches), self.P))
+        for s, ids in self._each_batch(patches):
+            accumulate_items(ids, self.weights, out[s:s + len(ids)])
         return out
 
     def matrix(self) -> np.ndarray:
@@ -270,5 +311,113 @@ class Hemicube:
 
     def release(self) -> None:
         gl.release_framebuffer(self.fbo)
-        for o in (self.vao, self.vbo, self.ibo, self.lut, self.item, self.depth, self.prog):
+        for o in (self.vao, self.vbo, self.ibo, *self.textures, self.item, self.depth, self.prog):
             o.release()
+
+
+def _table(ctx, rows: np.ndarray, dtype: str):
+    """A (TRI_ROW, n) four-component texture holding ``rows`` (K, 4), row-major."""
+    n = max(1, -(-len(rows) // TRI_ROW))
+    flat = np.zeros((n * TRI_ROW, 4), dtype=dtype)
+    flat[:len(rows)] = rows
+    return ctx.texture((TRI_ROW, n), 4, flat.tobytes(), dtype=dtype)
+
+
+@dataclass(frozen=True)
+class GridBlocks:
+    """Blocks of bilinear-grid cells the hemicube draws as one quad each (K blocks).
+
+    corners : (K, 4, 3) counter-clockwise from the front.
+    cells : (K, 4) (first patch, cells along a, cells along b, patch stride along a): cell
+        (i, j) of the block is patch ``first + i * stride + j``.
+    maps : (K, 8) the block's bilinear map in its plane, h = a e + b f + a b g:
+        (e.x, e.y, f.x, f.y, g.x, g.y, 0, 0), in units of the block's size.
+    """
+
+    corners: np.ndarray
+    cells: np.ndarray
+    maps: np.ndarray
+
+    def patch_block(self, P: int) -> np.ndarray:
+        """(P,) the block holding each patch, -1 for none."""
+        out = np.full(P, -1, dtype=np.int64)
+        for k, (first, nu, nv, stride) in enumerate(self.cells):
+            out[first + np.arange(nu)[:, None] * stride + np.arange(nv)[None, :]] = k
+        return out
+
+    @staticmethod
+    def empty() -> "GridBlocks":
+        return GridBlocks(np.zeros((0, 4, 3)), np.zeros((0, 4), np.int64), np.zeros((0, 8)))
+
+
+def _newell(c: np.ndarray) -> np.ndarray:
+    """Newell's (area-weighted) normal of the polygon ``c`` (k, 3), not normalised."""
+    d = np.roll(c, -1, axis=0)
+    return np.array([((c[:, 1] - d[:, 1]) * (c[:, 2] + d[:, 2])).sum(),
+                     ((c[:, 2] - d[:, 2]) * (c[:, 0] + d[:, 0])).sum(),
+                     ((c[:, 0] - d[:, 0]) * (c[:, 1] + d[:, 1])).sum()])
+
+
+def _block_map(c: np.ndarray) -> np.ndarray | None:
+    """The bilinear map (8,) of the quad ``c`` (4, 3) in its plane (see :class:`GridBlocks`),
+    or None if ``c`` is degenerate or not strictly convex."""
+    n = _newell(c)
+    L = float(np.linalg.norm(c - c[0], axis=1).max())
+    if L <= 0 or np.linalg.norm(n) <= tol.zero * L * L:
+        return None
+    n = n / np.linalg.norm(n)
+    edges = np.roll(c, -1, axis=0) - c
+    if (np.cross(edges, np.roll(edges, -1, axis=0)) @ n <= tol.zero * L * L).any():
+        return None
+    X = edges[0] - (edges[0] @ n) * n
+    X /= np.linalg.norm(X)
+    Y = np.cross(n, X)
+    to2 = np.stack([X, Y], 1) / L                            # (3, 2)
+    e, f, g = (c[1] - c[0]) @ to2, (c[3] - c[0]) @ to2, (c[0] - c[1] + c[2] - c[3]) @ to2
+    return np.concatenate([e, f, g, [0.0, 0.0]])
+
+
+def _split(n: int, k: int) -> np.ndarray:
+    """Cut points of [0, n] into min(n, k) nearly equal integer ranges."""
+    return np.unique(np.linspace(0, n, min(n, k) + 1).round().astype(int))
+
+
+def grid_regions(geom: Geometry, flat: float = tol.hemicube_flat) -> tuple[np.ndarray, np.ndarray, GridBlocks]:
+    """What the hemicube draws: each bilinear grid of ``geom.grids`` as a few quads (blocks)
+    in which the fragment shader finds the patch by inverting the bilinear map; every other
+    patch as its own triangles.
+
+    A grid is cut into blocks whose corners lie within ``flat`` times a patch edge of their
+    plane (the published Cornell box's red wall is 0.2 % off plane: it is drawn in 6 x 6
+    blocks); a block that is not convex is drawn as its patches' own triangles.  Drawing 32 triangles for the Cornell box's 16 quads
+    instead of 4,240 is what makes a hemicube cheap on llvmpipe.
+
+    Returns the patches' own triangles (T, 3, 3), the patch of each (T,), and the blocks.
+    """
+    by_block = np.zeros(len(geom), bool)
+    corners, cells, maps = [], [], []
+    for g in geom.grids:
+        q = g.quad
+        n = _newell(q)
+        nn = np.linalg.norm(n)
+        if g.nu * g.nv == 1 or nn == 0:
+            continue
+        twist = abs((q[0] - q[1] + q[2] - q[3]) @ n) / (4 * nn)   # corners off the plane
+        edge = min(np.linalg.norm(q[1] - q[0]) / g.nu, np.linalg.norm(q[3] - q[0]) / g.nv)
+        k = 1 if twist <= flat * edge else int(np.ceil(np.sqrt(twist / (flat * edge))))
+        cuts_u, cuts_v = _split(g.nu, k), _split(g.nv, k)
+        for i0, i1 in zip(cuts_u[:-1], cuts_u[1:]):
+            for j0, j1 in zip(cuts_v[:-1], cuts_v[1:]):
+                c = g.corners(i0 / g.nu, i1 / g.nu, j0 / g.nv, j1 / g.nv)
+                m = _block_map(c)
+                if m is None:
+                    continue
+                corners.append(c)
+                cells.append((g.first + i0 * g.nv + j0, i1 - i0, j1 - j0, g.nv))
+                maps.append(m)
+                ids = g.first + np.arange(i0, i1)[:, None] * g.nv + np.arange(j0, j1)[None, :]
+                by_block[ids.ravel()] = True
+    own = ~by_block[geom.tri_patch]
+    blocks = GridBlocks(np.reshape(corners, (-1, 4, 3)), np.reshape(cells, (-1, 4)).astype(np.int64),
+                        np.reshape(maps, (-1, 8))) if corners else GridBlocks.empty()
+    return geom.tris[own], geom.tri_patch[own], blocks

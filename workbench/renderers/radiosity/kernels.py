@@ -3,6 +3,7 @@
 * :func:`point_polygon_ff` / :func:`analytic_matrix`: Lambert's contour formula.
 * :func:`raycast_rows`: Malley's cosine-distributed rays against every triangle.
 * :func:`shoot`: progressive refinement by shooting on an explicit matrix (Cohen et al. 1988).
+* :func:`accumulate_items`: hemicube item buffers -> form-factor rows.
 
 Each has a readable numpy/Python counterpart it is tested against (``tests/test_radiosity_*``).
 """
@@ -264,3 +265,68 @@ def shoot(F, areas, rho, B, dB, max_shots, stop, history):
         if ok:
             return s + 1
     return max_shots
+
+
+@njit(cache=True)
+def accumulate_items(ids, weights, out):
+    """Hemicube rows from item buffers (Cohen & Greenberg 1985), in place:
+    ``out[b, ids[b, y, x] - 1] += weights[y, x]`` for every pixel showing a patch (id > 0).
+
+    ids : (K, H, W) uint32; weights : (H, W) delta form factors; out : (K, P).
+    Serial: 0.2-0.4 ms for 16 hemicubes at resolution 128, not worth threads that llvmpipe's
+    rasteriser wants."""
+    K, H, W = ids.shape
+    for b in range(K):
+        for y in range(H):
+            for x in range(W):
+                k = ids[b, y, x]
+                if k > 0:
+                    out[b, k - 1] += weights[y, x]
+
+
+@njit(cache=True)
+def shoot_rows(rows, shooters, areas, rho, B, dB, relax, stop, history, start):
+    """Progressive refinement from computed rows (Cohen et al. 1988), in place: patch
+    ``shooters[s]`` = i shoots with its row ``rows[s]`` = F[i, :], receivers taking
+    F_ji = F_ij A_i / A_j (reciprocity):
+
+        dB_j += rho_j F_ji w dB_i,  B_j += the same,  dB_i -= w dB_i
+
+    with the relaxation factor ``w = relax`` (1: plain shooting; > 1: overshooting, the
+    overrelaxed Southwell iteration of Gortler et al. 1994, which leaves a negative unshot
+    radiosity to be shot back later).  After each shot ``history[start + s]`` = max_c
+    ||dB_c||_inf / ||B_c||_inf; stops after the shot at which every channel has
+    ||dB_c||_inf <= stop ||B_c||_inf.  Returns the number of shots made.
+    """
+    n, C = B.shape
+    shot = np.empty(C)
+    for s in range(len(shooters)):
+        i = shooters[s]
+        for c in range(C):
+            shot[c] = relax * dB[i, c]
+            dB[i, c] -= shot[c]
+        Ai = areas[i]
+        for j in range(n):
+            f = rows[s, j]
+            if f != 0.0 and areas[j] > 0.0:
+                f *= Ai / areas[j]
+                for c in range(C):
+                    inc = rho[j, c] * f * shot[c]
+                    B[j, c] += inc
+                    dB[j, c] += inc
+        ok = True
+        worst = 0.0
+        for c in range(C):
+            mb = 0.0
+            md = 0.0
+            for j in range(n):
+                mb = max(mb, abs(B[j, c]))
+                md = max(md, abs(dB[j, c]))
+            r = md / mb if mb > 0.0 else 0.0
+            worst = max(worst, r)
+            if md > stop * mb:
+                ok = False
+        history[start + s] = worst
+        if ok:
+            return s + 1
+    return len(shooters)

@@ -52,6 +52,9 @@ class PatchSet:
         Name of each surface.
     surface_objects : tuple
         The scene object (or light) each surface belongs to, ``None`` for raw polygons.
+    grids : tuple of :class:`Grid`
+        The quadrilateral surfaces cut into bilinear grids (the hemicube draws each as a few
+        large quads and finds the patch per pixel, instead of two triangles per patch).
     """
 
     corners: np.ndarray
@@ -62,6 +65,7 @@ class PatchSet:
     reflectance: np.ndarray
     surface_names: tuple = ()
     surface_objects: tuple = ()
+    grids: tuple = ()
 
     def __len__(self) -> int:
         return len(self.corners)
@@ -116,7 +120,8 @@ class PatchSet:
         """The patches as form-factor :class:`~.formfactors.Geometry`."""
         from .formfactors import Geometry
         tri, patch = self.triangles()
-        return Geometry(tri, patch, self.centres, self.normals, self.areas, list(self.corners))
+        return Geometry(tri, patch, self.centres, self.normals, self.areas, list(self.corners),
+                        self.grids)
 
     def vertex_values(self, values: np.ndarray) -> np.ndarray:
         """Patch values (P, C) interpolated to vertices (V, C): the area-weighted mean of the
@@ -141,13 +146,43 @@ class PatchSet:
                         plain / np.maximum(cnt, 1.0)[:, None])
 
 
-# --------------------------------------------------------------------------- splitting
-def _split_quad(q: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
-    """Bilinear grid on a planar quad ``q`` (4, 3) with cells no longer than ``h``.
+@dataclass(frozen=True)
+class Grid:
+    """A quadrilateral surface cut into an ``nu`` x ``nv`` bilinear grid of patches.
 
-    Returns grid vertices (V, 3) and cells (C, 4) as vertex indices."""
+    quad : (4, 3) corners q0..q3, counter-clockwise from the front; the patch corners are
+        (1-a)(1-b) q0 + a(1-b) q1 + ab q2 + (1-a)b q3 at a = i/nu, b = j/nv.
+    nu, nv : cells along q0 -> q1 and along q0 -> q3.
+    first : index of cell (0, 0); cell (i, j) is patch ``first + i * nv + j``.
+    """
+
+    quad: np.ndarray
+    nu: int
+    nv: int
+    first: int
+
+    def corners(self, a0: float, a1: float, b0: float, b1: float) -> np.ndarray:
+        """(4, 3) corners of the block of parameters [a0, a1] x [b0, b1]."""
+        q = self.quad
+        a = np.array([a0, a1, a1, a0])[:, None]
+        b = np.array([b0, b0, b1, b1])[:, None]
+        return (1 - a) * (1 - b) * q[0] + a * (1 - b) * q[1] + a * b * q[2] + (1 - a) * b * q[3]
+
+
+# --------------------------------------------------------------------------- splitting
+def _grid_shape(q: np.ndarray, h: float) -> tuple[int, int]:
+    """Cells (nu, nv) of the bilinear grid on quad ``q`` with edges no longer than ``h``."""
     nu = max(1, int(np.ceil(max(np.linalg.norm(q[1] - q[0]), np.linalg.norm(q[2] - q[3])) / h)))
     nv = max(1, int(np.ceil(max(np.linalg.norm(q[3] - q[0]), np.linalg.norm(q[2] - q[1])) / h)))
+    return nu, nv
+
+
+def _split_quad(q: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
+    """Bilinear grid on a planar quad ``q`` (4, 3) with cells no longer than ``h``
+    (cell (i, j), i along q0 -> q1, is number i * nv + j).
+
+    Returns grid vertices (V, 3) and cells (C, 4) as vertex indices."""
+    nu, nv = _grid_shape(q, h)
     a, b = np.meshgrid(np.linspace(0, 1, nu + 1), np.linspace(0, 1, nv + 1), indexing="ij")
     a, b = a.reshape(-1, 1), b.reshape(-1, 1)
     verts = (1 - a) * (1 - b) * q[0] + a * (1 - b) * q[1] + a * b * q[2] + (1 - a) * b * q[3]
@@ -274,11 +309,13 @@ def _surfaces(scene: m.Scene, h: float) -> tuple[list, list[str]]:
 def _assemble(surfaces: list, h: float) -> PatchSet:
     """Cut each surface ``(kind, geometry, reflectance, emission, object, name)`` into
     patches."""
-    corners, vids, verts, surf, E, R = [], [], [], [], [], []
-    nv = 0
+    corners, vids, verts, surf, E, R, grids = [], [], [], [], [], [], []
+    nv = npatch = 0
     for s, (kind, geo, rho, emis, _obj, _name) in enumerate(surfaces):
         if kind == "polygon":
             v, cells = split_polygon(geo, h)
+            if len(geo) == 4:
+                grids.append(Grid(np.asarray(geo, dtype=np.float64), *_grid_shape(geo, h), npatch))
         else:
             v, F = geo
             cells = np.concatenate([F, F[:, 2:3]], 1)
@@ -286,6 +323,7 @@ def _assemble(surfaces: list, h: float) -> PatchSet:
         vids.append(cells + nv)
         verts.append(v)
         nv += len(v)
+        npatch += len(cells)
         surf.append(np.full(len(cells), s))
         E.append(np.broadcast_to(emis, (len(cells), 3)))
         R.append(np.broadcast_to(rho, (len(cells), 3)))
@@ -296,7 +334,7 @@ def _assemble(surfaces: list, h: float) -> PatchSet:
     return PatchSet(np.concatenate(corners), np.concatenate(vids), np.concatenate(verts),
                     np.concatenate(surf), np.concatenate(E).astype(np.float64),
                     np.concatenate(R).astype(np.float64),
-                    tuple(x[5] for x in surfaces), tuple(x[4] for x in surfaces))
+                    tuple(x[5] for x in surfaces), tuple(x[4] for x in surfaces), tuple(grids))
 
 
 def scene_extent(scene: m.Scene) -> float:
