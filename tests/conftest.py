@@ -1,7 +1,11 @@
-"""Shared fixtures: the headless GL context with an error-state check around each GL test."""
+"""Shared fixtures: the headless GL context with an error-state check around each GL test, and
+the private X server (Xvfb) of the UI tests."""
 from __future__ import annotations
 
 import os
+import shutil
+import subprocess
+import time
 from pathlib import Path
 
 import pytest
@@ -17,3 +21,27 @@ def gl_ctx():
     assert ctx.error == "GL_NO_ERROR", "GL error flag set before the test"
     yield ctx
     assert ctx.error == "GL_NO_ERROR", "the test left a GL error"
+
+
+def _free_display() -> int:
+    for n in range(90, 200):
+        if not Path(f"/tmp/.X11-unix/X{n}").exists() and not Path(f"/tmp/.X{n}-lock").exists():
+            return n
+    raise RuntimeError("no free X display number")
+
+
+@pytest.fixture(scope="session")
+def xvfb():
+    """A private X server (Xvfb) for the UI tests; its display name (\":N\")."""
+    if shutil.which("Xvfb") is None:
+        pytest.skip("Xvfb not installed")
+    n = _free_display()
+    proc = subprocess.Popen(["Xvfb", f":{n}", "-screen", "0", "1280x800x24", "-nolisten", "tcp"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    for _ in range(100):
+        if Path(f"/tmp/.X11-unix/X{n}").exists():
+            break
+        time.sleep(0.05)
+    yield f":{n}"
+    proc.terminate()
+    proc.wait(10)

@@ -8,7 +8,6 @@ import os
 import shutil
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -21,29 +20,6 @@ pytestmark = pytest.mark.gl
 ROOT = Path(__file__).resolve().parents[1]
 METHODS = ("flat", "gouraud", "phong", "raycast", "raytrace")
 RASTER = ("flat", "gouraud", "phong")
-
-
-def _free_display() -> int:
-    for n in range(90, 200):
-        if not Path(f"/tmp/.X11-unix/X{n}").exists() and not Path(f"/tmp/.X{n}-lock").exists():
-            return n
-    raise RuntimeError("no free X display number")
-
-
-@pytest.fixture(scope="module")
-def xvfb():
-    if shutil.which("Xvfb") is None:
-        pytest.skip("Xvfb not installed")
-    n = _free_display()
-    proc = subprocess.Popen(["Xvfb", f":{n}", "-screen", "0", "1280x800x24", "-nolisten", "tcp"],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    for _ in range(100):
-        if Path(f"/tmp/.X11-unix/X{n}").exists():
-            break
-        time.sleep(0.05)
-    yield f":{n}"
-    proc.terminate()
-    proc.wait(10)
 
 
 @pytest.fixture(scope="module")
@@ -168,14 +144,6 @@ def test_camera_functions_are_consistent():
     p = cam.pan(c, 0.1, -0.2)
     assert np.allclose(np.subtract(p.position, c.position), np.subtract(p.look_at, c.look_at))
     assert cam.orbit_parameters(cam.orbit(c, 0.0, 10.0))[2] <= cam.PITCH_LIMIT + 1e-12
-
-
-def test_display_table_matches_srgb_encode():
-    from workbench.app.ui.frames import srgb_lut, to_display
-    from workbench.core.imageio import to_srgb8
-    rng = np.random.default_rng(1)
-    img = (rng.random((64, 64, 3)) ** 3 * 1.2).astype(np.float32)
-    assert np.abs(to_display(srgb_lut(), img).astype(int) - to_srgb8(img)).max() <= 1
 
 
 def test_linked_view_zoom_keeps_the_point_under_the_mouse():

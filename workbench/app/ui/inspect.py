@@ -84,6 +84,7 @@ def settings(state: AppState) -> dict:
             "methods": list(state.methods),
             "options": {m: state.options[m] for m in state.methods},
             "material_overrides": state.overrides,
+            "light_overrides": {str(k): v for k, v in state.light_overrides.items()},
             "difference": {"a": state.diff_pair[0], "b": state.diff_pair[1],
                            "kind": state.diff_kind}}
 

@@ -23,8 +23,8 @@ from imgui_bundle import hello_imgui, imgui
 from .state import AppState
 
 SPLITS = (("MainDockSpace", "ControlSpace", imgui.Dir.left, 0.27),
-          ("ControlSpace", "ParamSpace", imgui.Dir.down, 0.55),
-          ("ControlSpace", "MethodSpace", imgui.Dir.down, 0.42),
+          ("ControlSpace", "ParamSpace", imgui.Dir.down, 0.5),
+          ("ControlSpace", "MethodSpace", imgui.Dir.down, 0.3),
           ("MainDockSpace", "ToolSpace", imgui.Dir.down, 0.45),
           ("ToolSpace", "DiffSpace", imgui.Dir.left, 0.45))
 """(dock space split, new dock space, side, fraction of the split one) in order."""
@@ -32,12 +32,15 @@ SPLITS = (("MainDockSpace", "ControlSpace", imgui.Dir.left, 0.27),
 
 def windows(state: AppState) -> list[tuple[str, str, object]]:
     """(label, dock space, gui function of no argument) of every dockable window."""
+    from .file_browser import file_browser
     from .inspect import ray_tree_view
+    from .lights import light_controls
     from .panels import (colour_wheel, difference_panel, image_panels, method_list, parameters,
                          scene_picker)
-    return [("Scene", "ControlSpace", lambda: scene_picker(state)),
+    return [("Scene", "ControlSpace", lambda: (scene_picker(state), file_browser(state))),
             ("Methods", "MethodSpace", lambda: method_list(state)),
             ("Parameters", "ParamSpace", lambda: parameters(state)),
+            ("Lights", "ParamSpace", lambda: light_controls(state)),
             ("Colour wheel", "ParamSpace", lambda: colour_wheel(state)),
             ("Panels", "MainDockSpace", lambda: image_panels(state)),
             ("Difference", "DiffSpace", lambda: difference_panel(state)),

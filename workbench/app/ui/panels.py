@@ -39,13 +39,15 @@ def colour_scale(values: np.ndarray, vmax: float) -> np.ndarray:
 
 
 def scene_picker(state: AppState) -> None:
-    """Combo over the bundled scenes."""
+    """Combo over the bundled scenes (a scene opened from a file is listed first)."""
     from ...scene.library import bundled
-    names = [p.stem for p in bundled()]
-    cur = names.index(state.scene_path.stem) if state.scene_path.stem in names else 0
-    changed, idx = imgui.combo("scene", cur, names)
-    if changed and names[idx] != state.scene_path.stem:
-        set_scene(state, names[idx])
+    paths = bundled()
+    if state.scene_path not in paths:
+        paths = [state.scene_path, *paths]
+    names = [p.stem if p.parent == paths[-1].parent else p.name for p in paths]
+    changed, idx = imgui.combo("scene", paths.index(state.scene_path), names)
+    if changed and paths[idx] != state.scene_path:
+        set_scene(state, str(paths[idx]))
     if imgui.button("reset camera"):
         state.camera = cam.reset(state.scene, state.camera)
     imgui.same_line()
@@ -60,9 +62,10 @@ def scene_picker(state: AppState) -> None:
 
 
 def method_list(state: AppState) -> None:
-    """Checkboxes over the methods (1 to 6 selected)."""
-    imgui.separator_text("methods")
-    for m in choosable_methods():
+    """Checkboxes over the methods (1 to 6 selected), two per row."""
+    for k, m in enumerate(choosable_methods()):
+        if k % 2:
+            imgui.same_line(imgui.get_window_width() / 2)
         on = m in state.methods
         changed, on = imgui.checkbox(m, on)
         if changed:

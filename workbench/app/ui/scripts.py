@@ -76,6 +76,54 @@ class Check:
             state.quit = True
 
 
+class Features:
+    """Scene file browser (a bad file, then a good one, from ``out/scenes``, which the caller
+    fills) -> light 0 moved (GL panels the next frame, CPU panels once their restarted jobs
+    end) -> quit.  Waits for background jobs between steps."""
+
+    def __init__(self, out: Path):
+        self.out, self.log, self.step, self.t_wait = out, {}, 0, time.perf_counter()
+
+    def _settled(self, state: AppState) -> bool:
+        return (not state.jobs.busy()
+                or time.perf_counter() - self.t_wait > CPU_WAIT_SECONDS)
+
+    def __call__(self, state: AppState) -> None:
+        from .file_browser import go_to, listing, open_scene
+        from .state import light_fields, light_value, set_light_value
+        out, step = self.out, self.step
+        if step == 0 and state.frame >= 2:
+            b = state.browser
+            go_to(b, out / "scenes")
+            self.log["listing"] = [p.name for group in listing(b.folder) for p in group]
+            version = state.scene_version
+            self.log["bad"] = {"opened": open_scene(state, b.folder / "bad.toml"),
+                               "message": b.message, "failed": b.failed,
+                               "version_kept": state.scene_version == version}
+            b.selected = b.folder / "good.toml"
+        elif step == 1:  # a frame drawn with the error message, then the good file
+            self.log["good"] = {"opened": open_scene(state, state.browser.selected),
+                                "scene_path": str(state.scene_path)}
+        elif step == 2 and self._settled(state):
+            _record(state, out, "lit0")
+            light = state.scene.lights[0]
+            where = light_fields(light)[0]
+            p = np.asarray(light_value(light, where), float)
+            moved = tuple(p + np.array([1.0, 0.5, 0.0]) * max(1.0, float(np.abs(p).max())) * 0.5)
+            set_light_value(state, 0, where, moved)
+            self.log["light"] = {"field": where, "before": p.tolist(), "after": list(moved)}
+        elif step == 3:
+            _record(state, out, "lit1_next_frame")
+            self.t_wait = time.perf_counter()
+        elif step == 4 and self._settled(state):
+            _record(state, out, "lit1")
+            self.log["cpu_done"] = not state.jobs.busy()
+            state.quit = True
+        else:
+            return
+        self.step += 1
+
+
 class Fps:
     """Count frames for ``seconds`` after a warm-up while the camera turns by ``step`` radians
     per frame (a steady mouse drag: every panel changes every frame and the CPU jobs restart).
@@ -105,5 +153,5 @@ class Fps:
                 state.quit = True
 
 
-SCRIPTS = {"check": Check, "fps": Fps,
+SCRIPTS = {"check": Check, "features": Features, "fps": Fps,
            "fps_static": lambda out: Fps(out, step=0.0, raytrace_spp=16)}

@@ -27,8 +27,9 @@ HARMONIES = ("complementary", "triad", "square", "hexagon")
 class AppState:
     """Everything the UI shows and edits.
 
-    ``scene`` is the loaded scene with the material overrides applied; ``scene_version`` grows
-    with every change of it (cache keys of GL sessions and background jobs).  ``camera`` is the
+    ``scene`` is the loaded scene with the material and light overrides applied;
+    ``scene_version`` grows with every change of it (cache keys of GL sessions and background
+    jobs).  ``camera`` is the
     shared camera of all panels at the panel resolution; ``view`` (zoom, centre u, centre v)
     the linked 2D zoom of every image panel.  ``images`` holds each panel's last
     linear (H, W, 3) float32 image, ``timings`` its last render time in seconds.
@@ -42,6 +43,7 @@ class AppState:
     options: dict[str, dict]
     material: str
     overrides: dict[str, dict[str, float]] = field(default_factory=dict)
+    light_overrides: dict[int, dict[str, object]] = field(default_factory=dict)
     scene_version: int = 0
     panel_size: tuple[int, int] = (256, 256)
     images: dict[str, np.ndarray] = field(default_factory=dict)
@@ -63,6 +65,7 @@ class AppState:
     display: dict[str, str] = field(default_factory=dict)
     wheel: tuple[float, str] = (0.0, "triad")
     export_dir: Path = Path("out/ui_export")
+    browser: object = None
     quit: bool = False
 
 
@@ -85,6 +88,7 @@ def new_state(scene_name: str, methods: list[str] | None = None,
     from ...core.errors import WorkbenchError
     from ...scene.io import load_scene
     from ...scene.library import resolve
+    from .file_browser import Browser
     from .jobs import JobBoard
     path = resolve(scene_name)
     scene = load_scene(path)
@@ -98,18 +102,38 @@ def new_state(scene_name: str, methods: list[str] | None = None,
                     camera=scene.camera.with_resolution(*panel_size), methods=methods,
                     options={m: default_options(m) for m in allowed},
                     material=next(iter(scene.materials)), panel_size=panel_size,
-                    diff_pair=(methods[0], methods[-1]), jobs=JobBoard())
+                    diff_pair=(methods[0], methods[-1]), jobs=JobBoard(),
+                    browser=Browser(path.parent))
 
 
 def set_scene(state: AppState, scene_name: str) -> None:
-    """Switch to another scene: camera reset, overrides dropped."""
+    """Switch to another scene: camera reset, overrides dropped.  A scene that does not load
+    raises its :class:`~workbench.core.errors.WorkbenchError` and changes nothing."""
     from ...scene.io import load_scene
     from ...scene.library import resolve
-    state.scene_path = resolve(scene_name)
-    state.base_scene = state.scene = load_scene(state.scene_path)
+    path = resolve(scene_name)
+    scene = load_scene(path)
+    state.scene_path, state.base_scene, state.scene = path, scene, scene
     state.camera = state.scene.camera.with_resolution(*state.panel_size)
-    state.overrides = {}
+    state.overrides, state.light_overrides = {}, {}
     state.material = next(iter(state.scene.materials))
+    state.scene_version += 1
+
+
+def _apply_overrides(state: AppState) -> None:
+    """``state.scene`` = the loaded scene with the material and light overrides applied
+    (``dataclasses.replace``: the model is frozen); the version grows."""
+    mats = dict(state.base_scene.materials)
+    for mname, fields in state.overrides.items():
+        mats[mname] = replace(mats[mname], **fields)
+    lights = list(state.base_scene.lights)
+    for k, fields in state.light_overrides.items():
+        fields = dict(fields)
+        if "centre" in fields:  # an area light moves as a whole
+            v = lights[k].vertices
+            fields["vertices"] = v - v.mean(0) + np.asarray(fields.pop("centre"))
+        lights[k] = replace(lights[k], **fields)
+    state.scene = replace(state.base_scene, materials=mats, lights=tuple(lights))
     state.scene_version += 1
 
 
@@ -118,11 +142,57 @@ def set_material_value(state: AppState, material: str, name: str, value: float) 
     if name not in MATERIAL_FIELDS:
         raise ValueError(f"not an editable material field: {name!r}")
     state.overrides.setdefault(material, {})[name] = float(value)
-    mats = dict(state.base_scene.materials)
-    for mname, fields in state.overrides.items():
-        mats[mname] = replace(mats[mname], **fields)
-    state.scene = replace(state.base_scene, materials=mats)
-    state.scene_version += 1
+    _apply_overrides(state)
+
+
+def light_fields(light) -> tuple[str, ...]:
+    """The editable fields of a light: where it is (``position``, ``direction`` or an area
+    light's ``centre``), ``color`` and ``intensity``."""
+    from ...scene.model import AreaLight, DirectionalLight
+    where = ("centre" if isinstance(light, AreaLight)
+             else "direction" if isinstance(light, DirectionalLight) else "position")
+    return (where, "color", "intensity")
+
+
+def light_value(light, name: str):
+    """A light's current value of an editable field (an area light's centre is its vertices'
+    mean)."""
+    if name == "centre":
+        return tuple(float(x) for x in light.vertices.mean(0))
+    return getattr(light, name)
+
+
+def set_light_value(state: AppState, index: int, name: str, value) -> None:
+    """Override one field of light ``index`` (see :func:`light_fields`); bad values raise
+    :class:`~workbench.core.errors.WorkbenchError` and change nothing."""
+    from ...core.errors import WorkbenchError
+    lights = state.base_scene.lights
+    if not 0 <= index < len(lights):
+        raise WorkbenchError(f"no light {index} (the scene has {len(lights)})")
+    if name not in light_fields(lights[index]):
+        raise WorkbenchError(f"light {index} has no editable field {name!r} "
+                             f"(editable: {', '.join(light_fields(lights[index]))})")
+    if name == "intensity":
+        value = float(value)
+        ok = np.isfinite(value) and value >= 0.0
+    else:
+        value = tuple(float(x) for x in value)
+        ok = len(value) == 3 and bool(np.isfinite(value).all())
+        if name == "color":
+            ok = ok and min(value) >= 0.0
+        if name == "direction":
+            ok = ok and float(np.linalg.norm(value)) > 0.0
+    if not ok:
+        raise WorkbenchError(f"light {index}: {name} = {value!r} is not valid (finite; colour and "
+                             "intensity >= 0; direction non-zero; positions as 3 numbers)")
+    state.light_overrides.setdefault(index, {})[name] = value
+    _apply_overrides(state)
+
+
+def reset_lights(state: AppState) -> None:
+    """Back to the scene file's lights."""
+    state.light_overrides = {}
+    _apply_overrides(state)
 
 
 def set_option(state: AppState, method: str, name: str, value) -> None:

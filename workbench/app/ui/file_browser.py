@@ -1,0 +1,110 @@
+"""An in-window file browser for scene files (``*.toml``).
+
+imgui-bundle's ``portable_file_dialogs`` opens zenity or kdialog, which a bare (or headless)
+machine does not have; this browser lists a folder inside the window instead: its sub-folders,
+its scene files, a parent button and a folder field.  Opening a file that does not load leaves
+the current scene as it was and shows the loader's message (:class:`~workbench.scene.io.SceneError`
+names the file, the key and what was expected) in the window.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from ...core.errors import WorkbenchError
+from .state import AppState, set_scene
+
+PATTERN = "*.toml"
+
+
+@dataclass
+class Browser:
+    """The browser's folder, the file selected in it and the last outcome (error or opened)."""
+
+    folder: Path
+    selected: Path | None = None
+    message: str = ""
+    failed: bool = False
+
+
+def listing(folder: Path) -> tuple[list[Path], list[Path]]:
+    """(sub-folders, scene files) of ``folder``, each sorted by name; hidden entries left out."""
+    folder = Path(folder)
+    try:
+        entries = [p for p in folder.iterdir() if not p.name.startswith(".")]
+    except OSError as e:
+        raise WorkbenchError(f"{folder}: cannot list this folder ({e.strerror or e})") from None
+    dirs = sorted((p for p in entries if p.is_dir()), key=lambda p: p.name.lower())
+    files = sorted((p for p in entries if p.is_file() and p.match(PATTERN)),
+                   key=lambda p: p.name.lower())
+    return dirs, files
+
+
+def go_to(browser: Browser, folder: Path) -> None:
+    """Show ``folder`` (a message instead if it is not a folder)."""
+    folder = Path(folder).expanduser()
+    if not folder.is_dir():
+        browser.message, browser.failed = f"{folder}: not a folder", True
+        return
+    browser.folder, browser.selected = folder.resolve(), None
+    browser.message, browser.failed = "", False
+
+
+def open_scene(state: AppState, path: Path) -> bool:
+    """Load ``path`` as the scene; on a bad file keep the current scene and keep the message."""
+    b = state.browser
+    try:
+        set_scene(state, str(path))
+    except WorkbenchError as e:
+        b.message, b.failed = str(e), True
+        return False
+    except OSError as e:  # unreadable file: permissions, vanished
+        b.message, b.failed = f"{path}: cannot be read ({e.strerror or e})", True
+        return False
+    b.message, b.failed = f"opened {Path(path).name}", False
+    return True
+
+
+def file_browser(state: AppState) -> None:
+    """The browser: folder field, parent button, folders and scene files, open button, outcome."""
+    from imgui_bundle import imgui
+    b = state.browser
+    imgui.separator_text("scene file")
+    if imgui.button("parent"):
+        go_to(b, b.folder.parent)
+    imgui.same_line()
+    imgui.set_next_item_width(-1)
+    entered, text = imgui.input_text("##folder", str(b.folder),
+                                     imgui.InputTextFlags_.enter_returns_true)
+    if entered:
+        go_to(b, Path(text))
+    try:
+        dirs, files = listing(b.folder)
+    except WorkbenchError as e:
+        dirs, files = [], []
+        b.message, b.failed = str(e), True
+    imgui.begin_child("listing", imgui.ImVec2(0, 110), imgui.ChildFlags_.borders)
+    for d in dirs:
+        if imgui.selectable(f"[{d.name}]", False, imgui.SelectableFlags_.allow_double_click)[0] \
+                and imgui.is_mouse_double_clicked(imgui.MouseButton_.left):
+            go_to(b, d)
+    for f in files:
+        clicked, _ = imgui.selectable(f.name, f == b.selected,
+                                      imgui.SelectableFlags_.allow_double_click)
+        if clicked:
+            b.selected = f
+            if imgui.is_mouse_double_clicked(imgui.MouseButton_.left):
+                open_scene(state, f)
+    if not dirs and not files:
+        imgui.text_disabled(f"no folder and no {PATTERN} file here")
+    imgui.end_child()
+    imgui.begin_disabled(b.selected is None)
+    if imgui.button("open"):
+        open_scene(state, b.selected)
+    imgui.end_disabled()
+    if b.message:
+        imgui.same_line()
+        colour = imgui.ImVec4(1.0, 0.35, 0.3, 1.0) if b.failed else imgui.ImVec4(0.5, 0.9, 0.5, 1.0)
+        imgui.push_text_wrap_pos(0.0)
+        imgui.text_colored(colour, b.message)
+        imgui.pop_text_wrap_pos()
