@@ -178,14 +178,16 @@ def test_radiosity_panels_in_the_window(xvfb, tmp_path):
 
 
 def test_docking_layout_and_status_bar(session):
-    """Every window is docked; one tab per dock space is in front (the parameters, not the colour
-    wheel sharing their space); the status bar names the GL renderer and each method's time."""
+    """Every window is docked; one tab per dock space is in front (the parameters, not the lights
+    and colour wheel sharing their space); the status bar names the GL renderer and each
+    method's time."""
     _, summary, _ = session
     win = summary["script"]["windows"]
     assert all(w["exists"] and w["docked"] for w in win.values()), win
-    for label in ("Scene", "Methods", "Parameters", "Panels", "Difference", "Ray tree"):
+    for label in ("Scene", "Methods", "Parameters", "Panels", "Difference", "Error plot"):
         assert win[label]["drawn"] and min(win[label]["size"]) > 100, label
-    assert not win["Colour wheel"]["drawn"]
+    for label in ("Lights", "Colour wheel", "Ray tree"):  # tabs behind the first of their space
+        assert not win[label]["drawn"], label
     # the panels window holds the widest part of the window
     assert win["Panels"]["size"][0] > max(win["Scene"]["size"][0], win["Difference"]["size"][0])
     status = summary["script"]["status_bar"]

@@ -135,3 +135,27 @@ def test_moving_a_light_updates_gl_panels_at_once_and_restarts_cpu_jobs(features
     rt0, rt1 = _img(out, "lit0", "raytrace"), _img(out, "lit1", "raytrace")
     assert np.abs(rt0 - rt1).max() > 0.05
     assert np.abs(rt1 - _img(out, "lit1_next_frame", "raytrace")).max() > 0.05
+
+
+def test_error_plot_points_are_the_compare_metrics(features):
+    """Each method on screen gets a point whose error is compare.metrics against the compare
+    module's reference for this scene (the ray tracer at its finest max_depth on whitted), and a
+    knob change adds a point of the same method."""
+    from workbench.compare.metrics import metrics
+    from workbench.compare.reference import finest_options
+    out, summary, _ = features
+    plot = summary["script"]["plot"]
+    assert plot["reference"] == "raytrace" and plot["ref_options"] == finest_options("raytrace")
+    ref = np.load(out / "plot_reference.npy")
+    for m in ("flat", "phong", "raytrace"):
+        (point,) = plot["points"][m]
+        expected = metrics(_img(out, "plot", m), ref)
+        assert np.isclose(point["rmse"], expected["rmse"], rtol=1e-6, atol=1e-9), m
+        assert np.isclose(point["flip"], expected["flip"], rtol=1e-4, atol=1e-6), m
+        assert point["seconds"] > 0
+    # Phong has no reflection, refraction or shadows: further from the reference than the
+    # ray tracer at max_depth 5
+    assert plot["points"]["raytrace"][0]["rmse"] < plot["points"]["phong"][0]["rmse"]
+    flat = summary["script"]["plot_knob"]
+    assert len(flat) == 2 and len({p["options"]["tessellation"] for p in flat}) == 2
+    assert flat[0]["rmse"] != flat[1]["rmse"]

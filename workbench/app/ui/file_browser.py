@@ -83,7 +83,7 @@ def file_browser(state: AppState) -> None:
     except WorkbenchError as e:
         dirs, files = [], []
         b.message, b.failed = str(e), True
-    imgui.begin_child("listing", imgui.ImVec2(0, 110), imgui.ChildFlags_.borders)
+    imgui.begin_child("listing", imgui.ImVec2(0, 90), imgui.ChildFlags_.borders)
     for d in dirs:
         if imgui.selectable(f"[{d.name}]", False, imgui.SelectableFlags_.allow_double_click)[0] \
                 and imgui.is_mouse_double_clicked(imgui.MouseButton_.left):
@@ -103,7 +103,6 @@ def file_browser(state: AppState) -> None:
         open_scene(state, b.selected)
     imgui.end_disabled()
     if b.message:
-        imgui.same_line()
         colour = imgui.ImVec4(1.0, 0.35, 0.3, 1.0) if b.failed else imgui.ImVec4(0.5, 0.9, 0.5, 1.0)
         imgui.push_text_wrap_pos(0.0)
         imgui.text_colored(colour, b.message)

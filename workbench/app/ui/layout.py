@@ -37,6 +37,7 @@ def windows(state: AppState) -> list[tuple[str, str, object]]:
     from .lights import light_controls
     from .panels import (colour_wheel, difference_panel, image_panels, method_list, parameters,
                          scene_picker)
+    from .plot import error_plot
     return [("Scene", "ControlSpace", lambda: (scene_picker(state), file_browser(state))),
             ("Methods", "MethodSpace", lambda: method_list(state)),
             ("Parameters", "ParamSpace", lambda: parameters(state)),
@@ -44,6 +45,7 @@ def windows(state: AppState) -> list[tuple[str, str, object]]:
             ("Colour wheel", "ParamSpace", lambda: colour_wheel(state)),
             ("Panels", "MainDockSpace", lambda: image_panels(state)),
             ("Difference", "DiffSpace", lambda: difference_panel(state)),
+            ("Error plot", "ToolSpace", lambda: error_plot(state)),
             ("Ray tree", "ToolSpace", lambda: ray_tree_view(state))]
 
 

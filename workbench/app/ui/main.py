@@ -28,6 +28,7 @@ def run(state: AppState, max_frames: int | None = None, script=None) -> None:
     from .frames import release_gl, update_images
     from .layout import docking_params
     from .panels import status_bar
+    from .plot import track
     clock = {"t": None}
 
     def post_init():
@@ -41,6 +42,7 @@ def run(state: AppState, max_frames: int | None = None, script=None) -> None:
             state.frame_seconds = now - clock["t"]
         clock["t"] = now
         update_images(state)
+        track(state)
         if script is not None:
             script(state)
 
@@ -52,6 +54,7 @@ def run(state: AppState, max_frames: int | None = None, script=None) -> None:
 
     def before_exit():
         state.jobs.join_all()
+        state.errors.shutdown()
         release_gl(state)
 
     params = hello_imgui.RunnerParams()
@@ -68,8 +71,9 @@ def run(state: AppState, max_frames: int | None = None, script=None) -> None:
     params.callbacks.before_imgui_render = end_frame
     params.callbacks.show_status = lambda: status_bar(state)
     params.callbacks.before_exit = before_exit
-    immapp.run(params)
+    immapp.run(params, immapp.AddOnsParams(with_implot=True))
     state.jobs.join_all()
+    state.errors.shutdown()
 
 
 def main(argv: list[str] | None = None) -> int:

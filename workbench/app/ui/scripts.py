@@ -79,7 +79,8 @@ class Check:
 class Features:
     """Scene file browser (a bad file, then a good one, from ``out/scenes``, which the caller
     fills) -> light 0 moved (GL panels the next frame, CPU panels once their restarted jobs
-    end) -> quit.  Waits for background jobs between steps."""
+    end) -> error plot: one point per method, then a second flat point after a knob change
+    -> quit.  Waits for background jobs between steps."""
 
     def __init__(self, out: Path):
         self.out, self.log, self.step, self.t_wait = out, {}, 0, time.perf_counter()
@@ -118,10 +119,32 @@ class Features:
         elif step == 4 and self._settled(state):
             _record(state, out, "lit1")
             self.log["cpu_done"] = not state.jobs.busy()
+            self.t_wait = time.perf_counter()
+        elif step == 5 and self._plotted(state, {m: 1 for m in state.methods}):
+            _record(state, out, "plot")
+            plot = state.errors
+            np.save(out / "plot_reference.npy", plot.ref_image)
+            self.log["plot"] = {"reference": plot.reference, "ref_options": plot.ref_options,
+                                "points": self._points(state)}
+            self.flat_tess = state.options["flat"]["tessellation"]
+            set_option(state, "flat", "tessellation", 1 if self.flat_tess != 1 else 2)
+        elif step == 6 and self._plotted(state, {"flat": 2}):
+            self.log["plot_knob"] = self._points(state)["flat"]
             state.quit = True
         else:
             return
         self.step += 1
+
+    def _plotted(self, state: AppState, counts: dict) -> bool:
+        """The error plot holds ``counts[m]`` points of each method (or the wait timed out)."""
+        have = state.errors.points
+        return (all(len(have.get(m, {})) >= n for m, n in counts.items())
+                or time.perf_counter() - self.t_wait > CPU_WAIT_SECONDS)
+
+    @staticmethod
+    def _points(state: AppState) -> dict:
+        return {m: [{**p, "options": dict(o)} for o, p in pts.items()]
+                for m, pts in state.errors.points.items()}
 
 
 class Fps:

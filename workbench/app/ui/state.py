@@ -66,6 +66,7 @@ class AppState:
     wheel: tuple[float, str] = (0.0, "triad")
     export_dir: Path = Path("out/ui_export")
     browser: object = None
+    errors: object = None
     quit: bool = False
 
 
@@ -90,6 +91,7 @@ def new_state(scene_name: str, methods: list[str] | None = None,
     from ...scene.library import resolve
     from .file_browser import Browser
     from .jobs import JobBoard
+    from .plot import ErrorPlot
     path = resolve(scene_name)
     scene = load_scene(path)
     allowed = choosable_methods()
@@ -103,7 +105,7 @@ def new_state(scene_name: str, methods: list[str] | None = None,
                     options={m: default_options(m) for m in allowed},
                     material=next(iter(scene.materials)), panel_size=panel_size,
                     diff_pair=(methods[0], methods[-1]), jobs=JobBoard(),
-                    browser=Browser(path.parent))
+                    browser=Browser(path.parent), errors=ErrorPlot())
 
 
 def set_scene(state: AppState, scene_name: str) -> None:

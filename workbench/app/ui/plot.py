@@ -1,0 +1,171 @@
+"""The live plot of error against run time for the methods on screen (implot).
+
+The reference is the compare module's (:func:`workbench.compare.reference.candidates`, first
+that renders, at its finest knob value, :func:`~workbench.compare.reference.finest_options`),
+rendered for the current scene and camera in a background job of its own
+(:class:`~.jobs.JobBoard`) once the camera has been still for :data:`SETTLE_SECONDS`.  Each
+panel whose image is final (a raster draw, a finished CPU job) gives one point per knob
+setting: its run time and :func:`workbench.compare.metrics.metrics` against the reference
+(RMSE, PSNR, FLIP), computed in a worker thread.  The UI thread only copies images and reads
+finished results; a change of scene or camera starts a new set of points.
+"""
+from __future__ import annotations
+
+import time
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .state import RASTER, AppState
+
+SETTLE_SECONDS = 0.3
+"""The camera and scene must stay unchanged this long before the reference render starts."""
+METRICS = ("rmse", "flip")
+FLOOR = 1e-6
+"""Errors are drawn at least this large on the log axis (the reference itself has error 0)."""
+MARGIN = 1.5
+
+
+@dataclass
+class ErrorPlot:
+    """Points of error against run time for one (scene version, camera).
+
+    ``points[method][option values]`` is ``{"seconds", "rmse", "psnr", "flip", "label"}``.
+    """
+
+    key: tuple | None = None
+    since: float = 0.0
+    candidates: list = field(default_factory=list)
+    reference: str | None = None
+    ref_options: dict = field(default_factory=dict)
+    ref_image: np.ndarray | None = None
+    message: str = ""
+    points: dict = field(default_factory=dict)
+    pending: dict = field(default_factory=dict)
+    metric: str = "rmse"
+    board: object = None
+    pool: ThreadPoolExecutor | None = None
+
+    def shutdown(self) -> None:
+        """Cancel the reference render and end the worker thread (joined)."""
+        if self.board is not None:
+            self.board.join_all()
+        if self.pool is not None:
+            self.pool.shutdown(wait=True, cancel_futures=True)
+            self.pool = None
+
+
+def _final_image(state: AppState, method: str) -> tuple[np.ndarray, float] | None:
+    """(image, run time) of a panel whose image is final for the current request, else None."""
+    if method in RASTER:
+        if method not in state.images or method not in state.timings:
+            return None
+        return np.array(state.images[method], np.float32), state.timings[method]
+    job = state.jobs.current.get(method)
+    key = (id(state.scene), state.camera, method, tuple(sorted(state.options[method].items())))
+    if job is None or job.key != key or job.image is None or job.seconds is None:
+        return None
+    return job.image, job.seconds
+
+
+def _reference(state: AppState, plot: ErrorPlot) -> np.ndarray | None:
+    """The reference image of the current key once rendered (requests it meanwhile)."""
+    from ...compare.reference import candidates, finest_options
+    from .frames import TILED
+    from .jobs import JobBoard
+    if plot.ref_image is not None:
+        return plot.ref_image
+    if time.perf_counter() - plot.since < SETTLE_SECONDS:
+        return None
+    if plot.board is None:
+        plot.board = JobBoard()
+    if not plot.candidates:
+        plot.candidates = [m for m, _ in candidates(state.scene)]
+    while plot.candidates:
+        m = plot.candidates[0]
+        plot.reference, plot.ref_options = m, finest_options(m)
+        job = plot.board.request(state.scene, state.camera, m, plot.ref_options, tiled=m in TILED)
+        if job.error is None:
+            break
+        plot.candidates.pop(0)  # does not apply to this scene: the next in the rule's order
+    else:
+        plot.message = "no reference: no method renders this scene"
+        return None
+    if job.image is None:
+        plot.message = f"rendering the reference ({plot.reference} {plot.ref_options})..."
+        return None
+    plot.ref_image = job.image
+    plot.message = f"reference: {plot.reference} {plot.ref_options} ({job.seconds:.2f} s)"
+    return plot.ref_image
+
+
+def _evaluate(image: np.ndarray, reference: np.ndarray) -> dict:
+    from ...compare.metrics import metrics
+    return metrics(image, reference)
+
+
+def track(state: AppState) -> None:
+    """Per frame: follow scene and camera, request the reference, queue the new final images
+    for evaluation and collect finished evaluations.  Never waits."""
+    plot = state.errors
+    key = (state.scene_version, state.camera)
+    if key != plot.key:
+        if plot.board is not None:
+            for job in plot.board.current.values():
+                job.cancelled.set()
+        plot.key, plot.since, plot.ref_image, plot.candidates = key, time.perf_counter(), None, []
+        plot.points, plot.pending = {}, {}
+    for (m, opts), fut in list(plot.pending.items()):
+        if fut.done():
+            del plot.pending[(m, opts)]
+            if fut.exception() is None:
+                plot.points.setdefault(m, {})[opts] = fut.result()
+    ref = _reference(state, plot)
+    if ref is None:
+        return
+    for m in state.methods:
+        opts = tuple(sorted(state.options[m].items()))
+        if opts in plot.points.get(m, {}) or (m, opts) in plot.pending:
+            continue
+        final = _final_image(state, m)
+        if final is None or final[0].shape != ref.shape:
+            continue
+        image, seconds = final
+        if plot.pool is None:
+            plot.pool = ThreadPoolExecutor(1, thread_name_prefix="ui-error-plot")
+        label = ", ".join(f"{k} {v}" for k, v in opts)
+        plot.pending[(m, opts)] = plot.pool.submit(_point, image, ref, seconds, label)
+
+
+def _point(image: np.ndarray, reference: np.ndarray, seconds: float, label: str) -> dict:
+    return {**_evaluate(image, reference), "seconds": float(seconds), "label": label}
+
+
+def error_plot(state: AppState) -> None:
+    """Log-log plot: one line per method through its knob settings, run time on x."""
+    from imgui_bundle import imgui, implot
+    plot = state.errors
+    imgui.set_next_item_width(100)
+    changed, k = imgui.combo("error", METRICS.index(plot.metric), list(METRICS))
+    if changed:
+        plot.metric = METRICS[k]
+    imgui.same_line()
+    imgui.text_disabled(plot.message)
+    lines = {}
+    for m, pts in plot.points.items():
+        rows = sorted(pts.values(), key=lambda p: p["seconds"])
+        lines[m] = (np.array([p["seconds"] * 1e3 for p in rows]),
+                    np.maximum(np.array([p[plot.metric] for p in rows]), FLOOR))
+    if implot.begin_plot("##error against run time", imgui.ImVec2(-1, -1)):
+        implot.setup_axes("run time (ms)", plot.metric)
+        implot.setup_axis_scale(implot.ImAxis_.x1, implot.Scale_.log10)
+        implot.setup_axis_scale(implot.ImAxis_.y1, implot.Scale_.log10)
+        if lines:  # fitted to the points, a factor MARGIN beyond them on each side
+            xs, ys = (np.concatenate([v[k] for v in lines.values()]) for k in (0, 1))
+            implot.setup_axes_limits(xs.min() / MARGIN, xs.max() * MARGIN,
+                                     ys.min() / MARGIN, ys.max() * MARGIN, implot.Cond_.always)
+        for m, (xs, ys) in lines.items():
+            implot.plot_line(m, xs, ys)
+            implot.plot_scatter(m, xs, ys)
+        implot.end_plot()
