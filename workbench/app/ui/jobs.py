@@ -5,9 +5,15 @@ A :class:`Job` renders one (scene, camera, method, options) request with
 by band, so the UI shows the image as it comes.  A job whose request is superseded is
 *cancelled*: its next ``on_tile`` raises :class:`Cancelled`, which ends the render early in its
 own thread (methods without ``on_tile`` finish in the background and their result is dropped).
-The UI thread never waits on a job except at exit (:func:`join_all`).  Jobs use one core fewer
-than the machine has for numba's parallel loops (``numba.set_num_threads`` is per calling
-thread), so the window keeps a core.
+The UI thread never waits on a job except at exit (:func:`join_all`).
+
+The window must not starve while a job runs: each job thread runs numba's parallel loops with
+one thread fewer than the machine has cores (``numba.set_num_threads`` is per calling thread;
+on 2 cores that is one thread, and with the OpenMP threading layer the loops then run in the
+job thread itself) at niceness :data:`JOB_NICE` (Linux nice values are per thread, and OpenMP
+workers inherit their creator's), so the UI thread and llvmpipe's threads win every contended
+core.  ``Job.version`` grows with every new tile: the UI re-uploads a
+job's image only then.
 """
 from __future__ import annotations
 
@@ -17,6 +23,10 @@ import time
 from dataclasses import replace
 
 import numpy as np
+
+JOB_NICE = 10
+"""Niceness added to each job thread (0: none; the maximum is 19).  bench/ui_fps.py measures
+the frame rate and the ray trace's completion time with it."""
 
 
 class Cancelled(Exception):
@@ -32,6 +42,7 @@ class Job:
     image : (H, W, 3) float32 or None, the finished image.
     seconds : wall time of the finished render, or None.
     error : message of a failed render, or None.
+    version : number of changes of ``partial``/``image``/``error`` so far.
     """
 
     def __init__(self, scene, camera, method: str, options: dict, tiled: bool):
@@ -41,6 +52,7 @@ class Job:
         self.seconds = None
         self.error = None
         self.rows_done = 0
+        self.version = 0
         self.cancelled = threading.Event()
         self.lock = threading.Lock()
         opts = dict(options)
@@ -57,23 +69,30 @@ class Job:
         with self.lock:
             self.partial[y0:y1, x0:x1] = tile
             self.rows_done = max(self.rows_done, y1)
+            self.version += 1
 
     def _run(self, scene, method, opts):
         import numba
 
         from ...renderers.base import render
         numba.set_num_threads(max(1, min(numba.config.NUMBA_NUM_THREADS, (os.cpu_count() or 1) - 1)))
+        if JOB_NICE and hasattr(os, "setpriority"):
+            tid = threading.get_native_id()
+            os.setpriority(os.PRIO_PROCESS, tid, min(19, os.getpriority(os.PRIO_PROCESS, tid) + JOB_NICE))
         t0 = time.perf_counter()
         try:
             res = render(scene, method, width=scene.camera.width, height=scene.camera.height, **opts)
         except Cancelled:
             return
         except Exception as e:  # shown in the panel, never kills the UI
-            self.error = f"{type(e).__name__}: {e}"
+            with self.lock:
+                self.error = f"{type(e).__name__}: {e}"
+                self.version += 1
             return
         with self.lock:
             self.image = np.asarray(res.image, np.float32)
             self.seconds = time.perf_counter() - t0
+            self.version += 1
 
     def snapshot(self) -> np.ndarray:
         """The finished image, else a copy of the partial one."""

@@ -13,14 +13,17 @@ import threading
 import time
 from pathlib import Path
 
+from ..args import size
 from .state import AppState, new_state
 
 WINDOW_SIZE = (1280, 760)
 
 
-def run(state: AppState, max_frames: int | None = None, script=None) -> None:
-    """Open the window and loop until it is closed, ``max_frames`` frames were shown or the
-    script sets ``state.quit``.  Background jobs are joined before returning."""
+def run(state: AppState, max_frames: int | None = None, script=None,
+        window: tuple[int, int] = WINDOW_SIZE) -> None:
+    """Open the window (``window`` = (width, height) pixels) and loop until it is closed,
+    ``max_frames`` frames were shown or the script sets ``state.quit``.  Background jobs are
+    joined before returning."""
     import moderngl
     from imgui_bundle import hello_imgui, immapp
 
@@ -59,8 +62,11 @@ def run(state: AppState, max_frames: int | None = None, script=None) -> None:
 
     params = hello_imgui.RunnerParams()
     params.app_window_params.window_title = f"workbench ui: {state.scene_path.stem}"
-    params.app_window_params.window_geometry.size = WINDOW_SIZE
+    params.app_window_params.window_geometry.size = window
     params.fps_idling.enable_idling = False
+    # hello_imgui asks for an 8x multisampled window by default: on llvmpipe that makes every
+    # frame ~4x dearer (imgui anti-aliases its own shapes and text without it)
+    params.renderer_backend_options.open_gl_options.anti_aliasing_samples = 0
     params.imgui_window_params.show_status_bar = True
     params.imgui_window_params.default_imgui_window_type = \
         hello_imgui.DefaultImGuiWindowType.provide_full_screen_dock_space
@@ -82,6 +88,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--methods", default="", help="comma-separated, 1 to 6")
     p.add_argument("--size", type=int, default=256, help="panel width and height in pixels")
     p.add_argument("--frames", type=int, default=None, help="stop after this many frames")
+    p.add_argument("--window", type=size, default=WINDOW_SIZE, metavar="WxH",
+                   help="window size in pixels (default %(default)s)")
     p.add_argument("--test-script", default=None, help="check or fps (see scripts.py)")
     p.add_argument("--out", type=Path, default=None, help="folder for the script's outputs")
     args = p.parse_args(argv)
@@ -94,7 +102,7 @@ def main(argv: list[str] | None = None) -> int:
         args.out.mkdir(parents=True, exist_ok=True)
         script = SCRIPTS[args.test_script](args.out)
     t0 = time.perf_counter()
-    run(state, args.frames, script)
+    run(state, args.frames, script, args.window)
     if args.out is not None:
         from imgui_bundle import hello_imgui
         from PIL import Image

@@ -5,12 +5,11 @@ import numpy as np
 from imgui_bundle import imgui
 
 from . import camera as cam
-from .frames import upload, upload_linear
+from .frames import panel_texture, stale, upload, upload_linear
 from .inspect import export, pixel_under_mouse, probe_tooltip, select_ray_tree
 from .layout import focus
 from .state import (DISPLAY_MODES, HARMONIES, LEFT_OUT, MATERIAL_FIELDS, MAX_PANELS, AppState,
-                    choosable_methods, set_display, set_material_value, set_option, set_scene,
-                    shown_image)
+                    choosable_methods, set_display, set_material_value, set_option, set_scene)
 
 ORBIT_SPEED = 0.01
 """Radians of orbit per pixel of mouse drag."""
@@ -145,7 +144,7 @@ def image_panels(state: AppState) -> None:
         t = state.timings.get(m)
         imgui.text(f"{m}  {'' if t is None else f'{t * 1e3:.1f} ms'}")
         if m in state.images:
-            tex = upload_linear(state, m, shown_image(state, m))
+            tex = panel_texture(state, m)
             imgui.image(imgui.ImTextureRef(tex.glo), imgui.ImVec2(w, h), *cam.view_window(state.view))
             handle_mouse(state)
             ij = pixel_under_mouse(state)
@@ -181,17 +180,23 @@ def difference_panel(state: AppState) -> None:
     imgui.set_next_item_width(80)
     _, ik = imgui.combo("kind", kinds.index(state.diff_kind), kinds)
     state.diff_pair, state.diff_kind = (ms[ia], ms[ib]), kinds[ik]
-    if state.diff_pair[0] not in state.images or state.diff_pair[1] not in state.images:
+    a, b = state.diff_pair
+    if a not in state.images or b not in state.images:
         return
-    err = error_map(state.images[state.diff_pair[0]], state.images[state.diff_pair[1]],
-                    state.diff_kind)
+    # recomputed only when either image or the kind changed (a static frame reads no pixels)
+    key = (a, b, state.diff_kind, state.images.version(a), state.images.version(b))
+    if stale(state, "difference", key) or "difference" not in state.textures:
+        err = error_map(state.images[a], state.images[b], state.diff_kind)
+        state.images["difference"] = err
+        upload(state, "difference", colour_scale(err, max(float(err.max()), 1e-6)))
+    err, tex = state.images["difference"], state.textures["difference"]
     vmax = max(float(err.max()), 1e-6)
-    state.images["difference"] = err
-    tex = upload(state, "difference", colour_scale(err, vmax))
     size = imgui.ImVec2(state.camera.width, state.camera.height)
     imgui.image(imgui.ImTextureRef(tex.glo), size, *cam.view_window(state.view))
-    bar = colour_scale(np.tile(np.linspace(0, 1, 128, dtype=np.float32), (8, 1)), 1.0)
-    tb = upload(state, "colour_scale", bar)
+    if "colour_scale" not in state.textures:
+        upload(state, "colour_scale",
+               colour_scale(np.tile(np.linspace(0, 1, 128, dtype=np.float32), (8, 1)), 1.0))
+    tb = state.textures["colour_scale"]
     imgui.text("0")
     imgui.same_line()
     imgui.image(imgui.ImTextureRef(tb.glo), imgui.ImVec2(size.x - 60, 10))

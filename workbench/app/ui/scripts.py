@@ -147,34 +147,80 @@ class Features:
                 for m, pts in state.errors.points.items()}
 
 
+def _gpu_counts(state: AppState) -> tuple[int, int]:
+    """(GL panel draws, pixel read-backs from the GPU) so far."""
+    draws = sum(p.draws for p in state.gpu.raster.values()) if state.gpu is not None else 0
+    return draws, state.images.reads
+
+
 class Fps:
     """Count frames for ``seconds`` after a warm-up while the camera turns by ``step`` radians
-    per frame (a steady mouse drag: every panel changes every frame and the CPU jobs restart).
-    ``raytrace_spp`` sets the ray tracer's samples per pixel (a longer background job)."""
+    per frame (a steady mouse drag: every panel changes every frame and the CPU jobs restart;
+    ``step`` 0 leaves the camera alone).  ``raytrace_spp`` sets the ray tracer's samples per
+    pixel (a longer background job).  With ``wait_cpu`` the count also ends when no background
+    job runs any more (the rate is the one *while* a job runs), then the session stays open
+    until the jobs end and logs the ray trace's run time with the window open."""
 
     def __init__(self, out: Path, seconds: float = 10.0, warmup: int = 10, step: float = 0.002,
-                 raytrace_spp: int | None = None):
+                 raytrace_spp: int | None = None, wait_cpu: bool = False):
         self.out, self.seconds, self.warmup, self.step, self.log = out, seconds, warmup, step, {}
-        self.spp, self.t0 = raytrace_spp, None
+        self.spp, self.wait_cpu, self.t0 = raytrace_spp, wait_cpu, None
 
     def __call__(self, state: AppState) -> None:
         if state.frame == 0 and self.spp is not None:
             set_option(state, "raytrace", "spp", self.spp)
-        state.camera = cam.orbit(state.camera, self.step, 0.0)
+        if self.step:
+            state.camera = cam.orbit(state.camera, self.step, 0.0)
         if state.frame == self.warmup:
             self.t0, self.busy_frames, self.gui = time.perf_counter(), 0, 0.0
-        elif self.t0 is not None:
-            self.busy_frames += state.jobs.busy()
+            self.counts = _gpu_counts(state)
+        elif self.t0 is not None and "fps" not in self.log:
+            busy = state.jobs.busy()
+            self.busy_frames += busy
             self.gui += state.gui_seconds
             dt = time.perf_counter() - self.t0
-            if dt >= self.seconds:
+            if dt >= self.seconds or (self.wait_cpu and not busy):
                 n = state.frame - self.warmup
+                (d0, r0), (d1, r1) = self.counts, _gpu_counts(state)
                 self.log.update(frames=n, seconds=dt, fps=n / dt, gui_ms_mean=self.gui / n * 1e3,
-                                frames_with_cpu_job_running=
-                                self.busy_frames, raster_ms={m: state.timings.get(m, 0) * 1e3
-                                                             for m in state.methods if m in RASTER})
-                state.quit = True
+                                frames_with_cpu_job_running=self.busy_frames,
+                                gl_panel_draws=d1 - d0, read_backs=r1 - r0,
+                                raster_ms={m: state.timings.get(m, 0) * 1e3
+                                           for m in state.methods if m in RASTER})
+                self.t_wait = time.perf_counter()
+                state.quit = not self.wait_cpu
+        elif "fps" in self.log and (not state.jobs.busy()
+                                    or time.perf_counter() - self.t_wait > CPU_WAIT_SECONDS):
+            job = state.jobs.current.get("raytrace")
+            self.log.update(raytrace_seconds=None if job is None else job.seconds,
+                            raytrace_options=state.options["raytrace"])
+            state.quit = True
+
+
+class GpuPanels:
+    """GL panels on the GPU: frames 2 to 5 change nothing, frame 5 orbits the camera, frame 7
+    saves each GL panel's display texture (the RGBA8 pixels imgui shows, ``shown_M.npy``) and
+    quits.  Logs each GL panel's draw count and the read-backs at frames 2, 5 and 7."""
+
+    def __init__(self, out: Path):
+        self.out, self.log = out, {}
+
+    def __call__(self, state: AppState) -> None:
+        f = state.frame
+        if f in (2, 5, 7):
+            self.log[f"frame{f}"] = {"draws": {m: p.draws for m, p in state.gpu.raster.items()},
+                                     "reads": state.images.reads}
+        if f == 5:
+            state.camera = cam.orbit(state.camera, 0.3, 0.1)
+        elif f == 7:
+            w, h = state.camera.width, state.camera.height
+            for m in state.gpu.raster:
+                shown = np.frombuffer(state.textures[m].read(), np.uint8).reshape(h, w, 4)
+                np.save(self.out / f"shown_{m}.npy", shown)
+            self.log["position"] = list(state.camera.position)
+            state.quit = True
 
 
 SCRIPTS = {"check": Check, "features": Features, "fps": Fps,
-           "fps_static": lambda out: Fps(out, step=0.0, raytrace_spp=16)}
+           "fps_static": lambda out: Fps(out, step=0.0, raytrace_spp=16, wait_cpu=True),
+           "gpu_panels": GpuPanels}

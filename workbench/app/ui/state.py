@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from ...scene.model import Camera, Scene
+from .images import PanelImages
 
 RASTER = ("flat", "gouraud", "phong")
 """Methods drawn every frame in the window's own GL context."""
@@ -32,7 +33,9 @@ class AppState:
     jobs).  ``camera`` is the
     shared camera of all panels at the panel resolution; ``view`` (zoom, centre u, centre v)
     the linked 2D zoom of every image panel.  ``images`` holds each panel's last
-    linear (H, W, 3) float32 image, ``timings`` its last render time in seconds.
+    linear (H, W, 3) float32 image (raster ones read back from the GPU on first access),
+    ``timings`` its last render time in seconds.  ``gpu`` is :class:`.frames.PanelGPU` (raster
+    sessions, the sRGB display pass), made in the window's GL context.
     """
 
     scene: Scene
@@ -46,7 +49,7 @@ class AppState:
     light_overrides: dict[int, dict[str, object]] = field(default_factory=dict)
     scene_version: int = 0
     panel_size: tuple[int, int] = (256, 256)
-    images: dict[str, np.ndarray] = field(default_factory=dict)
+    images: PanelImages = field(default_factory=PanelImages)
     textures: dict[str, object] = field(default_factory=dict)
     timings: dict[str, float] = field(default_factory=dict)
     status: dict[str, str] = field(default_factory=dict)
@@ -57,9 +60,8 @@ class AppState:
     diff_kind: str = "abs"
     gl_renderer: str = ""
     ctx: object = None
-    sessions: dict = field(default_factory=dict)
+    gpu: object = None
     jobs: object = None
-    srgb_lut: object = None
     ray_tree: dict | None = None
     view: tuple[float, float, float] = (1.0, 0.5, 0.5)
     display: dict[str, str] = field(default_factory=dict)

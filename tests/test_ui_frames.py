@@ -1,0 +1,93 @@
+"""GL panels kept on the GPU (``workbench.app.ui.frames``): under Xvfb the ``gpu_panels`` script
+(a subprocess, as in test_ui.py) checks that a frame with nothing changed draws no GL panel and
+reads no pixels back, that a camera change redraws each GL panel once, and that what imgui
+shows (the RGBA8 display texture) is the CLI's image of the same camera within one 8-bit
+level; closing leaves no thread.  The lazy image store is tested on its own."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import workbench
+from workbench.app.ui import camera as cam
+from workbench.app.ui.images import PanelImages
+from workbench.core.imageio import to_srgb8
+
+ROOT = Path(__file__).resolve().parents[1]
+RASTER = ("flat", "gouraud", "phong")
+SIZE = 96
+
+
+@pytest.fixture(scope="module")
+def gpu_session(xvfb, tmp_path_factory):
+    out = tmp_path_factory.mktemp("ui_frames")
+    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", "whitted",
+                        "--methods", "flat,gouraud,phong,raycast", "--size", str(SIZE),
+                        "--test-script", "gpu_panels", "--out", str(out), "--frames", "200"],
+                       cwd=ROOT, env={**os.environ, "DISPLAY": xvfb}, capture_output=True,
+                       text=True, timeout=300)
+    assert p.returncode == 0, p.stderr[-2000:]
+    return out, json.loads((out / "summary.json").read_text())
+
+
+pytestmark = pytest.mark.gl
+
+
+def test_static_frames_draw_nothing_and_a_camera_change_redraws_once(gpu_session):
+    _, summary = gpu_session
+    log = summary["script"]
+    start, static, orbit = log["frame2"], log["frame5"], log["frame7"]
+    assert sorted(start["draws"]) == sorted(RASTER)
+    assert all(start["draws"][m] >= 1 for m in RASTER)
+    assert static["draws"] == start["draws"]          # frames 2..5: nothing changed
+    assert static["reads"] == start["reads"]          # and no pixel came back from the GPU
+    assert orbit["draws"] == {m: static["draws"][m] + 1 for m in RASTER}
+
+
+def test_shown_panels_are_the_cli_images(gpu_session):
+    out, summary = gpu_session
+    scene = workbench.load_scene("whitted")
+    orbited = cam.orbit(scene.camera.with_resolution(SIZE, SIZE), 0.3, 0.1)
+    assert np.allclose(summary["script"]["position"], orbited.position)
+    for m in RASTER:
+        shown = np.load(out / f"shown_{m}.npy")
+        assert shown.shape == (SIZE, SIZE, 4) and (shown[..., 3] == 255).all()
+        cli = workbench.render(replace(scene, camera=orbited), m, width=SIZE, height=SIZE).image
+        expected = to_srgb8(cli)
+        assert expected.std() > 10, m  # a real picture, not a flat colour
+        assert np.abs(shown[..., :3].astype(int) - expected).max() <= 1, m
+
+
+def test_closing_leaves_no_thread(gpu_session):
+    _, summary = gpu_session
+    assert summary["threads"] == ["MainThread"]
+
+
+def test_panel_images_read_pending_entries_once():
+    calls = []
+    images = PanelImages()
+
+    def read():
+        calls.append(1)
+        return np.full((2, 2, 3), len(calls), np.float32)
+
+    images.set_pending("flat", read)
+    v = images.version("flat")
+    assert "flat" in images and calls == [] and images.reads == 0  # membership reads nothing
+    assert images["flat"][0, 0, 0] == 1 and images.get("flat")[0, 0, 0] == 1
+    assert calls == [1] and images.reads == 1 and images.version("flat") == v
+    images.set_pending("flat", read)                    # a new draw: read again on access
+    assert images.version("flat") == v + 1 and images["flat"][0, 0, 0] == 2
+    images["raycast"] = np.zeros((2, 2, 3), np.float32)
+    assert sorted(images) == ["flat", "raycast"] and len(images) == 2
+    del images["flat"]
+    assert "flat" not in images and images.version("flat") == v + 2
+    with pytest.raises(KeyError):
+        images["flat"]

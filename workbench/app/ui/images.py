@@ -1,0 +1,71 @@
+"""The panels' linear images, read back from the GPU only when someone looks at the pixels.
+
+A raster panel lives on the GPU (see :mod:`.frames`): after each draw its entry here is made
+*pending*, a function that reads the float framebuffer back.  The first access (pixel probe,
+difference view, export, a test script) calls it once and keeps the array until the panel is
+drawn again, so a frame in which nothing asks for pixels reads nothing back.
+
+``version(key)`` grows with every change of an entry: the cache key of everything derived from
+an image (its display texture, the difference view).
+"""
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator, MutableMapping
+
+import numpy as np
+
+
+class PanelImages(MutableMapping):
+    """``{name: (H, W, 3) float32 linear image}`` whose entries may be pending reads.
+
+    Attributes
+    ----------
+    reads : number of pending entries resolved so far (GPU read-backs).
+    """
+
+    def __init__(self):
+        self._values: dict[str, np.ndarray] = {}
+        self._pending: dict[str, Callable[[], np.ndarray]] = {}
+        self._versions: dict[str, int] = {}
+        self.reads = 0
+
+    def __getitem__(self, key: str) -> np.ndarray:
+        read = self._pending.pop(key, None)
+        if read is not None:
+            self._values[key] = read()
+            self.reads += 1
+        return self._values[key]
+
+    def __setitem__(self, key: str, image: np.ndarray) -> None:
+        self._pending.pop(key, None)
+        self._values[key] = image
+        self._bump(key)
+
+    def set_pending(self, key: str, read: Callable[[], np.ndarray]) -> None:
+        """Replace ``key`` by an image that ``read()`` produces on first access."""
+        self._values.pop(key, None)
+        self._pending[key] = read
+        self._bump(key)
+
+    def __delitem__(self, key: str) -> None:
+        if key not in self:
+            raise KeyError(key)
+        self._values.pop(key, None)
+        self._pending.pop(key, None)
+        self._bump(key)
+
+    def __contains__(self, key) -> bool:  # without reading a pending entry
+        return key in self._values or key in self._pending
+
+    def __iter__(self) -> Iterator[str]:
+        return iter([*self._values, *self._pending])
+
+    def __len__(self) -> int:
+        return len(self._values) + len(self._pending)
+
+    def version(self, key: str) -> int:
+        """Number of changes of ``key`` so far (0 if never set)."""
+        return self._versions.get(key, 0)
+
+    def _bump(self, key: str) -> None:
+        self._versions[key] = self._versions.get(key, 0) + 1
