@@ -4,10 +4,14 @@ Parts (each in its own process, so that peak memory is its own):
 
 * ``full``: ~2,000 patches: hemicube form factors for every patch + direct LU solve (target
   <= 15 s); then progressive refinement timed until it is within 1 % (area-weighted RMS over
-  the reflecting patches) of the converged solution (target <= 3 s), twice: on the stored
-  matrix (solver time only), and with one hemicube per shot and no matrix (hemicubes
-  included; the reference is then the exact solution of the system shooting solves,
-  F_ji = F_ij A_i / A_j, whose distance to the gathering solution is reported too).
+  the reflecting patches) of the converged solution (target <= 3 s): on the stored matrix
+  (solver time only); with one hemicube per shot and no matrix (hemicubes included;
+  overshooting 1.2, the method's default, with and without the ambient term, and plain
+  shooting; the reference is the exact solution of the system shooting solves,
+  F_ji = F_ij A_i / A_j, whose distance to the gathering solution is reported too); and with
+  ray-cast rows (no GL; the reference is the direct solution of their own gathering system).
+  Each run also reports its error against the hemicube matrix's direct solution when it
+  reaches 1 %.
 * ``pvf``: pyviewfactor (exact, unoccluded) on a sample of the same patch pairs, as the
   outside reference: its cost per pair and the hemicube's (and the analytic method's) error
   against it.  Pairs are taken in the empty room (walls, floor, ceiling: a convex enclosure,
@@ -15,8 +19,9 @@ Parts (each in its own process, so that peak memory is its own):
 * ``big``: ~10,000 patches, progressive refinement without the matrix (peak memory).
 
 Matrix-free progressive refinement keeps at most 128 MB of rows (float32) of patches that
-shoot again (:class:`~workbench.renderers.radiosity.solvers.RowCache`): 18 MB holds all
-2,120 rows of the Cornell box, 3,200 of the 10,341 rows of the big case.
+shoot again (:class:`~workbench.renderers.radiosity.solvers.RowCache`, least recently used
+dropped first): 18 MB holds all 2,120 rows of the Cornell box, 3,200 of the 10,341 rows of
+the big case.
 
 Usage: ``.venv/bin/python bench/radiosity_cornell.py [--quick]`` writes
 ``bench/results/radiosity_cornell.json`` and prints it.
@@ -146,6 +151,26 @@ def part_full(count: int, res: int) -> dict:
             trace if key == "with_ambient" else None)
         out[f"progressive_{key}"]["hemicubes_drawn"] = hc.drawn
         hc.release()
+    # ray-cast rows (receivers' exact factors x visibility): the gathering system, no GL
+    from workbench.renderers.radiosity.raycast import RayRows
+    rr = RayRows(g)
+    rr.rows([0])                                   # numba (cached) loading, apart
+    t0 = time.perf_counter()
+    rows_all = rr.rows(np.arange(len(A)))
+    t_rows = time.perf_counter() - t0
+    Fg = (rows_all * A[:, None]).T / np.where(A > 0, A, 1.0)[:, None]
+    del rows_all
+    conv_ray = solvers.solve(Fg, E, R, "direct").radiosity
+    del Fg
+    rr = RayRows(g)
+    out["progressive_raycast_rows_with_ambient"] = dict(
+        _progressive(rr.rows, A, E, R, True, RELAX, conv_ray, direct.radiosity, refl),
+        rays_per_patch_triangle=4 ** rr.level, all_rows_seconds=t_rows,
+        converged_solution_vs_gathering_direct=dict(zip(("rms_rel", "max_rel"),
+                                                        rel_errors(conv_ray, direct.radiosity, A, refl))),
+        note="reference: the direct solution of the ray-cast rows' own (gathering) system; "
+             "'at_1pct_rms_error_vs_gathering_direct' is against the hemicube matrix's direct "
+             "solution")
     # progressive refinement on the stored matrix (numba shooting kernel), timed in chunks
     from workbench.renderers.radiosity.kernels import shoot
     Fc = np.ascontiguousarray(ff.F)

@@ -330,3 +330,105 @@ def shoot_rows(rows, shooters, areas, rho, B, dB, relax, stop, history, start):
         if ok:
             return s + 1
     return len(shooters)
+
+
+@njit(cache=True, inline="always")
+def _seg_blocked(tv, box, meta, ox, oy, oz, dx, dy, dz, t0, t1, stack):
+    """Whether any triangle (``tv`` (T, 9), BVH ``box``/``meta`` of
+    :func:`workbench.renderers.raytrace.bvh.build_bvh`) crosses the segment o + t d,
+    t0 < t < t1 (Moller & Trumbore 1997 against each leaf triangle; any hit ends it)."""
+    ix = 1.0 / dx if dx != 0.0 else 1e300
+    iy = 1.0 / dy if dy != 0.0 else 1e300
+    iz = 1.0 / dz if dz != 0.0 else 1e300
+    sp = 0
+    nd = 0
+    while True:
+        a0 = (box[nd, 0] - ox) * ix
+        a1 = (box[nd, 3] - ox) * ix
+        tn, tf = min(a0, a1), max(a0, a1)
+        a0 = (box[nd, 1] - oy) * iy
+        a1 = (box[nd, 4] - oy) * iy
+        tn, tf = max(tn, min(a0, a1)), min(tf, max(a0, a1))
+        a0 = (box[nd, 2] - oz) * iz
+        a1 = (box[nd, 5] - oz) * iz
+        tn, tf = max(tn, min(a0, a1)), min(tf, max(a0, a1))
+        hit_box = tn <= tf * (1.0 + 1e-12) + 1e-300 and tf >= t0 and tn <= t1
+        if hit_box and meta[nd, 1] > 0:
+            for k in range(meta[nd, 0], meta[nd, 0] + meta[nd, 1]):
+                e1x, e1y, e1z = tv[k, 3] - tv[k, 0], tv[k, 4] - tv[k, 1], tv[k, 5] - tv[k, 2]
+                e2x, e2y, e2z = tv[k, 6] - tv[k, 0], tv[k, 7] - tv[k, 1], tv[k, 8] - tv[k, 2]
+                px, py, pz = _cross(dx, dy, dz, e2x, e2y, e2z)
+                det = e1x * px + e1y * py + e1z * pz
+                if det == 0.0:
+                    continue
+                inv = 1.0 / det
+                qx, qy, qz = ox - tv[k, 0], oy - tv[k, 1], oz - tv[k, 2]
+                u = (qx * px + qy * py + qz * pz) * inv
+                if u < 0.0 or u > 1.0:
+                    continue
+                rx, ry, rz = _cross(qx, qy, qz, e1x, e1y, e1z)
+                v = (dx * rx + dy * ry + dz * rz) * inv
+                if v < 0.0 or u + v > 1.0:
+                    continue
+                t = (e2x * rx + e2y * ry + e2z * rz) * inv
+                if t0 < t < t1:
+                    return True
+            nd = -1
+        elif hit_box:
+            if sp < stack.shape[0]:
+                stack[sp] = meta[nd, 0]
+                sp += 1
+            nd = nd + 1
+        else:
+            nd = -1
+        if nd < 0:
+            if sp == 0:
+                return False
+            sp -= 1
+            nd = stack[sp]
+
+
+@njit(cache=True, parallel=True)
+def receiver_rows(shooters, flat, offsets, centres, normals, areas, samples, sample_w,
+                  sample_first, tv, box, meta, offset, t_edge, zero, out):
+    """Ray-cast rows for progressive refinement (Wallace, Elmquist & Haines 1989): for each
+    shooter i and every receiver j, the exact point-to-polygon factor F_{dA_j -> A_i} from
+    j's centre (Lambert's formula, :func:`_ff_one`) times the fraction (weighted by
+    ``sample_w``) of segments from j's centre to i's sample points that no triangle blocks;
+    returned in row form ``out[s, j] = F_ji A_j / A_i`` (progressive refinement takes
+    F_ji = F_ij A_i / A_j back), so that shooting uses the receivers' own factors (the
+    gathering system, as the hemicube at j would estimate it) without reciprocity.
+
+    flat/offsets: polygons' vertices concatenated; samples (S, 3), sample_w (S,) and
+    sample_first (P + 1,): points on each patch, already moved off it by ``offset`` along
+    its normal; ``t_edge``: the segment's ends left out, as a fraction of it."""
+    P = centres.shape[0]
+    scale = 1.0
+    for c in range(3):
+        scale = max(scale, np.abs(flat[:, c]).max())
+    eps = zero * scale
+    # one parallel loop over (shooter, receiver) pairs: one thread launch per batch
+    for q in prange(len(shooters) * P):
+        s, j = q // P, q % P
+        i = shooters[s]
+        out[s, j] = 0.0
+        Ai = areas[i]
+        if j == i or Ai <= 0.0 or areas[j] <= 0.0:
+            continue
+        f = _ff_one(centres[j], normals[j], flat[offsets[i]:offsets[i + 1]], eps, scale)
+        if f <= 0.0:
+            continue
+        stack = np.empty(64, dtype=np.int64)
+        ox = centres[j, 0] + offset * normals[j, 0]
+        oy = centres[j, 1] + offset * normals[j, 1]
+        oz = centres[j, 2] + offset * normals[j, 2]
+        seen = 0.0
+        total = 0.0
+        for k in range(sample_first[i], sample_first[i + 1]):
+            total += sample_w[k]
+            if not _seg_blocked(tv, box, meta, ox, oy, oz, samples[k, 0] - ox,
+                                samples[k, 1] - oy, samples[k, 2] - oz, t_edge,
+                                1.0 - t_edge, stack):
+                seen += sample_w[k]
+        if total > 0.0:
+            out[s, j] = f * (seen / total) * areas[j] / Ai

@@ -1,7 +1,8 @@
 """The registered ``radiosity`` method: patches -> form factors -> solve -> Gouraud display.
 
 Only what is needed: no emitters, no radiosity (``NotApplicable``); progressive refinement
-with hemicube form factors draws one hemicube per shooting patch and never builds the matrix.
+draws one hemicube per shooting patch (or, ``shot_rows="raycast"``, casts rays from every
+receiver to the shooter) and never builds the matrix.
 """
 from __future__ import annotations
 
@@ -53,9 +54,13 @@ def common_options() -> dict[str, Option]:
         "tol": Option(float, 1e-3, "bound on the true relative error of the solution"),
         "max_iterations": Option(int, 0, "iteration / shot cap (0: what the error bound needs)"),
         "ambient": Option(bool, True, "progressive refinement: show Cohen et al.'s ambient term"),
-        "row_cache_mb": Option(float, 128.0, "progressive refinement with hemicubes: memory for "
-                               "rows of patches that shoot again (0: a hemicube every shot)"),
-        "relax": Option(float, 1.2, "progressive refinement with hemicubes: overshooting factor "
+        "row_cache_mb": Option(float, 128.0, "matrix-free progressive refinement: memory for "
+                               "rows of patches that shoot again (0: a new row every shot)"),
+        "shot_rows": Option(str, "hemicube", "matrix-free progressive refinement: each shot's "
+                            "form factors from one hemicube at the shooter (F_ji by reciprocity) "
+                            "or by ray casting from every receiver (exact factor x visibility, "
+                            "Wallace et al. 1989; no GL)", ("hemicube", "raycast")),
+        "relax": Option(float, 1.2, "matrix-free progressive refinement: overshooting factor "
                         "in (0, 2) (1: plain shooting; 1.2 needs ~40 % fewer shots on the "
                         "Cornell box)"),
     }
@@ -84,6 +89,48 @@ def _row_provider(hc, stats: dict):
     return rows
 
 
+def _shoot_hemicube(geom, E, R, opts, stats, timings, tol, cap) -> solvers.SolveResult:
+    """Matrix-free progressive refinement, one hemicube per shooting patch (rows cached)."""
+    from .hemicube import Hemicube
+    t1 = time.perf_counter()
+    hc = Hemicube(geom, opts["hemicube_resolution"], rotate=opts["hemicube_rotate"],
+                  normalize=opts["hemicube_normalize"])
+    timings["compile"] += time.perf_counter() - t1
+    try:
+        q = float(R.max()) * max(1.0, hc.info()["weight_sum"])
+        rows = solvers.RowCache(_row_provider(hc, stats), opts["row_cache_mb"])
+        res = solvers.progressive_rows(rows, geom.areas, E, R, tol=tol, max_shots=cap, q=q,
+                                       ambient=opts["ambient"], relax=opts["relax"])
+        info = hc.info()
+    finally:
+        hc.release()
+    stats.update({"hemicubes_drawn": info["hemicubes_drawn"], "matrix_stored": False,
+                  "shot_rows": "hemicube", "rows_cached": len(rows.rows),
+                  "row_cache_hits": rows.hits, "gl_renderer": info["gl_renderer"],
+                  "hemicube_weight_sum": info["weight_sum"],
+                  "hemicube_weight_sum_raw": info["weight_sum_raw"], "reciprocity_error": None,
+                  "note": "shooting takes F_ji = F_ij A_i / A_j from the shooter's hemicube; "
+                          "the error bound is for that system, which differs from gathering "
+                          "by the hemicube's reciprocity error (proximity, errata 6)"})
+    return res
+
+
+def _shoot_raycast(geom, E, R, opts, stats, timings, tol, cap) -> solvers.SolveResult:
+    """Matrix-free progressive refinement with ray-cast rows (receivers' exact factors times
+    ray-cast visibility, :class:`.raycast.RayRows`; rows cached)."""
+    from .raycast import RayRows
+    rr = RayRows(geom)
+    rows = solvers.RowCache(rr.rows, opts["row_cache_mb"])
+    res = solvers.progressive_rows(rows, geom.areas, E, R, tol=tol, max_shots=cap,
+                                   q=float(R.max()), ambient=opts["ambient"], relax=opts["relax"])
+    stats.update({"matrix_stored": False, "shot_rows": "raycast", "rows_cached": len(rows.rows),
+                  "row_cache_hits": rows.hits, "rows_computed": rows.computed,
+                  "visibility_rays": rr.rays_cast, "reciprocity_error": None,
+                  "note": "each receiver takes its exact point-to-polygon factor to the shooter "
+                          "times ray-cast visibility: the gathering system, without reciprocity"})
+    return res
+
+
 def solve_scene(scene: Scene, opts: dict, method: str) -> Solution:
     """Patches, form factors and solution of ``scene`` with the ``common_options``."""
     if opts["max_iterations"] < 0:
@@ -108,28 +155,10 @@ def solve_scene(scene: Scene, opts: dict, method: str) -> Solution:
     tol = opts["tol"]
     cap = opts["max_iterations"] or None
     if opts["solver"] == "progressive" and opts["form_factors"] == "hemicube":
-        from .hemicube import Hemicube
-        t1 = time.perf_counter()
-        hc = Hemicube(geom, opts["hemicube_resolution"], rotate=opts["hemicube_rotate"],
-                      normalize=opts["hemicube_normalize"])
-        timings["compile"] += time.perf_counter() - t1
-        try:
-            q = float(R.max()) * max(1.0, hc.info()["weight_sum"])
-            rows = solvers.RowCache(_row_provider(hc, stats), opts["row_cache_mb"])
-            res = solvers.progressive_rows(rows, geom.areas, E, R, tol=tol, max_shots=cap, q=q,
-                                           ambient=opts["ambient"], relax=opts["relax"])
-            info = hc.info()
-        finally:
-            hc.release()
-        timings["form_factors"] = res.seconds   # hemicubes and shots interleave
+        shoot = _shoot_raycast if opts["shot_rows"] == "raycast" else _shoot_hemicube
+        res = shoot(geom, E, R, opts, stats, timings, tol, cap)
+        timings["form_factors"] = res.seconds   # rows and shots interleave
         timings["solve"] = 0.0
-        stats.update({"hemicubes_drawn": info["hemicubes_drawn"], "matrix_stored": False,
-                      "rows_cached": len(rows.rows), "row_cache_hits": rows.hits,
-                      "gl_renderer": info["gl_renderer"], "hemicube_weight_sum": info["weight_sum"],
-                      "hemicube_weight_sum_raw": info["weight_sum_raw"], "reciprocity_error": None,
-                      "note": "shooting takes F_ji = F_ij A_i / A_j from the shooter's hemicube; "
-                              "the error bound is for that system, which differs from gathering "
-                              "by the hemicube's reciprocity error (proximity, errata 6)"})
     else:
         ff: FormFactors = compute(geom, opts["form_factors"], opts["hemicube_resolution"],
                                   rotate=opts["hemicube_rotate"], rays=opts["rays"],
