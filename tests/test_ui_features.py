@@ -159,3 +159,79 @@ def test_error_plot_points_are_the_compare_metrics(features):
     flat = summary["script"]["plot_knob"]
     assert len(flat) == 2 and len({p["options"]["tessellation"] for p in flat}) == 2
     assert flat[0]["rmse"] != flat[1]["rmse"]
+
+
+def _hinge_agreement(net: np.ndarray, surface: np.ndarray) -> list:
+    """Across each edge shared by the top face and a half side in the unfolded item buffer: the
+    fraction of pixel pairs (both seeing a patch) that see the same surface."""
+    res = net.shape[0] // 2
+    a, b = res // 2, 3 * res // 2
+    out = []
+    for x, y in ((net[a:b, a - 1], net[a:b, a]), (net[a:b, b], net[a:b, b - 1]),
+                 (net[a - 1, a:b], net[a, a:b]), (net[b, a:b], net[b - 1, a:b])):
+        seen = (x > 0) & (y > 0)
+        out.append(float((surface[x[seen] - 1] == surface[y[seen] - 1]).mean()) if seen.sum() > 8 else None)
+    return out
+
+
+@pytest.mark.gl
+def test_patch_pick_item_buffer_and_row(gl_ctx):
+    """The picked patch is the one under the pixel; the unfolded item buffer is continuous
+    across the top face's edges (a surface seen at the edge of the top face goes on in the
+    folded-out side); the row is the hemicube's and is drawn on the patches."""
+    from workbench.app.ui import patch_view as pv
+    state = new_state("cornell", ["phong", "radiosity"], (96, 96))
+    patches = pv.scene_patches(state)
+    for ij, surface in (((20, 48), "ceiling"), ((92, 30), "floor"), ((50, 10), "left_wall")):
+        pick = pv.select_patch(state, *ij)
+        assert state.patch_pick is pick and pick.surface == surface
+        # the patch's projected corners surround the pixel centre
+        xy, _ = state.camera.project(pick.patches.corners[pick.patch])
+        x, y = ij[1] + 0.5, ij[0] + 0.5
+        assert xy[:, 0].min() - 1 <= x <= xy[:, 0].max() + 1 and xy[:, 1].min() - 1 <= y <= xy[:, 1].max() + 1
+        assert len(pick.row) == len(patches) and pick.row[pick.patch] == 0.0  # flat: F_ii = 0
+        assert 0.3 < pick.row.sum() <= 1.0 + 1e-9   # the box is open at the front
+        net = pv.unfold(pick.item)
+        assert net.shape == (2 * pick.resolution,) * 2
+        # ids in the item buffer are the row's patches: F_ij > 0 exactly where j is seen
+        seen = np.unique(pick.item[pick.item > 0]) - 1
+        assert set(seen) == set(np.nonzero(pick.row > 0)[0])
+        agree = [a for a in _hinge_agreement(net, patches.surface) if a is not None]
+        assert len(agree) >= 2 and min(agree) > 0.9, agree
+    # a mirrored side flap breaks the continuity (the test can fail)
+    pick = pv.select_patch(state, 20, 48)
+    net = pv.unfold(pick.item)
+    res = pick.resolution
+    net[:res // 2, res // 2:3 * res // 2] = net[:res // 2, res // 2:3 * res // 2][:, ::-1]
+    assert min(a for a in _hinge_agreement(net, patches.surface) if a is not None) < 0.5
+    # the row image shows the picked patch in its colour at the picked pixel
+    img = pv.row_image(state, pick)
+    i, j = (np.array([20, 48]) * pv.VIEW_SIZE / 96).astype(int)
+    assert np.abs(img[i, j] / 255.0 - pv.SELECTED).max() < 0.02
+    # a pixel outside the box sees no patch: nothing is picked
+    assert pv.patch_ids(patches, state.camera)[0, 0] == -1
+    assert pv.select_patch(state, 0, 0) is None and state.patch_pick is None
+
+
+@pytest.fixture(scope="module")
+def radiosity_session(xvfb, tmp_path_factory):
+    """Run the ``radiosity`` script once on the Cornell box; (out folder, summary, process)."""
+    out = tmp_path_factory.mktemp("ui_radiosity")
+    env = {**os.environ, "DISPLAY": xvfb}
+    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", "cornell",
+                        "--methods", "phong,radiosity", "--size", "64",
+                        "--test-script", "radiosity", "--out", str(out), "--frames", "3000"],
+                       cwd=ROOT, env=env, capture_output=True, text=True, timeout=400)
+    summary = json.loads((out / "summary.json").read_text()) if (out / "summary.json").exists() else None
+    return out, summary, p
+
+
+def test_patch_view_in_the_window(radiosity_session):
+    out, summary, p = radiosity_session
+    assert p.returncode == 0, p.stderr[-2000:]
+    assert summary["threads"] == ["MainThread"] and summary["script"]["cpu_done"]
+    pick = summary["script"]["pick"]
+    assert pick["surface"] == "ceiling" and 0.5 < pick["row_sum"] <= 1.0 + 1e-9
+    win = summary["script"]["windows"]
+    assert win["Patch view"]["drawn"] and not win["Error plot"]["drawn"]
+    assert _img(out, "final", "radiosity").std() > 0.01

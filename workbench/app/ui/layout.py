@@ -37,6 +37,7 @@ def windows(state: AppState) -> list[tuple[str, str, object]]:
     from .lights import light_controls
     from .panels import (colour_wheel, difference_panel, image_panels, method_list, parameters,
                          scene_picker)
+    from .patch_view import patch_view
     from .plot import error_plot
     return [("Scene", "ControlSpace", lambda: (scene_picker(state), file_browser(state))),
             ("Methods", "MethodSpace", lambda: method_list(state)),
@@ -46,7 +47,8 @@ def windows(state: AppState) -> list[tuple[str, str, object]]:
             ("Panels", "MainDockSpace", lambda: image_panels(state)),
             ("Difference", "DiffSpace", lambda: difference_panel(state)),
             ("Error plot", "ToolSpace", lambda: error_plot(state)),
-            ("Ray tree", "ToolSpace", lambda: ray_tree_view(state))]
+            ("Ray tree", "ToolSpace", lambda: ray_tree_view(state)),
+            ("Patch view", "ToolSpace", lambda: patch_view(state))]
 
 
 def docking_params(state: AppState) -> hello_imgui.DockingParams:

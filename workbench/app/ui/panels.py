@@ -8,6 +8,7 @@ from . import camera as cam
 from .frames import panel_texture, stale, upload, upload_linear
 from .inspect import export, pixel_under_mouse, probe_tooltip, select_ray_tree
 from .layout import focus
+from .patch_view import select_patch
 from .state import (DISPLAY_MODES, HARMONIES, LEFT_OUT, MATERIAL_FIELDS, MAX_PANELS, AppState,
                     choosable_methods, set_display, set_material_value, set_option, set_scene)
 
@@ -154,6 +155,10 @@ def image_panels(state: AppState) -> None:
                         and imgui.is_mouse_clicked(imgui.MouseButton_.left)):
                     select_ray_tree(state, *ij)
                     focus("Ray tree")
+                if (m == "radiosity" and imgui.get_io().key_ctrl
+                        and imgui.is_mouse_clicked(imgui.MouseButton_.left)):
+                    select_patch(state, *ij)
+                    focus("Patch view")
         imgui.text_disabled(state.status.get(m, "")[:40])
         mode = state.display.get(m, "direct24")
         modes = list(DISPLAY_MODES) if mode in DISPLAY_MODES else [mode, *DISPLAY_MODES]

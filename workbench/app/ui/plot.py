@@ -3,7 +3,9 @@
 The reference is the compare module's (:func:`workbench.compare.reference.candidates`, first
 that renders, at its finest knob value, :func:`~workbench.compare.reference.finest_options`),
 rendered for the current scene and camera in a background job of its own
-(:class:`~.jobs.JobBoard`) once the camera has been still for :data:`SETTLE_SECONDS`.  Each
+(:class:`~.jobs.JobBoard`) once the camera has been still for :data:`SETTLE_SECONDS`, and
+only while the plot's window is shown (a reference can take long: radiosity or hybrid at the
+finest patches, which cannot be cancelled midway, so closing the window waits for it).  Each
 panel whose image is final (a raster draw, a finished CPU job) gives one point per knob
 setting: its run time and :func:`workbench.compare.metrics.metrics` against the reference
 (RMSE, PSNR, FLIP), computed in a worker thread.  The UI thread only copies images and reads
@@ -44,6 +46,7 @@ class ErrorPlot:
     points: dict = field(default_factory=dict)
     pending: dict = field(default_factory=dict)
     metric: str = "rmse"
+    shown: int = -2
     board: object = None
     pool: ThreadPoolExecutor | None = None
 
@@ -121,6 +124,8 @@ def track(state: AppState) -> None:
             del plot.pending[(m, opts)]
             if fut.exception() is None:
                 plot.points.setdefault(m, {})[opts] = fut.result()
+    if plot.shown < state.frame - 1:  # the plot's window is hidden: no reference render
+        return
     ref = _reference(state, plot)
     if ref is None:
         return
@@ -146,6 +151,7 @@ def error_plot(state: AppState) -> None:
     """Log-log plot: one line per method through its knob settings, run time on x."""
     from imgui_bundle import imgui, implot
     plot = state.errors
+    plot.shown = state.frame
     imgui.set_next_item_width(100)
     changed, k = imgui.combo("error", METRICS.index(plot.metric), list(METRICS))
     if changed:

@@ -153,6 +153,33 @@ def _gpu_counts(state: AppState) -> tuple[int, int]:
     return draws, state.images.reads
 
 
+class Radiosity:
+    """Coarse radiosity panel -> a patch picked at the top middle pixel (the Ctrl+click's
+    function) with the patch view brought to the front -> wait for the jobs -> quit."""
+
+    def __init__(self, out: Path):
+        self.out, self.log, self.t_wait = out, {}, time.perf_counter()
+
+    def __call__(self, state: AppState) -> None:
+        from .layout import focus
+        from .patch_view import select_patch
+        f = state.frame
+        if f == 0:  # the patch view in front of the error plot: no reference render
+            set_option(state, "radiosity", "patch_size", 0.2)
+            focus("Patch view")
+        elif f == 2:
+            i, j = state.camera.height // 5, state.camera.width // 2
+            pick = select_patch(state, i, j)
+            self.log["pick"] = {"pixel": [i, j], "patch": pick.patch, "surface": pick.surface,
+                                "row_sum": float(pick.row.sum()), "patches": len(pick.patches)}
+        elif f >= 5 and (not state.jobs.busy()
+                         or time.perf_counter() - self.t_wait > CPU_WAIT_SECONDS):
+            self.log["windows"] = window_report()
+            self.log["cpu_done"] = not state.jobs.busy()
+            _record(state, self.out, "final")
+            state.quit = True
+
+
 class Fps:
     """Count frames for ``seconds`` after a warm-up while the camera turns by ``step`` radians
     per frame (a steady mouse drag: every panel changes every frame and the CPU jobs restart;
@@ -221,6 +248,6 @@ class GpuPanels:
             state.quit = True
 
 
-SCRIPTS = {"check": Check, "features": Features, "fps": Fps,
+SCRIPTS = {"check": Check, "features": Features, "radiosity": Radiosity, "fps": Fps,
            "fps_static": lambda out: Fps(out, step=0.0, raytrace_spp=16, wait_cpu=True),
            "gpu_panels": GpuPanels}

@@ -69,6 +69,7 @@ class AppState:
     export_dir: Path = Path("out/ui_export")
     browser: object = None
     errors: object = None
+    patch_pick: object = None
     quit: bool = False
 
 
