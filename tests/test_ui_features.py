@@ -235,3 +235,34 @@ def test_patch_view_in_the_window(radiosity_session):
     win = summary["script"]["windows"]
     assert win["Patch view"]["drawn"] and not win["Error plot"]["drawn"]
     assert _img(out, "final", "radiosity").std() > 0.01
+
+
+@pytest.fixture(scope="module")
+def pyrender_session(xvfb, tmp_path_factory):
+    """Run the ``pyrender`` script once on whitted; (out folder, summary, process)."""
+    out = tmp_path_factory.mktemp("ui_pyrender")
+    env = {**os.environ, "DISPLAY": xvfb}
+    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", "whitted",
+                        "--methods", "phong,pyrender", "--size", "96",
+                        "--test-script", "pyrender", "--out", str(out), "--frames", "5000"],
+                       cwd=ROOT, env=env, capture_output=True, text=True, timeout=400)
+    summary = json.loads((out / "summary.json").read_text()) if (out / "summary.json").exists() else None
+    return out, summary, p
+
+
+def test_pyrender_panel_from_a_child_process(pyrender_session):
+    """pyrender renders in a child process, follows the shared camera (its silhouette is the
+    Phong panel's after an orbit), shows "rendering..." meanwhile, and the child is gone after
+    the window closes."""
+    from workbench.scene.io import load_scene
+    out, summary, p = pyrender_session
+    assert p.returncode == 0, p.stderr[-2000:]
+    log = summary["script"]
+    assert log["error"] is None and "rendering" in log["status_while_rendering"]
+    assert summary["threads"] == ["MainThread"] and summary["child_processes"] == []
+    assert not Path(f"/proc/{log['child_pid']}").exists()
+    bg = np.asarray(load_scene("whitted").background, np.float32)
+    before, after = _img(out, "before", "pyrender"), _img(out, "orbit", "pyrender")
+    assert np.isfinite(after).all() and np.abs(before - after).mean() > 0.01
+    cover = lambda img: np.abs(img - bg).max(-1) > 0.02  # pyrender's image is 8-bit
+    assert (cover(after) != cover(_img(out, "orbit", "phong"))).mean() < 0.03

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .state import RASTER, AppState, shown_image
+from .state import CHILD, RASTER, AppState, shown_image
 
 TILED = ("raycast", "raytrace")
 """CPU methods that accept ``on_tile`` (partial images)."""
@@ -179,9 +179,12 @@ def refresh_cpu(state: AppState, method: str) -> None:
 
 def update_images(state: AppState) -> None:
     """Bring every selected panel up to date (called once per frame, before the widgets)."""
+    from .pyrender_proc import refresh_pyrender
     for m in state.methods:
         if m in RASTER:
             refresh_raster(state, m)
+        elif m in CHILD:
+            refresh_pyrender(state)
         else:
             refresh_cpu(state, m)
 

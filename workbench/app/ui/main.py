@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import multiprocessing
 import sys
 import threading
 import time
@@ -56,8 +57,7 @@ def run(state: AppState, max_frames: int | None = None, script=None,
             hello_imgui.get_runner_params().app_shall_exit = True
 
     def before_exit():
-        state.jobs.join_all()
-        state.errors.shutdown()
+        stop_background(state)
         release_gl(state)
 
     params = hello_imgui.RunnerParams()
@@ -78,8 +78,17 @@ def run(state: AppState, max_frames: int | None = None, script=None,
     params.callbacks.show_status = lambda: status_bar(state)
     params.callbacks.before_exit = before_exit
     immapp.run(params, immapp.AddOnsParams(with_implot=True))
+    stop_background(state)
+
+
+def stop_background(state: AppState) -> None:
+    """End everything that runs beside the window (joined): the CPU jobs, the error plot's
+    reference render and worker, the pyrender child process."""
     state.jobs.join_all()
     state.errors.shutdown()
+    if state.pyrender is not None:
+        state.pyrender.close()
+        state.pyrender = None
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -114,6 +123,7 @@ def main(argv: list[str] | None = None) -> int:
                    "scene": state.scene_path.stem, "panel_size": list(state.panel_size),
                    "timings": state.timings,
                    "threads": [t.name for t in threading.enumerate()],
+                   "child_processes": [c.name for c in multiprocessing.active_children()],
                    "script": getattr(script, "log", {})}
         (args.out / "summary.json").write_text(json.dumps(summary, indent=1, default=str))
     return 0

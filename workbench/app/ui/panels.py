@@ -9,7 +9,7 @@ from .frames import panel_texture, stale, upload, upload_linear
 from .inspect import export, pixel_under_mouse, probe_tooltip, select_ray_tree
 from .layout import focus
 from .patch_view import select_patch
-from .state import (DISPLAY_MODES, HARMONIES, LEFT_OUT, MATERIAL_FIELDS, MAX_PANELS, AppState,
+from .state import (DISPLAY_MODES, HARMONIES, MATERIAL_FIELDS, MAX_PANELS, AppState,
                     choosable_methods, set_display, set_material_value, set_option, set_scene)
 
 ORBIT_SPEED = 0.01
@@ -73,8 +73,6 @@ def method_list(state: AppState) -> None:
                 state.methods.append(m)
             elif not on and len(state.methods) > 1:
                 state.methods.remove(m)
-    for m, why in LEFT_OUT.items():
-        imgui.text_disabled(f"{m}: {why}")
 
 
 def parameters(state: AppState) -> None:

@@ -180,6 +180,37 @@ class Radiosity:
             state.quit = True
 
 
+class Pyrender:
+    """The pyrender panel (child process): first image -> orbit -> the image of the orbited
+    camera -> quit (the child is stopped with the window)."""
+
+    def __init__(self, out: Path):
+        self.out, self.log, self.step, self.t0 = out, {}, 0, time.perf_counter()
+
+    def _ready(self, state: AppState) -> bool:
+        proc = state.pyrender
+        done = proc is not None and not proc.busy and proc.image is not None
+        return done or time.perf_counter() - self.t0 > CPU_WAIT_SECONDS
+
+    def __call__(self, state: AppState) -> None:
+        if self.step == 0 and self._ready(state):
+            _record(state, self.out, "before")
+            self.log["child_pid"] = state.pyrender.process.pid
+            self.log["first_image_seconds"] = time.perf_counter() - self.t0
+            state.camera = cam.orbit(state.camera, 0.5, 0.1)
+            self.t0 = time.perf_counter()
+            self.log["status_while_rendering"] = None
+        elif self.step == 1:
+            self.log["status_while_rendering"] = state.status.get("pyrender")
+        elif self.step == 2 and self._ready(state):
+            _record(state, self.out, "orbit")
+            self.log["error"] = state.pyrender.error
+            state.quit = True
+        else:
+            return
+        self.step += 1
+
+
 class Fps:
     """Count frames for ``seconds`` after a warm-up while the camera turns by ``step`` radians
     per frame (a steady mouse drag: every panel changes every frame and the CPU jobs restart;
@@ -248,6 +279,7 @@ class GpuPanels:
             state.quit = True
 
 
-SCRIPTS = {"check": Check, "features": Features, "radiosity": Radiosity, "fps": Fps,
+SCRIPTS = {"check": Check, "features": Features, "radiosity": Radiosity, "pyrender": Pyrender,
+           "fps": Fps,
            "fps_static": lambda out: Fps(out, step=0.0, raytrace_spp=16, wait_cpu=True),
            "gpu_panels": GpuPanels}

@@ -13,7 +13,9 @@ RASTER = ("flat", "gouraud", "phong")
 """Methods drawn every frame in the window's own GL context."""
 CPU = ("raycast", "raytrace", "radiosity", "hybrid")
 """Methods run in background threads."""
-LEFT_OUT = {"pyrender": "needs its own process with PyOpenGL's EGL platform; not in the UI"}
+CHILD = ("pyrender",)
+"""Methods rendered in a child process (PyOpenGL's EGL platform cannot share the window's
+process): :mod:`.pyrender_proc`."""
 MAX_PANELS = 6
 MATERIAL_FIELDS = ("ka", "kd", "ks", "shininess", "kr", "kt", "ior")
 DISPLAY_MODES = ("direct24", "direct16-555", "direct16-565", "direct16-565-fs",
@@ -70,13 +72,14 @@ class AppState:
     browser: object = None
     errors: object = None
     patch_pick: object = None
+    pyrender: object = None
     quit: bool = False
 
 
 def choosable_methods() -> list[str]:
-    """Registered methods the UI can show (pyrender is left out, see :data:`LEFT_OUT`)."""
+    """Registered methods the UI can show (all of them)."""
     from ...renderers.base import available
-    return [m for m in available() if m not in LEFT_OUT]
+    return list(available())
 
 
 def default_options(method: str) -> dict:
