@@ -259,6 +259,7 @@ def test_pyrender_panel_from_a_child_process(pyrender_session):
     assert p.returncode == 0, p.stderr[-2000:]
     log = summary["script"]
     assert log["error"] is None and "rendering" in log["status_while_rendering"]
+    assert log["plotted"] == ["phong", "pyrender"]  # its error against the reference too
     assert summary["threads"] == ["MainThread"] and summary["child_processes"] == []
     assert not Path(f"/proc/{log['child_pid']}").exists()
     bg = np.asarray(load_scene("whitted").background, np.float32)

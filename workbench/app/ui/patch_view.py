@@ -122,19 +122,24 @@ def id_colours(ids: np.ndarray) -> np.ndarray:
 def select_patch(state: AppState, i: int, j: int) -> PatchPick | None:
     """Pick the patch at pixel (i, j) of the radiosity panel and draw its hemicube (item buffer
     and form-factor row); kept in ``state.patch_pick`` (None where no patch is seen)."""
+    from ...core.errors import WorkbenchError
     from ...renderers.radiosity.hemicube import Hemicube
     opts = radiosity_options(state)
-    patches = scene_patches(state)
-    p = int(patch_ids(patches, state.camera)[i, j])
-    if p < 0:
-        state.patch_pick = None
-        return None
-    hc = Hemicube(patches.geometry(), opts["hemicube_resolution"],
-                  rotate=opts["hemicube_rotate"], normalize=opts["hemicube_normalize"])
+    state.patch_pick, state.status["patch pick"] = None, f"pixel ({i}, {j}) shows no patch"
     try:
-        item, row = hc.item_buffers([p])[0], hc.rows([p])[0]
-    finally:
-        hc.release()
+        patches = scene_patches(state)
+        p = int(patch_ids(patches, state.camera)[i, j])
+        if p < 0:
+            return None
+        hc = Hemicube(patches.geometry(), opts["hemicube_resolution"],
+                      rotate=opts["hemicube_rotate"], normalize=opts["hemicube_normalize"])
+        try:
+            item, row = hc.item_buffers([p])[0], hc.rows([p])[0]
+        finally:
+            hc.release()
+    except WorkbenchError as e:  # e.g. a surface that cannot be cut into patches
+        state.status["patch pick"] = str(e)
+        return None
     names = patches.surface_names
     surface = names[patches.surface[p]] if len(names) else str(patches.surface[p])
     state.patch_pick = PatchPick((i, j), p, surface, item, row, patches, hc.res)
@@ -162,6 +167,7 @@ def patch_view(state: AppState) -> None:
     pick = state.patch_pick
     if pick is None:
         imgui.text_disabled("Ctrl+click a surface in the radiosity panel")
+        imgui.text_disabled(state.status.get("patch pick", ""))
         return
     key = ("patch item", pick.patch, id(pick))
     if key != state.status.get("patch view"):

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .state import RASTER, AppState
+from .state import CHILD, RASTER, AppState
 
 SETTLE_SECONDS = 0.3
 """The camera and scene must stay unchanged this long before the reference render starts."""
@@ -65,6 +65,12 @@ def _final_image(state: AppState, method: str) -> tuple[np.ndarray, float] | Non
         if method not in state.images or method not in state.timings:
             return None
         return np.array(state.images[method], np.float32), state.timings[method]
+    if method in CHILD:
+        proc = state.pyrender
+        current = (state.scene_version, state.camera, tuple(sorted(state.options[method].items())))
+        if proc is None or proc.image_key != current:
+            return None
+        return np.asarray(proc.image, np.float32), proc.seconds
     job = state.jobs.current.get(method)
     key = (id(state.scene), state.camera, method, tuple(sorted(state.options[method].items())))
     if job is None or job.key != key or job.image is None or job.seconds is None:

@@ -182,7 +182,7 @@ class Radiosity:
 
 class Pyrender:
     """The pyrender panel (child process): first image -> orbit -> the image of the orbited
-    camera -> quit (the child is stopped with the window)."""
+    camera and its point in the error plot -> quit (the child is stopped with the window)."""
 
     def __init__(self, out: Path):
         self.out, self.log, self.step, self.t0 = out, {}, 0, time.perf_counter()
@@ -202,9 +202,11 @@ class Pyrender:
             self.log["status_while_rendering"] = None
         elif self.step == 1:
             self.log["status_while_rendering"] = state.status.get("pyrender")
-        elif self.step == 2 and self._ready(state):
+        elif self.step == 2 and self._ready(state) and ("pyrender" in state.errors.points or
+                                                         time.perf_counter() - self.t0 > CPU_WAIT_SECONDS):
             _record(state, self.out, "orbit")
             self.log["error"] = state.pyrender.error
+            self.log["plotted"] = sorted(state.errors.points)
             state.quit = True
         else:
             return
