@@ -245,7 +245,8 @@ class Hemicube:
             pad_r[:nf] = rects
             self.prog["clip_from_world"].write(pad_m.tobytes())
             self.prog["rect"].write(pad_r.tobytes())
-        self.fbo.clear(depth=1.0)         # the item buffer (integer) to 0 too
+        used = (0, 0, 3 * self.res, len(chunk) * self.res)    # the chunk's rows only
+        self.fbo.clear(depth=1.0, viewport=used)              # the item buffer (integer) to 0 too
         if len(live) and len(tri_idx):
             self.ibo.write(tri_idx.tobytes())
             lut = np.zeros(-(-len(tri_patch) // TRI_ROW) * TRI_ROW, dtype="u4")
@@ -253,8 +254,8 @@ class Hemicube:
             self.lut.write(lut.tobytes(), viewport=(0, 0, TRI_ROW, len(lut) // TRI_ROW))
             self.vao.render(vertices=3 * len(tri_idx))
         self.drawn += len(live)
-        ids = np.frombuffer(self.fbo.read(components=1, dtype="u4"), dtype="u4")
-        return ids.reshape(self.batch, self.res, 3 * self.res)[:len(chunk)]
+        ids = np.frombuffer(self.fbo.read(viewport=used, components=1, dtype="u4"), dtype="u4")
+        return ids.reshape(len(chunk), self.res, 3 * self.res)
 
     def _each_batch(self, patches):
         """Draw the item buffers of ``patches`` batch by batch: yields (start, ids)."""
