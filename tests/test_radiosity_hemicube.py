@@ -4,7 +4,6 @@ numba accumulation of item buffers into rows against np.bincount."""
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 import workbench
 from workbench.renderers.radiosity.hemicube import Hemicube, delta_form_factors, grid_regions

@@ -19,7 +19,14 @@ the scene's vertices are uploaded once per face slot; for ``batch`` patches at a
 CPU keeps, for each face, only the triangles not wholly outside one of its frustum planes
 (outcodes), and ONE draw call (llvmpipe pays ~0.5 ms per draw) renders the 5 x batch lists
 into one framebuffer (each face mapped into its own rectangle, ``gl_ClipDistance`` clipping
-it there), read back once.
+it there), read back once, and summed into rows by a numba loop.
+
+Triangles are what llvmpipe pays for, so a quadrilateral surface cut into a bilinear grid of
+patches is not drawn patch by patch: it is drawn as one quad (or a few, if it is warped),
+and the fragment shader finds the patch under each pixel by inverting the grid's bilinear
+map (:func:`grid_regions`).  The Cornell box at 2,120 patches is then ~100 triangles
+instead of 4,240; its item buffers agree with the per-patch triangles' (``regions=False``,
+the readable reference) on >= 99.9 % of the pixels (the rest are ties on cell boundaries).
 """
 from __future__ import annotations
 
@@ -308,6 +315,7 @@ class Hemicube:
         return {"hemicube_resolution": self.res, "weight_sum": float(self.weights.sum()),
                 "weight_sum_raw": self.weight_sum_raw,
                 "rotate": self.rotate, "gl_renderer": gl.renderer_name(self.ctx),
+                "grid_blocks_drawn": self.blocks,
                 "hemicubes_drawn": self.drawn}
 
     def release(self) -> None:
