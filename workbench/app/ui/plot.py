@@ -153,6 +153,16 @@ def _point(image: np.ndarray, reference: np.ndarray, seconds: float, label: str)
     return {**_evaluate(image, reference), "seconds": float(seconds), "label": label}
 
 
+def log_limits(values: np.ndarray) -> tuple[float, float]:
+    """Axis range of positive ``values`` on a log axis: a factor :data:`MARGIN` beyond them,
+    and at least one decade (so that the axis has a labelled tick)."""
+    lo, hi = float(values.min()) / MARGIN, float(values.max()) * MARGIN
+    if hi < 10.0 * lo:
+        mid = np.sqrt(lo * hi)
+        lo, hi = mid / np.sqrt(10.0), mid * np.sqrt(10.0)
+    return lo, hi
+
+
 def error_plot(state: AppState) -> None:
     """Log-log plot: one line per method through its knob settings, run time on x."""
     from imgui_bundle import imgui, implot
@@ -171,12 +181,14 @@ def error_plot(state: AppState) -> None:
                     np.maximum(np.array([p[plot.metric] for p in rows]), FLOOR))
     if implot.begin_plot("##error against run time", imgui.ImVec2(-1, -1)):
         implot.setup_axes("run time (ms)", plot.metric)
+        implot.setup_legend(implot.Location_.north_east, implot.LegendFlags_.outside)
         implot.setup_axis_scale(implot.ImAxis_.x1, implot.Scale_.log10)
         implot.setup_axis_scale(implot.ImAxis_.y1, implot.Scale_.log10)
-        if lines:  # fitted to the points, a factor MARGIN beyond them on each side
+        if lines:
             xs, ys = (np.concatenate([v[k] for v in lines.values()]) for k in (0, 1))
-            implot.setup_axes_limits(xs.min() / MARGIN, xs.max() * MARGIN,
-                                     ys.min() / MARGIN, ys.max() * MARGIN, implot.Cond_.always)
+            implot.setup_axes_limits(*log_limits(xs), *log_limits(ys), implot.Cond_.always)
+        else:  # 1 ms to 1 s, errors 1e-3 to 1
+            implot.setup_axes_limits(1.0, 1e3, 1e-3, 1.0, implot.Cond_.always)
         for m, (xs, ys) in lines.items():
             implot.plot_line(m, xs, ys)
             implot.plot_scatter(m, xs, ys)

@@ -16,6 +16,8 @@ from .state import RASTER, AppState, set_display, set_material_value, set_option
 
 CPU_WAIT_SECONDS = 120.0
 """How long the check script waits for background jobs before giving up."""
+PLOT_WAIT_SECONDS = 10.0
+"""How long the check script then waits for the error plot's points."""
 
 
 def _record(state: AppState, out: Path, phase: str) -> None:
@@ -34,7 +36,7 @@ class Check:
     """before -> orbit -> flat knob change -> ks change -> wait for CPU jobs -> quit."""
 
     def __init__(self, out: Path):
-        self.out, self.log, self.t_wait = out, {}, None
+        self.out, self.log, self.t_wait, self.t_plot = out, {}, None, None
 
     def __call__(self, state: AppState) -> None:
         f, out = state.frame, self.out
@@ -54,7 +56,7 @@ class Check:
         elif f == 5:
             _record(state, out, "ks")
             self.t_wait = time.perf_counter()
-        elif f > 5 and (not state.jobs.busy()
+        elif f > 5 and ((not state.jobs.busy() and self._plotted(state))
                         or time.perf_counter() - self.t_wait > CPU_WAIT_SECONDS):
             _record(state, out, "final")
             self.log["cpu_done"] = not state.jobs.busy()
@@ -74,6 +76,15 @@ class Check:
                                         "depth": tree.get("depth"),
                                         "n_children": len(tree.get("children", []))}
             state.quit = True
+
+
+    def _plotted(self, state: AppState) -> bool:
+        """Every panel has its point in the error plot, or :data:`PLOT_WAIT_SECONDS` passed
+        since the jobs ended (the screenshot shows the plot)."""
+        if self.t_plot is None:
+            self.t_plot = time.perf_counter()
+        return (all(m in state.errors.points for m in state.methods)
+                or time.perf_counter() - self.t_plot > PLOT_WAIT_SECONDS)
 
 
 class Features:
@@ -245,6 +256,7 @@ class Fps:
                 self.log.update(frames=n, seconds=dt, fps=n / dt, gui_ms_mean=self.gui / n * 1e3,
                                 frames_with_cpu_job_running=self.busy_frames,
                                 gl_panel_draws=d1 - d0, read_backs=r1 - r0,
+                                panels_window=window_report()["Panels"].get("size"),
                                 raster_ms={m: state.timings.get(m, 0) * 1e3
                                            for m in state.methods if m in RASTER})
                 self.t_wait = time.perf_counter()
