@@ -61,13 +61,16 @@ def rel_errors(B, ref, areas, reflecting):
 RELAX = 1.2
 
 
-def _progressive(row, A, E, R, ambient, relax, conv, direct, refl, trace=None) -> dict:
+def _progressive(make_rows, A, E, R, ambient, relax, conv, direct, refl, trace=None) -> dict:
     """Matrix-free progressive refinement timed until the shown radiosity (with the ambient
     term if ``ambient``) is within 1 % (area-weighted RMS, then max) of ``conv``; the time
-    spent measuring the error is left out."""
+    spent measuring the error is left out, the time ``make_rows()`` takes to set up the row
+    provider (hemicube buffers, BVH) is in.  ``make_rows() -> (row, source)``."""
     from workbench.renderers.radiosity import solvers
     state = {"spent": 0.0, "t_hit": None, "shots_hit": None, "t_hit_max": None, "direct": None}
     t_start = time.perf_counter()
+    row, source = make_rows()
+    setup = time.perf_counter() - t_start
 
     def on_batch(B, dB, shots):
         tc = time.perf_counter()
@@ -92,7 +95,8 @@ def _progressive(row, A, E, R, ambient, relax, conv, direct, refl, trace=None) -
     except StopIteration:
         pass
     d = state["direct"] or (None, None)
-    return {"relax": relax, "seconds_to_1pct_rms": state["t_hit"],
+    return {"relax": relax, "source": source, "setup_seconds": setup,
+            "seconds_to_1pct_rms": state["t_hit"],
             "shots_to_1pct_rms": state["shots_hit"], "seconds_to_1pct_max": state["t_hit_max"],
             "rows_computed": cache.computed, "row_cache_hits": cache.hits,
             "at_1pct_rms_error_vs_gathering_direct": {"rms_rel": d[0], "max_rel": d[1]},
@@ -145,12 +149,17 @@ def part_full(count: int, res: int) -> dict:
     runs = (("with_ambient", True, RELAX), ("without_ambient", False, RELAX),
             ("plain_shooting_with_ambient", True, 1.0))
     for key, ambient, relax in runs:
-        hc = Hemicube(g, res)
+        made = []
+
+        def make_rows():
+            made.append(Hemicube(g, res))
+            return made[0].rows, "hemicube"
+
         out[f"progressive_{key}"] = _progressive(
-            hc.rows, A, E, R, ambient, relax, conv, direct.radiosity, refl,
+            make_rows, A, E, R, ambient, relax, conv, direct.radiosity, refl,
             trace if key == "with_ambient" else None)
-        out[f"progressive_{key}"]["hemicubes_drawn"] = hc.drawn
-        hc.release()
+        out[f"progressive_{key}"]["hemicubes_drawn"] = made[0].drawn
+        made[0].release()
     # ray-cast rows (receivers' exact factors x visibility): the gathering system, no GL
     from workbench.renderers.radiosity.raycast import RayRows
     rr = RayRows(g)
@@ -162,9 +171,9 @@ def part_full(count: int, res: int) -> dict:
     del rows_all
     conv_ray = solvers.solve(Fg, E, R, "direct").radiosity
     del Fg
-    rr = RayRows(g)
     out["progressive_raycast_rows_with_ambient"] = dict(
-        _progressive(rr.rows, A, E, R, True, RELAX, conv_ray, direct.radiosity, refl),
+        _progressive(lambda: (RayRows(g).rows, "raycast"), A, E, R, True, RELAX, conv_ray,
+                     direct.radiosity, refl),
         rays_per_patch_triangle=4 ** rr.level, all_rows_seconds=t_rows,
         converged_solution_vs_gathering_direct=dict(zip(("rms_rel", "max_rel"),
                                                         rel_errors(conv_ray, direct.radiosity, A, refl))),
