@@ -46,15 +46,20 @@ def test_cornell_blocks_give_the_patch_triangles_item_buffer(gl_ctx):
 
 
 def test_trapezoid_grid_inverse_bilinear(gl_ctx):
-    """A strongly non-parallelogram convex quad cut 7 x 5, seen by a small patch facing it:
-    the fragment shader's inverse bilinear map finds the same cells as the rasterised cells."""
+    """A strongly non-parallelogram convex quad cut 7 x 6, seen by a small patch facing it
+    beside a pentagon (cut into triangle fans, drawn as its patches' own triangles in the same
+    draw): the fragment shader's inverse bilinear map finds the same cells as the rasterised
+    cells, and every cell is seen."""
     quad = np.array([[0, 0, 0], [3, 0, 0], [2.2, 1.7, 0], [0.4, 2.5, 0]], float)
+    ang = np.linspace(0, 2 * np.pi, 5, endpoint=False)
+    penta = np.stack([3.6 + 0.5 * np.cos(ang), 1.0 + 0.5 * np.sin(ang), 0.2 + 0 * ang], 1)
     eye = np.array([[1.2, 1.0, 1.5], [1.3, 1.0, 1.5], [1.3, 1.1, 1.5], [1.2, 1.1, 1.5]])[::-1]
     surfaces = [("polygon", quad, np.full(3, 0.5), np.zeros(3), None, "trapezoid"),
+                ("polygon", penta, np.full(3, 0.5), np.zeros(3), None, "pentagon"),
                 ("polygon", eye, np.full(3, 0.5), np.ones(3), None, "eye")]
     ps = _assemble(surfaces, 0.45)
     g = ps.geometry()
-    assert (g.grids[0].nu, g.grids[0].nv) == (7, 6)
+    assert (g.grids[0].nu, g.grids[0].nv) == (7, 6) and len(g.grids) == 2    # quad, eye
     viewer = np.array([len(ps) - 1])
     nblocks, agree, d = _agree(g, viewer, 128)
     assert nblocks == 1 and agree >= 0.999 and d.max() < 5e-3
@@ -63,7 +68,7 @@ def test_trapezoid_grid_inverse_bilinear(gl_ctx):
         r = row.rows(viewer)[0]
     finally:
         row.release()
-    assert (r[:-1] > 0).all()                    # every cell of the trapezoid is seen
+    assert (r[:42] > 0).all() and r[42:-1].sum() > 0     # every cell, and the pentagon
 
 
 def test_accumulate_items_is_bincount():
