@@ -14,7 +14,8 @@ the pixel, its hemicube item buffer and its form-factor row (Cohen & Greenberg 1
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+import time
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -39,6 +40,7 @@ class PatchPick:
     row: np.ndarray           # (P,) F[patch, :]
     patches: object           # the PatchSet
     resolution: int
+    made: float = field(default_factory=time.perf_counter)   # tells two picks apart
 
 
 def radiosity_options(state: AppState) -> dict:
@@ -163,17 +165,15 @@ def patch_view(state: AppState) -> None:
     """The picked patch: item buffer (unfolded hemicube) and form-factor row."""
     from imgui_bundle import imgui
 
-    from .frames import upload
+    from .frames import stale, upload
     pick = state.patch_pick
     if pick is None:
         imgui.text_disabled("Ctrl+click a surface in the radiosity panel")
         imgui.text_disabled(state.status.get("patch pick", ""))
         return
-    key = ("patch item", pick.patch, id(pick))
-    if key != state.status.get("patch view"):
+    if stale(state, "patch view", pick.made) or "patch row" not in state.textures:
         upload(state, "patch item", id_colours(unfold(pick.item)))
         upload(state, "patch row", row_image(state, pick))
-        state.status["patch view"] = key
     imgui.text(f"patch {pick.patch} of {len(pick.patches)} ({pick.surface}), pixel {pick.pixel}")
     imgui.text(f"hemicube {pick.resolution} px: row sum {pick.row.sum():.4f}, "
                f"{int((pick.row > 0).sum())} patches seen, max F {pick.row.max():.4g}")
