@@ -21,6 +21,7 @@ from __future__ import annotations
 from imgui_bundle import hello_imgui, imgui
 
 from .state import AppState
+from .window_style import with_background
 
 SPLITS = (("MainDockSpace", "ControlSpace", imgui.Dir.left, 0.27),
           ("ControlSpace", "ParamSpace", imgui.Dir.down, 0.5),
@@ -55,7 +56,8 @@ def docking_params(state: AppState) -> hello_imgui.DockingParams:
     """The splits and dockable windows, applied at every start (no settings file is kept)."""
     params = hello_imgui.DockingParams()
     params.docking_splits = [hello_imgui.DockingSplit(a, b, d, r) for a, b, d, r in SPLITS]
-    params.dockable_windows = [hello_imgui.DockableWindow(label, space, fn, can_be_closed_=False)
+    params.dockable_windows = [hello_imgui.DockableWindow(label, space, with_background(fn),
+                                                          can_be_closed_=False)
                                for label, space, fn in windows(state)]
     params.layout_condition = hello_imgui.DockingLayoutCondition.application_start
     for w in params.dockable_windows:  # the first tab of each space is the one shown

@@ -29,6 +29,7 @@ def run(state: AppState, max_frames: int | None = None, script=None,
     from imgui_bundle import hello_imgui, immapp
 
     from ...renderers import gl
+    from . import window_style
     from .frames import release_gl, update_images
     from .layout import docking_params
     from .panels import status_bar
@@ -73,6 +74,12 @@ def run(state: AppState, max_frames: int | None = None, script=None,
     params.docking_params = docking_params(state)
     params.ini_disable = True  # no settings file written into the working folder
     params.callbacks.post_init = post_init
+    theme_style = params.callbacks.setup_imgui_style
+
+    def setup_style():  # window backgrounds: one clear per frame, not one fill per window
+        theme_style()
+        window_style.clear_to_window_background()
+    params.callbacks.setup_imgui_style = setup_style
     params.callbacks.show_gui = show_gui
     params.callbacks.before_imgui_render = end_frame
     params.callbacks.show_status = lambda: status_bar(state)
