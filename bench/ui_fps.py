@@ -1,22 +1,34 @@
 """Frames per second of the UI with three GL panels (flat, Gouraud, Phong) at 512 x 512 on a
 bundled scene while a ray trace runs in the background, under Xvfb (llvmpipe).
 
-Runs ``python -m workbench.app.ui.main --test-script fps`` in a subprocess on a fresh Xvfb
-display and writes ``bench/results/ui_fps.json``.  ``gui_ms_mean`` is the time spent in the
-frame's Python callback (raster draws + read-back + texture uploads + widgets); the rest of a
-frame is imgui's own rendering of the window and the buffer swap.
+Each case runs ``python -m workbench.app.ui.main --test-script fps|fps_static`` in a
+subprocess on a fresh Xvfb display (``scripts.Fps`` counts frames for 10 s after 10 warm-up
+frames) and the results go to ``bench/results/ui_fps.json``:
 
-Each run counts frames for 10 s after 10 warm-up frames (``scripts.Fps``): with a static camera
-while a 16 spp ray trace runs (the issue's case), during a steady drag (every panel changes each
-frame, the ray trace restarts) and during a drag with the GL panels only (baseline).
+* ``static_camera_raytrace_running`` (the issue's case): nothing moves while a 16 spp ray trace
+  runs; the count stops early if the ray trace ends first (the rate is the one *while* it
+  runs), then the session waits for it and logs its run time with the window open
+  (``raytrace_seconds``) and the number of GL panel draws and GPU read-backs during the count
+  (both 0 when nothing changes);
+* ``drag_with_raytrace_restarting``: the camera turns every frame (a steady mouse drag: all
+  three GL panels redraw each frame, the difference view follows, the ray trace restarts);
+* ``drag_gl_only``: the same drag with the three GL panels only;
+* ``raytrace_without_window``: the same 512 x 512, 16 spp ray trace rendered by the library in
+  a plain process (numba's default threads), for the completion-time comparison.
 
-Usage: python bench/ui_fps.py [--scene whitted] [--size 512]
+``gui_ms_mean`` is the time in the frame's Python callbacks (panel updates + widgets); the rest
+of a frame is imgui's rendering of the window on llvmpipe and the buffer swap.  The window is
+``--window`` (default 2200 x 1140: the docking layout's panel area then holds the three 512 px
+panels side by side, so all three are on screen; ``panels_window`` logs that area's size).
+
+Usage: python bench/ui_fps.py [--scene whitted] [--size 512] [--window 2200x1140]
 """
 from __future__ import annotations
 
 import argparse
 import json
 import os
+import platform
 import subprocess
 import sys
 import tempfile
@@ -24,6 +36,8 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+SPP = 16
+"""Samples per pixel of the background ray trace (the ``fps_static`` script sets it)."""
 
 
 def free_display() -> int:
@@ -33,39 +47,66 @@ def free_display() -> int:
     raise RuntimeError("no free X display number")
 
 
-def measure(scene: str, size: int, cpu: bool, script: str = "fps") -> dict:
+def measure(scene: str, size: int, window: str, cpu: bool, script: str) -> dict:
     n = free_display()
-    xvfb = subprocess.Popen(["Xvfb", f":{n}", "-screen", "0", "1920x1200x24", "-nolisten", "tcp"],
+    w, h = (int(x) for x in window.split("x"))
+    xvfb = subprocess.Popen(["Xvfb", f":{n}", "-screen", "0", f"{w + 64}x{h + 64}x24",
+                             "-nolisten", "tcp"],
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         while not Path(f"/tmp/.X11-unix/X{n}").exists():
             time.sleep(0.05)
         methods = "flat,gouraud,phong" + (",raytrace" if cpu else "")
         with tempfile.TemporaryDirectory() as out:
+            load = os.getloadavg()
             subprocess.run([sys.executable, "-m", "workbench.app.ui.main", scene, "--methods",
-                            methods, "--size", str(size), "--test-script", script, "--out", out],
+                            methods, "--size", str(size), "--window", window,
+                            "--test-script", script, "--out", out],
                            cwd=ROOT, env={**os.environ, "DISPLAY": f":{n}"}, check=True,
-                           timeout=600)
+                           timeout=900)
             summary = json.loads(Path(out, "summary.json").read_text())
     finally:
         xvfb.terminate()
         xvfb.wait(10)
-    return {"scene": scene, "panel_size": size, "methods": methods.split(","),
-            "gl_renderer": summary["gl_renderer"], **summary["script"]}
+    return {"scene": scene, "panel_size": size, "window": window, "methods": methods.split(","),
+            "gl_renderer": summary["gl_renderer"], "load_average_1_5_15_before": load,
+            **summary["script"]}
+
+
+def raytrace_without_window(scene: str, size: int) -> dict:
+    """The ray trace of the static case in a plain process (warm kernels, default threads)."""
+    code = f"""
+import json, time, numba, workbench
+sc = workbench.load_scene({scene!r})
+workbench.render(sc, "raytrace", width=32, height=32, spp={SPP})  # load the compiled kernels
+t0 = time.perf_counter()
+workbench.render(sc, "raytrace", width={size}, height={size}, spp={SPP})
+print(json.dumps({{"seconds": time.perf_counter() - t0, "numba_threads": numba.get_num_threads()}}))
+"""
+    load = os.getloadavg()
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, check=True, timeout=900,
+                         capture_output=True, text=True).stdout
+    return {"scene": scene, "size": size, "spp": SPP, "load_average_1_5_15_before": load,
+            **json.loads(out.strip().splitlines()[-1])}
 
 
 def main() -> None:
     p = argparse.ArgumentParser()
     p.add_argument("--scene", default="whitted")
     p.add_argument("--size", type=int, default=512)
+    p.add_argument("--window", default="2200x1140", help="WIDTHxHEIGHT of the UI window")
     a = p.parse_args()
-    load = os.getloadavg()
-    res = {"static_camera_raytrace_spp16_running": measure(a.scene, a.size, True, "fps_static"),
-           "drag_with_raytrace_restarting": measure(a.scene, a.size, True),
-           "drag_gl_only": measure(a.scene, a.size, False),
-           "cpu_count": os.cpu_count(), "load_average_1_5_15_before": load}
+    res = {"static_camera_raytrace_running":
+           measure(a.scene, a.size, a.window, True, "fps_static"),
+           "drag_with_raytrace_restarting": measure(a.scene, a.size, a.window, True, "fps"),
+           "drag_gl_only": measure(a.scene, a.size, a.window, False, "fps"),
+           "raytrace_without_window": raytrace_without_window(a.scene, a.size),
+           "cpu_count": os.cpu_count(), "machine": platform.machine(),
+           "processor": platform.processor() or platform.uname().processor}
     out = ROOT / "bench" / "results" / "ui_fps.json"
-    out.write_text(json.dumps(res, indent=1))
+    tmp = out.with_suffix(".json.tmp")
+    tmp.write_text(json.dumps(res, indent=1))
+    tmp.replace(out)
     print(json.dumps(res, indent=1))
 
 

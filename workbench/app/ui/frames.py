@@ -120,13 +120,22 @@ def stale(state: AppState, name: str, key) -> bool:
     return True
 
 
+def _new_texture(state: AppState, size: tuple[int, int], components: int, **kw):
+    """A display texture sampled nearest: a zoomed panel shows its pixels as squares (what a
+    pixel probe needs), and llvmpipe samples it faster than with bilinear filtering."""
+    import moderngl
+    tex = state.ctx.texture(size, components, **kw)
+    tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    return tex
+
+
 def display_texture(state: AppState, key: str, size: tuple[int, int]):
     """The RGBA8 texture ``key`` of ``size`` (w, h), created or resized as needed."""
     tex = state.textures.get(key)
     if tex is None or tex.size != size:
         if tex is not None:
             tex.release()
-        tex = state.textures[key] = state.ctx.texture(size, 4)
+        tex = state.textures[key] = _new_texture(state, size, 4)
     return tex
 
 
@@ -207,7 +216,7 @@ def upload(state: AppState, key: str, rgb8: np.ndarray):
     if tex is None or tex.size != (w, h) or tex.components != 3:
         if tex is not None:
             tex.release()
-        tex = state.textures[key] = state.ctx.texture((w, h), 3, alignment=1)
+        tex = state.textures[key] = _new_texture(state, (w, h), 3, alignment=1)
     tex.write(np.ascontiguousarray(rgb8).tobytes())
     return tex
 
