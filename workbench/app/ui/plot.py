@@ -95,6 +95,9 @@ def _reference(state: AppState, plot: ErrorPlot) -> np.ndarray | None:
         m = plot.candidates[0]
         plot.reference, plot.ref_options = m, finest_options(m)
         job = plot.board.request(state.scene, state.camera, m, plot.ref_options, tiled=m in TILED)
+        if job.cancelled.is_set():  # the previous key's job, still ending: wait for it
+            plot.message = "rendering the reference..."
+            return None
         if job.error is None:
             break
         plot.candidates.pop(0)  # does not apply to this scene: the next in the rule's order
