@@ -65,15 +65,21 @@ def _progressive(make_rows, A, E, R, ambient, relax, conv, direct, refl, trace=N
     """Matrix-free progressive refinement timed until the shown radiosity (with the ambient
     term if ``ambient``) is within 1 % (area-weighted RMS, then max) of ``conv``; the time
     spent measuring the error is left out, the time ``make_rows()`` takes to set up the row
-    provider (hemicube buffers, BVH) is in.  ``make_rows() -> (row, source)``."""
+    provider (hemicube buffers, BVH) is in.  ``make_rows() -> (row, source)``.
+
+    Also the process's CPU time (all threads: ours, llvmpipe's, numba's) to the same point:
+    on a shared machine the wall time swings with the load; the CPU time much less."""
     from workbench.renderers.radiosity import solvers
-    state = {"spent": 0.0, "t_hit": None, "shots_hit": None, "t_hit_max": None, "direct": None}
+    state = {"spent": 0.0, "cpu_spent": 0.0, "t_hit": None, "cpu_hit": None, "shots_hit": None,
+             "t_hit_max": None, "direct": None}
+    cpu_start = time.process_time()
     t_start = time.perf_counter()
     row, source = make_rows()
     setup = time.perf_counter() - t_start
 
     def on_batch(B, dB, shots):
         tc = time.perf_counter()
+        cc = time.process_time()
         shown = B + R * solvers._ambient(dB, R, A) if ambient else B
         rms, mx = rel_errors(shown, conv, A, refl)
         el = tc - t_start - state["spent"]
@@ -81,10 +87,12 @@ def _progressive(make_rows, A, E, R, ambient, relax, conv, direct, refl, trace=N
             trace.append((el, shots, rms, mx))
         if state["t_hit"] is None and rms <= 0.01:
             state["t_hit"], state["shots_hit"] = el, shots
+            state["cpu_hit"] = cc - cpu_start - state["cpu_spent"]
             state["direct"] = rel_errors(shown, direct, A, refl)
         if state["t_hit_max"] is None and mx <= 0.01:
             state["t_hit_max"] = el
         state["spent"] += time.perf_counter() - tc
+        state["cpu_spent"] += time.process_time() - cc
         if state["t_hit_max"] is not None and state["t_hit"] is not None:
             raise StopIteration
 
@@ -96,7 +104,7 @@ def _progressive(make_rows, A, E, R, ambient, relax, conv, direct, refl, trace=N
         pass
     d = state["direct"] or (None, None)
     return {"relax": relax, "source": source, "setup_seconds": setup,
-            "seconds_to_1pct_rms": state["t_hit"],
+            "seconds_to_1pct_rms": state["t_hit"], "cpu_seconds_to_1pct_rms": state["cpu_hit"],
             "shots_to_1pct_rms": state["shots_hit"], "seconds_to_1pct_max": state["t_hit_max"],
             "rows_computed": cache.computed, "row_cache_hits": cache.hits,
             "at_1pct_rms_error_vs_gathering_direct": {"rms_rel": d[0], "max_rel": d[1]},
