@@ -9,6 +9,7 @@ import os
 import re
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -271,3 +272,21 @@ def test_pyrender_panel_from_a_child_process(pyrender_session):
     assert np.isfinite(after).all() and np.abs(before - after).mean() > 0.01
     cover = lambda img: np.abs(img - bg).max(-1) > 0.02  # pyrender's image is 8-bit
     assert (cover(after) != cover(_img(out, "orbit", "phong"))).mean() < 0.03
+
+
+def test_pyrender_child_that_dies_is_reported_not_raised():
+    """A killed child: the panel says so, later requests send nothing, closing still joins."""
+    from workbench.app.ui.pyrender_proc import DIED, PyrenderProcess
+    state = new_state("whitted", ["phong"], (32, 32))
+    proc = PyrenderProcess()
+    proc.process.kill()
+    proc.process.join(10)
+    proc.request(1, state.scene, state.camera, {"tessellation": 1})
+    deadline = time.time() + 10
+    while proc.error is None and time.time() < deadline:
+        proc.poll()
+    assert proc.error == DIED and not proc.busy
+    proc.request(2, state.scene, state.camera, {"tessellation": 1})
+    assert not proc.busy
+    proc.close()
+    assert not proc.process.is_alive()

@@ -16,6 +16,7 @@ from dataclasses import replace
 
 METHOD = "pyrender"
 STOP_SECONDS = 5.0
+DIED = "the pyrender child process ended unexpectedly"
 """How long closing waits for the child to end by itself before terminating it."""
 
 
@@ -62,21 +63,29 @@ class PyrenderProcess:
 
     def request(self, key, scene, camera, options: dict) -> None:
         """Ask for a render of ``key`` (sent now, or after the one in flight)."""
-        if key == self.wanted:
+        if key == self.wanted or self.error == DIED:
             return
         self.wanted, self.waiting = key, (key, scene, camera, dict(options))
         self._send()
 
     def _send(self) -> None:
         if self.in_flight is None and self.waiting is not None:
-            self.conn.send(self.waiting)
+            try:
+                self.conn.send(self.waiting)
+            except OSError:  # the child is gone
+                self.error, self.waiting = DIED, None
+                return
             self.in_flight, self.waiting = self.waiting[0], None
 
     def poll(self) -> bool:
         """Take the finished results (never waits); True when a new image arrived."""
         new = False
         while self.in_flight is not None and self.conn.poll():
-            key, image, seconds, error = self.conn.recv()
+            try:
+                key, image, seconds, error = self.conn.recv()
+            except (EOFError, OSError):  # the child ended without answering
+                self.error, self.in_flight = DIED, None
+                return new
             self.in_flight = None
             if error is None:
                 self.image, self.image_key, self.seconds, self.error = image, key, seconds, None
