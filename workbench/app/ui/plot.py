@@ -8,13 +8,16 @@ only while the plot's window is shown (a reference can take long: radiosity or h
 finest patches, which cannot be cancelled midway, so closing the window waits for it).  Each
 panel whose image is final (a raster draw, a finished CPU job) gives one point per knob
 setting: its run time and :func:`workbench.compare.metrics.metrics` against the reference
-(RMSE, PSNR, FLIP), computed in a worker thread.  The UI thread only copies images and reads
-finished results; a change of scene or camera starts a new set of points.
+(RMSE, PSNR, FLIP), computed in a worker process: ``flip_evaluator`` holds the GIL (a 256 x 256
+evaluation, ~0.2 s, stalled the UI thread for as long when it ran in a thread).  The UI thread
+only copies images and reads finished results; a change of scene or camera starts a new set of
+points.
 """
 from __future__ import annotations
 
+import multiprocessing as mp
 import time
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -48,10 +51,10 @@ class ErrorPlot:
     metric: str = "rmse"
     shown: int = -2
     board: object = None
-    pool: ThreadPoolExecutor | None = None
+    pool: ProcessPoolExecutor | None = None
 
     def shutdown(self) -> None:
-        """Cancel the reference render and end the worker thread (joined)."""
+        """Cancel the reference render and end the worker process (joined)."""
         if self.board is not None:
             self.board.join_all()
         if self.pool is not None:
@@ -147,7 +150,7 @@ def track(state: AppState) -> None:
             continue
         image, seconds = final
         if plot.pool is None:
-            plot.pool = ThreadPoolExecutor(1, thread_name_prefix="ui-error-plot")
+            plot.pool = ProcessPoolExecutor(1, mp_context=mp.get_context("spawn"))
         label = ", ".join(f"{k} {v}" for k, v in opts)
         plot.pending[(m, opts)] = plot.pool.submit(_point, image, ref, seconds, label)
 
