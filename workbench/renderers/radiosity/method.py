@@ -119,7 +119,10 @@ def _shoot_raycast(geom, E, R, opts, stats, timings, tol, cap) -> solvers.SolveR
     """Matrix-free progressive refinement with ray-cast rows (receivers' exact factors times
     ray-cast visibility, :class:`.raycast.RayRows`; rows cached)."""
     from .raycast import RayRows
+    t1 = time.perf_counter()
     rr = RayRows(geom)
+    rr.rows(np.zeros(0, dtype=np.int64))      # the numba kernel's compile (or cache load), apart
+    timings["compile"] += time.perf_counter() - t1
     rows = solvers.RowCache(rr.rows, opts["row_cache_mb"])
     res = solvers.progressive_rows(rows, geom.areas, E, R, tol=tol, max_shots=cap,
                                    q=float(R.max()), ambient=opts["ambient"], relax=opts["relax"])
