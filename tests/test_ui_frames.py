@@ -65,6 +65,22 @@ def test_shown_panels_are_the_cli_images(gpu_session):
         assert np.abs(shown[..., :3].astype(int) - expected).max() <= 1, m
 
 
+def test_difference_view_on_the_gpu_is_the_cpu_error_map(gpu_session):
+    from workbench.app.ui.panels import colour_scale
+    from workbench.compare.metrics import error_map
+    out, _ = gpu_session
+    flat, phong = np.load(out / "image_flat.npy"), np.load(out / "image_phong.npy")
+    err, shown = np.load(out / "image_difference.npy"), np.load(out / "shown_difference.npy")
+    expected = error_map(flat, phong, "abs")
+    assert expected.max() > 0.05  # flat and phong differ (faceted spheres)
+    assert np.abs(err - expected).max() < 1e-5
+    colours = colour_scale(expected, float(expected.max()))
+    # same colour, or the neighbouring entry of the table where v / vmax rounds differently
+    off = np.abs(shown[..., :3].astype(int) - colours).max(-1)
+    step = np.abs(np.diff(colour_scale(np.linspace(0, 1, 256)[None], 1.0)[0].astype(int), axis=0)).max()
+    assert off.max() <= step and (off > 0).mean() < 1e-3
+
+
 def test_closing_leaves_no_thread(gpu_session):
     _, summary = gpu_session
     assert summary["threads"] == ["MainThread"]

@@ -6,11 +6,11 @@
   window's own moderngl context, and only when the panel's inputs change: the scene version
   (materials, lights), the tessellation knob and the shared camera (which carries the panel
   size).  A frame in which nothing changed draws nothing.
-* Every linear image reaches the screen through one GPU pass (:class:`SrgbEncoder`,
-  ``shaders/display_srgb.*``): sRGB encoding (IEC 61966-2-1, the numbers of
-  :func:`workbench.core.imageio.to_srgb8`) into an RGBA8 texture that imgui shows.  Raster
-  images are encoded straight from their framebuffer; CPU images (background jobs, display
-  modes, the colour wheel) are uploaded as float textures first, once per change.
+* Every panel's linear image has a GPU copy (:func:`linear_source`: a raster panel's
+  framebuffer, else a float texture uploaded once per change of the image) and reaches the
+  screen through GPU passes (:class:`DisplayPasses`, ``shaders/display*``): sRGB encoding
+  (IEC 61966-2-1, the numbers of :func:`workbench.core.imageio.to_srgb8`) into an RGBA8
+  texture that imgui shows, and the difference view's ``"abs"`` map and colour scale.
 * Pixels come back to the CPU only when asked for: ``state.images[m]`` of a raster panel is a
   pending read (:class:`~.images.PanelImages`), resolved once per draw by the probe, the
   difference view, the export or a script.
@@ -30,53 +30,83 @@ TILED = ("raycast", "raytrace")
 """CPU methods that accept ``on_tile`` (partial images)."""
 
 
-class SrgbEncoder:
-    """The display pass: a linear float texture -> an RGBA8 sRGB texture of the same size.
+class DisplayPasses:
+    """The GPU passes between the panels' linear images and the screen, each a full-screen
+    triangle (``shaders/display.vert``) reading its inputs with ``texelFetch`` (no filtering):
 
-    One program (``shaders/display_srgb.vert|frag``, a full-screen triangle, ``texelFetch`` so
-    nothing is filtered) and one float scratch texture per image size for uploads."""
+    * :meth:`encode` (``display_srgb.frag``): linear float -> RGBA8 sRGB;
+    * :meth:`difference` (``display_difference.frag``): two linear images -> their per-pixel
+      mean absolute difference (R32F), the ``"abs"`` error map;
+    * :meth:`colour_map` (``display_colour_map.frag``): a value image -> RGBA8 colours of a
+      table (the difference view's colour scale).
+
+    Also one float scratch texture per image size for :meth:`upload`."""
 
     def __init__(self, ctx):
-        from ...renderers.raster_shaders import SHADER_DIR
         self.ctx = ctx
-        self.program = ctx.program(
-            vertex_shader=(SHADER_DIR / "display_srgb.vert").read_text(encoding="utf-8"),
-            fragment_shader=(SHADER_DIR / "display_srgb.frag").read_text(encoding="utf-8"))
-        self.program["u_linear"].value = 0
-        self.vao = ctx.vertex_array(self.program, [])
+        self.programs = {name: self._program(name) for name in ("srgb", "difference", "colour_map")}
+        self.vaos = {name: ctx.vertex_array(prog, []) for name, prog in self.programs.items()}
         self.scratch: dict[tuple[int, int], object] = {}
 
-    def upload(self, image: np.ndarray):
-        """(H, W, 3) linear image (row 0 on top) -> the float scratch texture of its size."""
+    def _program(self, name: str):
+        from ...renderers.raster_shaders import SHADER_DIR
+        prog = self.ctx.program(
+            vertex_shader=(SHADER_DIR / "display.vert").read_text(encoding="utf-8"),
+            fragment_shader=(SHADER_DIR / f"display_{name}.frag").read_text(encoding="utf-8"))
+        for unit, sampler in enumerate(("u_linear", "u_a", "u_b", "u_value", "u_table")):
+            if sampler in prog:
+                prog[sampler].value = unit
+        return prog
+
+    def upload(self, image: np.ndarray, texture=None):
+        """(H, W, 3) linear image (row 0 on top) -> ``texture`` (a float RGB texture of its
+        size), by default the scratch texture of that size."""
         h, w = image.shape[:2]
-        tex = self.scratch.get((w, h))
-        if tex is None:
-            tex = self.scratch[(w, h)] = self.ctx.texture((w, h), 3, dtype="f4")
-        tex.write(np.ascontiguousarray(image, dtype=np.float32).tobytes())
-        return tex
+        if texture is None:
+            texture = self.scratch.get((w, h))
+            if texture is None:
+                texture = self.scratch[(w, h)] = self.ctx.texture((w, h), 3, dtype="f4")
+        texture.write(np.ascontiguousarray(image, dtype=np.float32).tobytes())
+        return texture
+
+    def _run(self, name: str, target, inputs: dict, **uniforms) -> None:
+        """Draw pass ``name`` into ``target`` with ``inputs`` {sampler: texture}."""
+        import moderngl
+
+        from ...renderers import gl
+        ctx, prog = self.ctx, self.programs[name]
+        fbo = ctx.framebuffer(color_attachments=[target])
+        fbo.use()
+        ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.CULL_FACE)
+        for sampler, tex in inputs.items():
+            tex.use(prog[sampler].value)
+        for k, v in uniforms.items():
+            prog[k].value = v
+        self.vaos[name].render(moderngl.TRIANGLES, vertices=3)
+        gl.release_framebuffer(fbo)
+        ctx.screen.use()  # back to the window's framebuffer for imgui
 
     def encode(self, source, target, flip: bool) -> None:
         """Fill ``target`` (RGBA8, the size of ``source``) with ``source`` sRGB-encoded, row 0
         on top; ``flip`` when ``source`` has row 0 at the bottom (a framebuffer)."""
-        import moderngl
+        self._run("srgb", target, {"u_linear": source}, u_flip=int(flip))
 
-        from ...renderers import gl
-        ctx = self.ctx
-        fbo = ctx.framebuffer(color_attachments=[target])
-        fbo.use()
-        ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.CULL_FACE)
-        source.use(0)
-        self.program["u_flip"].value = int(flip)
-        self.vao.render(moderngl.TRIANGLES, vertices=3)
-        gl.release_framebuffer(fbo)
-        ctx.screen.use()  # back to the window's framebuffer for imgui
+    def difference(self, a, b, target) -> None:
+        """Fill ``target`` (R32F) with the ``"abs"`` error map of ``a`` and ``b``, each given as
+        (texture, flip)."""
+        self._run("difference", target, {"u_a": a[0], "u_b": b[0]},
+                  u_flip_a=int(a[1]), u_flip_b=int(b[1]))
+
+    def colour_map(self, values, table, vmax: float, target) -> None:
+        """Fill ``target`` (RGBA8) with the colours of ``table`` ((n, 1) texture) for
+        ``values`` (R32F) in [0, ``vmax``]."""
+        self._run("colour_map", target, {"u_value": values, "u_table": table},
+                  u_scale=1.0 / vmax if vmax > 0 else 0.0)
 
     def release(self) -> None:
-        for tex in self.scratch.values():
-            tex.release()
+        for obj in [*self.scratch.values(), *self.vaos.values(), *self.programs.values()]:
+            obj.release()
         self.scratch.clear()
-        self.vao.release()
-        self.program.release()
 
 
 @dataclass
@@ -94,11 +124,16 @@ class RasterPanel:
 
 @dataclass
 class PanelGPU:
-    """The GPU side of the panels, created with the window's context: the display pass, the
-    raster panels, and the cache keys of the textures derived from CPU images."""
+    """The GPU side of the panels, created with the window's context: the display passes,
+    the raster panels, each panel's linear image on the GPU and the cache keys of what is
+    derived from images."""
 
-    encoder: SrgbEncoder
+    passes: DisplayPasses
     raster: dict[str, RasterPanel] = field(default_factory=dict)
+    linear: dict[str, tuple] = field(default_factory=dict)
+    """panel -> (float texture, flip, ``state.images.version`` it holds)."""
+    uploads: dict[str, object] = field(default_factory=dict)
+    """panel -> its float texture (CPU images uploaded), value images (R32F) and tables."""
     shown: dict[str, tuple] = field(default_factory=dict)
     """texture name -> key of the image it was last made from."""
 
@@ -106,7 +141,7 @@ class PanelGPU:
 def gpu(state: AppState) -> PanelGPU:
     """``state.gpu``, created on first use in the window's context."""
     if state.gpu is None:
-        state.gpu = PanelGPU(SrgbEncoder(state.ctx))
+        state.gpu = PanelGPU(DisplayPasses(state.ctx))
     return state.gpu
 
 
@@ -132,11 +167,35 @@ def _new_texture(state: AppState, size: tuple[int, int], components: int, **kw):
 def display_texture(state: AppState, key: str, size: tuple[int, int]):
     """The RGBA8 texture ``key`` of ``size`` (w, h), created or resized as needed."""
     tex = state.textures.get(key)
-    if tex is None or tex.size != size:
+    if tex is None or tex.size != size or tex.components != 4:
         if tex is not None:
             tex.release()
         tex = state.textures[key] = _new_texture(state, size, 4)
     return tex
+
+
+def _float_texture(state: AppState, name: str, size: tuple[int, int], components: int):
+    """The float texture ``name`` of :attr:`PanelGPU.uploads`, created or resized."""
+    g = gpu(state)
+    tex = g.uploads.get(name)
+    if tex is None or tex.size != size or tex.components != components:
+        if tex is not None:
+            tex.release()
+        tex = g.uploads[name] = state.ctx.texture(size, components, dtype="f4")
+    return tex
+
+
+def linear_source(state: AppState, method: str) -> tuple[object, bool]:
+    """(float texture, flip) holding ``state.images[method]`` on the GPU: a raster panel's
+    framebuffer as drawn, otherwise the image uploaded (once per change of it)."""
+    g = gpu(state)
+    version = state.images.version(method)
+    held = g.linear.get(method)
+    if held is None or held[2] != version:
+        image = state.images[method]
+        tex = _float_texture(state, method, (image.shape[1], image.shape[0]), 3)
+        held = g.linear[method] = (g.passes.upload(image, tex), False, version)
+    return held[0], held[1]
 
 
 def refresh_raster(state: AppState, method: str) -> bool:
@@ -153,17 +212,16 @@ def refresh_raster(state: AppState, method: str) -> bool:
             RasterSession(state.scene, method, tessellation=tess, ctx=state.ctx), key)
         state.status[method] = f"{panel.session.n_triangles} triangles"
     cam = state.camera
-    if panel.drawn == cam and method in state.images and method in state.textures:
+    if panel.drawn == cam and method in state.images:
         return False
     t0 = time.perf_counter()
     fbo = panel.session.framebuffer(cam.width, cam.height)
     panel.session.draw_to(fbo, cam)
-    g.encoder.encode(fbo.color_attachments[0],
-                     display_texture(state, method, (cam.width, cam.height)), flip=True)
     state.ctx.finish()  # the time shown is the draw's, not just its submission
+    state.ctx.screen.use()  # back to the window's framebuffer for imgui
     state.timings[method] = time.perf_counter() - t0
     state.images.set_pending(method, lambda: RasterSession.read_image(fbo))
-    g.shown[method] = (state.images.version(method), "direct24")
+    g.linear[method] = (fbo.color_attachments[0], True, state.images.version(method))
     panel.drawn, panel.draws = cam, panel.draws + 1
     return True
 
@@ -204,8 +262,35 @@ def panel_texture(state: AppState, method: str):
     mode = state.display.get(method, "direct24")
     key = (state.images.version(method), mode)
     if stale(state, method, key) or method not in state.textures:
-        upload_linear(state, method, shown_image(state, method))
+        if mode == "direct24":
+            source, flip = linear_source(state, method)
+            gpu(state).passes.encode(source, display_texture(state, method, source.size), flip)
+        else:
+            upload_linear(state, method, shown_image(state, method))
     return state.textures[method]
+
+
+def difference_on_gpu(state: AppState, a: str, b: str, table: np.ndarray) -> np.ndarray | None:
+    """The ``"abs"`` error map of panels ``a`` and ``b`` computed on the GPU from their
+    linear copies (no read-back of either image), shown in texture ``"difference"`` through
+    ``table`` ((n, 3) uint8 colour scale from 0 to the map's maximum, uploaded once per
+    window).  Returns the (H, W)
+    float32 map (read back: the probe and the export use it), or None when the two images
+    differ in size (the caller's CPU path then reports it)."""
+    g = gpu(state)
+    (ta, fa), (tb, fb) = linear_source(state, a), linear_source(state, b)
+    if ta.size != tb.size:
+        return None
+    values = _float_texture(state, "difference values", ta.size, 1)
+    g.passes.difference((ta, fa), (tb, fb), values)
+    err = np.frombuffer(values.read(), np.float32).reshape(ta.size[1], ta.size[0])
+    if "colour table" not in g.uploads:
+        g.uploads["colour table"] = state.ctx.texture((len(table), 1), 3,
+                                                      np.ascontiguousarray(table, np.uint8).tobytes(),
+                                                      alignment=1)
+    g.passes.colour_map(values, g.uploads["colour table"], max(float(err.max()), 1e-6),
+                        display_texture(state, "difference", ta.size))
+    return err
 
 
 def upload(state: AppState, key: str, rgb8: np.ndarray):
@@ -225,9 +310,9 @@ def upload_linear(state: AppState, key: str, image: np.ndarray):
     """Show a linear (H, W, 3) image: upload it as floats and sRGB-encode it on the GPU into
     the RGBA8 texture ``key``."""
     h, w = image.shape[:2]
-    enc = gpu(state).encoder
+    passes = gpu(state).passes
     target = display_texture(state, key, (w, h))
-    enc.encode(enc.upload(image), target, flip=False)
+    passes.encode(passes.upload(image), target, flip=False)
     return target
 
 
@@ -236,7 +321,9 @@ def release_gl(state: AppState) -> None:
     if state.gpu is not None:
         for panel in state.gpu.raster.values():
             panel.session.release()
-        state.gpu.encoder.release()
+        for tex in state.gpu.uploads.values():
+            tex.release()
+        state.gpu.passes.release()
         state.gpu = None
     for tex in state.textures.values():
         tex.release()

@@ -5,7 +5,7 @@ import numpy as np
 from imgui_bundle import imgui
 
 from . import camera as cam
-from .frames import panel_texture, stale, upload, upload_linear
+from .frames import difference_on_gpu, panel_texture, stale, upload, upload_linear
 from .inspect import export, pixel_under_mouse, probe_tooltip, select_ray_tree
 from .layout import focus
 from .patch_view import select_patch
@@ -189,9 +189,11 @@ def difference_panel(state: AppState) -> None:
     # recomputed only when either image or the kind changed (a static frame reads no pixels)
     key = (a, b, state.diff_kind, state.images.version(a), state.images.version(b))
     if stale(state, "difference", key) or "difference" not in state.textures:
-        err = error_map(state.images[a], state.images[b], state.diff_kind)
+        err = difference_on_gpu(state, a, b, hot_table()) if state.diff_kind == "abs" else None
+        if err is None:  # FLIP (or images of different sizes: error_map says so)
+            err = error_map(state.images[a], state.images[b], state.diff_kind)
+            upload(state, "difference", colour_scale(err, max(float(err.max()), 1e-6)))
         state.images["difference"] = err
-        upload(state, "difference", colour_scale(err, max(float(err.max()), 1e-6)))
     err, tex = state.images["difference"], state.textures["difference"]
     vmax = max(float(err.max()), 1e-6)
     size = imgui.ImVec2(state.camera.width, state.camera.height)

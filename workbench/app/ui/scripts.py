@@ -270,9 +270,11 @@ class Fps:
 
 
 class GpuPanels:
-    """GL panels on the GPU: frames 2 to 5 change nothing, frame 5 orbits the camera, frame 7
-    saves each GL panel's display texture (the RGBA8 pixels imgui shows, ``shown_M.npy``) and
-    quits.  Logs each GL panel's draw count and the read-backs at frames 2, 5 and 7."""
+    """GL panels on the GPU: frames 2 to 5 change nothing, frame 5 orbits the camera and sets
+    the difference view to flat - phong ("abs"), frame 7 saves each GL panel's display texture
+    (the RGBA8 pixels imgui shows, ``shown_M.npy``), the difference map with its texture and
+    both images, and quits.  Logs each GL panel's draw count and the read-backs at frames 2, 5
+    and 7."""
 
     def __init__(self, out: Path):
         self.out, self.log = out, {}
@@ -284,11 +286,14 @@ class GpuPanels:
                                      "reads": state.images.reads}
         if f == 5:
             state.camera = cam.orbit(state.camera, 0.3, 0.1)
+            state.diff_pair, state.diff_kind = ("flat", "phong"), "abs"
         elif f == 7:
             w, h = state.camera.width, state.camera.height
-            for m in state.gpu.raster:
-                shown = np.frombuffer(state.textures[m].read(), np.uint8).reshape(h, w, 4)
+            for m in [*state.gpu.raster, "difference"]:
+                shown = np.frombuffer(state.textures[m].read(), np.uint8).reshape(h, w, -1)
                 np.save(self.out / f"shown_{m}.npy", shown)
+            for m in ("flat", "phong", "difference"):
+                np.save(self.out / f"image_{m}.npy", state.images[m])
             self.log["position"] = list(state.camera.position)
             state.quit = True
 
