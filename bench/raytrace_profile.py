@@ -1,10 +1,14 @@
-"""Where the Whitted ray tracer spends its trace phase: numba kernels against the numpy glue
-between ray generations, per generation, on 1 and 2 threads.
+"""Where the Whitted ray tracer spends its trace phase, on 1 and 2 threads: the fused kernel
+(whole ray trees per pixel, the path the Whitted scene takes) against the wavefront path
+(the path of scenes with numpy textures), whose numba kernels are timed against the numpy glue
+between ray generations, per generation.
 
 The Whitted scene at 640 x 480, depth 5, threshold 1/255 (as ``bench/povray_whitted.py``),
-warm JIT cache, best of 3 renders per thread count.  The kernels of
-:mod:`workbench.renderers.raytrace.kernels` are wrapped (in this process only) by timers that
-record wall and CPU seconds of each call; ``glue`` is the trace phase minus the kernels.
+warm JIT cache, best of 3 renders per thread count and path.  For the wavefront runs the
+Whitted scene is sent down the wavefront path (``whitted.fused_textures`` answers None) and
+the kernels of :mod:`workbench.renderers.raytrace.kernels` are wrapped (in this process only)
+by timers that record wall and CPU seconds of each call; ``glue`` is the trace phase minus
+the kernels.
 CPU seconds over wall seconds of a kernel is its thread utilisation (2.0 = both threads busy;
 on a shared machine other processes lower it).
 
@@ -49,6 +53,19 @@ def _instrument(kernels, whitted, log):
     whitted._Tracer.trace = trace
 
 
+def fused(threads: int, repeats: int = 3) -> dict:
+    """Best trace phase of the fused path."""
+    import numba
+
+    import workbench
+    numba.set_num_threads(threads)
+    scene = workbench.load_scene("whitted")
+    r = min((workbench.render(scene, "raytrace", width=W, height=H, threshold=1.0 / 255.0, max_depth=5)
+             for _ in range(repeats)), key=lambda r: r.timings["trace"])
+    return dict(threads=threads, trace_s=r.timings["trace"], trace_cpu_s=r.timings["trace_cpu"],
+                total_rays=r.stats["total_rays"], mrays_per_s=r.stats["total_rays"] / r.timings["trace"] / 1e6)
+
+
 def profile(threads: int, repeats: int = 3) -> dict:
     import numba
 
@@ -89,10 +106,13 @@ def main() -> dict:
     import workbench
     from workbench.renderers.raytrace import kernels, whitted
     workbench.render(workbench.load_scene("whitted"), "raytrace", width=32, height=24)  # JIT / cache
-    _instrument(kernels, whitted, LOG)
     res = dict(machine=f"{os.cpu_count()} CPUs (shared); load average {os.getloadavg()[0]:.2f} at start",
                numba_threading_layer=numba.threading_layer(), size=f"{W}x{H}",
-               runs=[profile(t) for t in (1, 2)])
+               fused=[fused(t) for t in (1, 2)])
+    whitted.fused_textures = lambda scene, sd: None  # the wavefront path from here on
+    workbench.render(workbench.load_scene("whitted"), "raytrace", width=32, height=24)
+    _instrument(kernels, whitted, LOG)
+    res["wavefront"] = [profile(t) for t in (1, 2)]
     RESULTS.mkdir(parents=True, exist_ok=True)
     (RESULTS / "raytrace_profile.json").write_text(json.dumps(res, indent=2))
     print(json.dumps(res, indent=2))

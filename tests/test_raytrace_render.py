@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import workbench
-from workbench.renderers.raytrace import reference
+from workbench.renderers.raytrace import reference, whitted
 from workbench.scene import library
 from workbench.scene.io import scene_from_dict
 
@@ -29,6 +29,34 @@ def test_kernels_match_the_reference(name):
     err = np.abs(r.image - ref).max(-1)
     assert np.mean(err > 1e-5) <= 0.02, f"{np.sum(err > 1e-5)} pixels differ, max {err.max()}"
     assert np.median(err) < 1e-6
+
+
+@pytest.mark.parametrize("name", ["whitted", "csg", "cornell", "mesh", "quadrics"])
+def test_fused_kernel_matches_the_wavefront_kernels(name, monkeypatch):
+    """The fused kernel (whole ray trees pixel by pixel, checker textures evaluated in numba)
+    gives the wavefront kernels' image, depth map and ray counts (generation by generation,
+    textures in numpy); only the order of the floating-point sums differs."""
+    sc = workbench.load_scene(name)
+    opts = dict(width=24, height=18, max_depth=5, threshold=1e-3, spp=2, fresnel="schlick")
+    paths = []
+    fused_trace = whitted._Tracer._trace_fused
+    monkeypatch.setattr(whitted._Tracer, "_trace_fused",
+                        lambda self, *a: paths.append("fused") or fused_trace(self, *a))
+    fused = workbench.render(sc, "raytrace", **opts)
+    monkeypatch.setattr(whitted, "fused_textures", lambda scene, sd: None)
+    wave = workbench.render(sc, "raytrace", **opts)
+    assert paths == ["fused"]  # the first render went through the fused kernel, the second did not
+    assert np.allclose(fused.image, wave.image, rtol=0, atol=1e-6)
+    assert np.array_equal(fused.depth, wave.depth)
+    assert fused.stats == {**wave.stats, "mrays_per_s": fused.stats["mrays_per_s"]}
+
+
+def test_textures_the_fused_kernel_cannot_evaluate_take_the_wavefront_path():
+    """Image textures, bump maps and environments need numpy between generations."""
+    for name, fused in (("whitted", True), ("globe", False), ("bricks", False), ("envmap", False)):
+        sc = workbench.load_scene(name)
+        sd = whitted.flatten(sc)
+        assert (whitted.fused_textures(sc, sd) is not None) == fused, name
 
 
 def _scaled_whitted(s):

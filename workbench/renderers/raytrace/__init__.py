@@ -2,8 +2,9 @@
 ``intersect`` (``workbench.raytrace.intersect``) and ``ray_tree``.
 
 Modules: :mod:`.flatten` (scene -> arrays), :mod:`.bvh` (binned SAH BVH), :mod:`.kernels`
-(numba: intersection, shading with shadow feelers, child rays), :mod:`.whitted` (the two
-renderers, wavefront loop, textures through :mod:`workbench.renderers.texturing`), and the
+(numba: intersection, shading with shadow feelers, child rays; the fused per-pixel kernel),
+:mod:`.whitted` (the two renderers: the fused path, or the wavefront loop with textures
+through :mod:`workbench.renderers.texturing`), and the
 readable reference :mod:`.shapes` + :mod:`.csg` + :mod:`.reference` (one ray at a time, the
 course's trace / shade / intersect structure; tested against the kernels).
 
@@ -23,7 +24,8 @@ of rows with the finished (y1 - y0, x1 - x0, 3) float32 linear tile (full width 
 Stats: ``primary_rays``, ``shadow_rays``, ``reflected_rays``, ``refracted_rays``,
 ``ended_by_depth``, ``ended_by_threshold``, ``escaped_rays``, ``total_internal_reflections``,
 ``total_rays``, ``mrays_per_s``; timings ``build`` (scene arrays and BVH), ``bvh_build``,
-``compile`` (first-call JIT or numba disk-cache load), ``trace`` and ``trace_cpu``;
+``compile`` (first-call JIT or numba disk-cache load of the kernels the render needs),
+``trace`` (camera rays, tracing and shading) and ``trace_cpu``;
 ``RenderResult.depth`` is the camera-space depth of the primary hit.
 
 Conventions: normals from the intersection are outward; the shading normal is turned towards

@@ -19,6 +19,7 @@ Primitive table (``P`` rows)
 ``solid`` (P,) bool: a closed surface with an inside (refraction enters a medium), else a thin
 sheet (transmission goes straight through).
 ``shadow`` (P,) bool: casts shadows (area lights' own polygons do not).
+``ident`` (P,) bool: ``object_from_world`` is the identity (the kernels skip the transform).
 """
 from __future__ import annotations
 
@@ -37,6 +38,7 @@ CSG_DEPTH = 16
 check bounds, so deeper trees are refused when the scene is flattened)."""
 _CSG_OPS = {"union": CSG_UNION, "intersection": CSG_INTERSECTION, "difference": CSG_DIFFERENCE}
 NPAR = 20
+_IDENTITY_ROWS = np.eye(4)[:3].reshape(-1)
 
 
 @dataclass
@@ -52,6 +54,7 @@ class SceneData:
     par: np.ndarray
     solid: np.ndarray
     shadow: np.ndarray
+    ident: np.ndarray
     wfo: np.ndarray             # (P, 4, 4) world_from_object (texturing, bump)
     has_uv: np.ndarray          # (P,) bool: a mesh with uvs (else texturing's own mapping)
     poly_v: np.ndarray          # (K, 3) polygon vertices, object space
@@ -74,7 +77,7 @@ class SceneData:
         """The geometry tuple passed to every numba kernel."""
         return (self.ptype, self.top, self.xf, self.nm, self.par, self.solid, self.shadow,
                 self.poly_v, self.csg_prog, self.tri_v, self.tri_n, self.tri_uv, self.tri_e,
-                self.tri_prim, self.bvh_box, self.bvh_meta)
+                self.tri_prim, self.bvh_box, self.bvh_meta, self.ident)
 
 
 def _material_row(mat: m.Material, front_only: bool = False) -> np.ndarray:
@@ -273,6 +276,7 @@ def flatten(scene: m.Scene) -> SceneData:
         mat=col("mat", np.int64), xf=col("xf", np.float64).reshape(-1, 12),
         nm=col("nm", np.float64).reshape(-1, 9), par=col("par", np.float64).reshape(-1, NPAR),
         solid=col("solid", np.bool_), shadow=col("shadow", np.bool_),
+        ident=np.ascontiguousarray([bool(np.array_equal(r["xf"], _IDENTITY_ROWS)) for r in rows], dtype=np.bool_),
         wfo=col("wfo", np.float64).reshape(-1, 4, 4), has_uv=col("has_uv", np.bool_),
         poly_v=np.ascontiguousarray(np.concatenate(b.poly_v) if b.poly_v else np.zeros((1, 3))),
         csg_prog=np.array(b.prog if b.prog else [0], dtype=np.int64),

@@ -24,6 +24,16 @@ from .flatten import (BOX, CSG_DEPTH, CSG_DIFFERENCE, CSG_INTERSECTION, CSG_UNIO
                       QUADRIC, RECT, SPHERE)
 
 CHUNK = 64
+FAST_MATH = {"nsz", "arcp"}
+"""The fast-math flags of the hot kernels: signed zeros may be ignored, a division may become a
+multiplication by a reciprocal.  Not ``nnan``/``ninf``: misses are ``inf`` and the tests look
+for NaN, so the compiler may not assume either away.  Not ``contract``: a fused multiply-add
+breaks the watertight triangle test (the two triangles of a shared edge must round its edge
+function the same way, or a ray through the edge misses both)."""
+NO_REFCOUNT = dict(cache=True, error_model="numpy", _nrt=False, fastmath=FAST_MATH)
+"""Options of the kernels that allocate nothing: compiled without numba's reference counting
+(no atomic increments and decrements of every array they touch, which cost the fused kernel
+40 % of its time); the arrays they use belong to their (reference-counted) callers."""
 BVH_STACK = 128
 CSG_EVENTS = 32
 # Slab exits are enlarged by 1 + 2 gamma_3 (gamma_n = n u / (1 - n u), u = 2^-53) so that
@@ -40,7 +50,7 @@ def _to_object(xf, k, ox, oy, oz, dx, dy, dz):
             xf[k, 8] * dx + xf[k, 9] * dy + xf[k, 10] * dz)
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**NO_REFCOUNT)
 def solve_quadratic(A, B, C, zero):
     """Real roots of ``A t^2 + B t + C`` sorted (DESIGN errata 7: ``q = -(B + sign(B) sqrt(disc))/2``,
     roots ``q/A`` and ``C/q``); ``A = 0`` (relative to ``zero``) gives the linear root ``-C/B``.
@@ -65,7 +75,15 @@ def solve_quadratic(A, B, C, zero):
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
 def sphere_roots(par, k, ox, oy, oz, dx, dy, dz):
-    """Roots of the ray / sphere equation in object space.
+    """Roots of the ray / sphere equation in object space (see :func:`sphere_roots_unit`)."""
+    inv_s = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
+    return sphere_roots_unit(par, k, ox, oy, oz, dx * inv_s, dy * inv_s, dz * inv_s, inv_s)
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def sphere_roots_unit(par, k, ox, oy, oz, ux, uy, uz, inv_s):
+    """Roots of the ray / sphere equation in object space, for the unit direction ``u`` of a
+    ray direction of length ``1 / inv_s`` (the roots are in units of that direction).
 
     Errata 1 (B uses O - C) and the cancellation-free discriminant of Haines et al.,
     "Precision improvements for ray/sphere intersection" (Ray Tracing Gems, 2019):
@@ -73,8 +91,6 @@ def sphere_roots(par, k, ox, oy, oz, dx, dy, dz):
     entirely behind the origin reports no roots (no ray or CSG query needs ``t < 0``)."""
     fx, fy, fz = ox - par[k, 0], oy - par[k, 1], oz - par[k, 2]
     r = par[k, 3]
-    inv_s = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
-    ux, uy, uz = dx * inv_s, dy * inv_s, dz * inv_s
     b = fx * ux + fy * uy + fz * uz
     ff = fx * fx + fy * fy + fz * fz
     if b > 0.0 and ff > r * r:  # outside and moving away: both roots behind the origin
@@ -153,7 +169,7 @@ def _in_bounds(par, k, x, y, z, slack):
 
 
 # ----------------------------------------------------------------------------- primitives
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**NO_REFCOUNT)
 def _polygon_hit(k, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax):
     """Planar convex polygon ``k``: plane hit inside every edge.  Not inlined (a rarely used
     path: one compiled copy instead of one per call site of :func:`closest`)."""
@@ -177,7 +193,7 @@ def _polygon_hit(k, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax):
     return t, 0
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**NO_REFCOUNT)
 def _quadric_hit(k, par, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
     """General quadric ``k`` cut to its bounds: first root in ``(tmin, tmax)`` inside them.
     Not inlined (see :func:`_polygon_hit`)."""
@@ -191,12 +207,13 @@ def _quadric_hit(k, par, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def prim_hit(k, ptype, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
-    """Closest hit ``tmin < t < tmax`` of analytic primitive ``k`` (object-space ray).
+def prim_hit(k, ptype, par, poly_v, ox, oy, oz, dx, dy, dz, ux, uy, uz, inv_s, tmin, tmax, zero):
+    """Closest hit ``tmin < t < tmax`` of analytic primitive ``k`` (object-space ray with
+    direction ``d``; spheres use its unit direction ``u`` and ``inv_s = 1 / |d|``).
     Returns ``(t, face)``, ``t = inf`` on a miss."""
     kind = ptype[k]
     if kind == SPHERE:
-        ok, t0, t1 = sphere_roots(par, k, ox, oy, oz, dx, dy, dz)
+        ok, t0, t1 = sphere_roots_unit(par, k, ox, oy, oz, ux, uy, uz, inv_s)
         if ok:
             if tmin < t0 < tmax:
                 return t0, 0
@@ -230,7 +247,7 @@ def prim_hit(k, ptype, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
     return np.inf, 0
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**NO_REFCOUNT)
 def leaf_events(k, ptype, par, ox, oy, oz, dx, dy, dz, zero, et, ep, ef):
     """Interval list (entering / leaving events along the whole line) of solid leaf ``k``:
     sphere, box, or quadric inside ``P^T Q P < 0`` intersected with its bounds box.
@@ -305,7 +322,7 @@ def _op(op, a, b):
     return a and not b
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**NO_REFCOUNT)
 def combine(op, ta, pa, fa, na, tb, pb, fb, nb_, to, po, fo, eps):
     """Combine two interval lists by a boolean ``op`` (the course's ``composite_intersect``):
     sweep the events of both lists in order, grouping events closer than ``eps`` (coincident
@@ -347,7 +364,7 @@ def combine(op, ta, pa, fa, na, tb, pb, fb, nb_, to, po, fo, eps):
     return m
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**NO_REFCOUNT)
 def csg_hit(start, length, prog, ptype, xf, par, ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps,
             st, sp_, sf, sn):
     """Evaluate a CSG postfix program along a ray (the course's recursive ``intersect``, made
@@ -426,10 +443,11 @@ def _box_entry(box, nd, ox, oy, oz, ix, iy, iz, tmin, best):
     return tn
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**NO_REFCOUNT)
 def bvh_hit(tv, box, meta, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     """Closest (or any) triangle hit through the BVH, near child first (both children's boxes
-    are tested at their parent; the farther one waits on ``stack``).  Returns
+    are tested at their parent; the farther one waits on ``stack``, a row ``(entry distance,
+    node)``, and is skipped when popped if the best hit is now nearer than its box).  Returns
     ``(t, tri, b1, b2)``."""
     ax0, ax1, ax2 = abs(dx), abs(dy), abs(dz)
     kz = 0
@@ -473,15 +491,15 @@ def bvh_hit(tv, box, meta, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
             elif tl == np.inf:
                 nd = right
             else:
-                near, far = (left, right) if tl <= tr else (right, left)
+                near, far, tfar = (left, right, tr) if tl <= tr else (right, left, tl)
                 if sp < stack.shape[0]:
-                    stack[sp] = far
+                    stack[sp, 0], stack[sp, 1] = tfar, far
                     sp += 1
                 nd = near
         while nd < 0 and sp > 0:  # pop, culling nodes now beyond the best hit
             sp -= 1
-            if _box_entry(box, stack[sp], ox, oy, oz, ix, iy, iz, tmin, best) < np.inf:
-                nd = stack[sp]
+            if stack[sp, 0] <= best:
+                nd = int(stack[sp, 1])
         if nd < 0:
             break
     if btri < 0:
@@ -496,12 +514,18 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
     BVH over triangles).  Returns ``(t, prim, face, tri, b1, b2)``; ``prim = -1`` on a miss,
     negative ``face`` is never returned (a flipped CSG normal is ``face + 16``)."""
     (ptype, top, xf, nm, par, solid, shadow, poly_v, prog, tri_v, tri_n, tri_uv, tri_e,
-     tri_prim, bvh_box, bvh_meta) = geo
+     tri_prim, bvh_box, bvh_meta, ident) = geo
     best, bp, bf, btri, bb1, bb2 = tmax, -1, 0, -1, 0.0, 0.0
+    inv_w = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
     for k in range(ptype.shape[0]):
         if not top[k] or (shadow_only and not shadow[k]):
             continue
-        lo = _to_object(xf, k, ox, oy, oz, dx, dy, dz)
+        if ident[k]:  # object space is world space: no transform, the world unit direction
+            lo = (ox, oy, oz, dx, dy, dz)
+            inv_s = inv_w
+        else:
+            lo = _to_object(xf, k, ox, oy, oz, dx, dy, dz)
+            inv_s = 1.0 / math.sqrt(lo[3] * lo[3] + lo[4] * lo[4] + lo[5] * lo[5])
         if ptype[k] == CSGNODE:
             t, code, f = csg_hit(int(par[k, 0]), int(par[k, 1]), prog, ptype, xf, par, ox, oy, oz,
                                  dx, dy, dz, tmin, best, zero, eps, st, sp_, sf, sn)
@@ -510,7 +534,7 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
                 btri = -1
         else:
             t, f = prim_hit(k, ptype, par, poly_v, lo[0], lo[1], lo[2], lo[3], lo[4], lo[5],
-                            tmin, best, zero)
+                            lo[3] * inv_s, lo[4] * inv_s, lo[5] * inv_s, inv_s, tmin, best, zero)
             if t < best:
                 best, bp, bf, btri = t, k, f, -1
         if any_hit and bp >= 0:
@@ -553,13 +577,13 @@ def _normalize(x, y, z):
     return 0.0, 0.0, 0.0
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_uv, out_po, out_e, i):
     """Geometric (outward) normal, shading normal, uv (meshes; analytic primitives leave the
     mapping to the texturing module), object-space point and vertex emission at a hit, written
     to row ``i`` of the output arrays."""
     (ptype, top, xf, nm, par, solid, shadow, poly_v, prog, tri_v, tri_n, tri_uv, tri_e,
-     tri_prim, bvh_box, bvh_meta) = geo
+     tri_prim, bvh_box, bvh_meta, ident) = geo
     x = xf[k, 0] * px + xf[k, 1] * py + xf[k, 2] * pz + xf[k, 3]
     y = xf[k, 4] * px + xf[k, 5] * py + xf[k, 6] * pz + xf[k, 7]
     z = xf[k, 8] * px + xf[k, 9] * py + xf[k, 10] * pz + xf[k, 11]
@@ -600,9 +624,9 @@ def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_
 # ----------------------------------------------------------------------------- batch kernels
 @nb.njit(cache=True, error_model="numpy", inline="always")
 def scratch():
-    """Per-thread work arrays of :func:`closest`: the BVH traversal stack and the CSG stack of
-    interval lists (times, signed primitive codes, faces, counts)."""
-    return (np.empty(BVH_STACK, dtype=np.int64), np.empty((CSG_DEPTH, CSG_EVENTS)),
+    """Per-thread work arrays of :func:`closest`: the BVH traversal stack (rows: entry distance,
+    node) and the CSG stack of interval lists (times, signed primitive codes, faces, counts)."""
+    return (np.empty((BVH_STACK, 2)), np.empty((CSG_DEPTH, CSG_EVENTS)),
             np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64),
             np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64), np.empty(CSG_DEPTH, dtype=np.int64))
 
@@ -614,34 +638,40 @@ def trace_batch(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel,
     n = O.shape[0]
     nchunks = (n + CHUNK - 1) // CHUNK
     for c in prange(nchunks):
-        stack, st, sp_, sf, sn = scratch()
-        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
-            ox, oy, oz = O[i, 0], O[i, 1], O[i, 2]
-            eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
-            t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, D[i, 0], D[i, 1], D[i, 2], tmin[i],
-                                           tmax[i], False, False, zero, eps, stack, st, sp_, sf, sn)
-            t_out[i], prim_out[i] = t, k
-            if k >= 0:
-                surface(geo, k, f, tri, b1, b2, ox + t * D[i, 0], oy + t * D[i, 1],
-                        oz + t * D[i, 2], ncancel, ng, ns, uv, po, ev, i)
+        trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, t_out, prim_out, ng, ns,
+                    uv, po, ev, c * CHUNK, min(n, (c + 1) * CHUNK), scratch())
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**NO_REFCOUNT)
+def trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, t_out, prim_out, ng, ns, uv,
+                po, ev, i0, i1, scr):
+    """Rays ``i0 .. i1 - 1`` of :func:`trace_batch` (``scr``: :func:`scratch`)."""
+    stack, st, sp_, sf, sn = scr
+    for i in range(i0, i1):
+        ox, oy, oz = O[i, 0], O[i, 1], O[i, 2]
+        eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
+        t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, D[i, 0], D[i, 1], D[i, 2], tmin[i],
+                                       tmax[i], False, False, zero, eps, stack, st, sp_, sf, sn)
+        t_out[i], prim_out[i] = t, k
+        if k >= 0:
+            surface(geo, k, f, tri, b1, b2, ox + t * D[i, 0], oy + t * D[i, 1],
+                    oz + t * D[i, 2], ncancel, ng, ns, uv, po, ev, i)
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def _transmittance(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmin, tmax, transmissive, zero,
                    eps, stack, st, sp_, sf, sn):
-    """Shadow feeler: 1 if nothing blocks the segment, 0 if blocked; with ``transmissive``, the
-    product of the ``kt`` of every surface crossed (at most 32)."""
-    if not transmissive:
-        t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, True, True, zero,
-                                       eps, stack, st, sp_, sf, sn)
-        return 0.0 if k >= 0 else 1.0
+    """Shadow feeler: 1 if nothing blocks the segment, 0 if blocked (any hit ends the search);
+    with ``transmissive``, the product of the ``kt`` of every surface crossed (at most 32)."""
     v = 1.0
     t0 = tmin
     for _ in range(32):
-        t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, t0, tmax, True, False, zero,
-                                       eps, stack, st, sp_, sf, sn)
+        t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, t0, tmax, True, not transmissive,
+                                       zero, eps, stack, st, sp_, sf, sn)
         if k < 0:
             return v
+        if not transmissive:
+            return 0.0
         v *= mat_tab[mat_of[k], 8]
         if v <= 0.0:
             return 0.0
@@ -669,21 +699,25 @@ def _ior(mat_tab, stk, ns_):
     return mat_tab[stk[ns_ - 1], 9] if ns_ > 0 else 1.0
 
 
-@nb.njit(cache=True, error_model="numpy", parallel=True)
-def shade_batch(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim, ng, nsh, col, ev,
-                w, depth, stk, nstk, pix, opts, contrib, out_o, out_d, out_w, out_stk, out_nstk,
-                out_kind, out_tmin, out_pix, out_gen, counts):
-    """Local model with shadow feelers at each hit, then the reflected and refracted children.
+@nb.njit(**NO_REFCOUNT)
+def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, O, D, w, depth, stk, nstk, i,
+              t, prim, ng, nsh, col, ev, contrib, out_o, out_d, out_w, out_stk, out_nstk, out_kind,
+              out_tmin, out_gen, s0, counts, stack, st, sp_, sf, sn):
+    """Local model with shadow feelers at the hit of ray ``i``, then its reflected and refracted
+    children (one step of the course's ``shade``).
+
+    The ray is row ``i`` of ``O, D, w, depth, stk, nstk`` and its hit row ``i`` of ``t, prim,
+    ng, nsh, col, ev``; the local colour times the ray's weight goes to ``contrib[i]``, the
+    children to slots ``s0`` (reflection) and ``s0 + 1`` (refraction) of the ``out_*`` arrays
+    (``out_kind`` 0 = none, 1 reflected, 2 refracted), the counts to ``counts[i]``: shadow
+    rays, ended by depth, ended by threshold, total internal reflections, reflected and
+    refracted children, escaped (missed everything).
 
     ``opts``: max_depth, threshold, fresnel (0 none, 1 Schlick, 2 exact), transmissive shadows,
     blinn, shadows on, reflection on, refraction on, tol.ray_offset, tol.t_min, tol.zero,
     extent, misses see ``background`` (else they contribute nothing here: an environment map
-    is evaluated by the caller).  Child slots: ``2 i`` (reflection), ``2 i + 1`` (refraction);
-    ``out_kind`` 0 = none, with their ``tmin``, pixel and generation.  ``counts[i]``: shadow
-    rays, ended by depth, ended by threshold, total internal reflections, reflected and
-    refracted children, escaped (missed everything).
+    is evaluated by the caller).
     """
-    n = O.shape[0]
     max_depth, threshold, fres = int(opts[0]), opts[1], int(opts[2])
     transmissive, blinn = opts[3] > 0.5, opts[4] > 0.5
     do_shadow, do_refl, do_refr = opts[5] > 0.5, opts[6] > 0.5, opts[7] > 0.5
@@ -691,209 +725,375 @@ def shade_batch(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim
     add_bg = opts[12] > 0.5
     nl = lights.shape[0]
     solid = geo[5]
+    out_kind[s0], out_kind[s0 + 1] = 0, 0
+    for q in range(7):
+        counts[i, q] = 0
+    k = prim[i]
+    if k < 0:
+        counts[i, 6] = 1
+        for q in range(3):
+            contrib[i, q] = w[i, q] * background[q] if add_bg else 0.0
+        return
+    mi = mat_of[k]
+    dx, dy, dz = D[i, 0], D[i, 1], D[i, 2]
+    px, py, pz = O[i, 0] + t[i] * dx, O[i, 1] + t[i] * dy, O[i, 2] + t[i] * dz
+    # Beer-Lambert absorption by the medium the ray travelled through
+    w0, w1, w2 = w[i, 0], w[i, 1], w[i, 2]
+    if nstk[i] > 0:
+        ma = stk[i, nstk[i] - 1]
+        w0 *= math.exp(-mat_tab[ma, 10] * t[i])
+        w1 *= math.exp(-mat_tab[ma, 11] * t[i])
+        w2 *= math.exp(-mat_tab[ma, 12] * t[i])
+    sx, sy, sz = -dx, -dy, -dz
+    gx, gy, gz = ng[i, 0], ng[i, 1], ng[i, 2]
+    nx, ny, nz = nsh[i, 0], nsh[i, 1], nsh[i, 2]
+    if nx * sx + ny * sy + nz * sz < 0.0:  # two-sided: shading normal faces the viewer
+        nx, ny, nz = -nx, -ny, -nz
+    front = gx * sx + gy * sy + gz * sz > 0.0
+    # side of the surface the ray came from
+    fx, fy, fz = (gx, gy, gz) if front else (-gx, -gy, -gz)
+    if mat_tab[mi, 17] > 0.5:  # textured: the caller's colour
+        cr, cg, cb = col[i, 0], col[i, 1], col[i, 2]
+    else:
+        cr, cg, cb = mat_tab[mi, 0], mat_tab[mi, 1], mat_tab[mi, 2]
+    ka, kd, ks, shin = mat_tab[mi, 3], mat_tab[mi, 4], mat_tab[mi, 5], mat_tab[mi, 6]
+    er, eg, eb = ev[i, 0], ev[i, 1], ev[i, 2]
+    if mat_tab[mi, 16] < 0.5 or front:
+        er, eg, eb = er + mat_tab[mi, 13], eg + mat_tab[mi, 14], eb + mat_tab[mi, 15]
+    lr = ka * cr * ambient[0] + er
+    lg = ka * cg * ambient[1] + eg
+    lb = ka * cb * ambient[2] + eb
+    pm = max(abs(px), abs(py), abs(pz))
+    off = ray_off * max(pm, extent)
+    eps = off
+    nshadow = 0
+    for li in range(nl):
+        if lights[li, 0] > 0.5:
+            lx, ly, lz = -lights[li, 1], -lights[li, 2], -lights[li, 3]
+            dist = np.inf
+            scale = 1.0
+        else:
+            vx, vy, vz = lights[li, 1] - px, lights[li, 2] - py, lights[li, 3] - pz
+            dist = math.sqrt(vx * vx + vy * vy + vz * vz)
+            lx, ly, lz = _normalize(vx, vy, vz)
+            scale = 1.0
+            if lights[li, 7] > 0.5:
+                scale = 1.0 / max(dist * dist, 1e-300)
+            if lights[li, 8] > 0.5:
+                scale *= max(0.0, -(lx * lights[li, 9] + ly * lights[li, 10] + lz * lights[li, 11]))
+        ndl = nx * lx + ny * ly + nz * lz
+        if ndl <= 0.0 or scale == 0.0:
+            continue
+        vis = 1.0
+        if do_shadow:
+            side = 1.0 if gx * lx + gy * ly + gz * lz >= 0.0 else -1.0
+            qx, qy, qz = px + side * off * gx, py + side * off * gy, pz + side * off * gz
+            tmx = dist - 2.0 * off if dist < np.inf else np.inf
+            nshadow += 1
+            vis = _transmittance(geo, mat_of, mat_tab, qx, qy, qz, lx, ly, lz,
+                                 t_min * max(pm, extent), tmx, transmissive, zero, eps,
+                                 stack, st, sp_, sf, sn)
+            if vis <= 0.0:
+                continue
+        spec = 0.0
+        if ks > 0.0:
+            if blinn:
+                hx, hy, hz = _normalize(lx + sx, ly + sy, lz + sz)
+                base = nx * hx + ny * hy + nz * hz
+            else:
+                rx, ry, rz = 2.0 * ndl * nx - lx, 2.0 * ndl * ny - ly, 2.0 * ndl * nz - lz
+                base = rx * sx + ry * sy + rz * sz
+            base = min(1.0, max(0.0, base))
+            spec = ks * _pow(base, shin)
+        f = vis * scale
+        lr += lights[li, 4] * f * (kd * cr * ndl + spec)
+        lg += lights[li, 5] * f * (kd * cg * ndl + spec)
+        lb += lights[li, 6] * f * (kd * cb * ndl + spec)
+    contrib[i, 0], contrib[i, 1], contrib[i, 2] = w0 * lr, w1 * lg, w2 * lb
+    counts[i, 0] = nshadow
+    # ---- reflection / transmission weights (Whitted 1980; Fresnel optional)
+    kr, kt = mat_tab[mi, 7], mat_tab[mi, 8]
+    if not do_refl:
+        kr = 0.0
+    if not do_refr:
+        kt = 0.0
+    if kr <= 0.0 and kt <= 0.0:
+        return
+    cosi = -(dx * fx + dy * fy + dz * fz)  # >= 0
+    ns_ = nstk[i]
+    is_solid = solid[k]
+    wr, wt = kr, kt
+    tx, ty, tz = dx, dy, dz
+    new_n = ns_
+    if kt > 0.0 and is_solid:
+        # media on both sides (nested dielectrics: a small stack of materials)
+        if front:
+            n1 = _ior(mat_tab, stk[i], ns_)
+            n2 = mat_tab[mi, 9]
+        else:
+            n1 = mat_tab[mi, 9]
+            # the medium beyond: the stack without its topmost entry of this material
+            j = ns_ - 1
+            while j >= 0 and stk[i, j] != mi:
+                j -= 1
+            n2 = 1.0
+            if j >= 0:
+                new_n = ns_ - 1
+                top_ = -1
+                for q in range(ns_ - 1, -1, -1):
+                    if q != j:
+                        top_ = stk[i, q]
+                        break
+                n2 = mat_tab[top_, 9] if top_ >= 0 else 1.0
+            elif ns_ > 0:
+                n2 = _ior(mat_tab, stk[i], ns_)
+        eta = n1 / n2
+        kk = 1.0 - eta * eta * (1.0 - cosi * cosi)
+        if kk <= 0.0:  # total internal reflection (or exactly critical): all to reflection
+            wr, wt = kr + kt, 0.0
+            counts[i, 3] = 1
+        else:
+            cost = math.sqrt(kk)
+            tx, ty, tz = _normalize(eta * dx + (eta * cosi - cost) * fx,
+                                    eta * dy + (eta * cosi - cost) * fy,
+                                    eta * dz + (eta * cosi - cost) * fz)
+            if fres > 0:
+                if fres == 1:
+                    r0 = (n1 - n2) / (n1 + n2)
+                    r0 *= r0
+                    cc = cosi if n1 <= n2 else cost
+                    F = r0 + (1.0 - r0) * (1.0 - cc) ** 5
+                else:
+                    rs = (n1 * cosi - n2 * cost) / (n1 * cosi + n2 * cost)
+                    rp = (n2 * cosi - n1 * cost) / (n2 * cosi + n1 * cost)
+                    F = 0.5 * (rs * rs + rp * rp)
+                wr, wt = kr + kt * F, kt * (1.0 - F)
+    for branch in range(2):
+        kb = wr if branch == 0 else wt
+        if kb <= 0.0:
+            continue
+        if depth[i] + 1 >= max_depth:
+            counts[i, 1] += 1
+            continue
+        b0, b1_, b2_ = w0 * kb, w1 * kb, w2 * kb
+        if max(b0, b1_, b2_) <= threshold:
+            counts[i, 2] += 1
+            continue
+        s = s0 + branch
+        if branch == 0:
+            # R = I - 2 (I.N) N with the shading normal on the incident side
+            mx, my, mz = nx, ny, nz
+            dn = dx * mx + dy * my + dz * mz
+            rx, ry, rz = dx - 2.0 * dn * mx, dy - 2.0 * dn * my, dz - 2.0 * dn * mz
+            if rx * fx + ry * fy + rz * fz <= 0.0:  # below the surface: use Ng
+                dn = dx * fx + dy * fy + dz * fz
+                rx, ry, rz = dx - 2.0 * dn * fx, dy - 2.0 * dn * fy, dz - 2.0 * dn * fz
+            rx, ry, rz = _normalize(rx, ry, rz)
+            out_o[s, 0], out_o[s, 1], out_o[s, 2] = px + off * fx, py + off * fy, pz + off * fz
+            out_d[s, 0], out_d[s, 1], out_d[s, 2] = rx, ry, rz
+            for q in range(4):
+                out_stk[s, q] = stk[i, q]
+            out_nstk[s] = ns_
+            out_kind[s] = 1
+            counts[i, 4] += 1
+        else:
+            out_o[s, 0], out_o[s, 1], out_o[s, 2] = px - off * fx, py - off * fy, pz - off * fz
+            out_d[s, 0], out_d[s, 1], out_d[s, 2] = tx, ty, tz
+            for q in range(4):
+                out_stk[s, q] = stk[i, q]
+            out_nstk[s] = ns_
+            if is_solid:
+                if front:
+                    if ns_ < 4:
+                        out_stk[s, ns_] = mi
+                        out_nstk[s] = ns_ + 1
+                elif new_n < ns_:
+                    # remove the topmost entry of this material
+                    j = ns_ - 1
+                    while stk[i, j] != mi:
+                        j -= 1
+                    q2 = 0
+                    for q in range(ns_):
+                        if q != j:
+                            out_stk[s, q2] = stk[i, q]
+                            q2 += 1
+                    out_nstk[s] = ns_ - 1
+            out_kind[s] = 2
+            counts[i, 5] += 1
+        out_w[s, 0], out_w[s, 1], out_w[s, 2] = b0, b1_, b2_
+        out_tmin[s] = t_min * max(max(abs(out_o[s, 0]), abs(out_o[s, 1]), abs(out_o[s, 2])), extent)
+        out_gen[s] = depth[i] + 1
+
+
+@nb.njit(cache=True, error_model="numpy", parallel=True)
+def shade_batch(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim, ng, nsh, col, ev,
+                w, depth, stk, nstk, pix, opts, contrib, out_o, out_d, out_w, out_stk, out_nstk,
+                out_kind, out_tmin, out_pix, out_gen, counts):
+    """:func:`shade_hit` on every ray of a generation (the wavefront path).  Child slots:
+    ``2 i`` (reflection), ``2 i + 1`` (refraction), with the parent's pixel ``out_pix``."""
+    n = O.shape[0]
     nchunks = (n + CHUNK - 1) // CHUNK
     for c in prange(nchunks):
-        stack, st, sp_, sf, sn = scratch()
-        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
-            out_kind[2 * i], out_kind[2 * i + 1] = 0, 0
-            for q in range(7):
-                counts[i, q] = 0
-            k = prim[i]
-            if k < 0:
-                counts[i, 6] = 1
+        shade_chunk(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim, ng, nsh, col,
+                    ev, w, depth, stk, nstk, pix, opts, contrib, out_o, out_d, out_w, out_stk,
+                    out_nstk, out_kind, out_tmin, out_pix, out_gen, counts, c * CHUNK,
+                    min(n, (c + 1) * CHUNK), scratch())
+
+
+@nb.njit(**NO_REFCOUNT)
+def shade_chunk(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim, ng, nsh, col, ev,
+                w, depth, stk, nstk, pix, opts, contrib, out_o, out_d, out_w, out_stk, out_nstk,
+                out_kind, out_tmin, out_pix, out_gen, counts, i0, i1, scr):
+    """Rays ``i0 .. i1 - 1`` of :func:`shade_batch` (``scr``: :func:`scratch`)."""
+    stack, st, sp_, sf, sn = scr
+    for i in range(i0, i1):
+        shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, O, D, w, depth, stk,
+                  nstk, i, t, prim, ng, nsh, col, ev, contrib, out_o, out_d, out_w, out_stk,
+                  out_nstk, out_kind, out_tmin, out_gen, 2 * i, counts, stack, st, sp_, sf, sn)
+        out_pix[2 * i] = pix[i]
+        out_pix[2 * i + 1] = pix[i]
+
+
+# ----------------------------------------------------------------------------- fused path
+CHECKER_PLANAR, CHECKER_SOLID = 1, 2
+"""``tex_tab`` kinds of the procedural textures the fused kernel evaluates itself."""
+PIXEL_BLOCK = 64
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def checker_color(tex_tab, mi, x, y, z):
+    """Texture factor of material ``mi`` at object-space point ``(x, y, z)``: the
+    ``checker`` pattern of :func:`workbench.renderers.texturing.pattern_value` with the
+    ``planar`` (``s = scale (d.Se, d.W)``) or ``solid`` (``s = scale d``) projection,
+    ``d = P - center``.  ``tex_tab`` row: kind, scale, center (3), Se (3), W (3), colors (6)."""
+    cx, cy, cz = x - tex_tab[mi, 2], y - tex_tab[mi, 3], z - tex_tab[mi, 4]
+    sc = tex_tab[mi, 1]
+    if tex_tab[mi, 0] == CHECKER_PLANAR:
+        parity = (math.floor(sc * (cx * tex_tab[mi, 5] + cy * tex_tab[mi, 6] + cz * tex_tab[mi, 7]))
+                  + math.floor(sc * (cx * tex_tab[mi, 8] + cy * tex_tab[mi, 9] + cz * tex_tab[mi, 10])))
+    else:
+        parity = math.floor(sc * cx) + math.floor(sc * cy) + math.floor(sc * cz)
+    a = parity - 2.0 * math.floor(parity / 2.0)
+    return (tex_tab[mi, 11] * (1.0 - a) + tex_tab[mi, 14] * a,
+            tex_tab[mi, 12] * (1.0 - a) + tex_tab[mi, 15] * a,
+            tex_tab[mi, 13] * (1.0 - a) + tex_tab[mi, 16] * a)
+
+
+@nb.njit(cache=True, error_model="numpy", parallel=True)
+def render_pixels(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts, O, D, spp,
+                  fwd, ncancel, image, depth_map, counts):
+    """Whole ray trees of every pixel in one kernel (the fused path): each pixel's ``spp``
+    primary rays (``O, D`` rows ``p spp ... p spp + spp - 1``) and their reflected and refracted
+    descendants are traced depth first (:func:`pixel_block`), so no array crosses back to
+    Python between ray generations.
+
+    Writes ``image[p]`` (mean over the samples), ``depth_map[p]`` (camera-space depth of the
+    first sample's primary hit, ``fwd`` the unit view axis, ``inf`` on a miss) and adds the
+    ray counts of :func:`shade_hit` to ``counts`` (7,).  Blocks of ``PIXEL_BLOCK`` pixels are
+    visited in a scrambled order so that the static split of ``prange`` between threads gives
+    each a fair share of the expensive parts of the image.
+    """
+    npix = image.shape[0]
+    nblocks = (npix + PIXEL_BLOCK - 1) // PIXEL_BLOCK
+    stride = 1
+    if nblocks > 2:  # a stride coprime with nblocks: c -> c * stride % nblocks is a permutation
+        stride = nblocks // 2 + 1
+        while math.gcd(stride, nblocks) != 1:
+            stride += 1
+    part = np.zeros((nblocks, 7), np.int64)
+    cap = 2 * int(opts[0]) + 2
+    for c in prange(nblocks):
+        b = (c * stride) % nblocks
+        pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts, O, D, spp,
+                    fwd, ncancel, image, depth_map, part[b], b * PIXEL_BLOCK,
+                    min(npix, (b + 1) * PIXEL_BLOCK), scratch(), ray_stack(cap))
+    for b in range(nblocks):
+        for q in range(7):
+            counts[q] += part[b, q]
+
+
+@nb.njit(cache=True, error_model="numpy")
+def ray_stack(cap):
+    """Work arrays of :func:`pixel_block`: ``cap`` pending rays (origin, direction, weight,
+    media stack and its size, kind, tmin, generation), then the current ray and its hit (one
+    row each: origin, direction, weight, media stack and size, generation, t, primitive,
+    normals, uv, object-space point, emission, colour, contribution, counts), and the block's
+    ray counts (summed here, written once: the threads' count rows share cache lines)."""
+    return (np.empty((cap, 3)), np.empty((cap, 3)), np.empty((cap, 3)), np.zeros((cap, 4), np.int64),
+            np.zeros(cap, np.int64), np.zeros(cap, np.int64), np.empty(cap), np.zeros(cap, np.int64),
+            np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 3)), np.zeros((1, 4), np.int64),
+            np.zeros(1, np.int64), np.zeros(1, np.int64), np.empty(1), np.empty(1, np.int64),
+            np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 2)), np.empty((1, 3)), np.empty((1, 3)),
+            np.zeros((1, 3)), np.empty((1, 3)), np.zeros((1, 7), np.int64), np.zeros(7, np.int64))
+
+
+@nb.njit(**NO_REFCOUNT)
+def pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts, O, D, spp, fwd,
+                ncancel, image, depth_map, counts, p0, p1, scr, bufs):
+    """Pixels ``p0 .. p1 - 1`` of :func:`render_pixels`: each primary ray and its descendants
+    depth first with an explicit stack of pending rays (the course's ``raytrace`` recursion),
+    shaded by :func:`shade_hit`; textured colours from the ``tex_tab`` checkers
+    (:func:`checker_color`).  Adds the ray counts to ``counts`` (7,).  ``scr``:
+    :func:`scratch`; ``bufs``: :func:`ray_stack`."""
+    zero, rel_eps, extent = opts[10], opts[8], opts[11]
+    stack, st, sp_, sf, sn = scr
+    (r_o, r_d, r_w, r_stk, r_n, r_kind, r_tmin, r_gen, c_o, c_d, c_w, c_stk, c_n, c_gen, h_t, h_p,
+     h_ng, h_ns, h_uv, h_po, h_ev, h_col, contrib, cnt, tot) = bufs
+    for p in range(p0, p1):
+        ar, ag, ab = 0.0, 0.0, 0.0
+        for s in range(spp):
+            i = p * spp + s
+            for q in range(3):
+                r_o[0, q], r_d[0, q], r_w[0, q] = O[i, q], D[i, q], 1.0
+            r_n[0], r_tmin[0], r_gen[0] = 0, 0.0, 0
+            top = 1
+            while top > 0:
+                top -= 1
                 for q in range(3):
-                    contrib[i, q] = w[i, q] * background[q] if add_bg else 0.0
-                continue
-            mi = mat_of[k]
-            dx, dy, dz = D[i, 0], D[i, 1], D[i, 2]
-            px, py, pz = O[i, 0] + t[i] * dx, O[i, 1] + t[i] * dy, O[i, 2] + t[i] * dz
-            # Beer-Lambert absorption by the medium the ray travelled through
-            w0, w1, w2 = w[i, 0], w[i, 1], w[i, 2]
-            if nstk[i] > 0:
-                ma = stk[i, nstk[i] - 1]
-                w0 *= math.exp(-mat_tab[ma, 10] * t[i])
-                w1 *= math.exp(-mat_tab[ma, 11] * t[i])
-                w2 *= math.exp(-mat_tab[ma, 12] * t[i])
-            sx, sy, sz = -dx, -dy, -dz
-            gx, gy, gz = ng[i, 0], ng[i, 1], ng[i, 2]
-            nx, ny, nz = nsh[i, 0], nsh[i, 1], nsh[i, 2]
-            if nx * sx + ny * sy + nz * sz < 0.0:  # two-sided: shading normal faces the viewer
-                nx, ny, nz = -nx, -ny, -nz
-            front = gx * sx + gy * sy + gz * sz > 0.0
-            # side of the surface the ray came from
-            fx, fy, fz = (gx, gy, gz) if front else (-gx, -gy, -gz)
-            if mat_tab[mi, 17] > 0.5:  # textured: the caller's colour
-                cr, cg, cb = col[i, 0], col[i, 1], col[i, 2]
-            else:
-                cr, cg, cb = mat_tab[mi, 0], mat_tab[mi, 1], mat_tab[mi, 2]
-            ka, kd, ks, shin = mat_tab[mi, 3], mat_tab[mi, 4], mat_tab[mi, 5], mat_tab[mi, 6]
-            er, eg, eb = ev[i, 0], ev[i, 1], ev[i, 2]
-            if mat_tab[mi, 16] < 0.5 or front:
-                er, eg, eb = er + mat_tab[mi, 13], eg + mat_tab[mi, 14], eb + mat_tab[mi, 15]
-            lr = ka * cr * ambient[0] + er
-            lg = ka * cg * ambient[1] + eg
-            lb = ka * cb * ambient[2] + eb
-            pm = max(abs(px), abs(py), abs(pz))
-            off = ray_off * max(pm, extent)
-            eps = off
-            nshadow = 0
-            for li in range(nl):
-                if lights[li, 0] > 0.5:
-                    lx, ly, lz = -lights[li, 1], -lights[li, 2], -lights[li, 3]
-                    dist = np.inf
-                    scale = 1.0
-                else:
-                    vx, vy, vz = lights[li, 1] - px, lights[li, 2] - py, lights[li, 3] - pz
-                    dist = math.sqrt(vx * vx + vy * vy + vz * vz)
-                    lx, ly, lz = _normalize(vx, vy, vz)
-                    scale = 1.0
-                    if lights[li, 7] > 0.5:
-                        scale = 1.0 / max(dist * dist, 1e-300)
-                    if lights[li, 8] > 0.5:
-                        scale *= max(0.0, -(lx * lights[li, 9] + ly * lights[li, 10] + lz * lights[li, 11]))
-                ndl = nx * lx + ny * ly + nz * lz
-                if ndl <= 0.0 or scale == 0.0:
-                    continue
-                vis = 1.0
-                if do_shadow:
-                    side = 1.0 if gx * lx + gy * ly + gz * lz >= 0.0 else -1.0
-                    qx, qy, qz = px + side * off * gx, py + side * off * gy, pz + side * off * gz
-                    tmx = dist - 2.0 * off if dist < np.inf else np.inf
-                    nshadow += 1
-                    vis = _transmittance(geo, mat_of, mat_tab, qx, qy, qz, lx, ly, lz,
-                                         t_min * max(pm, extent), tmx, transmissive, zero, eps,
-                                         stack, st, sp_, sf, sn)
-                    if vis <= 0.0:
-                        continue
-                spec = 0.0
-                if ks > 0.0:
-                    if blinn:
-                        hx, hy, hz = _normalize(lx + sx, ly + sy, lz + sz)
-                        base = nx * hx + ny * hy + nz * hz
-                    else:
-                        rx, ry, rz = 2.0 * ndl * nx - lx, 2.0 * ndl * ny - ly, 2.0 * ndl * nz - lz
-                        base = rx * sx + ry * sy + rz * sz
-                    base = min(1.0, max(0.0, base))
-                    spec = ks * _pow(base, shin)
-                f = vis * scale
-                lr += lights[li, 4] * f * (kd * cr * ndl + spec)
-                lg += lights[li, 5] * f * (kd * cg * ndl + spec)
-                lb += lights[li, 6] * f * (kd * cb * ndl + spec)
-            contrib[i, 0], contrib[i, 1], contrib[i, 2] = w0 * lr, w1 * lg, w2 * lb
-            counts[i, 0] = nshadow
-            # ---- reflection / transmission weights (Whitted 1980; Fresnel optional)
-            kr, kt = mat_tab[mi, 7], mat_tab[mi, 8]
-            if not do_refl:
-                kr = 0.0
-            if not do_refr:
-                kt = 0.0
-            if kr <= 0.0 and kt <= 0.0:
-                continue
-            cosi = -(dx * fx + dy * fy + dz * fz)  # >= 0
-            ns_ = nstk[i]
-            is_solid = solid[k]
-            wr, wt = kr, kt
-            tx, ty, tz = dx, dy, dz
-            new_n = ns_
-            if kt > 0.0 and is_solid:
-                # media on both sides (nested dielectrics: a small stack of materials)
-                if front:
-                    n1 = _ior(mat_tab, stk[i], ns_)
-                    n2 = mat_tab[mi, 9]
-                else:
-                    n1 = mat_tab[mi, 9]
-                    # the medium beyond: the stack without its topmost entry of this material
-                    j = ns_ - 1
-                    while j >= 0 and stk[i, j] != mi:
-                        j -= 1
-                    n2 = 1.0
-                    if j >= 0:
-                        new_n = ns_ - 1
-                        top_ = -1
-                        for q in range(ns_ - 1, -1, -1):
-                            if q != j:
-                                top_ = stk[i, q]
-                                break
-                        n2 = mat_tab[top_, 9] if top_ >= 0 else 1.0
-                    elif ns_ > 0:
-                        n2 = _ior(mat_tab, stk[i], ns_)
-                eta = n1 / n2
-                kk = 1.0 - eta * eta * (1.0 - cosi * cosi)
-                if kk <= 0.0:  # total internal reflection (or exactly critical): all to reflection
-                    wr, wt = kr + kt, 0.0
-                    counts[i, 3] = 1
-                else:
-                    cost = math.sqrt(kk)
-                    tx, ty, tz = _normalize(eta * dx + (eta * cosi - cost) * fx,
-                                            eta * dy + (eta * cosi - cost) * fy,
-                                            eta * dz + (eta * cosi - cost) * fz)
-                    if fres > 0:
-                        if fres == 1:
-                            r0 = (n1 - n2) / (n1 + n2)
-                            r0 *= r0
-                            cc = cosi if n1 <= n2 else cost
-                            F = r0 + (1.0 - r0) * (1.0 - cc) ** 5
-                        else:
-                            rs = (n1 * cosi - n2 * cost) / (n1 * cosi + n2 * cost)
-                            rp = (n2 * cosi - n1 * cost) / (n2 * cosi + n1 * cost)
-                            F = 0.5 * (rs * rs + rp * rp)
-                        wr, wt = kr + kt * F, kt * (1.0 - F)
-            for branch in range(2):
-                kb = wr if branch == 0 else wt
-                if kb <= 0.0:
-                    continue
-                if depth[i] + 1 >= max_depth:
-                    counts[i, 1] += 1
-                    continue
-                b0, b1_, b2_ = w0 * kb, w1 * kb, w2 * kb
-                if max(b0, b1_, b2_) <= threshold:
-                    counts[i, 2] += 1
-                    continue
-                s = 2 * i + branch
-                if branch == 0:
-                    # R = I - 2 (I.N) N with the shading normal on the incident side
-                    mx, my, mz = nx, ny, nz
-                    dn = dx * mx + dy * my + dz * mz
-                    rx, ry, rz = dx - 2.0 * dn * mx, dy - 2.0 * dn * my, dz - 2.0 * dn * mz
-                    if rx * fx + ry * fy + rz * fz <= 0.0:  # below the surface: use Ng
-                        dn = dx * fx + dy * fy + dz * fz
-                        rx, ry, rz = dx - 2.0 * dn * fx, dy - 2.0 * dn * fy, dz - 2.0 * dn * fz
-                    rx, ry, rz = _normalize(rx, ry, rz)
-                    out_o[s, 0], out_o[s, 1], out_o[s, 2] = px + off * fx, py + off * fy, pz + off * fz
-                    out_d[s, 0], out_d[s, 1], out_d[s, 2] = rx, ry, rz
+                    c_o[0, q], c_d[0, q], c_w[0, q] = r_o[top, q], r_d[top, q], r_w[top, q]
+                for q in range(4):
+                    c_stk[0, q] = r_stk[top, q]
+                c_n[0], c_gen[0] = r_n[top], r_gen[top]
+                ox, oy, oz = c_o[0, 0], c_o[0, 1], c_o[0, 2]
+                dx, dy, dz = c_d[0, 0], c_d[0, 1], c_d[0, 2]
+                eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
+                t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, r_tmin[top], np.inf,
+                                               False, False, zero, eps, stack, st, sp_, sf, sn)
+                h_t[0], h_p[0] = t, k
+                if c_gen[0] == 0 and s == 0:
+                    depth_map[p] = t * (dx * fwd[0] + dy * fwd[1] + dz * fwd[2]) if k >= 0 else np.inf
+                if k >= 0:
+                    surface(geo, k, f, tri, b1, b2, ox + t * dx, oy + t * dy, oz + t * dz, ncancel,
+                            h_ng, h_ns, h_uv, h_po, h_ev, 0)
+                    mi = mat_of[k]
+                    if mat_tab[mi, 17] > 0.5:
+                        tr_, tg_, tb_ = checker_color(tex_tab, mi, h_po[0, 0], h_po[0, 1], h_po[0, 2])
+                        h_col[0, 0] = mat_tab[mi, 0] * tr_
+                        h_col[0, 1] = mat_tab[mi, 1] * tg_
+                        h_col[0, 2] = mat_tab[mi, 2] * tb_
+                shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, c_o, c_d, c_w,
+                          c_gen, c_stk, c_n, 0, h_t, h_p, h_ng, h_ns, h_col, h_ev, contrib, r_o, r_d,
+                          r_w, r_stk, r_n, r_kind, r_tmin, r_gen, top, cnt, stack, st, sp_, sf, sn)
+                ar += contrib[0, 0]
+                ag += contrib[0, 1]
+                ab += contrib[0, 2]
+                for q in range(7):
+                    tot[q] += cnt[0, q]
+                # keep the children that exist on the stack
+                if r_kind[top] != 0:
+                    top += 1
+                    if r_kind[top] != 0:
+                        top += 1
+                elif r_kind[top + 1] != 0:
+                    for q in range(3):
+                        r_o[top, q], r_d[top, q], r_w[top, q] = r_o[top + 1, q], r_d[top + 1, q], r_w[top + 1, q]
                     for q in range(4):
-                        out_stk[s, q] = stk[i, q]
-                    out_nstk[s] = ns_
-                    out_kind[s] = 1
-                    counts[i, 4] += 1
-                else:
-                    out_o[s, 0], out_o[s, 1], out_o[s, 2] = px - off * fx, py - off * fy, pz - off * fz
-                    out_d[s, 0], out_d[s, 1], out_d[s, 2] = tx, ty, tz
-                    for q in range(4):
-                        out_stk[s, q] = stk[i, q]
-                    out_nstk[s] = ns_
-                    if is_solid:
-                        if front:
-                            if ns_ < 4:
-                                out_stk[s, ns_] = mi
-                                out_nstk[s] = ns_ + 1
-                        elif new_n < ns_:
-                            # remove the topmost entry of this material
-                            j = ns_ - 1
-                            while stk[i, j] != mi:
-                                j -= 1
-                            q2 = 0
-                            for q in range(ns_):
-                                if q != j:
-                                    out_stk[s, q2] = stk[i, q]
-                                    q2 += 1
-                            out_nstk[s] = ns_ - 1
-                    out_kind[s] = 2
-                    counts[i, 5] += 1
-                out_w[s, 0], out_w[s, 1], out_w[s, 2] = b0, b1_, b2_
-                out_tmin[s] = t_min * max(max(abs(out_o[s, 0]), abs(out_o[s, 1]), abs(out_o[s, 2])), extent)
-                out_pix[s] = pix[i]
-                out_gen[s] = depth[i] + 1
+                        r_stk[top, q] = r_stk[top + 1, q]
+                    r_n[top], r_tmin[top], r_gen[top] = r_n[top + 1], r_tmin[top + 1], r_gen[top + 1]
+                    top += 1
+        image[p, 0], image[p, 1], image[p, 2] = ar / spp, ag / spp, ab / spp
+    for q in range(7):
+        counts[q] += tot[q]
 
 
 @nb.njit(cache=True, error_model="numpy")

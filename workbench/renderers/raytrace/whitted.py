@@ -2,12 +2,21 @@
 "lancer de rayons") and ``raytrace`` (plus recursive reflection and refraction, "suivi de rayons",
 Whitted 1980).
 
-Wavefront organisation: the image is cut into bands of rows ("tiles", delivered to ``on_tile``
-as they finish); for each band, each generation of rays is intersected by a numba kernel,
-coloured (textures through :mod:`workbench.renderers.texturing` in numpy, so that they match the
-raster methods exactly), shaded with shadow feelers by a second kernel, which also spawns the
-reflected and refracted children that form the next generation.  A pixel's colour is the sum of
-``weight x local colour`` over the ray tree (the course's ``raytrace``/``shade`` recursion).
+Two organisations of the same algorithm, both over bands of rows ("tiles", delivered to
+``on_tile`` as they finish):
+
+* fused (:func:`.kernels.render_pixels`), when every surface colour is plain or a ``checker``
+  (planar or solid) and nothing needs numpy (no image texture, bump, opacity map or
+  environment): one numba kernel traces each pixel's whole ray tree depth first with an
+  explicit stack (the course's ``raytrace``/``shade`` recursion), checkers evaluated in the
+  kernel;
+* wavefront, otherwise: each generation of rays is intersected by a numba kernel, coloured
+  (textures through :mod:`workbench.renderers.texturing` in numpy, so that they match the
+  raster methods exactly), shaded with shadow feelers by a second kernel, which also spawns
+  the reflected and refracted children that form the next generation.
+
+Both shade with :func:`.kernels.shade_hit`; a pixel's colour is the sum of ``weight x local
+colour`` over the ray tree, and the two paths give the same images and ray counts (tested).
 
 Options (see ``Option`` help texts): ``max_depth`` (quality knob of ``raytrace``: the maximum
 number of ray generations in a path, primary = 1, as the course's ``recurs_max`` and POV-Ray's
@@ -148,19 +157,27 @@ def _kernels():
     return kernels
 
 
-def ensure_compiled(sd: SceneData) -> float:
-    """Run each kernel once on one ray (first-call JIT, or a load from the numba disk cache).
-    Returns the seconds spent (0 if already compiled in this process)."""
+def ensure_compiled(sd: SceneData, fused: bool = False) -> float:
+    """Run the kernels a render needs once on one ray (first-call JIT, or a load from the numba
+    disk cache): :func:`.kernels.render_pixels` for the fused path, the wavefront kernels
+    otherwise.  Returns the seconds spent (0 if already compiled in this process)."""
     k = _kernels()
-    from .bvh import _build
-    if all(f.signatures for f in (k.trace_batch, k.shade_batch, _build, k.accumulate, k.compact, k.column_sums)):
+    needed = (k.render_pixels,) if fused else (k.trace_batch, k.shade_batch, k.accumulate, k.compact,
+                                               k.column_sums)
+    if all(f.signatures for f in needed):
         return 0.0
     t0 = time.perf_counter()
-    _build(np.array([[0.0, 0, 0, 1, 0, 0, 0, 1, 0]]))
     O = np.zeros((1, 3))
     D = np.array([[0.0, 0.0, 1.0]])
-    arr = _alloc(1)
     geo = sd.kernel_args()
+    kopts = np.zeros(13)
+    kopts[0] = 1.0
+    if fused:
+        k.render_pixels(geo, sd.mat, sd.mat_tab, np.zeros((len(sd.mat_tab), TEX_COLS)), sd.lights,
+                        np.zeros(3), np.zeros(3), kopts, O, D, 1, np.array([0.0, 0.0, 1.0]),
+                        tol.normal_cancel, np.zeros((1, 3)), np.zeros(1), np.zeros(7, np.int64))
+        return time.perf_counter() - t0
+    arr = _alloc(1)
     k.trace_batch(geo, O, D, np.zeros(1), np.full(1, np.inf), tol.zero, tol.ray_offset, 1.0,
                   tol.normal_cancel, arr["t"], arr["prim"], arr["ng"], arr["ns"], arr["uv"],
                   arr["po"], arr["ev"])
@@ -168,7 +185,7 @@ def ensure_compiled(sd: SceneData) -> float:
     k.shade_batch(geo, sd.mat, sd.mat_tab, sd.lights, np.zeros(3), np.zeros(3), O, D, np.ones(1),
                   np.zeros(1, np.int64), D.copy(), D.copy(), np.ones((1, 3)), np.zeros((1, 3)),
                   np.ones((1, 3)), np.zeros(1, np.int64), np.zeros((1, 4), np.int64),
-                  np.zeros(1, np.int64), np.zeros(1, np.int64), np.zeros(13), np.zeros((1, 3)),
+                  np.zeros(1, np.int64), np.zeros(1, np.int64), kopts, np.zeros((1, 3)),
                   ch["o"], ch["d"], ch["w"], ch["stk"], ch["nstk"], ch["kind"], ch["tmin"], ch["pix"],
                   ch["gen"], np.zeros((1, 7), np.int64))
     k.accumulate(np.zeros((1, 3)), np.zeros(1, np.int64), np.zeros((1, 3)))
@@ -176,6 +193,36 @@ def ensure_compiled(sd: SceneData) -> float:
               ch["gen"])
     k.column_sums(np.zeros((1, 7), np.int64))
     return time.perf_counter() - t0
+
+
+TEX_COLS = 17
+"""Columns of the fused kernel's texture table (see :func:`.kernels.checker_color`)."""
+
+
+def fused_textures(scene: Scene, sd: SceneData):
+    """The (M, TEX_COLS) texture table of :func:`.kernels.render_pixels` when every material's
+    surface colour is one the fused kernel evaluates itself (plain, or a ``checker`` with the
+    ``planar`` or ``solid`` projection) and nothing else needs numpy (bump, opacity, an
+    environment); else None (the wavefront path)."""
+    if scene.environment is not None:
+        return None
+    tab = np.zeros((len(sd.materials), TEX_COLS))
+    for i, m in enumerate(sd.materials):
+        if m.bump is not None or m.opacity is not None:
+            return None
+        tx = m.texture
+        if tx is None:
+            continue
+        if tx.kind != "checker" or tx.projection not in ("planar", "solid"):
+            return None
+        from ..texturing import frame
+        _, se, w = frame(tx.pole, tx.equator)
+        tab[i, 0] = _kernels().CHECKER_PLANAR if tx.projection == "planar" else _kernels().CHECKER_SOLID
+        tab[i, 1] = tx.scale
+        tab[i, 2:5] = tx.center
+        tab[i, 5:8], tab[i, 8:11] = se, w
+        tab[i, 11:14], tab[i, 14:17] = tx.colors[0], tx.colors[1]
+    return tab
 
 
 def _alloc(n):
@@ -220,9 +267,31 @@ class _Tracer:
                           ended_by_depth=0, ended_by_threshold=0, escaped_rays=0,
                           total_internal_reflections=0)
         self.has_opacity = F.OPACITY in needs and self.col.tex is not None
+        self.tex_tab = None if self.col.missing else fused_textures(scene, sd)
+        self.fused = self.tex_tab is not None
 
     def trace(self, O, D, pix, n_pixels, spp, fwd):
         """Trace a band's primary rays and their trees; returns (image (n_pixels, 3), depth)."""
+        if self.fused:
+            return self._trace_fused(O, D, n_pixels, spp, fwd)
+        return self._trace_wavefront(O, D, pix, n_pixels, spp, fwd)
+
+    def _trace_fused(self, O, D, n_pixels, spp, fwd):
+        """One :func:`.kernels.render_pixels` call: whole ray trees, pixel by pixel."""
+        sd = self.sd
+        image = np.empty((n_pixels, 3))
+        depth_map = np.empty(n_pixels)
+        counts = np.zeros(7, np.int64)
+        _kernels().render_pixels(self.geo, sd.mat, sd.mat_tab, self.tex_tab, sd.lights, self.ambient,
+                                 self.col.bg, self.kopts, O, D, spp, fwd, tol.normal_cancel, image,
+                                 depth_map, counts)
+        self.stats["primary_rays"] += len(O)
+        for key, v in zip(_COUNTS, counts):
+            self.stats[key] += int(v)
+        return image, depth_map
+
+    def _trace_wavefront(self, O, D, pix, n_pixels, spp, fwd):
+        """Generation by generation: intersect all rays, colour the hits in numpy, shade."""
         k = _kernels()
         sd = self.sd
         acc = np.zeros((n_pixels, 3))
@@ -326,24 +395,24 @@ class _WhittedBase:
         sd = flatten(scene)
         timings["build"] = time.perf_counter() - t0
         timings["bvh_build"] = sd.bvh_build_time
-        timings["compile"] = ensure_compiled(sd)
         opts = dict(o)
         opts.setdefault("max_depth", 1)
         tr = _Tracer(scene, sd, opts, self.recursive)
+        timings["compile"] = ensure_compiled(sd, tr.fused)
         spp = opts["spp"]
         cam = scene.camera
         fwd = np.asarray(cam.look_at, float) - np.asarray(cam.position, float)
         fwd /= np.linalg.norm(fwd)
+        bar = None
+        if opts["progress"]:
+            from tqdm import tqdm
+            bar = tqdm(total=height, unit="row", desc=self.name)
+        t1, c1 = time.perf_counter(), time.process_time()  # the trace phase includes the camera rays
         O, D, pix = camera_rays(cam, width, height, spp, opts["seed"])
         image = np.zeros((height * width, 3), np.float32)
         depth = np.full(height * width, np.inf, np.float32)
         rows = max(1, _RAYS_PER_BAND // (width * spp))
         bands = list(range(0, height, rows))
-        bar = None
-        if opts["progress"]:
-            from tqdm import tqdm
-            bar = tqdm(total=height, unit="row", desc=self.name)
-        t1, c1 = time.perf_counter(), time.process_time()
         for y0 in bands:
             y1 = min(height, y0 + rows)
             a, b = y0 * width * spp, y1 * width * spp
