@@ -136,6 +136,8 @@ class PanelGPU:
     """panel -> its float texture (CPU images uploaded), value images (R32F) and tables."""
     shown: dict[str, tuple] = field(default_factory=dict)
     """texture name -> key of the image it was last made from."""
+    stats: dict[str, tuple] = field(default_factory=dict)
+    """image name -> (version, maximum, mean) (:func:`image_stats`)."""
 
 
 def gpu(state: AppState) -> PanelGPU:
@@ -268,6 +270,17 @@ def panel_texture(state: AppState, method: str):
         else:
             upload_linear(state, method, shown_image(state, method))
     return state.textures[method]
+
+
+def image_stats(state: AppState, name: str) -> tuple[float, float]:
+    """(maximum, mean) of ``state.images[name]``, computed once per change of the image."""
+    g = gpu(state)
+    key = state.images.version(name)
+    held = g.stats.get(name)
+    if held is None or held[0] != key:
+        image = state.images[name]
+        held = g.stats[name] = (key, float(image.max()), float(image.mean()))
+    return held[1], held[2]
 
 
 def difference_on_gpu(state: AppState, a: str, b: str, table: np.ndarray) -> np.ndarray | None:

@@ -5,7 +5,7 @@ import numpy as np
 from imgui_bundle import imgui
 
 from . import camera as cam
-from .frames import difference_on_gpu, panel_texture, stale, upload, upload_linear
+from .frames import difference_on_gpu, image_stats, panel_texture, stale, upload, upload_linear
 from .inspect import export, pixel_under_mouse, probe_tooltip, select_ray_tree
 from .layout import focus
 from .patch_view import select_patch
@@ -194,8 +194,9 @@ def difference_panel(state: AppState) -> None:
             err = error_map(state.images[a], state.images[b], state.diff_kind)
             upload(state, "difference", colour_scale(err, max(float(err.max()), 1e-6)))
         state.images["difference"] = err
-    err, tex = state.images["difference"], state.textures["difference"]
-    vmax = max(float(err.max()), 1e-6)
+    tex = state.textures["difference"]
+    vmax, mean = image_stats(state, "difference")
+    vmax = max(vmax, 1e-6)
     size = imgui.ImVec2(state.camera.width, state.camera.height)
     imgui.image(imgui.ImTextureRef(tex.glo), size, *cam.view_window(state.view))
     if "colour_scale" not in state.textures:
@@ -207,7 +208,7 @@ def difference_panel(state: AppState) -> None:
     imgui.image(imgui.ImTextureRef(tb.glo), imgui.ImVec2(size.x - 60, 10))
     imgui.same_line()
     imgui.text(f"{vmax:.3g}")
-    imgui.text(f"mean {float(err.mean()):.4f}")
+    imgui.text(f"mean {mean:.4f}")
 
 
 def colour_wheel(state: AppState) -> None:
