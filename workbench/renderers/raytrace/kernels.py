@@ -981,11 +981,12 @@ def checker_color(tex_tab, mi, x, y, z):
 
 @nb.njit(cache=True, error_model="numpy", parallel=True)
 def render_pixels(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts, O, D, spp,
-                  fwd, ncancel, image, depth_map, counts):
+                  fwd, cam, first, ncancel, image, depth_map, counts):
     """Whole ray trees of every pixel in one kernel (the fused path): each pixel's ``spp``
-    primary rays (``O, D`` rows ``p spp ... p spp + spp - 1``) and their reflected and refracted
-    descendants are traced depth first (:func:`pixel_block`), so no array crosses back to
-    Python between ray generations.
+    primary rays (``O, D`` rows ``p spp ... p spp + spp - 1``; with ``O`` empty and ``spp = 1``,
+    the centre ray of image pixel ``first + p`` of the camera ``cam``, see
+    ``whitted.camera_frame``) and their reflected and refracted descendants are traced depth
+    first (:func:`pixel_block`), so no array crosses back to Python between ray generations.
 
     Writes ``image[p]`` (mean over the samples), ``depth_map[p]`` (camera-space depth of the
     first sample's primary hit, ``fwd`` the unit view axis, ``inf`` on a miss) and adds the
@@ -1005,11 +1006,27 @@ def render_pixels(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, op
     for c in prange(nblocks):
         b = (c * stride) % nblocks
         pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts, O, D, spp,
-                    fwd, ncancel, image, depth_map, part[b], b * PIXEL_BLOCK,
+                    fwd, cam, first, ncancel, image, depth_map, part[b], b * PIXEL_BLOCK,
                     min(npix, (b + 1) * PIXEL_BLOCK), scratch(), ray_stack(cap))
     for b in range(nblocks):
         for q in range(7):
             counts[q] += part[b, q]
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def camera_ray(cam, q, o, d):
+    """Row 0 of ``o, d``: the centre ray of image pixel ``q`` (row-major) of the camera ``cam``
+    (``whitted.camera_frame``: position, rotation, tan(fov_y / 2), aspect, width, height)."""
+    width = int(cam[14])
+    i, j = q // width, q % width
+    x = ((j + 0.5) / cam[14] * 2.0 - 1.0) * cam[12] * cam[13]
+    y = (1.0 - (i + 0.5) / cam[15] * 2.0) * cam[12]
+    dx = x * cam[3] + y * cam[4] - cam[5]
+    dy = x * cam[6] + y * cam[7] - cam[8]
+    dz = x * cam[9] + y * cam[10] - cam[11]
+    n = math.sqrt(dx * dx + dy * dy + dz * dz)
+    o[0, 0], o[0, 1], o[0, 2] = cam[0], cam[1], cam[2]
+    d[0, 0], d[0, 1], d[0, 2] = dx / n, dy / n, dz / n
 
 
 @nb.njit(cache=True, error_model="numpy")
@@ -1029,7 +1046,7 @@ def ray_stack(cap):
 
 @nb.njit(**NO_REFCOUNT)
 def pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts, O, D, spp, fwd,
-                ncancel, image, depth_map, counts, p0, p1, scr, bufs):
+                cam, first, ncancel, image, depth_map, counts, p0, p1, scr, bufs):
     """Pixels ``p0 .. p1 - 1`` of :func:`render_pixels`: each primary ray and its descendants
     depth first with an explicit stack of pending rays (the course's ``raytrace`` recursion),
     shaded by :func:`shade_hit`; textured colours from the ``tex_tab`` checkers
@@ -1043,8 +1060,13 @@ def pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts
         ar, ag, ab = 0.0, 0.0, 0.0
         for s in range(spp):
             i = p * spp + s
+            if O.shape[0] > 0:
+                for q in range(3):
+                    r_o[0, q], r_d[0, q] = O[i, q], D[i, q]
+            else:
+                camera_ray(cam, first + p, r_o, r_d)
             for q in range(3):
-                r_o[0, q], r_d[0, q], r_w[0, q] = O[i, q], D[i, q], 1.0
+                r_w[0, q] = 1.0
             r_n[0], r_tmin[0], r_gen[0] = 0, 0.0, 0
             top = 1
             while top > 0:

@@ -60,6 +60,17 @@ _PRIMARY_RAYS_GIB = 4.0
 """Largest primary-ray set accepted (the machine has 24 GiB; bands bound everything else)."""
 
 
+def camera_frame(camera, width: int, height: int) -> np.ndarray:
+    """The pinhole camera as the fused kernel reads it: position (3), ``world_from_camera``'s
+    rotation (3 x 3, row-major; columns r, u, -f), ``tan(fov_y / 2)``, aspect ratio, width and
+    height.  Pixel ``(i, j)``'s centre ray (as :func:`camera_rays` with ``spp = 1``) has the
+    direction ``x r + y u - (-f)`` normalised, ``x = ((j + 1/2) / width * 2 - 1) tan aspect``,
+    ``y = (1 - (i + 1/2) / height * 2) tan``."""
+    R = np.linalg.inv(camera.camera_from_world())[:3, :3]
+    return np.array([*np.asarray(camera.position, dtype=np.float64), *R.reshape(-1),
+                     np.tan(np.radians(camera.fov_y) / 2.0), width / height, width, height])
+
+
 def camera_rays(camera, width: int, height: int, spp: int, seed: int):
     """Primary rays, ``spp`` per pixel, stratified jitter on an ``m x ceil(spp/m)`` grid
     (``m = ceil(sqrt(spp))``); one sample per pixel goes through the pixel centre (same rays as
@@ -81,7 +92,7 @@ def camera_rays(camera, width: int, height: int, spp: int, seed: int):
         oy = ((s // m)[None, None, :] + jit[..., 1]) / m2
     x = ((np.arange(width)[None, :, None] + ox) / width * 2.0 - 1.0) * th * aspect
     y = (1.0 - (np.arange(height)[:, None, None] + oy) / height * 2.0) * th
-    R = np.linalg.inv(camera.camera_from_world())[:3, :3]  # world_from_camera: columns r, u, -f
+    R = camera_frame(camera, width, height)[3:12].reshape(3, 3)  # world_from_camera: columns r, u, -f
     d = np.empty((height, width, spp, 3))
     for c in range(3):
         d[..., c] = x * R[c, 0] + y * R[c, 1] - R[c, 2]
@@ -175,7 +186,8 @@ def ensure_compiled(sd: SceneData, fused: bool = False) -> float:
     if fused:
         k.render_pixels(geo, sd.mat, sd.mat_tab, np.zeros((len(sd.mat_tab), TEX_COLS)), sd.lights,
                         np.zeros(3), np.zeros(3), kopts, O, D, 1, np.array([0.0, 0.0, 1.0]),
-                        tol.normal_cancel, np.zeros((1, 3)), np.zeros(1), np.zeros(7, np.int64))
+                        np.zeros(16), 0, tol.normal_cancel, np.zeros((1, 3)), np.zeros(1),
+                        np.zeros(7, np.int64))
         return time.perf_counter() - t0
     arr = _alloc(1)
     k.trace_batch(geo, O, D, np.zeros(1), np.full(1, np.inf), tol.zero, tol.ray_offset, 1.0,
@@ -270,22 +282,24 @@ class _Tracer:
         self.tex_tab = None if self.col.missing else fused_textures(scene, sd)
         self.fused = self.tex_tab is not None
 
-    def trace(self, O, D, pix, n_pixels, spp, fwd):
-        """Trace a band's primary rays and their trees; returns (image (n_pixels, 3), depth)."""
+    def trace(self, O, D, pix, n_pixels, spp, fwd, cam, first):
+        """Trace a band's primary rays and their trees; returns (image (n_pixels, 3), depth).
+        The band's pixels are ``first ... first + n_pixels - 1`` of the image; the fused path
+        makes their centre rays from ``cam`` (:func:`camera_frame`) when ``O`` is empty."""
         if self.fused:
-            return self._trace_fused(O, D, n_pixels, spp, fwd)
+            return self._trace_fused(O, D, n_pixels, spp, fwd, cam, first)
         return self._trace_wavefront(O, D, pix, n_pixels, spp, fwd)
 
-    def _trace_fused(self, O, D, n_pixels, spp, fwd):
+    def _trace_fused(self, O, D, n_pixels, spp, fwd, cam, first):
         """One :func:`.kernels.render_pixels` call: whole ray trees, pixel by pixel."""
         sd = self.sd
         image = np.empty((n_pixels, 3))
         depth_map = np.empty(n_pixels)
         counts = np.zeros(7, np.int64)
         _kernels().render_pixels(self.geo, sd.mat, sd.mat_tab, self.tex_tab, sd.lights, self.ambient,
-                                 self.col.bg, self.kopts, O, D, spp, fwd, tol.normal_cancel, image,
-                                 depth_map, counts)
-        self.stats["primary_rays"] += len(O)
+                                 self.col.bg, self.kopts, O, D, spp, fwd, cam, first,
+                                 tol.normal_cancel, image, depth_map, counts)
+        self.stats["primary_rays"] += n_pixels * spp
         for key, v in zip(_COUNTS, counts):
             self.stats[key] += int(v)
         return image, depth_map
@@ -408,7 +422,12 @@ class _WhittedBase:
             from tqdm import tqdm
             bar = tqdm(total=height, unit="row", desc=self.name)
         t1, c1 = time.perf_counter(), time.process_time()  # the trace phase includes the camera rays
-        O, D, pix = camera_rays(cam, width, height, spp, opts["seed"])
+        frame = camera_frame(cam, width, height)
+        if tr.fused and spp == 1:  # the kernel makes the pixel-centre rays itself
+            O = D = np.empty((0, 3))
+            pix = np.empty(0, np.int64)
+        else:
+            O, D, pix = camera_rays(cam, width, height, spp, opts["seed"])
         image = np.zeros((height * width, 3), np.float32)
         depth = np.full(height * width, np.inf, np.float32)
         rows = max(1, _RAYS_PER_BAND // (width * spp))
@@ -416,7 +435,8 @@ class _WhittedBase:
         for y0 in bands:
             y1 = min(height, y0 + rows)
             a, b = y0 * width * spp, y1 * width * spp
-            img, dep = tr.trace(O[a:b], D[a:b], pix[a:b] - y0 * width, (y1 - y0) * width, spp, fwd)
+            img, dep = tr.trace(O[a:b], D[a:b], pix[a:b] - y0 * width, (y1 - y0) * width, spp, fwd,
+                                frame, y0 * width)
             image[y0 * width:y1 * width] = img
             depth[y0 * width:y1 * width] = dep
             if opts["on_tile"] is not None:
