@@ -540,8 +540,9 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
         if any_hit and bp >= 0:
             return best, bp, bf, btri, bb1, bb2
     if tri_v.shape[0] > 0:
+        # np.bool_: a runtime flag, not a literal True/False (one compiled bvh_hit for all)
         t, tri, b1, b2 = bvh_hit(tri_v, bvh_box, bvh_meta, ox, oy, oz, dx, dy, dz, tmin, best,
-                                 any_hit, stack)
+                                 np.bool_(any_hit), stack)
         if tri >= 0:
             best, bp, bf, btri, bb1, bb2 = t, tri_prim[tri], 0, tri, b1, b2
     if bp < 0:
@@ -1056,6 +1057,8 @@ def pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts
     stack, st, sp_, sf, sn = scr
     (r_o, r_d, r_w, r_stk, r_n, r_kind, r_tmin, r_gen, c_o, c_d, c_w, c_stk, c_n, c_gen, h_t, h_p,
      h_ng, h_ns, h_uv, h_po, h_ev, h_col, contrib, cnt, tot) = bufs
+    row = np.int64(0)  # the current ray's row, typed int64 (not the literal 0): the same
+    # compiled shade_hit as shade_chunk's
     for p in range(p0, p1):
         ar, ag, ab = 0.0, 0.0, 0.0
         for s in range(spp):
@@ -1094,7 +1097,7 @@ def pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts
                         h_col[0, 1] = mat_tab[mi, 1] * tg_
                         h_col[0, 2] = mat_tab[mi, 2] * tb_
                 shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, c_o, c_d, c_w,
-                          c_gen, c_stk, c_n, 0, h_t, h_p, h_ng, h_ns, h_col, h_ev, contrib, r_o, r_d,
+                          c_gen, c_stk, c_n, row, h_t, h_p, h_ng, h_ns, h_col, h_ev, contrib, r_o, r_d,
                           r_w, r_stk, r_n, r_kind, r_tmin, r_gen, top, cnt, stack, st, sp_, sf, sn)
                 ar += contrib[0, 0]
                 ag += contrib[0, 1]
