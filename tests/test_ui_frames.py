@@ -65,6 +65,21 @@ def test_shown_panels_are_the_cli_images(gpu_session):
         assert np.abs(shown[..., :3].astype(int) - expected).max() <= 1, m
 
 
+def test_panels_are_copied_into_the_window_where_imgui_laid_them_out(gpu_session):
+    """The last frame's screenshot holds each panel's display texture at its item rectangle
+    (blitted under imgui's drawing, top row on top)."""
+    from PIL import Image
+    out, summary = gpu_session
+    shot = np.asarray(Image.open(out / "ui.png"))[..., :3].astype(int)
+    rects = dict(summary["script"]["blits"])
+    assert set(RASTER) | {"difference"} <= set(rects)
+    for m in [*RASTER, "difference"]:
+        x0, y0, x1, y1 = (round(v) for v in rects[m])
+        assert (x1 - x0, y1 - y0) == (SIZE, SIZE)
+        shown = np.load(out / f"shown_{m}.npy")[..., :3].astype(int)
+        assert np.array_equal(shot[y0:y1, x0:x1], shown), m
+
+
 def test_difference_view_on_the_gpu_is_the_cpu_error_map(gpu_session):
     from workbench.app.ui.panels import colour_scale
     from workbench.compare.metrics import error_map

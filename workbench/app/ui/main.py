@@ -30,7 +30,7 @@ def run(state: AppState, max_frames: int | None = None, script=None,
 
     from ...renderers import gl
     from . import window_style
-    from .frames import release_gl, update_images
+    from .frames import blit_panels, release_gl, update_images
     from .layout import docking_params
     from .panels import status_bar
     from .plot import track
@@ -81,7 +81,7 @@ def run(state: AppState, max_frames: int | None = None, script=None,
         window_style.clear_to_window_background()
     params.callbacks.setup_imgui_style = setup_style
     params.callbacks.show_gui = show_gui
-    params.callbacks.before_imgui_render = end_frame
+    params.callbacks.before_imgui_render = lambda: (end_frame(), blit_panels(state))
     params.callbacks.show_status = lambda: status_bar(state)
     params.callbacks.before_exit = before_exit
     immapp.run(params, immapp.AddOnsParams(with_implot=True))

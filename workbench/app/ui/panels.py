@@ -5,7 +5,8 @@ import numpy as np
 from imgui_bundle import imgui
 
 from . import camera as cam
-from .frames import difference_on_gpu, image_stats, panel_texture, stale, upload, upload_linear
+from .frames import (difference_on_gpu, image_stats, panel_texture, show_image, stale, upload,
+                     upload_linear)
 from .inspect import export, pixel_under_mouse, probe_tooltip, select_ray_tree
 from .layout import focus
 from .patch_view import select_patch
@@ -144,7 +145,7 @@ def image_panels(state: AppState) -> None:
         imgui.text(f"{m}  {'' if t is None else f'{t * 1e3:.1f} ms'}")
         if m in state.images:
             tex = panel_texture(state, m)
-            imgui.image(imgui.ImTextureRef(tex.glo), imgui.ImVec2(w, h), *cam.view_window(state.view))
+            show_image(state, m, tex, imgui.ImVec2(w, h), *cam.view_window(state.view))
             handle_mouse(state)
             ij = pixel_under_mouse(state)
             if ij is not None:
@@ -198,7 +199,7 @@ def difference_panel(state: AppState) -> None:
     vmax, mean = image_stats(state, "difference")
     vmax = max(vmax, 1e-6)
     size = imgui.ImVec2(state.camera.width, state.camera.height)
-    imgui.image(imgui.ImTextureRef(tex.glo), size, *cam.view_window(state.view))
+    show_image(state, "difference", tex, size, *cam.view_window(state.view))
     if "colour_scale" not in state.textures:
         upload(state, "colour_scale",
                colour_scale(np.tile(np.linspace(0, 1, 128, dtype=np.float32), (8, 1)), 1.0))

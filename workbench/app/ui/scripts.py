@@ -294,6 +294,7 @@ class GpuPanels:
                 np.save(self.out / f"shown_{m}.npy", shown)
             for m in ("flat", "phong", "difference"):
                 np.save(self.out / f"image_{m}.npy", state.images[m])
+            self.log["blits"] = [[m, list(rect)] for m, rect in state.gpu.blits.last]
             self.log["position"] = list(state.camera.position)
             state.quit = True
 
