@@ -6,14 +6,16 @@ compile, including llvmpipe's JIT at the first draw: ``setup_seconds`` and
 least ``--seconds`` (and at least 10 frames):
 
 * ``fps`` / ``ms_per_frame``: a frame as a user sees it: ``draw_to`` into the FBO and
-  ``ctx.finish()`` (the UI shows the FBO's texture; nothing is read back);
+  ``ctx.finish()`` (the UI shows the FBO's texture; nothing is read back), over the whole
+  window; ``fps_median`` and ``fps_best`` over batches of 5 frames (the best batch is the
+  rate least disturbed by other processes on the shared cores);
 * ``cpu_ms_per_frame``: CPU time of this process per frame, llvmpipe's threads included: on 2
   cores shared with other work, the wall-clock rate drops with the load average recorded in
   the file, the CPU time much less;
 * ``readback_ms``: reading the finished float32 colour image back to numpy
-  (``RasterSession.read_image``), for images only, timed alone;
+  (``RasterSession.read_image``), for images only, timed alone (median batch);
 * ``ms_with_readback``: ``draw(camera, with_depth=True)``, what ``render()`` does (colour and
-  depth read back), the number to set beside pyrender's.
+  depth read back; median batch), the number to set beside pyrender's median frame.
 
 pyrender's frame time (its offscreen render, which always reads colour and depth back) on the
 same scene and camera is measured beside ours, in a child process
@@ -29,6 +31,7 @@ import argparse
 import json
 import os
 import platform
+import statistics
 import time
 from pathlib import Path
 
@@ -40,17 +43,23 @@ from workbench.scene.library import bundled
 OUT = Path(__file__).resolve().parent / "results" / "raster_fps.json"
 
 
-def _rate(fn, seconds: float) -> tuple[float, float]:
-    """Frames per second (wall clock) and CPU seconds per frame (all threads of this process:
-    llvmpipe's rasteriser threads included; less sensitive to other processes' load), after 3
-    warm-up calls."""
+def _rate(fn, seconds: float, batch: int = 5) -> dict:
+    """Rates of ``fn`` after 3 warm-up calls, timed in batches of ``batch`` calls for at least
+    ``seconds`` (and 4 batches): ``fps`` over the whole window, ``fps_median`` and
+    ``fps_best`` over the batches (the best batch is the rate with the least interference
+    from other processes on the shared cores), ``cpu_ms`` per call (all threads of this
+    process, llvmpipe's rasteriser threads included: much less sensitive to the load)."""
     for _ in range(3):
         fn()
-    n, t0, c0 = 0, time.perf_counter(), time.process_time()
-    while n < 10 or time.perf_counter() - t0 < seconds:
-        fn()
-        n += 1
-    return n / (time.perf_counter() - t0), (time.process_time() - c0) / n
+    rates, t0, c0 = [], time.perf_counter(), time.process_time()
+    while len(rates) < 4 or time.perf_counter() - t0 < seconds:
+        tb = time.perf_counter()
+        for _ in range(batch):
+            fn()
+        rates.append(batch / (time.perf_counter() - tb))
+    n = batch * len(rates)
+    return {"fps": n / (time.perf_counter() - t0), "fps_median": statistics.median(rates),
+            "fps_best": max(rates), "cpu_ms": 1e3 * (time.process_time() - c0) / n}
 
 
 def bench_scene(name: str, size: int, seconds: float) -> dict:
@@ -68,17 +77,19 @@ def bench_scene(name: str, size: int, seconds: float) -> dict:
             session.draw_to(fbo, cam)
             ctx.finish()
 
-        fps, cpu = _rate(frame, seconds)
-        read_rate, _ = _rate(lambda: session.read_image(fbo), seconds / 4)
-        full_rate, _ = _rate(lambda: session.draw(cam, with_depth=True), seconds / 2)
+        r = _rate(frame, seconds)
+        read = _rate(lambda: session.read_image(fbo), seconds / 4)
+        full = _rate(lambda: session.draw(cam, with_depth=True), seconds / 2)
         row["methods"][mode] = {
             "triangles": session.n_triangles,
             "culled_objects": len(session.cull_boxes),
             "setup_seconds": round(setup, 4),
             "compile_seconds": round(session.timings["compile"], 4),
             "tessellate_seconds": round(session.timings["tessellate"], 4),
-            "fps": round(fps, 1), "ms_per_frame": round(1e3 / fps, 2), "cpu_ms_per_frame": round(1e3 * cpu, 2),
-            "readback_ms": round(1e3 / read_rate, 2), "ms_with_readback": round(1e3 / full_rate, 2),
+            "fps": round(r["fps"], 1), "fps_median": round(r["fps_median"], 1), "fps_best": round(r["fps_best"], 1),
+            "ms_per_frame": round(1e3 / r["fps"], 2), "cpu_ms_per_frame": round(r["cpu_ms"], 2),
+            "readback_ms": round(1e3 / read["fps_median"], 2),
+            "ms_with_readback": round(1e3 / full["fps_median"], 2),
         }
         session.release()
         print(name, mode, row["methods"][mode], flush=True)
