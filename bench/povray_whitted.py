@@ -18,7 +18,9 @@ bail-out differ in detail: POV-Ray reports about 18 % more rays on the Whitted s
 of the trace times for the same image (``trace_time_ratio``), which does not depend on how
 rays are counted.  Whole commands: POV-Ray's process wall time against ``workbench render
 ...`` as a process (Python start-up, imports, scene loading, warm numba cache, PNG writing).
-Cold compile: the same render in a fresh process with an empty numba cache directory (it
+Our commands run with Python's bytecode cache on, as for a user (``PYTHONDONTWRITEBYTECODE``
+is removed from their environment).  Cold compile: the same render in a fresh process with an
+empty numba cache directory (it
 compiles the kernels this scene needs: the fused kernel of :mod:`workbench.renderers.raytrace`).
 The load average is recorded before and after (the machine is shared).
 
@@ -97,6 +99,9 @@ def ours_in_process(scene_name: str, repeats: int = 3) -> dict:
 def ours_command(scene: str, cache_dir: str, out: Path) -> dict:
     """``workbench render`` as a separate process; returns wall time and its timings."""
     env = dict(os.environ, NUMBA_CACHE_DIR=cache_dir, NUMBA_NUM_THREADS="2")
+    # as a user runs it: with Python's bytecode cache (a harness's PYTHONDONTWRITEBYTECODE
+    # would recompile every workbench module at each start, ~0.05 s)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
     js = out.with_suffix(".json")
     cmd = [str(Path(PY).parent / "workbench"), "render", scene, "-m", "raytrace", "-o", str(out),
            "--size", f"{W}x{H}", "--set", f"threshold={THRESHOLD}", "--set", "max_depth=5",

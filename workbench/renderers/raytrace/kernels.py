@@ -1,11 +1,16 @@
-"""Numba kernels of the ray tracer: intersection (closest hit, shadow feelers) and the shading
-and spawning step of one ray generation ("wavefront": each generation of rays is traced, then
-shaded, then its reflected and refracted children form the next generation).
+"""Numba kernels of the ray tracer: intersection (closest hit, shadow feelers), the shading and
+spawning step of a hit (:func:`shade_hit`), and the two drivers: the fused kernel
+(:func:`render_pixels`: each pixel's whole ray tree depth first) and the wavefront kernels
+(:func:`trace_batch`, :func:`shade_batch`: each generation of rays is traced, then shaded, then
+its reflected and refracted children form the next generation).
 
-Everything is scalar code over flat arrays (:mod:`.flatten`); the batch kernels are
-``parallel=True`` over chunks of ``CHUNK`` rays (``prange``), each chunk with its own scratch
-arrays (BVH stack, CSG interval stacks).  ``error_model="numpy"``: float divisions follow IEEE
-(no zero-divisor check and exception path on every division; the results are the same wherever
+Everything is scalar code over flat arrays (:mod:`.flatten`); the drivers are ``parallel=True``
+over chunks of rays or blocks of pixels (``prange``), each with its own scratch arrays (BVH
+stack, CSG interval stacks, ray stack), and hand each chunk to a worker compiled without
+reference counting (:data:`NO_REFCOUNT`).  Helpers marked ``inline="always"`` are inlined into
+their callers, which are cached, so they are not cached themselves (one dispatcher cache less
+to set up per helper at import).  ``error_model="numpy"``: float divisions follow IEEE (no
+zero-divisor check and exception path on every division; the results are the same wherever
 the default Python model would not raise).  ``cache=True``: compiled code is kept on disk
 (``NUMBA_CACHE_DIR``), so a warm cache compiles nothing.
 
@@ -42,7 +47,7 @@ BOX_GAMMA = 1.0 + 2.0 * 3.0 * 2.0 ** -53 / (1.0 - 3.0 * 2.0 ** -53)
 
 
 # ----------------------------------------------------------------------------- small helpers
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(error_model="numpy", inline="always")
 def _to_object(xf, k, ox, oy, oz, dx, dy, dz):
     return (xf[k, 0] * ox + xf[k, 1] * oy + xf[k, 2] * oz + xf[k, 3], xf[k, 4] * ox + xf[k, 5] * oy + xf[k, 6] * oz + xf[k, 7],
             xf[k, 8] * ox + xf[k, 9] * oy + xf[k, 10] * oz + xf[k, 11],
@@ -73,14 +78,14 @@ def solve_quadratic(A, B, C, zero):
     return 2, t0, t1
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(error_model="numpy", inline="always")
 def sphere_roots(par, k, ox, oy, oz, dx, dy, dz):
     """Roots of the ray / sphere equation in object space (see :func:`sphere_roots_unit`)."""
     inv_s = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
     return sphere_roots_unit(par, k, ox, oy, oz, dx * inv_s, dy * inv_s, dz * inv_s, inv_s)
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(error_model="numpy", inline="always")
 def sphere_roots_unit(par, k, ox, oy, oz, ux, uy, uz, inv_s):
     """Roots of the ray / sphere equation in object space, for the unit direction ``u`` of a
     ray direction of length ``1 / inv_s`` (the roots are in units of that direction).
@@ -110,7 +115,7 @@ def sphere_roots_unit(par, k, ox, oy, oz, ux, uy, uz, inv_s):
     return True, t0 * inv_s, t1 * inv_s
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(error_model="numpy", inline="always")
 def slab(lo0, lo1, lo2, hi0, hi1, hi2, ox, oy, oz, dx, dy, dz):
     """Ray / axis-aligned box (Kay & Kajiya slabs).  Returns ``(ok, t_near, face_near, t_far,
     face_far)``; faces are ``1 + 2 axis + side`` (side 1 = max face)."""
@@ -142,7 +147,7 @@ def slab(lo0, lo1, lo2, hi0, hi1, hi2, ox, oy, oz, dx, dy, dz):
     return True, tn, fn, tf, ff
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(error_model="numpy", inline="always")
 def quadric_coeffs(par, k, ox, oy, oz, dx, dy, dz):
     """``A = D^T Q D``, ``B = 2 D^T Q P0``, ``C = P0^T Q P0`` with D lifted with w = 0 and P0
     with w = 1 (errata 2: the cross terms of C carry their factor 2)."""
@@ -162,7 +167,7 @@ def quadric_coeffs(par, k, ox, oy, oz, dx, dy, dz):
     return A, B, C
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(error_model="numpy", inline="always")
 def _in_bounds(par, k, x, y, z, slack):
     return (par[k, 10] - slack <= x <= par[k, 13] + slack and par[k, 11] - slack <= y <= par[k, 14] + slack
             and par[k, 12] - slack <= z <= par[k, 15] + slack)
@@ -206,7 +211,7 @@ def _quadric_hit(k, par, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
     return np.inf, 0
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(error_model="numpy", inline="always")
 def prim_hit(k, ptype, par, poly_v, ox, oy, oz, dx, dy, dz, ux, uy, uz, inv_s, tmin, tmax, zero):
     """Closest hit ``tmin < t < tmax`` of analytic primitive ``k`` (object-space ray with
     direction ``d``; spheres use its unit direction ``u`` and ``inv_s = 1 / |d|``).
@@ -313,7 +318,7 @@ def leaf_events(k, ptype, par, ox, oy, oz, dx, dy, dz, zero, et, ep, ef):
     return 0
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(error_model="numpy", inline="always")
 def _op(op, a, b):
     if op == CSG_UNION:
         return a or b
@@ -394,22 +399,19 @@ def csg_hit(start, length, prog, ptype, xf, par, ox, oy, oz, dx, dy, dz, tmin, t
     return np.inf, 0, 0
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
-def tri_hit(tv, i, ox, oy, oz, kx, ky, kz, sx, sy, sz, tmin, tmax):
-    """Watertight ray / triangle test (Woop, Benthin & Wald, JCGT 2013).  Returns
-    ``(t, b1, b2)`` with barycentric weights of vertices 1 and 2, ``t = inf`` on a miss."""
-    a0, a1, a2 = tv[i, 0] - ox, tv[i, 1] - oy, tv[i, 2] - oz
-    b0, b1, b2 = tv[i, 3] - ox, tv[i, 4] - oy, tv[i, 5] - oz
-    c0, c1, c2 = tv[i, 6] - ox, tv[i, 7] - oy, tv[i, 8] - oz
-    A = (a0, a1, a2)
-    B = (b0, b1, b2)
-    Cc = (c0, c1, c2)
-    ax = A[kx] - sx * A[kz]
-    ay = A[ky] - sy * A[kz]
-    bx = B[kx] - sx * B[kz]
-    by = B[ky] - sy * B[kz]
-    cx = Cc[kx] - sx * Cc[kz]
-    cy = Cc[ky] - sy * Cc[kz]
+@nb.njit(error_model="numpy", inline="always")
+def tri_hit(tv, i, okx, oky, okz, kx, ky, kz, sx, sy, sz, tmin, tmax):
+    """Watertight ray / triangle test (Woop, Benthin & Wald, JCGT 2013), in the ray's permuted
+    axes ``kx, ky, kz`` (``kz`` the dominant axis of the direction; ``ok*`` the origin's
+    components along them, ``s*`` the shear).  Returns ``(t, b1, b2)`` with barycentric
+    weights of vertices 1 and 2, ``t = inf`` on a miss."""
+    az, bz, cz = tv[i, kz] - okz, tv[i, 3 + kz] - okz, tv[i, 6 + kz] - okz
+    ax = (tv[i, kx] - okx) - sx * az
+    ay = (tv[i, ky] - oky) - sy * az
+    bx = (tv[i, 3 + kx] - okx) - sx * bz
+    by = (tv[i, 3 + ky] - oky) - sy * bz
+    cx = (tv[i, 6 + kx] - okx) - sx * cz
+    cy = (tv[i, 6 + ky] - oky) - sy * cz
     U = cx * by - cy * bx
     V = ax * cy - ay * cx
     W = bx * ay - by * ax
@@ -418,14 +420,14 @@ def tri_hit(tv, i, ox, oy, oz, kx, ky, kz, sx, sy, sz, tmin, tmax):
     det = U + V + W
     if det == 0.0:
         return np.inf, 0.0, 0.0
-    T = U * sz * A[kz] + V * sz * B[kz] + W * sz * Cc[kz]
+    T = U * sz * az + V * sz * bz + W * sz * cz
     t = T / det
     if not (tmin < t < tmax):
         return np.inf, 0.0, 0.0
     return t, V / det, W / det
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(error_model="numpy", inline="always")
 def _box_entry(box, nd, ox, oy, oz, ix, iy, iz, tmin, best):
     """Entry distance of the ray into node ``nd``'s box (slabs), ``inf`` if it misses it or
     enters beyond ``best``; exits are enlarged by ``BOX_GAMMA`` (Ize, JCGT 2013)."""
@@ -461,6 +463,8 @@ def bvh_hit(tv, box, meta, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     if d[kz] < 0.0:
         kx, ky = ky, kx
     sx, sy, sz = d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]
+    o = (ox, oy, oz)
+    okx, oky, okz = o[kx], o[ky], o[kz]
     big = 1e300
     ix = 1.0 / dx if dx != 0.0 else (big if dx >= 0.0 else -big)
     iy = 1.0 / dy if dy != 0.0 else (big if dy >= 0.0 else -big)
@@ -473,7 +477,7 @@ def bvh_hit(tv, box, meta, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
         if meta[nd, 1] > 0:
             first, cnt = meta[nd, 0], meta[nd, 1]
             for i in range(first, first + cnt):
-                t, b1, b2 = tri_hit(tv, i, ox, oy, oz, kx, ky, kz, sx, sy, sz, tmin, best)
+                t, b1, b2 = tri_hit(tv, i, okx, oky, okz, kx, ky, kz, sx, sy, sz, tmin, best)
                 if t < best:
                     best, btri, bb1, bb2 = t, i, b1, b2
                     if any_hit:
@@ -507,7 +511,7 @@ def bvh_hit(tv, box, meta, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     return best, btri, bb1, bb2
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(error_model="numpy", inline="always")
 def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
             st, sp_, sf, sn):
     """Nearest hit of a world ray over all primitives (linear loop over analytic primitives,
@@ -550,7 +554,7 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
     return best, bp, bf, btri, bb1, bb2
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(error_model="numpy", inline="always")
 def object_normal(k, face, ptype, par, x, y, z):
     """Outward normal (unnormalised) of primitive ``k`` at object-space point, by face."""
     kind = ptype[k]
@@ -570,7 +574,7 @@ def object_normal(k, face, ptype, par, x, y, z):
     return 0.0, 1.0, 0.0
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(error_model="numpy", inline="always")
 def _normalize(x, y, z):
     n = math.sqrt(x * x + y * y + z * z)
     if n > 0.0:
@@ -578,7 +582,7 @@ def _normalize(x, y, z):
     return 0.0, 0.0, 0.0
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(error_model="numpy", inline="always")
 def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_uv, out_po, out_e, i):
     """Geometric (outward) normal, shading normal, uv (meshes; analytic primitives leave the
     mapping to the texturing module), object-space point and vertex emission at a hit, written
@@ -623,7 +627,7 @@ def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_
 
 
 # ----------------------------------------------------------------------------- batch kernels
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(error_model="numpy", inline="always")
 def scratch():
     """Per-thread work arrays of :func:`closest`: the BVH traversal stack (rows: entry distance,
     node) and the CSG stack of interval lists (times, signed primitive codes, faces, counts)."""
@@ -659,7 +663,7 @@ def trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, t_out, pr
                     oz + t * D[i, 2], ncancel, ng, ns, uv, po, ev, i)
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(error_model="numpy", inline="always")
 def _transmittance(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmin, tmax, transmissive, zero,
                    eps, stack, st, sp_, sf, sn):
     """Shadow feeler: 1 if nothing blocks the segment, 0 if blocked (any hit ends the search);
@@ -688,14 +692,14 @@ def accumulate(acc, pix, contrib):
             acc[pix[i], c] += contrib[i, c]
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(error_model="numpy", inline="always")
 def _pow(base, n):
     if n == 0.0:
         return 1.0
     return base ** n
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(error_model="numpy", inline="always")
 def _ior(mat_tab, stk, ns_):
     return mat_tab[stk[ns_ - 1], 9] if ns_ > 0 else 1.0
 
@@ -961,7 +965,7 @@ CHECKER_PLANAR, CHECKER_SOLID = 1, 2
 PIXEL_BLOCK = 64
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(error_model="numpy", inline="always")
 def checker_color(tex_tab, mi, x, y, z):
     """Texture factor of material ``mi`` at object-space point ``(x, y, z)``: the
     ``checker`` pattern of :func:`workbench.renderers.texturing.pattern_value` with the
@@ -1014,7 +1018,7 @@ def render_pixels(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, op
             counts[q] += part[b, q]
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(error_model="numpy", inline="always")
 def camera_ray(cam, q, o, d):
     """Row 0 of ``o, d``: the centre ray of image pixel ``q`` (row-major) of the camera ``cam``
     (``whitted.camera_frame``: position, rotation, tan(fov_y / 2), aspect, width, height)."""
