@@ -10,7 +10,9 @@
   framebuffer, else a float texture uploaded once per change of the image) and reaches the
   screen through GPU passes (:class:`DisplayPasses`, ``shaders/display*``): sRGB encoding
   (IEC 61966-2-1, the numbers of :func:`workbench.core.imageio.to_srgb8`) into an RGBA8
-  texture that imgui shows, and the difference view's ``"abs"`` map and colour scale.
+  texture, and the difference view's ``"abs"`` map and colour scale.  These textures are
+  copied into the window's framebuffer under imgui's drawing (:class:`ScreenBlits`), not
+  drawn by imgui as quads.
 * Pixels come back to the CPU only when asked for: ``state.images[m]`` of a raster panel is a
   pending read (:class:`~.images.PanelImages`), resolved once per draw by the probe, the
   difference view, the export or a script.
