@@ -46,6 +46,18 @@ def test_browser_lists_folders_and_scene_files(tmp_path):
     assert state.browser.folder == (d / "sub").resolve() and state.browser.failed
 
 
+def test_browser_lists_a_folder_again_only_after_a_while_or_a_change(tmp_path):
+    from workbench.app.ui.file_browser import RELIST_SECONDS, Browser, cached_listing
+    d = _scene_folder(tmp_path)
+    b = Browser(folder=d)
+    assert [p.name for p in cached_listing(b, now=100.0)[1]] == ["bad.toml", "broken.toml", "good.toml"]
+    (d / "new.toml").write_text("")
+    assert len(cached_listing(b, now=100.0 + 0.5 * RELIST_SECONDS)[1]) == 3  # not listed again yet
+    assert len(cached_listing(b, now=100.0 + RELIST_SECONDS)[1]) == 4
+    go_to(b, d / "sub")
+    assert cached_listing(b, now=100.0 + RELIST_SECONDS) == ([], [])  # a new folder: listed at once
+
+
 def test_bad_scene_file_keeps_the_scene_and_says_why(tmp_path):
     d = _scene_folder(tmp_path)
     state = new_state("whitted")

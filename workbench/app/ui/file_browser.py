@@ -8,13 +8,16 @@ names the file, the key and what was expected) in the window.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from ...core.errors import WorkbenchError
 from .state import AppState, set_scene
 
 PATTERN = "*.toml"
+RELIST_SECONDS = 1.0
+"""A shown folder is listed again after this long (files saved meanwhile appear), not every frame."""
 
 
 @dataclass
@@ -25,6 +28,18 @@ class Browser:
     selected: Path | None = None
     message: str = ""
     failed: bool = False
+    listed: tuple[list[Path], list[Path]] | None = field(default=None, repr=False)
+    listed_at: float = 0.0
+
+
+def cached_listing(browser: Browser, now: float | None = None) -> tuple[list[Path], list[Path]]:
+    """:func:`listing` of the browser's folder, listed again only after ``RELIST_SECONDS`` or a
+    change of folder (a folder that cannot be listed raises each time it is listed)."""
+    now = time.monotonic() if now is None else now
+    if browser.listed is None or now - browser.listed_at >= RELIST_SECONDS:
+        browser.listed, browser.listed_at = None, now
+        browser.listed = listing(browser.folder)
+    return browser.listed
 
 
 def listing(folder: Path) -> tuple[list[Path], list[Path]]:
@@ -46,7 +61,7 @@ def go_to(browser: Browser, folder: Path) -> None:
     if not folder.is_dir():
         browser.message, browser.failed = f"{folder}: not a folder", True
         return
-    browser.folder, browser.selected = folder.resolve(), None
+    browser.folder, browser.selected, browser.listed = folder.resolve(), None, None
     browser.message, browser.failed = "", False
 
 
@@ -79,7 +94,7 @@ def file_browser(state: AppState) -> None:
     if entered:
         go_to(b, Path(text))
     try:
-        dirs, files = listing(b.folder)
+        dirs, files = cached_listing(b)
     except WorkbenchError as e:
         dirs, files = [], []
         b.message, b.failed = str(e), True
