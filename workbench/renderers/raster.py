@@ -48,7 +48,7 @@ import numpy as np
 from ..core.errors import WorkbenchError
 from ..core.tol import tol
 from ..scene import features as ft
-from ..scene.model import AreaLight, Camera, DirectionalLight, Environment, Material, Scene
+from ..scene.model import AreaLight, Camera, Environment, Material, Scene
 from ..scene.tessellate import DEFAULT_LEVEL, MAX_LEVEL, Part, tessellate_scene
 from ..scene.tessellate_topology import closed_outward, provoking_layout
 from . import gl
@@ -295,7 +295,8 @@ class RasterSession:
         return _Draw(part, mat, prog, vao, blended, part.positions.mean(0), images, uniforms)
 
     def _static_uniforms(self, prog, part: Part, mat: Material) -> _Uniforms:
-        """Material, maps and lights of one draw (the camera is set per frame)."""
+        """Material and maps of one draw (the lights are compiled in, raster_shaders.light_list;
+        the camera is set per frame)."""
         u = _Uniforms(prog)
         u.set("u_color", tuple(mat.color))
         u.set("u_emission", tuple(mat.emission))
@@ -329,20 +330,6 @@ class RasterSession:
             u.set("u_env_ground", tuple(e.ground))
         for name, unit in UNITS.items():
             u.set(name, unit)
-        if self.lights:  # kinds and falloffs are compiled in (raster_shaders.light_list)
-            pos, col, lobe = [], [], []
-            for light in self.lights:
-                col.append(np.asarray(light.color, dtype=np.float64) * light.intensity)
-                if isinstance(light, DirectionalLight):
-                    pos.append(-np.asarray(light.direction, dtype=np.float64))  # towards the light
-                    lobe.append(np.zeros(3))
-                else:
-                    pos.append(np.asarray(light.position, dtype=np.float64))
-                    cn = light.cosine_normal
-                    lobe.append(np.zeros(3) if cn is None else np.asarray(cn, dtype=np.float64))
-            u.set("u_light_pos", np.array(pos))
-            u.set("u_light_color", np.array(col))
-            u.set("u_light_lobe", np.array(lobe))
         if self.depth_bits == 16:
             u.set("u_depth_levels", float(2 ** 16 - 1))
         return u

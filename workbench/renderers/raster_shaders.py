@@ -17,6 +17,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from ..core.errors import WorkbenchError
 from ..core.tol import tol
 from ..scene import features as ft
@@ -87,18 +89,30 @@ def base_defines() -> dict[str, object]:
             "TOL_BUMP_STEP": f"{tol.bump_step:.6e}"}
 
 
+def _vec3(v) -> str:
+    """A GLSL vec3 literal of the float32 rounding of ``v`` (the value a uniform would hold:
+    the shortest decimal of that float32's exact value parses back to it)."""
+    return "vec3(" + ", ".join(repr(float(np.float32(x))) for x in v) + ")"
+
+
 def light_list(lights) -> str:
-    """Body of the ``FOR_EACH_LIGHT(X)`` macro: ``X(l, POINT, INV_SQ, LOBE)`` per light, the
-    flags as GLSL literals (``lighting.glsl`` folds them away: each light compiles to its own
-    arithmetic only)."""
+    """Body of the ``FOR_EACH_LIGHT(X)`` macro: ``X(POINT, INV_SQ, LOBE, pos, color,
+    lobe_normal)`` per light, as GLSL literals (``lighting.glsl`` folds them: each light
+    compiles to its own arithmetic, with no uniform read).  ``pos`` is the position, or the
+    direction towards a directional light; ``color`` is ``color * intensity``."""
     def flag(b: bool) -> str:
         return "true" if b else "false"
     items = []
-    for i, light in enumerate(lights):
-        point = not isinstance(light, DirectionalLight)
-        inv_sq = point and light.falloff == "inverse_square"
-        lobe = point and light.cosine_normal is not None
-        items.append(f"X({i}, {flag(point)}, {flag(inv_sq)}, {flag(lobe)})")
+    for light in lights:
+        color = np.asarray(light.color, dtype=np.float64) * light.intensity
+        if isinstance(light, DirectionalLight):
+            point, inv_sq, lobe = False, False, None
+            pos = -np.asarray(light.direction, dtype=np.float64)
+        else:
+            point, inv_sq, lobe = True, light.falloff == "inverse_square", light.cosine_normal
+            pos = np.asarray(light.position, dtype=np.float64)
+        items.append(f"X({flag(point)}, {flag(inv_sq)}, {flag(lobe is not None)}, {_vec3(pos)}, "
+                     f"{_vec3(color)}, {_vec3(np.zeros(3) if lobe is None else lobe)})")
     return " ".join(items)
 
 
@@ -106,9 +120,9 @@ def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: i
                      has_uv: bool, blinn: bool, depth_bits: int, allow_bump: bool) -> dict[str, object]:
     """The ``#define``s of one draw: what the scene needs and this material uses, nothing else.
 
-    ``MODE_*`` (flat, gouraud, phong), ``N_LIGHTS`` (uniform array size) and
-    ``FOR_EACH_LIGHT(X)`` (:func:`light_list` of the scene's first ``n_lights`` point and
-    directional lights; empty for a material with ``kd = ks = 0``, which no light changes),
+    ``MODE_*`` (flat, gouraud, phong), ``N_LIGHTS`` and ``FOR_EACH_LIGHT(X)`` (:func:`light_list`
+    of the scene's first ``n_lights`` point and directional lights, their data compiled in;
+    empty for a material with ``kd = ks = 0``, which no light changes),
     ``SPECULAR`` for a material with
     ``ks > 0`` (and ``BLINN`` when asked), ``HAS_UV`` (mesh uvs), ``TEX_KIND/TEX_PROJ``, ``BUMP_KIND/BUMP_PROJ``
     (only when ``allow_bump``: per-fragment normals), ``OPACITY_KIND/OPACITY_PROJ``,
