@@ -636,15 +636,30 @@ def scratch():
             np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64), np.empty(CSG_DEPTH, dtype=np.int64))
 
 
+MAX_TASKS = 64
+"""``prange`` tasks of a kernel call: each takes every ``MAX_TASKS``-th chunk of rays or block
+of pixels and allocates its scratch arrays once (an allocation per chunk cost more than the
+chunk's rays).  Enough for a fair split between threads; a constant, because a kernel that
+asks numba for its thread count cannot be cached."""
+
+
+@nb.njit(error_model="numpy", inline="always")
+def _tasks(nchunks):
+    return max(1, min(nchunks, MAX_TASKS))
+
+
 @nb.njit(cache=True, error_model="numpy", parallel=True)
 def trace_batch(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel,
                 t_out, prim_out, ng, ns, uv, po, ev):
     """Closest hits of N rays and their surface data (``prim_out = -1``, ``t = inf`` on a miss)."""
     n = O.shape[0]
     nchunks = (n + CHUNK - 1) // CHUNK
-    for c in prange(nchunks):
-        trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, t_out, prim_out, ng, ns,
-                    uv, po, ev, c * CHUNK, min(n, (c + 1) * CHUNK), scratch())
+    nit = _tasks(nchunks)
+    for c in prange(nit):
+        scr = scratch()
+        for q in range(c, nchunks, nit):
+            trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, t_out, prim_out, ng,
+                        ns, uv, po, ev, q * CHUNK, min(n, (q + 1) * CHUNK), scr)
 
 
 @nb.njit(**NO_REFCOUNT)
@@ -704,15 +719,17 @@ def _ior(mat_tab, stk, ns_):
     return mat_tab[stk[ns_ - 1], 9] if ns_ > 0 else 1.0
 
 
-@nb.njit(**NO_REFCOUNT)
-def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, O, D, w, depth, stk, nstk, i,
-              t, prim, ng, nsh, col, ev, contrib, out_o, out_d, out_w, out_stk, out_nstk, out_kind,
-              out_tmin, out_gen, s0, counts, stack, st, sp_, sf, sn):
+@nb.njit(error_model="numpy", inline="always")
+def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, hits, contrib,
+              out, s0, counts, scr):
     """Local model with shadow feelers at the hit of ray ``i``, then its reflected and refracted
-    children (one step of the course's ``shade``).
+    children (one step of the course's ``shade``).  Inlined into both drivers (a call with this
+    many arrays cost more than the shading of a ray); the arrays come in tuples because Python
+    passes a call of more than 30 arguments as ``*args``, which numba cannot inline.
 
-    The ray is row ``i`` of ``O, D, w, depth, stk, nstk`` and its hit row ``i`` of ``t, prim,
-    ng, nsh, col, ev``; the local colour times the ray's weight goes to ``contrib[i]``, the
+    The ray is row ``i`` of ``rays = (O, D, w, depth, stk, nstk)`` and its hit row ``i`` of
+    ``hits = (t, prim, ng, nsh, col, ev)``; ``out = (out_o, out_d, out_w, out_stk, out_nstk,
+    out_kind, out_tmin, out_gen)``; ``scr``: :func:`scratch`.  The local colour times the ray's weight goes to ``contrib[i]``, the
     children to slots ``s0`` (reflection) and ``s0 + 1`` (refraction) of the ``out_*`` arrays
     (``out_kind`` 0 = none, 1 reflected, 2 refracted), the counts to ``counts[i]``: shadow
     rays, ended by depth, ended by threshold, total internal reflections, reflected and
@@ -723,6 +740,10 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, O, D, w, 
     extent, misses see ``background`` (else they contribute nothing here: an environment map
     is evaluated by the caller).
     """
+    O, D, w, depth, stk, nstk = rays
+    t, prim, ng, nsh, col, ev = hits
+    out_o, out_d, out_w, out_stk, out_nstk, out_kind, out_tmin, out_gen = out
+    stack, st, sp_, sf, sn = scr
     max_depth, threshold, fres = int(opts[0]), opts[1], int(opts[2])
     transmissive, blinn = opts[3] > 0.5, opts[4] > 0.5
     do_shadow, do_refl, do_refr = opts[5] > 0.5, opts[6] > 0.5, opts[7] > 0.5
@@ -938,11 +959,14 @@ def shade_batch(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim
     ``2 i`` (reflection), ``2 i + 1`` (refraction), with the parent's pixel ``out_pix``."""
     n = O.shape[0]
     nchunks = (n + CHUNK - 1) // CHUNK
-    for c in prange(nchunks):
-        shade_chunk(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim, ng, nsh, col,
-                    ev, w, depth, stk, nstk, pix, opts, contrib, out_o, out_d, out_w, out_stk,
-                    out_nstk, out_kind, out_tmin, out_pix, out_gen, counts, c * CHUNK,
-                    min(n, (c + 1) * CHUNK), scratch())
+    nit = _tasks(nchunks)
+    for c in prange(nit):
+        scr = scratch()
+        for q in range(c, nchunks, nit):
+            shade_chunk(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim, ng, nsh,
+                        col, ev, w, depth, stk, nstk, pix, opts, contrib, out_o, out_d, out_w,
+                        out_stk, out_nstk, out_kind, out_tmin, out_pix, out_gen, counts, q * CHUNK,
+                        min(n, (q + 1) * CHUNK), scr)
 
 
 @nb.njit(**NO_REFCOUNT)
@@ -950,11 +974,11 @@ def shade_chunk(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim
                 w, depth, stk, nstk, pix, opts, contrib, out_o, out_d, out_w, out_stk, out_nstk,
                 out_kind, out_tmin, out_pix, out_gen, counts, i0, i1, scr):
     """Rays ``i0 .. i1 - 1`` of :func:`shade_batch` (``scr``: :func:`scratch`)."""
-    stack, st, sp_, sf, sn = scr
+    rays, hits = (O, D, w, depth, stk, nstk), (t, prim, ng, nsh, col, ev)
+    out = (out_o, out_d, out_w, out_stk, out_nstk, out_kind, out_tmin, out_gen)
     for i in range(i0, i1):
-        shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, O, D, w, depth, stk,
-                  nstk, i, t, prim, ng, nsh, col, ev, contrib, out_o, out_d, out_w, out_stk,
-                  out_nstk, out_kind, out_tmin, out_gen, 2 * i, counts, stack, st, sp_, sf, sn)
+        shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, hits, contrib,
+                  out, 2 * i, counts, scr)
         out_pix[2 * i] = pix[i]
         out_pix[2 * i + 1] = pix[i]
 
@@ -996,8 +1020,8 @@ def render_pixels(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, op
     Writes ``image[p]`` (mean over the samples), ``depth_map[p]`` (camera-space depth of the
     first sample's primary hit, ``fwd`` the unit view axis, ``inf`` on a miss) and adds the
     ray counts of :func:`shade_hit` to ``counts`` (7,).  Blocks of ``PIXEL_BLOCK`` pixels are
-    visited in a scrambled order so that the static split of ``prange`` between threads gives
-    each a fair share of the expensive parts of the image.
+    dealt to a few tasks per thread in a scrambled order, so that the static split of
+    ``prange`` between threads gives each a fair share of the expensive parts of the image.
     """
     npix = image.shape[0]
     nblocks = (npix + PIXEL_BLOCK - 1) // PIXEL_BLOCK
@@ -1006,16 +1030,19 @@ def render_pixels(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, op
         stride = nblocks // 2 + 1
         while math.gcd(stride, nblocks) != 1:
             stride += 1
-    part = np.zeros((nblocks, 7), np.int64)
     cap = 2 * int(opts[0]) + 2
-    for c in prange(nblocks):
-        b = (c * stride) % nblocks
-        pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts, O, D, spp,
-                    fwd, cam, first, ncancel, image, depth_map, part[b], b * PIXEL_BLOCK,
-                    min(npix, (b + 1) * PIXEL_BLOCK), scratch(), ray_stack(cap))
-    for b in range(nblocks):
+    nit = _tasks(nblocks)
+    part = np.zeros((nit, 8), np.int64)  # a row per task (8: rows a cache line apart)
+    for c in prange(nit):
+        scr, bufs = scratch(), ray_stack(cap)
+        for k in range(c, nblocks, nit):
+            b = (k * stride) % nblocks
+            pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts, O, D, spp,
+                        fwd, cam, first, ncancel, image, depth_map, part[c], b * PIXEL_BLOCK,
+                        min(npix, (b + 1) * PIXEL_BLOCK), scr, bufs)
+    for c in range(nit):
         for q in range(7):
-            counts[q] += part[b, q]
+            counts[q] += part[c, q]
 
 
 @nb.njit(error_model="numpy", inline="always")
@@ -1061,8 +1088,10 @@ def pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts
     stack, st, sp_, sf, sn = scr
     (r_o, r_d, r_w, r_stk, r_n, r_kind, r_tmin, r_gen, c_o, c_d, c_w, c_stk, c_n, c_gen, h_t, h_p,
      h_ng, h_ns, h_uv, h_po, h_ev, h_col, contrib, cnt, tot) = bufs
-    row = np.int64(0)  # the current ray's row, typed int64 (not the literal 0): the same
-    # compiled shade_hit as shade_chunk's
+    row = 0  # the current ray's row
+    cur = (c_o, c_d, c_w, c_gen, c_stk, c_n)
+    hits = (h_t, h_p, h_ng, h_ns, h_col, h_ev)
+    pending = (r_o, r_d, r_w, r_stk, r_n, r_kind, r_tmin, r_gen)
     for p in range(p0, p1):
         ar, ag, ab = 0.0, 0.0, 0.0
         for s in range(spp):
@@ -1100,9 +1129,8 @@ def pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts
                         h_col[0, 0] = mat_tab[mi, 0] * tr_
                         h_col[0, 1] = mat_tab[mi, 1] * tg_
                         h_col[0, 2] = mat_tab[mi, 2] * tb_
-                shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, c_o, c_d, c_w,
-                          c_gen, c_stk, c_n, row, h_t, h_p, h_ng, h_ns, h_col, h_ev, contrib, r_o, r_d,
-                          r_w, r_stk, r_n, r_kind, r_tmin, r_gen, top, cnt, stack, st, sp_, sf, sn)
+                shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, cur, row, hits,
+                          contrib, pending, top, cnt, scr)
                 ar += contrib[0, 0]
                 ag += contrib[0, 1]
                 ab += contrib[0, 2]
@@ -1123,6 +1151,7 @@ def pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts
         image[p, 0], image[p, 1], image[p, 2] = ar / spp, ag / spp, ab / spp
     for q in range(7):
         counts[q] += tot[q]
+        tot[q] = 0
 
 
 @nb.njit(cache=True, error_model="numpy")
