@@ -34,9 +34,7 @@ in vec3 v_specular;
 #endif
 
 uniform vec3 u_eye;
-uniform vec3 u_color;
-uniform vec3 u_emission;
-uniform float u_kr;
+// the material's C, E and kr: literals MAT_COLOR, MAT_EMISSION, MAT_KR (material_defines)
 #ifdef DEPTH_LEVELS
 uniform float u_depth_levels;  // 2^bits - 1: emulated fixed-point depth buffer
 #endif
@@ -49,7 +47,7 @@ void main() {
     a = opacity(v_obj, v_uv);
     if (a < 0.5) discard;
 #endif
-    vec3 C = u_color;
+    vec3 C = MAT_COLOR;
 #ifdef TEX_KIND
     C *= texture_color(v_obj, v_uv);
 #endif
@@ -71,9 +69,9 @@ void main() {
     vec3 diffuse = v_diffuse;
     vec3 specular = v_specular;
 #endif
-    vec3 color = u_emission + C * diffuse + specular;
+    vec3 color = MAT_EMISSION + C * diffuse + specular;
 #if defined(ENV_MAP) && defined(ENV_KIND)
-    color += u_kr * environment(2.0 * dot(N, S) * N - S);
+    color += MAT_KR * environment(2.0 * dot(N, S) * N - S);
 #endif
     frag_color = vec4(color, a);
 #ifdef DEPTH_LEVELS

@@ -48,10 +48,14 @@ def test_program_cache_keys_on_defines(gl_ctx):
     cache = ProgramCache(gl_ctx)
     scene = workbench.load_scene("whitted")
     kw = dict(n_lights=2, has_uv=False, blinn=False, depth_bits=24, allow_bump=True)
-    d1 = material_defines(scene, scene.materials["matte"], "phong", **kw)
-    d2 = material_defines(scene, scene.materials["glass"], "phong", **kw)
-    d3 = material_defines(scene, scene.materials["checker"], "phong", **kw)
-    assert cache.get("raster", d1) is cache.get("raster", d2)  # same defines, one program
+    matte = scene.materials["matte"]
+    d1 = material_defines(scene, matte, "phong", **kw)
+    # a material of another name with the same constants: same defines, one program
+    d2 = material_defines(scene, replace(matte, name="matte copy"), "phong", **kw)
+    # the material's constants are compiled in: another kd is another program
+    d3 = material_defines(scene, replace(matte, kd=matte.kd / 2), "phong", **kw)
+    assert d2 == d1 and d3["MAT_KD"] != d1["MAT_KD"]
+    assert cache.get("raster", d1) is cache.get("raster", d2)
     assert cache.get("raster", d3) is not cache.get("raster", d1)
     assert len(cache.programs) == 2 and cache.compile_seconds > 0
 

@@ -7,14 +7,13 @@
 //
 // It is split as I = E + C * diffuse + specular so that flat and Gouraud shading can light at
 // the polygon / vertex and still modulate by a per-fragment texture colour C.
-// Needs: FOR_EACH_LIGHT, TOL_ZERO; SPECULAR when ks > 0 (defines).
+// Needs: FOR_EACH_LIGHT, SCENE_AMBIENT, MAT_KA, MAT_KD, MAT_KS, MAT_SHININESS, TOL_ZERO; SPECULAR
+// when ks > 0 (defines).
 #include "common.glsl"
 
-uniform vec3 u_ambient;      // the scene's Ia
-uniform float u_ka;
-uniform float u_kd;
-uniform float u_ks;
-uniform float u_shininess;
+// The scene's Ia and the material's ka, kd, ks, n are literals (SCENE_AMBIENT, MAT_KA, MAT_KD,
+// MAT_KS, MAT_SHININESS from raster_shaders.material_defines), like the lights: llvmpipe reads
+// a uniform per fragment, and the compiler folds literals (kd = 1, ka = 0, n = 0, ...).
 
 #ifndef FOR_EACH_LIGHT
 #define FOR_EACH_LIGHT(X)
@@ -43,14 +42,14 @@ void add_light(bool POINT, bool INV_SQ, bool LOBE, vec3 pos, vec3 color, vec3 lo
     float scale = 1.0;
     if (INV_SQ) scale = 1.0 / max(r2, TOL_ZERO * TOL_ZERO);
     if (LOBE) scale *= max(0.0, -dot(d, lobe_normal) * inv_r);
-    diffuse += color * (scale * u_kd * max(ndl, 0.0));
+    diffuse += color * (scale * MAT_KD * max(ndl, 0.0));
 #ifdef SPECULAR
 #ifdef BLINN
     float base = dot(N, safe_normalize(d * inv_r + S));
 #else
     float base = 2.0 * ndl * NdS - dot(d, S) * inv_r;
 #endif
-    specular += color * (ndl > 0.0 ? scale * u_ks * spec_pow(base, u_shininess) : 0.0);
+    specular += color * (ndl > 0.0 ? scale * MAT_KS * spec_pow(base, MAT_SHININESS) : 0.0);
 #endif
 }
 
@@ -59,7 +58,7 @@ void add_light(bool POINT, bool INV_SQ, bool LOBE, vec3 pos, vec3 color, vec3 lo
 // FOR_EACH_LIGHT(X) expands to X(POINT, INV_SQ, LOBE, pos, color, lobe_normal) for each light
 // that can contribute (none for a material with kd = ks = 0).
 void local_terms(vec3 P, vec3 N, vec3 S, out vec3 diffuse, out vec3 specular) {
-    diffuse = u_ka * u_ambient;
+    diffuse = MAT_KA * SCENE_AMBIENT;
     specular = vec3(0.0);
     float NdS = dot(N, S);
 #define X(POINT, INV_SQ, LOBE, pos, color, lobe_normal) \

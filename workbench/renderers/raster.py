@@ -295,14 +295,9 @@ class RasterSession:
         return _Draw(part, mat, prog, vao, blended, part.positions.mean(0), images, uniforms)
 
     def _static_uniforms(self, prog, part: Part, mat: Material) -> _Uniforms:
-        """Material and maps of one draw (the lights are compiled in, raster_shaders.light_list;
-        the camera is set per frame)."""
+        """The maps of one draw (lights and material constants are compiled in,
+        raster_shaders.material_defines; the camera is set per frame)."""
         u = _Uniforms(prog)
-        u.set("u_color", tuple(mat.color))
-        u.set("u_emission", tuple(mat.emission))
-        for k in ("ka", "kd", "ks", "kr", "shininess"):
-            u.set(f"u_{k}", float(getattr(mat, k)))
-        u.set("u_ambient", tuple(self.scene.ambient))
         for prefix, m in (("u_tex", mat.texture), ("u_bump", mat.bump), ("u_op", mat.opacity)):
             if m is None:
                 continue

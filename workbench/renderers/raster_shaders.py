@@ -89,10 +89,14 @@ def base_defines() -> dict[str, object]:
             "TOL_BUMP_STEP": f"{tol.bump_step:.6e}"}
 
 
-def _vec3(v) -> str:
-    """A GLSL vec3 literal of the float32 rounding of ``v`` (the value a uniform would hold:
+def _float(x) -> str:
+    """A GLSL float literal of the float32 rounding of ``x`` (the value a uniform would hold:
     the shortest decimal of that float32's exact value parses back to it)."""
-    return "vec3(" + ", ".join(repr(float(np.float32(x))) for x in v) + ")"
+    return repr(float(np.float32(x)))
+
+
+def _vec3(v) -> str:
+    return "vec3(" + ", ".join(_float(x) for x in v) + ")"
 
 
 def light_list(lights) -> str:
@@ -120,7 +124,10 @@ def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: i
                      has_uv: bool, blinn: bool, depth_bits: int, allow_bump: bool) -> dict[str, object]:
     """The ``#define``s of one draw: what the scene needs and this material uses, nothing else.
 
-    ``MODE_*`` (flat, gouraud, phong), ``N_LIGHTS`` and ``FOR_EACH_LIGHT(X)`` (:func:`light_list`
+    ``MODE_*`` (flat, gouraud, phong); the scene's ambient and the material's constants as
+    literals (``SCENE_AMBIENT``, ``MAT_COLOR``, ``MAT_EMISSION``, ``MAT_KA``, ``MAT_KD``,
+    ``MAT_KS``, ``MAT_KR``, ``MAT_SHININESS``: llvmpipe reads uniforms per fragment, literals
+    fold); ``N_LIGHTS`` and ``FOR_EACH_LIGHT(X)`` (:func:`light_list`
     of the scene's first ``n_lights`` point and directional lights, their data compiled in;
     empty for a material with ``kd = ks = 0``, which no light changes),
     ``SPECULAR`` for a material with
@@ -132,6 +139,10 @@ def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: i
     needs = scene.needs()
     d = base_defines()
     d[MODES[mode]] = ""
+    d["SCENE_AMBIENT"] = _vec3(scene.ambient)
+    d["MAT_COLOR"], d["MAT_EMISSION"] = _vec3(material.color), _vec3(material.emission)
+    for k in ("ka", "kd", "ks", "kr", "shininess"):
+        d[f"MAT_{k.upper()}"] = _float(getattr(material, k))
     d["N_LIGHTS"] = n_lights
     if material.kd > 0 or material.ks > 0:
         d["FOR_EACH_LIGHT(X)"] = light_list(scene.point_lights()[:n_lights])
