@@ -171,38 +171,35 @@ const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);
 
 // ---------------------------------------------------------------- colour texture
 #ifdef TEX_KIND
-uniform Mapping u_tex;
-uniform vec3 u_tex_color0;
-uniform vec3 u_tex_color1;
+const Mapping m_tex = TEX_MAPPING;   // literals (raster_shaders.material_defines)
 #if TEX_KIND == K_IMAGE
 uniform sampler2D u_tex_image;
 #endif
 
 vec3 texture_color(vec3 P, vec2 uv) {
 #if TEX_KIND == K_IMAGE
-    return sample_image(u_tex_image, PROJECT(TEX_PROJ, u_tex, P, uv) * u_tex.scale).rgb;
+    return sample_image(u_tex_image, PROJECT(TEX_PROJ, m_tex, P, uv) * m_tex.scale).rgb;
 #else
-    vec3 s = PATTERN_COORDS(TEX_PROJ, u_tex, P, uv);
+    vec3 s = PATTERN_COORDS(TEX_PROJ, m_tex, P, uv);
 #if TEX_KIND == K_CHECKER
     float t = checker(s);
 #elif TEX_KIND == K_BRICKS
-    float t = bricks(s, u_tex.width);
+    float t = bricks(s, m_tex.width);
 #elif TEX_KIND == K_GRID
-    float t = grid(s, u_tex.width);
+    float t = grid(s, m_tex.width);
 #elif TEX_KIND == K_MARBLE
     float t = marble(s);
 #else
     float t = wood(s, TEX_PROJ == PROJ_SOLID);
 #endif
-    return mix(u_tex_color0, u_tex_color1, t);
+    return mix(TEX_COLOR0, TEX_COLOR1, t);
 #endif
 }
 #endif
 
 // ---------------------------------------------------------------- bump
 #ifdef BUMP_KIND
-uniform Mapping u_bump;
-uniform float u_bump_strength;
+const Mapping m_bump = BUMP_MAPPING;
 uniform mat3 u_grad_from_object;   // M^-T: object-space gradient -> world-space gradient
 #if BUMP_KIND == K_IMAGE
 uniform sampler2D u_bump_image;
@@ -210,11 +207,11 @@ uniform sampler2D u_bump_image;
 
 float bump_height(vec3 P) {
 #if BUMP_KIND == K_IMAGE
-    return dot(sample_image(u_bump_image, PROJECT(BUMP_PROJ, u_bump, P, v_uv) * u_bump.scale).rgb, LUMA);
+    return dot(sample_image(u_bump_image, PROJECT(BUMP_PROJ, m_bump, P, v_uv) * m_bump.scale).rgb, LUMA);
 #else
-    vec3 s = PATTERN_COORDS(BUMP_PROJ, u_bump, P, v_uv);
+    vec3 s = PATTERN_COORDS(BUMP_PROJ, m_bump, P, v_uv);
 #if BUMP_KIND == K_BRICKS
-    float hw = 0.5 * u_bump.width;
+    float hw = 0.5 * m_bump.width;
     return smoothstep(0.5 * hw, 1.5 * hw, mortar_distance(s));
 #elif BUMP_KIND == K_NOISE
     return 0.5 + fbm(s);
@@ -227,12 +224,12 @@ float bump_height(vec3 P) {
 // Perturbed unit world normal (texturing.bump_normal): N' = normalize(N - tangential grad d),
 // grad d by forward differences along the object axes.
 vec3 bump_normal(vec3 P, vec3 Nw) {
-    float delta = TOL_BUMP_STEP / u_bump.scale;
+    float delta = TOL_BUMP_STEP / m_bump.scale;
     float h0 = bump_height(P);
     vec3 g = vec3(bump_height(P + vec3(delta, 0.0, 0.0)), bump_height(P + vec3(0.0, delta, 0.0)),
                   bump_height(P + vec3(0.0, 0.0, delta)));
     g = (g - h0) / delta;
-    g *= u_bump_strength / u_bump.scale;
+    g *= BUMP_STRENGTH / m_bump.scale;
     vec3 gw = u_grad_from_object * g;
     vec3 gt = gw - dot(gw, Nw) * Nw;
     vec3 Np = safe_normalize(Nw - gt);
@@ -242,23 +239,21 @@ vec3 bump_normal(vec3 P, vec3 Nw) {
 
 // ---------------------------------------------------------------- opacity
 #ifdef OPACITY_KIND
-uniform Mapping u_op;
-uniform float u_op_value;
+const Mapping m_op = OPACITY_MAPPING;
 #if OPACITY_KIND == K_IMAGE
 uniform sampler2D u_op_image;
-uniform float u_op_has_alpha;   // 1: the image's alpha channel, 0: its luminance
 #endif
 
 float opacity(vec3 P, vec2 uv) {
 #if OPACITY_KIND == K_CONSTANT
-    return u_op_value;
+    return OPACITY_VALUE;
 #elif OPACITY_KIND == K_IMAGE
-    vec4 c = sample_image(u_op_image, PROJECT(OPACITY_PROJ, u_op, P, uv) * u_op.scale);
-    return u_op_has_alpha > 0.5 ? c.a : dot(c.rgb, LUMA);
+    vec4 c = sample_image(u_op_image, PROJECT(OPACITY_PROJ, m_op, P, uv) * m_op.scale);
+    return OPACITY_HAS_ALPHA > 0.5 ? c.a : dot(c.rgb, LUMA);
 #else
-    vec3 s = PATTERN_COORDS(OPACITY_PROJ, u_op, P, uv);
+    vec3 s = PATTERN_COORDS(OPACITY_PROJ, m_op, P, uv);
 #if OPACITY_KIND == K_GRID
-    return grid(s, u_op.width);
+    return grid(s, m_op.width);
 #else
     return 1.0 - checker(s);
 #endif

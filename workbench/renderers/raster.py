@@ -295,28 +295,12 @@ class RasterSession:
         return _Draw(part, mat, prog, vao, blended, part.positions.mean(0), images, uniforms)
 
     def _static_uniforms(self, prog, part: Part, mat: Material) -> _Uniforms:
-        """The maps of one draw (lights and material constants are compiled in,
-        raster_shaders.material_defines; the camera is set per frame)."""
+        """Samplers, the bump gradient's transform, the sky colours and the depth levels of one
+        draw (lights, material and map constants are compiled in, raster_shaders.
+        material_defines; the camera is set per frame)."""
         u = _Uniforms(prog)
-        for prefix, m in (("u_tex", mat.texture), ("u_bump", mat.bump), ("u_op", mat.opacity)):
-            if m is None:
-                continue
-            sp, se, w = tx.frame(m.pole, m.equator)
-            for name, v in (("center", m.center), ("sp", sp), ("se", se), ("w", w)):
-                u.set(f"{prefix}.{name}", tuple(float(x) for x in v))
-            u.set(f"{prefix}.scale", float(m.scale))
-            width = m.width if prefix == "u_op" else m.mortar
-            u.set(f"{prefix}.width", float(width))
-        if mat.texture is not None:
-            u.set("u_tex_color0", tuple(mat.texture.colors[0]))
-            u.set("u_tex_color1", tuple(mat.texture.colors[1]))
-        if mat.bump is not None:
-            u.set("u_bump_strength", float(mat.bump.strength))
+        if mat.bump is not None:  # per part, not per material
             u.set("u_grad_from_object", np.linalg.inv(part.world_from_object[:3, :3]))
-        if mat.opacity is not None:
-            u.set("u_op_value", float(mat.opacity.value))
-            if mat.opacity.kind == "image":
-                u.set("u_op_has_alpha", float(tx.image(mat.opacity.path)[..., 3].min() < 1.0))
         env = self.scene.environment
         if env is None or env.kind == "sky":
             e = env or Environment()

@@ -79,16 +79,6 @@ def build_source(stage_file: str, defines: dict[str, object]) -> str:
     return "\n".join(lines) + "\n" + rest + "\n"
 
 
-def _mapping_defines(prefix: str, m) -> dict[str, object]:
-    return {f"{prefix}_KIND": KIND[m.kind], f"{prefix}_PROJ": PROJ[m.projection]}
-
-
-def base_defines() -> dict[str, object]:
-    """Constants every program gets (tolerances from the one ``tol`` object)."""
-    return {"TOL_ZERO": f"{tol.zero:.6e}", "TOL_NORMAL_CANCEL": f"{tol.normal_cancel:.6e}",
-            "TOL_BUMP_STEP": f"{tol.bump_step:.6e}"}
-
-
 def _float(x) -> str:
     """A GLSL float literal of the float32 rounding of ``x`` (the value a uniform would hold:
     the shortest decimal of that float32's exact value parses back to it)."""
@@ -97,6 +87,33 @@ def _float(x) -> str:
 
 def _vec3(v) -> str:
     return "vec3(" + ", ".join(_float(x) for x in v) + ")"
+
+
+def _mapping_defines(prefix: str, m) -> dict[str, object]:
+    """Kind, projection and the map's constants as literals: ``<prefix>_MAPPING`` (a GLSL
+    ``Mapping(center, sp, se, w, scale, width)``), and per map ``TEX_COLOR0/1``,
+    ``BUMP_STRENGTH``, ``OPACITY_VALUE`` and ``OPACITY_HAS_ALPHA`` (1: an image's alpha channel,
+    0: its luminance)."""
+    from . import texturing as tx
+    sp, se, w = tx.frame(m.pole, m.equator)
+    width = m.width if prefix == "OPACITY" else m.mortar
+    d = {f"{prefix}_KIND": KIND[m.kind], f"{prefix}_PROJ": PROJ[m.projection],
+         f"{prefix}_MAPPING": f"Mapping({_vec3(m.center)}, {_vec3(sp)}, {_vec3(se)}, {_vec3(w)}, "
+                              f"{_float(m.scale)}, {_float(width)})"}
+    if prefix == "TEX":
+        d["TEX_COLOR0"], d["TEX_COLOR1"] = _vec3(m.colors[0]), _vec3(m.colors[1])
+    elif prefix == "BUMP":
+        d["BUMP_STRENGTH"] = _float(m.strength)
+    else:
+        d["OPACITY_VALUE"] = _float(m.value)
+        d["OPACITY_HAS_ALPHA"] = _float(m.kind == "image" and tx.image(m.path)[..., 3].min() < 1.0)
+    return d
+
+
+def base_defines() -> dict[str, object]:
+    """Constants every program gets (tolerances from the one ``tol`` object)."""
+    return {"TOL_ZERO": f"{tol.zero:.6e}", "TOL_NORMAL_CANCEL": f"{tol.normal_cancel:.6e}",
+            "TOL_BUMP_STEP": f"{tol.bump_step:.6e}"}
 
 
 def light_list(lights) -> str:
