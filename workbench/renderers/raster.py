@@ -98,10 +98,7 @@ class _Uniforms:
             if isinstance(value, int):
                 self.items.append((u, value, False))
             else:
-                # the compiler trims a uniform array after its last element in use (e.g. the
-                # lobes of lights that have none): write only what is left
-                flat = np.ascontiguousarray(value, dtype="f4").reshape(-1)[:u.array_length * u.dimension]
-                self.items.append((u, flat.tobytes(), True))
+                self.items.append((u, np.ascontiguousarray(value, dtype="f4").tobytes(), True))
 
     def apply(self) -> None:
         for u, v, raw in self.items:
