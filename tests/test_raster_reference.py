@@ -227,3 +227,20 @@ def test_mesh_uvs_drive_uv_projection(gl_ctx):
     clear = ((f > 0.05) & (f < 0.95)).all(-1)  # away from checker edges
     assert clear.sum() > 500
     assert np.allclose(r.image[clear], want[clear], rtol=RTOL, atol=RTOL)
+
+
+@pytest.mark.parametrize("level, drawn", [(140, True), (110, False)])
+def test_opacity_image_is_read_as_data_not_srgb(gl_ctx, tmp_path, level, drawn):
+    # a uniform opaque grey opacity map: its luminance is the opacity, level / 255 (0.55 kept and
+    # blended over the black background, 0.43 cut out at the 0.5 threshold); decoded as sRGB, 140
+    # would be 0.26 and cut out too
+    from PIL import Image
+    path = str(tmp_path / "grey.png")
+    Image.fromarray(np.full((4, 4, 3), level, dtype=np.uint8)).save(path)
+    mat = {"color": [1, 1, 1], "ka": 1.0, "kd": 0.0,
+           "opacity": {"type": "image", "path": path, "projection": "planar", "pole": [0, 0, 1]}}
+    scene = _plane_scene(mat)
+    r = workbench.render(scene, "phong")
+    seen = np.median(r.image.reshape(-1, 3), 0)  # the plane fills most of the frame
+    want = np.asarray(scene.ambient) * (level / 255 if drawn else 0.0)
+    assert np.allclose(seen, want, atol=2e-3), (seen, want)

@@ -131,3 +131,18 @@ def test_solid_textures_vary_and_stay_between_colours(kind):
     c = tx.texture_color(tex, P)
     assert np.isfinite(c).all() and c.std(0).max() > 0.1
     assert (c <= 1 + 1e-12).all() and (c >= -1e-12).all()
+
+
+def test_height_and_opacity_maps_are_data_colour_maps_are_srgb(tmp_path):
+    # a uniform grey of 8-bit level 128: a colour map means linear 0.216 (sRGB decoded); a height or
+    # opacity map holds values, 128 / 255 = 0.502, not a colour to decode
+    from PIL import Image
+    path = str(tmp_path / "grey.png")
+    Image.fromarray(np.full((4, 4, 3), 128, dtype=np.uint8)).save(path)
+    P = np.array([[0.3, 0.4, 0.0], [0.7, 0.1, 0.0]])
+    common = dict(projection="planar", pole=(0, 0, 1), equator=(1, 0, 0), path=path)
+    colour = tx.texture_color(Texture("image", **common), P)
+    assert np.allclose(colour, 0.2158605, atol=1e-5)
+    assert np.allclose(tx.height(Bump("image", **common), P), 128 / 255, atol=1e-6)
+    m = Material("m", opacity=Opacity("image", **common))
+    assert np.allclose(tx.alpha(m, P, np.tile([0.0, 0.0, 1.0], (2, 1)), None), 128 / 255, atol=1e-6)

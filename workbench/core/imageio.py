@@ -73,12 +73,13 @@ def save_npy(path, array: np.ndarray) -> Path:
     return Path(path)
 
 
-def load_image_linear(path) -> np.ndarray:
-    """Read an 8-bit image file as linear float32 (H, W, C) (sRGB decoded, alpha kept linear)."""
+def load_image_linear(path, data: bool = False) -> np.ndarray:
+    """Read an 8-bit image file as float32 RGBA (H, W, 4): colours sRGB-decoded to linear, alpha
+    kept as stored; with ``data`` (height and opacity maps, which hold values, not colours) every
+    channel is taken as stored, ``v / 255``."""
     from PIL import Image
     with Image.open(path) as im:
         a = np.asarray(im.convert("RGBA"), dtype=np.float64) / 255.0
-    out = np.empty_like(a)
-    out[..., :3] = srgb_decode(a[..., :3])
-    out[..., 3] = a[..., 3]
-    return out.astype(np.float32)
+    if not data:
+        a[..., :3] = srgb_decode(a[..., :3])
+    return a.astype(np.float32)

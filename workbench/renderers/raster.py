@@ -220,10 +220,11 @@ class RasterSession:
         self.left_out, self.features_used = self._report()
 
     # ------------------------------------------------------------------ building
-    def _image_texture(self, path: str, repeat_v: bool = True):
-        key = (path, repeat_v)
+    def _image_texture(self, path: str, repeat_v: bool = True, data: bool = False):
+        """The GL texture of an image file (``data``: bump/opacity values, not sRGB colours)."""
+        key = (path, repeat_v, data)
         if key not in self._gl_images:
-            img = tx.image(path)
+            img = tx.image(path, data=data)
             tex = self.ctx.texture((img.shape[1], img.shape[0]), 4,
                                    np.ascontiguousarray(img[::-1], dtype="f4").tobytes(), dtype="f4")
             import moderngl
@@ -280,9 +281,9 @@ class RasterSession:
         if mat.texture is not None and mat.texture.kind == "image":
             images["u_tex_image"] = self._image_texture(mat.texture.path)
         if mat.bump is not None and mat.bump.kind == "image" and self.mode == "phong":
-            images["u_bump_image"] = self._image_texture(mat.bump.path)
+            images["u_bump_image"] = self._image_texture(mat.bump.path, data=True)
         if mat.opacity is not None and mat.opacity.kind == "image":
-            images["u_op_image"] = self._image_texture(mat.opacity.path)
+            images["u_op_image"] = self._image_texture(mat.opacity.path, data=True)
         env = self.scene.environment
         if "ENV_MAP" in defines and env is not None and env.kind == "image":
             images["u_env_image"] = self._image_texture(env.path, repeat_v=False)

@@ -215,10 +215,11 @@ def pattern_value(kind: str, s: np.ndarray, width: float) -> np.ndarray:
 
 
 @lru_cache(maxsize=16)
-def image(path: str) -> np.ndarray:
-    """A texture image, linear RGBA float32 (H, W, 4), top row first (cached by path)."""
+def image(path: str, data: bool = False) -> np.ndarray:
+    """A texture image, RGBA float32 (H, W, 4), top row first (cached by path and ``data``):
+    colour maps sRGB-decoded to linear; ``data`` maps (bump heights, opacity) as stored, v / 255."""
     try:
-        img = load_image_linear(path)
+        img = load_image_linear(path, data=data)
     except OSError as e:
         raise WorkbenchError(f"cannot read texture image {path}: {e}") from None
     img.setflags(write=False)
@@ -280,7 +281,7 @@ def height(bump, P: np.ndarray, uv: np.ndarray | None = None) -> np.ndarray:
     ``noise``: ``0.5 + fbm(s)``; ``waves``: ``0.5 + 0.25 (sin 2pi s_u + sin 2pi s_v)``;
     ``image``: the image's luminance (Rec. 709 weights)."""
     if bump.kind == "image":
-        rgb = sample_image(image(bump.path), project(bump, P, uv) * bump.scale)[:, :3]
+        rgb = sample_image(image(bump.path, data=True), project(bump, P, uv) * bump.scale)[:, :3]
         return rgb @ np.array([0.2126, 0.7152, 0.0722])
     s = pattern_coords(bump, P, uv)
     if bump.kind == "bricks":
@@ -348,7 +349,7 @@ def alpha(material: Material, P_obj: np.ndarray, N_obj: np.ndarray,
     if op.kind == "constant":
         return np.full(len(P), op.value)
     if op.kind == "image":
-        img = image(op.path)
+        img = image(op.path, data=True)
         rgba = sample_image(img, project(op, P, uv) * op.scale)
         if img[..., 3].min() < 1.0:
             return rgba[:, 3]
