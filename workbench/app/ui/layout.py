@@ -2,19 +2,23 @@
 
 ::
 
-    +-----------+---------------------------------------+
-    | Scene     |                                       |
-    +-----------+  Panels (MainDockSpace)               |
-    | Methods   |                                       |
-    +-----------+-------------------+-------------------+
-    | Parameters| Difference        | Error plot        |
-    | Lights    |                   | Ray tree          |
-    | Colour    |                   | Patch view        |
-    +-----------+-------------------+-------------------+
-    | status bar: GL_RENDERER | frame time | per-method timings |
+    +---------------------------------------------------------------------+
+    |  Panels (MainDockSpace): the image panels in one row, full width     |
+    |                                                                     |
+    +----------+---------+------------+--------------+--------------------+
+    | Scene    | Methods | Parameters | Difference   | Error plot         |
+    |          |         | Lights     |              | Ray tree           |
+    |          |         | Colour     |              | Patch view         |
+    +----------+---------+------------+--------------+--------------------+
+    | status bar: GL_RENDERER | frame time | per-method timings            |
 
-Windows in one dock space are tabs; every window can be dragged elsewhere, split or floated.
-Each window's content is a gui function taking the :class:`~.state.AppState`.
+The controls sit in a row under the panels rather than in a column beside them, so the panels
+get the window's full width: three 512 px panels side by side fit a 1600 px wide window (a
+column beside them needed 2200 px, wider than a 1920 px screen, and every window pixel costs
+frame time on a software GL).  The row's height is set at start from the window and panel
+heights (:func:`splits`) so that one row of panels fits above it.  Windows in one dock space
+are tabs; every window can be dragged elsewhere, split or floated.  Each window's content is a
+gui function taking the :class:`~.state.AppState`.
 """
 from __future__ import annotations
 
@@ -23,12 +27,24 @@ from imgui_bundle import hello_imgui, imgui
 from .state import AppState
 from .window_style import with_background
 
-SPLITS = (("MainDockSpace", "ControlSpace", imgui.Dir.left, 0.27),
-          ("ControlSpace", "ParamSpace", imgui.Dir.down, 0.5),
-          ("ControlSpace", "MethodSpace", imgui.Dir.down, 0.3),
-          ("MainDockSpace", "ToolSpace", imgui.Dir.down, 0.45),
-          ("ToolSpace", "DiffSpace", imgui.Dir.left, 0.45))
-"""(dock space split, new dock space, side, fraction of the split one) in order."""
+PANEL_CHROME = 110
+"""Pixels of the panels window's height besides one row of images: its tab bar, each panel's
+title line, status line and display-mode combo, and padding."""
+STATUS_BAR = 30
+"""Pixels of the window's height taken by the status bar."""
+
+
+def splits(window_height: int, panel_height: int) -> list[tuple[str, str, object, float]]:
+    """(dock space split, new dock space, side, fraction of the split one) in order: the
+    control row takes what one row of panels leaves of the window's height (between 20 % and
+    50 % of it), then is split into five columns."""
+    avail = max(1, window_height - STATUS_BAR)
+    row = min(0.5, max(0.2, 1.0 - (panel_height + PANEL_CHROME) / avail))
+    return [("MainDockSpace", "ControlSpace", imgui.Dir.down, row),
+            ("ControlSpace", "ToolSpace", imgui.Dir.right, 0.5),
+            ("ToolSpace", "DiffSpace", imgui.Dir.left, 0.45),
+            ("ControlSpace", "ParamSpace", imgui.Dir.right, 0.45),
+            ("ControlSpace", "MethodSpace", imgui.Dir.right, 0.4)]
 
 
 def windows(state: AppState) -> list[tuple[str, str, object]]:
@@ -52,10 +68,12 @@ def windows(state: AppState) -> list[tuple[str, str, object]]:
             ("Patch view", "ToolSpace", lambda: patch_view(state))]
 
 
-def docking_params(state: AppState) -> hello_imgui.DockingParams:
-    """The splits and dockable windows, applied at every start (no settings file is kept)."""
+def docking_params(state: AppState, window_height: int) -> hello_imgui.DockingParams:
+    """The splits (:func:`splits` for a window of ``window_height`` pixels) and dockable
+    windows, applied at every start (no settings file is kept)."""
     params = hello_imgui.DockingParams()
-    params.docking_splits = [hello_imgui.DockingSplit(a, b, d, r) for a, b, d, r in SPLITS]
+    params.docking_splits = [hello_imgui.DockingSplit(a, b, d, r)
+                             for a, b, d, r in splits(window_height, state.camera.height)]
     params.dockable_windows = [hello_imgui.DockableWindow(label, space, with_background(fn),
                                                           can_be_closed_=False)
                                for label, space, fn in windows(state)]

@@ -71,7 +71,7 @@ def run(state: AppState, max_frames: int | None = None, script=None,
     params.imgui_window_params.show_status_bar = True
     params.imgui_window_params.default_imgui_window_type = \
         hello_imgui.DefaultImGuiWindowType.provide_full_screen_dock_space
-    params.docking_params = docking_params(state)
+    params.docking_params = docking_params(state, window[1])
     params.ini_disable = True  # no settings file written into the working folder
     params.callbacks.post_init = post_init
     theme_style = params.callbacks.setup_imgui_style
