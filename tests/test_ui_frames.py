@@ -122,3 +122,30 @@ def test_panel_images_read_pending_entries_once():
     assert "flat" not in images and images.version("flat") == v + 2
     with pytest.raises(KeyError):
         images["flat"]
+
+
+def test_job_restarts_wait_for_the_request_to_settle():
+    """A changed request cancels the running job at once but starts its own only once it has
+    stayed the same for ``settle`` seconds; a request that keeps changing (a drag) starts
+    nothing; the first request of a method starts at once."""
+    import time
+
+    from workbench.app.ui.jobs import JobBoard
+    scene = workbench.load_scene("whitted")
+    board = JobBoard(settle=0.3)
+    c0 = scene.camera.with_resolution(16, 16)
+    first = board.request(scene, c0, "raycast", {}, tiled=True)
+    assert len(board.started) == 1 and not first.cancelled.is_set()
+    first.thread.join(60)
+    t0 = time.perf_counter()
+    for k in range(1, 4):  # three different cameras in a row: the first job is cancelled
+        job = board.request(scene, cam.orbit(c0, 0.1 * k, 0.0), "raycast", {}, tiled=True)
+        assert job is first and first.cancelled.is_set()
+    assert len(board.started) == 1 and board.busy()  # a restart is pending
+    last = cam.orbit(c0, 0.3, 0.0)
+    while board.request(scene, last, "raycast", {}, tiled=True) is first:
+        time.sleep(0.01)
+    assert time.perf_counter() - t0 >= 0.3 and len(board.started) == 2
+    assert board.current["raycast"].key[1] == last
+    board.join_all(60)
+    assert not any(j.thread.is_alive() for j in board.started)

@@ -14,6 +14,13 @@ job thread itself) at niceness :data:`JOB_NICE` (Linux nice values are per threa
 workers inherit their creator's), so the UI thread and llvmpipe's threads win every contended
 core.  ``Job.version`` grows with every new tile: the UI re-uploads a
 job's image only then.
+
+A superseded job is cancelled at once, but the UI's board starts the new one only once the
+request has stayed the same for :data:`RESTART_SETTLE_SECONDS` (the camera rests after a drag,
+a slider is let go): a ray trace restarted at every frame of a drag is cancelled at its first
+band, so it never shows more than one band, yet each restart sets the scene up again (flat
+arrays, BVH, the primary rays of every sample) on the cores the window needs.  Meanwhile the
+panel shows its previous image marked stale.
 """
 from __future__ import annotations
 
@@ -24,6 +31,9 @@ from dataclasses import replace
 
 import numpy as np
 
+RESTART_SETTLE_SECONDS = 0.15
+"""How long a new request must stay unchanged before the UI's board starts its job (0 for the
+error plot's reference board, which waits for a still camera itself)."""
 JOB_NICE = 10
 """Niceness added to each job thread (0: none; the maximum is 19).  bench/ui_fps.py measures
 the frame rate and the ray trace's completion time with it."""
@@ -105,24 +115,37 @@ class Job:
 
 
 class JobBoard:
-    """The current job of each CPU method plus every thread ever started (joined at exit)."""
+    """The current job of each CPU method plus every thread ever started (joined at exit).
 
-    def __init__(self):
+    ``settle``: seconds a changed request must stay the same before its job starts (the old
+    job is cancelled at once); ``waiting[method]`` is (request key, when it was first seen)."""
+
+    def __init__(self, settle: float = 0.0):
+        self.settle = settle
         self.current: dict[str, Job] = {}
         self.started: list[Job] = []
+        self.waiting: dict[str, tuple] = {}
 
     def request(self, scene, camera, method: str, options: dict, tiled: bool) -> Job:
         """The job for this request: the current one if its key matches; else the old one is
-        cancelled and, once its thread has ended, a new one starts (at most one thread per
-        method, so a mouse drag does not pile up renders: meanwhile the old image shows)."""
+        cancelled and a new one starts once the old thread has ended and the request has not
+        changed for ``settle`` seconds (at most one thread per method, so a mouse drag does not
+        pile up renders: meanwhile the old image shows).  The first request of a method
+        starts at once."""
         key = (id(scene), camera, method, tuple(sorted(options.items())))
         job = self.current.get(method)
         if job is not None and job.key == key:
+            self.waiting.pop(method, None)
             return job
+        now = time.perf_counter()
+        seen = self.waiting.get(method)
+        if seen is None or seen[0] != key:
+            seen = self.waiting[method] = (key, now)
         if job is not None:
             job.cancelled.set()
-            if job.thread.is_alive():
+            if job.thread.is_alive() or now - seen[1] < self.settle:
                 return job
+        del self.waiting[method]
         job = Job(scene, camera, method, options, tiled)
         self.current[method] = job
         self.started.append(job)

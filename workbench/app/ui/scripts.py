@@ -244,7 +244,7 @@ class Fps:
             state.camera = cam.orbit(state.camera, self.step, 0.0)
         if state.frame == self.warmup:
             self.t0, self.busy_frames, self.gui = time.perf_counter(), 0, 0.0
-            self.counts = _gpu_counts(state)
+            self.counts, self.starts = _gpu_counts(state), len(state.jobs.started)
         elif self.t0 is not None and "fps" not in self.log:
             busy = state.jobs.busy()
             self.busy_frames += busy
@@ -256,6 +256,7 @@ class Fps:
                 self.log.update(frames=n, seconds=dt, fps=n / dt, gui_ms_mean=self.gui / n * 1e3,
                                 frames_with_cpu_job_running=self.busy_frames,
                                 gl_panel_draws=d1 - d0, read_backs=r1 - r0,
+                                cpu_jobs_started=len(state.jobs.started) - self.starts,
                                 panels_window=window_report()["Panels"].get("size"),
                                 raster_ms={m: state.timings.get(m, 0) * 1e3
                                            for m in state.methods if m in RASTER})

@@ -96,7 +96,7 @@ def new_state(scene_name: str, methods: list[str] | None = None,
     from ...scene.io import load_scene
     from ...scene.library import resolve
     from .file_browser import Browser
-    from .jobs import JobBoard
+    from .jobs import RESTART_SETTLE_SECONDS, JobBoard
     from .plot import ErrorPlot
     path = resolve(scene_name)
     scene = load_scene(path)
@@ -110,7 +110,7 @@ def new_state(scene_name: str, methods: list[str] | None = None,
                     camera=scene.camera.with_resolution(*panel_size), methods=methods,
                     options={m: default_options(m) for m in allowed},
                     material=next(iter(scene.materials)), panel_size=panel_size,
-                    diff_pair=(methods[0], methods[-1]), jobs=JobBoard(),
+                    diff_pair=(methods[0], methods[-1]), jobs=JobBoard(RESTART_SETTLE_SECONDS),
                     browser=Browser(path.parent), errors=ErrorPlot())
 
 
