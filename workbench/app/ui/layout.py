@@ -37,14 +37,14 @@ STATUS_BAR = 30
 def splits(window_height: int, panel_height: int) -> list[tuple[str, str, object, float]]:
     """(dock space split, new dock space, side, fraction of the split one) in order: the
     control row takes what one row of panels leaves of the window's height (between 20 % and
-    50 % of it), then is split into five columns."""
+    65 % of it), then is split into five columns."""
     avail = max(1, window_height - STATUS_BAR)
-    row = min(0.5, max(0.2, 1.0 - (panel_height + PANEL_CHROME) / avail))
+    row = min(0.65, max(0.2, 1.0 - (panel_height + PANEL_CHROME) / avail))
     return [("MainDockSpace", "ControlSpace", imgui.Dir.down, row),
-            ("ControlSpace", "ToolSpace", imgui.Dir.right, 0.5),
+            ("ControlSpace", "ToolSpace", imgui.Dir.right, 0.45),
             ("ToolSpace", "DiffSpace", imgui.Dir.left, 0.45),
-            ("ControlSpace", "ParamSpace", imgui.Dir.right, 0.45),
-            ("ControlSpace", "MethodSpace", imgui.Dir.right, 0.4)]
+            ("ControlSpace", "ParamSpace", imgui.Dir.right, 0.4),
+            ("ControlSpace", "MethodSpace", imgui.Dir.right, 0.45)]
 
 
 def windows(state: AppState) -> list[tuple[str, str, object]]:
