@@ -428,18 +428,15 @@ def tri_hit(tv, i, okx, oky, okz, kx, ky, kz, sx, sy, sz, tmin, tmax):
 
 
 @nb.njit(error_model="numpy", inline="always")
-def _box_entry(box, nd, ox, oy, oz, ix, iy, iz, tmin, best):
+def _box_entry(box, nd, cx, cy, cz, ox, oy, oz, ix, iy, iz, tmin, best):
     """Entry distance of the ray into node ``nd``'s box (slabs), ``inf`` if it misses it or
-    enters beyond ``best``; exits are enlarged by ``BOX_GAMMA`` (Ize, JCGT 2013)."""
-    t0 = (box[nd, 0] - ox) * ix
-    t1 = (box[nd, 3] - ox) * ix
-    tn, tf = min(t0, t1), max(t0, t1)
-    t0 = (box[nd, 1] - oy) * iy
-    t1 = (box[nd, 4] - oy) * iy
-    tn, tf = max(tn, min(t0, t1)), min(tf, max(t0, t1))
-    t0 = (box[nd, 2] - oz) * iz
-    t1 = (box[nd, 5] - oz) * iz
-    tn, tf = max(tn, min(t0, t1)), min(tf, max(t0, t1))
+    enters beyond ``best``; exits are enlarged by ``BOX_GAMMA`` (Ize, JCGT 2013).  ``cx, cy,
+    cz``: the columns of the planes the ray enters by (``0, 1, 2`` for a positive direction
+    component, ``3, 4, 5`` for a negative one), so that no min / max sorts each slab's two
+    distances (Williams et al., "An efficient and robust ray-box intersection algorithm",
+    JGT 2005)."""
+    tn = max((box[nd, cx] - ox) * ix, (box[nd, cy] - oy) * iy, (box[nd, cz] - oz) * iz)
+    tf = min((box[nd, 3 - cx] - ox) * ix, (box[nd, 5 - cy] - oy) * iy, (box[nd, 7 - cz] - oz) * iz)
     if tn > tf * BOX_GAMMA or tf < tmin or tn > best:
         return np.inf
     return tn
@@ -449,8 +446,9 @@ def _box_entry(box, nd, ox, oy, oz, ix, iy, iz, tmin, best):
 def bvh_hit(tv, box, meta, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     """Closest (or any) triangle hit through the BVH, near child first (both children's boxes
     are tested at their parent; the farther one waits on ``stack``, a row ``(entry distance,
-    node)``, and is skipped when popped if the best hit is now nearer than its box).  Returns
-    ``(t, tri, b1, b2)``."""
+    node)``, and is skipped when popped if the best hit is now nearer than its box).  The
+    choice of the near child and the push of the far one are selects, not branches (which
+    box is nearer is a coin toss to the branch predictor).  Returns ``(t, tri, b1, b2)``."""
     ax0, ax1, ax2 = abs(dx), abs(dy), abs(dz)
     kz = 0
     if ax1 > ax0 and ax1 >= ax2:
@@ -469,10 +467,14 @@ def bvh_hit(tv, box, meta, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     ix = 1.0 / dx if dx != 0.0 else (big if dx >= 0.0 else -big)
     iy = 1.0 / dy if dy != 0.0 else (big if dy >= 0.0 else -big)
     iz = 1.0 / dz if dz != 0.0 else (big if dz >= 0.0 else -big)
+    cx = 0 if ix >= 0.0 else 3
+    cy = 1 if iy >= 0.0 else 4
+    cz = 2 if iz >= 0.0 else 5
     best, btri, bb1, bb2 = tmax, -1, 0.0, 0.0
-    if _box_entry(box, 0, ox, oy, oz, ix, iy, iz, tmin, best) == np.inf:
+    if _box_entry(box, 0, cx, cy, cz, ox, oy, oz, ix, iy, iz, tmin, best) == np.inf:
         return np.inf, -1, 0.0, 0.0
     nd, sp = 0, 0
+    top = stack.shape[0] - 1  # a full stack drops the farther child (a tree deeper than BVH_STACK)
     while True:
         if meta[nd, 1] > 0:
             first, cnt = meta[nd, 0], meta[nd, 1]
@@ -486,20 +488,17 @@ def bvh_hit(tv, box, meta, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
         else:
             # test both children, descend into the nearer, keep the farther for later
             left, right = nd + 1, meta[nd, 0]
-            tl = _box_entry(box, left, ox, oy, oz, ix, iy, iz, tmin, best)
-            tr = _box_entry(box, right, ox, oy, oz, ix, iy, iz, tmin, best)
-            if tl == np.inf and tr == np.inf:
-                nd = -1
-            elif tr == np.inf:
-                nd = left
-            elif tl == np.inf:
-                nd = right
-            else:
-                near, far, tfar = (left, right, tr) if tl <= tr else (right, left, tl)
-                if sp < stack.shape[0]:
-                    stack[sp, 0], stack[sp, 1] = tfar, far
-                    sp += 1
-                nd = near
+            tl = _box_entry(box, left, cx, cy, cz, ox, oy, oz, ix, iy, iz, tmin, best)
+            tr = _box_entry(box, right, cx, cy, cz, ox, oy, oz, ix, iy, iz, tmin, best)
+            swap = tr < tl
+            near = right if swap else left
+            far = left if swap else right
+            tnear = tr if swap else tl
+            tfar = tl if swap else tr
+            stack[sp, 0] = tfar
+            stack[sp, 1] = far
+            sp += 1 if (tfar < np.inf and sp < top) else 0
+            nd = near if tnear < np.inf else -1
         while nd < 0 and sp > 0:  # pop, culling nodes now beyond the best hit
             sp -= 1
             if stack[sp, 0] <= best:
