@@ -30,6 +30,10 @@ METRICS = ("rmse", "flip")
 FLOOR = 1e-6
 """Errors are drawn at least this large on the log axis (the reference itself has error 0)."""
 MARGIN = 1.5
+CLEAR_FILLS = ("frame_bg", "plot_bg", "legend_bg")
+"""implot colours drawn fully transparent (imgui skips such fills): the plot shows the window
+background instead of painting its frame, plot area and legend, which on llvmpipe cost
+~2.4 ms of CPU per frame (9.0-9.4 against 11.5-11.8 ms for a whole 1600 x 860 frame)."""
 
 
 @dataclass
@@ -185,6 +189,8 @@ def error_plot(state: AppState) -> None:
         rows = sorted(pts.values(), key=lambda p: p["seconds"])
         lines[m] = (np.array([p["seconds"] * 1e3 for p in rows]),
                     np.maximum(np.array([p[plot.metric] for p in rows]), FLOOR))
+    for name in CLEAR_FILLS:
+        implot.push_style_color(getattr(implot.Col_, name), imgui.ImVec4(0.0, 0.0, 0.0, 0.0))
     if implot.begin_plot("##error against run time", imgui.ImVec2(-1, -1)):
         implot.setup_axes("run time (ms)", plot.metric)
         implot.setup_legend(implot.Location_.north_east, implot.LegendFlags_.outside)
@@ -199,3 +205,4 @@ def error_plot(state: AppState) -> None:
             implot.plot_line(m, xs, ys)
             implot.plot_scatter(m, xs, ys)
         implot.end_plot()
+    implot.pop_style_color(len(CLEAR_FILLS))
