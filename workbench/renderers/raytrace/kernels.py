@@ -449,6 +449,17 @@ def bvh_hit(tv, box, meta, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     node)``, and is skipped when popped if the best hit is now nearer than its box).  The
     choice of the near child and the push of the far one are selects, not branches (which
     box is nearer is a coin toss to the branch predictor).  Returns ``(t, tri, b1, b2)``."""
+    big = 1e300
+    ix = 1.0 / dx if dx != 0.0 else (big if dx >= 0.0 else -big)
+    iy = 1.0 / dy if dy != 0.0 else (big if dy >= 0.0 else -big)
+    iz = 1.0 / dz if dz != 0.0 else (big if dz >= 0.0 else -big)
+    cx = 0 if ix >= 0.0 else 3
+    cy = 1 if iy >= 0.0 else 4
+    cz = 2 if iz >= 0.0 else 5
+    best, btri, bb1, bb2 = tmax, -1, 0.0, 0.0
+    if _box_entry(box, 0, cx, cy, cz, ox, oy, oz, ix, iy, iz, tmin, best) == np.inf:
+        return np.inf, -1, 0.0, 0.0
+    # the watertight test's shear, for rays that enter the root box
     ax0, ax1, ax2 = abs(dx), abs(dy), abs(dz)
     kz = 0
     if ax1 > ax0 and ax1 >= ax2:
@@ -463,16 +474,6 @@ def bvh_hit(tv, box, meta, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     sx, sy, sz = d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]
     o = (ox, oy, oz)
     okx, oky, okz = o[kx], o[ky], o[kz]
-    big = 1e300
-    ix = 1.0 / dx if dx != 0.0 else (big if dx >= 0.0 else -big)
-    iy = 1.0 / dy if dy != 0.0 else (big if dy >= 0.0 else -big)
-    iz = 1.0 / dz if dz != 0.0 else (big if dz >= 0.0 else -big)
-    cx = 0 if ix >= 0.0 else 3
-    cy = 1 if iy >= 0.0 else 4
-    cz = 2 if iz >= 0.0 else 5
-    best, btri, bb1, bb2 = tmax, -1, 0.0, 0.0
-    if _box_entry(box, 0, cx, cy, cz, ox, oy, oz, ix, iy, iz, tmin, best) == np.inf:
-        return np.inf, -1, 0.0, 0.0
     nd, sp = 0, 0
     top = stack.shape[0] - 1  # a full stack drops the farther child (a tree deeper than BVH_STACK)
     while True:
