@@ -149,3 +149,30 @@ def test_job_restarts_wait_for_the_request_to_settle():
     assert board.current["raycast"].key[1] == last
     board.join_all(60)
     assert not any(j.thread.is_alive() for j in board.started)
+
+
+def test_probe_reads_one_pixel_not_the_panel(gpu_session):
+    """The pixel probe's read of a drawn GL panel is the pixel of the full read-back (same
+    float32 value, row 0 on top) and does not read the whole image back."""
+    out, summary = gpu_session
+    probe = summary["script"]["probe"]
+    assert probe["full_reads"] == 0 and probe["pixel_reads"] == 3 * len(probe["pixels"])
+    for m in ("flat", "phong"):
+        image = np.load(out / f"image_{m}.npy")
+        for i, j, v in probe["pixels"][m]:
+            assert np.array_equal(np.float32(v), image[i, j]), (m, i, j)
+    assert len({tuple(p[2]) for p in probe["pixels"]["phong"]}) > 1  # not one colour
+
+
+def test_panel_images_pixel_keeps_pending_entries():
+    images = PanelImages()
+    full = np.arange(2 * 3 * 3, dtype=np.float32).reshape(2, 3, 3)
+    images.set_pending("flat", lambda: full, pixel=lambda i, j, shape: full[i, j] if shape == (2, 3) else None)
+    assert np.array_equal(images.pixel("flat", 1, 2, (2, 3)), full[1, 2])
+    assert images.pixel("flat", 0, 0, (4, 4)) is None
+    assert images.reads == 0 and images.pixel_reads == 2  # still pending
+    images["raycast"] = full  # a plain entry: indexed, size checked
+    assert np.array_equal(images.pixel("raycast", 0, 1, (2, 3)), full[0, 1])
+    assert images.pixel("raycast", 0, 1, (3, 3)) is None
+    images.set_pending("gouraud", lambda: full)  # no pixel reader: the image is read once
+    assert np.array_equal(images.pixel("gouraud", 1, 1, (2, 3)), full[1, 1]) and images.reads == 1

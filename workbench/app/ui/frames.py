@@ -324,10 +324,21 @@ def refresh_raster(state: AppState, method: str) -> bool:
     state.ctx.finish()  # the time shown is the draw's, not just its submission
     state.ctx.screen.use()  # back to the window's framebuffer for imgui
     state.timings[method] = time.perf_counter() - t0
-    state.images.set_pending(method, lambda: RasterSession.read_image(fbo))
+    state.images.set_pending(method, lambda: RasterSession.read_image(fbo),
+                             pixel=lambda i, j, shape: read_pixel(fbo, i, j, shape))
     g.linear[method] = (fbo.color_attachments[0], True, state.images.version(method))
     panel.drawn, panel.draws = cam, panel.draws + 1
     return True
+
+
+def read_pixel(fbo, i: int, j: int, shape: tuple[int, int]) -> np.ndarray | None:
+    """Pixel (row ``i`` from the top, column ``j``) of a raster panel's framebuffer as (3,)
+    float32, or None unless the framebuffer is ``shape`` (H, W): the probe's read of one
+    pixel instead of the whole image."""
+    if tuple(shape) != (fbo.height, fbo.width):
+        return None
+    raw = fbo.read(viewport=(j, fbo.height - 1 - i, 1, 1), components=3, dtype="f4")
+    return np.frombuffer(raw, np.float32).copy()
 
 
 def refresh_cpu(state: AppState, method: str) -> None:

@@ -32,11 +32,11 @@ def probe_tooltip(state: AppState, ij: tuple[int, int]) -> None:
     """Tooltip with every panel's linear value at pixel ``ij`` (and the difference value)."""
     i, j = ij
     lines = [f"pixel row {i}, column {j}"]
+    shape = (state.camera.height, state.camera.width)
     for m in [*state.methods, "difference"]:
-        img = state.images.get(m)
-        if img is not None and img.shape[:2] == (state.camera.height, state.camera.width):
-            v = np.atleast_1d(img[i, j])
-            lines.append(f"{m:>10}: " + " ".join(f"{x:.4f}" for x in v))
+        v = state.images.pixel(m, i, j, shape) if m in state.images else None
+        if v is not None:
+            lines.append(f"{m:>10}: " + " ".join(f"{x:.4f}" for x in np.atleast_1d(v)))
     imgui.set_tooltip("\n".join(lines))
 
 

@@ -273,8 +273,9 @@ class Fps:
 class GpuPanels:
     """GL panels on the GPU: frames 2 to 5 change nothing, frame 5 orbits the camera and sets
     the difference view to flat - phong ("abs"), frame 7 saves each GL panel's display texture
-    (the RGBA8 pixels imgui shows, ``shown_M.npy``), the difference map with its texture and
-    both images, and quits.  Logs each GL panel's draw count and the read-backs at frames 2, 5
+    (the RGBA8 pixels imgui shows, ``shown_M.npy``), logs three pixels of each GL panel read
+    as the probe reads them (one pixel from the GPU), saves the difference map with its
+    texture and both images, and quits.  Logs each GL panel's draw count and the read-backs at frames 2, 5
     and 7."""
 
     def __init__(self, out: Path):
@@ -293,6 +294,12 @@ class GpuPanels:
             for m in [*state.gpu.raster, "difference"]:
                 shown = np.frombuffer(state.textures[m].read(), np.uint8).reshape(h, w, -1)
                 np.save(self.out / f"shown_{m}.npy", shown)
+            reads, probe = state.images.reads, {}
+            for m in state.gpu.raster:  # the probe's one-pixel reads, before any full read
+                probe[m] = [[i, j, state.images.pixel(m, i, j, (h, w)).tolist()]
+                            for i, j in ((0, 0), (h // 2, w // 3), (h - 1, w - 1))]
+            self.log["probe"] = {"pixels": probe, "full_reads": state.images.reads - reads,
+                                 "pixel_reads": state.images.pixel_reads}
             for m in ("flat", "phong", "difference"):
                 np.save(self.out / f"image_{m}.npy", state.images[m])
             self.log["blits"] = [[m, list(rect)] for m, rect in state.gpu.blits.last]
