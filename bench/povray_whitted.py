@@ -8,12 +8,13 @@
 
 Rays per second, counted the same way for both: every ray each program actually traced, by
 kind.  POV-Ray: its "Rays" (eye + reflected + refracted) plus its "Shadow Ray Tests", over its
-"Trace Time" (which excludes its start-up and parsing; best of 3 runs) and over the
+"Trace Time" (which excludes its start-up and parsing; best of 5 runs) and over the
 CPU-seconds it reports for the trace (a fairer measure on a shared, loaded machine).  Ours:
 primary + shadow feelers + reflected + refracted rays over our trace phase
 (``timings["trace"]``: camera rays, tracing, shading; and its CPU seconds
-``timings["trace_cpu"]``; warm JIT cache, best of 3).  The two programs do not trace the same
-number of rays for the same picture (which shadow tests each skips and how each applies the
+``timings["trace_cpu"]``; warm JIT cache, best of 5: the second thread of this shared
+machine comes and goes, so that 2-thread trace times of the same render vary by up to 50 %).
+The two programs do not trace the same number of rays for the same picture (which shadow tests each skips and how each applies the
 bail-out differ in detail: POV-Ray reports about 18 % more rays on the Whitted scene), so the JSON also gives the ratio
 of the trace times for the same image (``trace_time_ratio``), which does not depend on how
 rays are counted.  Whole commands: POV-Ray's process wall time against ``workbench render
@@ -47,7 +48,7 @@ THRESHOLD = 1.0 / 255.0
 PY = sys.executable
 
 
-def povray(pov: Path, out: Path, repeats: int = 3) -> dict:
+def povray(pov: Path, out: Path, repeats: int = 5) -> dict:
     """POV-Ray's statistics, best trace time of ``repeats`` runs (as for ours)."""
     return min((_povray_once(pov, out) for _ in range(repeats)), key=lambda d: d["trace_s"])
 
@@ -75,7 +76,7 @@ def _povray_once(pov: Path, out: Path) -> dict:
                 mrays_per_cpu_s=(rays + shadow) / max(cpu, 1e-9) / 1e6)
 
 
-def ours_in_process(scene_name: str, repeats: int = 3) -> dict:
+def ours_in_process(scene_name: str, repeats: int = 5) -> dict:
     import numba
 
     import workbench
