@@ -44,9 +44,12 @@ print(json.dumps(dict(build_s=dt, baseline_rss_mb=base / 1024, peak_rss_mb=peak 
 def main() -> dict:
     import time
 
+    import os
+
     import workbench
     from workbench.scene.generate import generate_mesh
     from workbench.scene.io import scene_from_dict
+    load_start = os.getloadavg()
     t0 = time.perf_counter()
     mesh = generate_mesh("blob", subdivisions=8)
     gen_s = time.perf_counter() - t0
@@ -59,7 +62,8 @@ def main() -> dict:
         if p.returncode != 0:
             raise RuntimeError(p.stderr[-3000:])
         res = json.loads(p.stdout.strip().splitlines()[-1])
-    res.update(triangles=int(len(F)), mesh_generation_s=gen_s)
+    res.update(machine=f"{os.cpu_count()} CPUs (shared)", load_average_start=load_start,
+               triangles=int(len(F)), mesh_generation_s=gen_s)
     # primary rays against the 1.3M-triangle mesh (BVH built inside the render: timings)
     from workbench.scene import model as m
     sc = scene_from_dict({"camera": {"position": [0, 0.5, -3.5], "look_at": [0, 0, 0], "resolution": [640, 480]},
@@ -71,6 +75,7 @@ def main() -> dict:
     r = workbench.render(sc, "raycast")
     res["render_640x480_primary"] = dict(trace_s=r.timings["trace"], bvh_build_in_render_s=r.timings["bvh_build"],
                                          mrays_per_s=r.stats["mrays_per_s"], rays=r.stats["total_rays"])
+    res["load_average_end"] = os.getloadavg()
     RESULTS.mkdir(parents=True, exist_ok=True)
     (RESULTS / "bvh_1m.json").write_text(json.dumps(res, indent=2))
     print(json.dumps(res, indent=2))
