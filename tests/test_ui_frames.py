@@ -176,3 +176,14 @@ def test_panel_images_pixel_keeps_pending_entries():
     assert images.pixel("raycast", 0, 1, (3, 3)) is None
     images.set_pending("gouraud", lambda: full)  # no pixel reader: the image is read once
     assert np.array_equal(images.pixel("gouraud", 1, 1, (2, 3)), full[1, 1]) and images.reads == 1
+
+
+def test_frames_are_capped_only_while_a_background_job_runs():
+    from workbench.app.ui.main import frame_rest
+    from workbench.app.ui.state import FPS_CAP_WHILE_JOB
+    assert FPS_CAP_WHILE_JOB > 30.0  # the window must keep 30 fps
+    assert frame_rest(10.0, 10.005, 40.0, True) == pytest.approx(0.020)
+    assert frame_rest(10.0, 10.030, 40.0, True) == 0.0  # a slow frame is not delayed further
+    assert frame_rest(10.0, 10.005, 40.0, False) == 0.0
+    assert frame_rest(10.0, 10.005, 0.0, True) == 0.0
+    assert frame_rest(None, 10.005, 40.0, True) == 0.0

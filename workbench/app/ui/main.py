@@ -20,6 +20,15 @@ from .state import AppState, new_state
 WINDOW_SIZE = (1280, 760)
 
 
+def frame_rest(last: float | None, now: float, cap: float, job_running: bool) -> float:
+    """Seconds to sleep before a frame that starts at ``now`` when the previous one started at
+    ``last``: enough to keep at most ``cap`` frames per second while a background job runs
+    (0 without a job, without a cap or on the first frame)."""
+    if last is None or cap <= 0.0 or not job_running:
+        return 0.0
+    return max(0.0, last + 1.0 / cap - now)
+
+
 def run(state: AppState, max_frames: int | None = None, script=None,
         window: tuple[int, int] = WINDOW_SIZE) -> None:
     """Open the window (``window`` = (width, height) pixels) and loop until it is closed,
@@ -43,6 +52,10 @@ def run(state: AppState, max_frames: int | None = None, script=None,
 
     def show_gui():
         now = time.perf_counter()
+        rest = frame_rest(clock["t"], now, state.fps_cap_while_job, state.jobs.busy())
+        if rest > 0.0:
+            time.sleep(rest)
+            now = time.perf_counter()
         if clock["t"] is not None:
             state.frame_seconds = now - clock["t"]
         clock["t"] = now

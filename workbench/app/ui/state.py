@@ -17,6 +17,9 @@ CHILD = ("pyrender",)
 """Methods rendered in a child process (PyOpenGL's EGL platform cannot share the window's
 process): :mod:`.pyrender_proc`."""
 MAX_PANELS = 6
+FPS_CAP_WHILE_JOB = 40.0
+"""While a background job runs, frames come at most this often (the rest of a frame's time is
+slept, so the job gets the CPU); 0 for no cap.  Above the 30 fps the window must keep."""
 MATERIAL_FIELDS = ("ka", "kd", "ks", "shininess", "kr", "kt", "ior")
 DISPLAY_MODES = ("direct24", "direct16-555", "direct16-565", "direct16-565-fs",
                  "indexed256-mediancut", "indexed16-mediancut", "indexed16-kmeans-fs",
@@ -58,6 +61,7 @@ class AppState:
     frame: int = 0
     frame_seconds: float = 0.0
     gui_seconds: float = 0.0
+    fps_cap_while_job: float = FPS_CAP_WHILE_JOB
     diff_pair: tuple[str, str] = ("flat", "phong")
     diff_kind: str = "abs"
     gl_renderer: str = ""
