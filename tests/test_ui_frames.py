@@ -187,3 +187,26 @@ def test_frames_are_capped_only_while_a_background_job_runs():
     assert frame_rest(10.0, 10.005, 40.0, False) == 0.0
     assert frame_rest(10.0, 10.005, 0.0, True) == 0.0
     assert frame_rest(None, 10.005, 40.0, True) == 0.0
+
+
+def test_a_job_is_not_taken_for_a_later_scene_and_removed_panels_are_cancelled():
+    """Every light or material edit builds a new Scene: a job keyed on the old scene's id must
+    never match a later scene (the job keeps its scene, so the id cannot be reused while it is
+    current); a panel taken off the screen has its job cancelled and forgotten."""
+    import gc
+    from dataclasses import replace
+
+    from workbench.app.ui.jobs import JobBoard
+    base = workbench.load_scene("whitted")
+    c0 = base.camera.with_resolution(8, 8)
+    board = JobBoard(settle=0.0)
+    job = board.request(replace(base), c0, "raycast", {}, tiled=True)  # its scene has no other owner
+    job.thread.join(60)
+    for _ in range(50):  # later scenes, each freed at once: none may match the job's key
+        gc.collect()
+        later = replace(base)
+        assert later is not job.scene
+        assert (id(later), c0, "raycast", ()) != job.key
+    board.keep_only(["flat"])
+    assert "raycast" not in board.current and job.cancelled.is_set() and not board.busy()
+    board.join_all(60)

@@ -362,6 +362,7 @@ def refresh_cpu(state: AppState, method: str) -> None:
 def update_images(state: AppState) -> None:
     """Bring every selected panel up to date (called once per frame, before the widgets)."""
     from .pyrender_proc import refresh_pyrender
+    state.jobs.keep_only(state.methods)
     for m in state.methods:
         if m in RASTER:
             refresh_raster(state, m)

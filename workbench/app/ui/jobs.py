@@ -56,6 +56,9 @@ class Job:
     """
 
     def __init__(self, scene, camera, method: str, options: dict, tiled: bool):
+        # the job keeps its scene: while the job is current no later scene can reuse the id
+        # in its key (every material or light edit builds a new Scene)
+        self.scene = scene
         self.key = (id(scene), camera, method, tuple(sorted(options.items())))
         self.partial = np.zeros((camera.height, camera.width, 3), np.float32)
         self.image = None
@@ -150,6 +153,13 @@ class JobBoard:
         self.current[method] = job
         self.started.append(job)
         return job
+
+    def keep_only(self, methods) -> None:
+        """Cancel and forget the jobs of methods no longer shown (a removed panel's render
+        must not run on to its end)."""
+        for m in [m for m in self.current if m not in methods]:
+            self.current.pop(m).cancelled.set()
+            self.waiting.pop(m, None)
 
     def busy(self) -> bool:
         """A job is running or its result is stale (a restart is pending)."""

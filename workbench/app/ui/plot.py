@@ -18,6 +18,7 @@ from __future__ import annotations
 import multiprocessing as mp
 import time
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -52,6 +53,7 @@ class ErrorPlot:
     message: str = ""
     points: dict = field(default_factory=dict)
     pending: dict = field(default_factory=dict)
+    failed: dict = field(default_factory=dict)
     metric: str = "rmse"
     shown: int = -2
     board: object = None
@@ -134,12 +136,15 @@ def track(state: AppState) -> None:
             for job in plot.board.current.values():
                 job.cancelled.set()
         plot.key, plot.since, plot.ref_image, plot.candidates = key, time.perf_counter(), None, []
-        plot.points, plot.pending = {}, {}
+        plot.points, plot.pending, plot.failed = {}, {}, {}
     for (m, opts), fut in list(plot.pending.items()):
         if fut.done():
             del plot.pending[(m, opts)]
             if fut.exception() is None:
                 plot.points.setdefault(m, {})[opts] = fut.result()
+            else:  # kept as failed: not submitted again for this key
+                plot.failed[(m, opts)] = f"{m}: error evaluation failed ({fut.exception()})"
+                plot.message = plot.failed[(m, opts)]
     if plot.shown < state.frame - 1:  # the plot's window is hidden: no reference render
         return
     ref = _reference(state, plot)
@@ -147,7 +152,7 @@ def track(state: AppState) -> None:
         return
     for m in state.methods:
         opts = tuple(sorted(state.options[m].items()))
-        if opts in plot.points.get(m, {}) or (m, opts) in plot.pending:
+        if opts in plot.points.get(m, {}) or (m, opts) in plot.pending or (m, opts) in plot.failed:
             continue
         final = _final_image(state, m)
         if final is None or final[0].shape != ref.shape:
@@ -156,7 +161,12 @@ def track(state: AppState) -> None:
         if plot.pool is None:
             plot.pool = ProcessPoolExecutor(1, mp_context=mp.get_context("spawn"))
         label = ", ".join(f"{k} {v}" for k, v in opts)
-        plot.pending[(m, opts)] = plot.pool.submit(_point, image, ref, seconds, label)
+        try:
+            plot.pending[(m, opts)] = plot.pool.submit(_point, image, ref, seconds, label)
+        except BrokenProcessPool:  # the worker died (e.g. out of memory): a new one next time
+            plot.pool.shutdown(wait=False, cancel_futures=True)
+            plot.pool = None
+            plot.failed[(m, opts)] = plot.message = f"{m}: the error-evaluation process died"
 
 
 def _point(image: np.ndarray, reference: np.ndarray, seconds: float, label: str) -> dict:

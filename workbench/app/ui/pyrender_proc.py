@@ -106,7 +106,15 @@ class PyrenderProcess:
                 self.conn.send(None)
             except OSError:  # the child is already gone
                 pass
-            self.process.join(STOP_SECONDS)
+            # a render in flight blocks the child in send() until its image is read: drain
+            end = time.monotonic() + STOP_SECONDS
+            while self.process.is_alive() and time.monotonic() < end:
+                try:
+                    if self.conn.poll(0.05):
+                        self.conn.recv()
+                except (EOFError, OSError):
+                    self.process.join(max(0.0, end - time.monotonic()))
+                    break
         if self.process.is_alive():
             self.process.terminate()
         self.process.join()
