@@ -36,6 +36,19 @@ def test_closed_outward_per_kind(obj, closed):
     assert not closed_outward(part.positions, part.faces[1:])
 
 
+def test_every_shell_must_be_outward_not_only_the_total_volume():
+    (big,) = tessellate_object(_scene([{**BOX, "min": [-1.5] * 3, "max": [1.5] * 3}]).objects[0], 3)
+    (small,) = tessellate_object(_scene([BOX]).objects[0], 3)
+    small_far = small.positions + 5.0  # a separate shell beside the big one
+
+    def joined(faces_small):
+        return (np.concatenate([big.positions, small_far]),
+                np.concatenate([big.faces, faces_small + len(big.positions)]))
+    assert closed_outward(*joined(small.faces))
+    # the big shell's volume outweighs an inside-out small one: still not outward
+    assert not closed_outward(*joined(small.faces[:, ::-1]))
+
+
 def test_provoking_layout_gives_each_triangle_its_own_last_vertex():
     (part,) = tessellate_object(_scene([SPHERE]).objects[0], 4)
     V, F = len(part.positions), part.faces

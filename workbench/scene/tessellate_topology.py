@@ -19,7 +19,8 @@ def closed_outward(positions: np.ndarray, faces: np.ndarray) -> bool:
     Vertices are welded by exact position first (tessellators duplicate seam and corner
     vertices); triangles that collapse under welding (a UV sphere's pole caps) are dropped.
     Closed and consistent: every directed edge ``(i, j)`` occurs once and its reverse
-    ``(j, i)`` once.  Outward: the signed volume ``sum p0 . (p1 x p2) / 6`` is positive.
+    ``(j, i)`` once.  Outward: the signed volume ``sum p0 . (p1 x p2) / 6`` of every closed
+    shell (connected component) is positive.
 
     Parameters
     ----------
@@ -30,7 +31,8 @@ def closed_outward(positions: np.ndarray, faces: np.ndarray) -> bool:
     _, weld = np.unique(np.asarray(positions), axis=0, return_inverse=True)
     weld = weld.reshape(-1)
     G = weld[np.asarray(faces)]
-    G = G[(G[:, 0] != G[:, 1]) & (G[:, 1] != G[:, 2]) & (G[:, 2] != G[:, 0])]
+    kept = (G[:, 0] != G[:, 1]) & (G[:, 1] != G[:, 2]) & (G[:, 2] != G[:, 0])
+    G = G[kept]
     if len(G) == 0:
         return False
     n = int(weld.max()) + 1
@@ -43,9 +45,15 @@ def closed_outward(positions: np.ndarray, faces: np.ndarray) -> bool:
     k = np.searchsorted(edges, reverse)
     if not (edges[np.minimum(k, len(edges) - 1)] == reverse).all():
         return False
-    P = np.asarray(positions, dtype=np.float64)[faces]
-    volume = np.einsum("ij,ij->", P[:, 0], np.cross(P[:, 1], P[:, 2])) / 6.0
-    return bool(volume > 0.0)
+    # each closed shell on its own: an inside-out shell inside (or beside) an outward one would
+    # be culled wrongly if only the total volume were tested
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    _, shell = connected_components(coo_matrix((np.ones(len(a)), (a, b)), shape=(n, n)), directed=False)
+    P = np.asarray(positions, dtype=np.float64)[np.asarray(faces)[kept]]
+    volumes = np.einsum("ij,ij->i", P[:, 0], np.cross(P[:, 1], P[:, 2])) / 6.0
+    per_shell = np.bincount(shell[G[:, 0]], weights=volumes)
+    return bool((per_shell[np.unique(shell[G[:, 0]])] > 0.0).all())
 
 
 def provoking_layout(n_vertices: int, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
