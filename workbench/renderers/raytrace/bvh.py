@@ -133,6 +133,10 @@ def _build(tri_v):
                 hi -= 1
         mid = lo
         meta[node, 1], meta[node, 2] = 0, axis
+        if sp + 2 > stack.shape[0]:  # a degenerate, very deep tree: grow the stack
+            grown = np.empty((2 * stack.shape[0], 4), dtype=np.int64)
+            grown[:sp] = stack[:sp]
+            stack = grown
         # push right then left: the left child is popped next and gets index node + 1
         stack[sp, 0], stack[sp, 1], stack[sp, 2], stack[sp, 3] = mid, e, node, 1
         sp += 1
