@@ -39,6 +39,12 @@ JOB_NICE = 10
 the frame rate and the ray trace's completion time with it."""
 
 
+def job_key(scene, camera, method: str, options: dict) -> tuple:
+    """What a background render depends on: the scene object (a :class:`Job` keeps it alive, so
+    its id is not reused while the job is current), the camera, the method and its options."""
+    return (id(scene), camera, method, tuple(sorted(options.items())))
+
+
 class Cancelled(Exception):
     """Raised inside a superseded job's ``on_tile`` to stop its render."""
 
@@ -59,7 +65,7 @@ class Job:
         # the job keeps its scene: while the job is current no later scene can reuse the id
         # in its key (every material or light edit builds a new Scene)
         self.scene = scene
-        self.key = (id(scene), camera, method, tuple(sorted(options.items())))
+        self.key = job_key(scene, camera, method, options)
         self.partial = np.zeros((camera.height, camera.width, 3), np.float32)
         self.image = None
         self.seconds = None
@@ -135,7 +141,7 @@ class JobBoard:
         changed for ``settle`` seconds (at most one thread per method, so a mouse drag does not
         pile up renders: meanwhile the old image shows).  The first request of a method
         starts at once."""
-        key = (id(scene), camera, method, tuple(sorted(options.items())))
+        key = job_key(scene, camera, method, options)
         job = self.current.get(method)
         if job is not None and job.key == key:
             self.waiting.pop(method, None)

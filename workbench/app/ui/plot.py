@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .jobs import job_key
 from .state import CHILD, RASTER, AppState
 
 SETTLE_SECONDS = 0.3
@@ -81,7 +82,7 @@ def _final_image(state: AppState, method: str) -> tuple[np.ndarray, float] | Non
             return None
         return np.asarray(proc.image, np.float32), proc.seconds
     job = state.jobs.current.get(method)
-    key = (id(state.scene), state.camera, method, tuple(sorted(state.options[method].items())))
+    key = job_key(state.scene, state.camera, method, state.options[method])
     if job is None or job.key != key or job.image is None or job.seconds is None:
         return None
     return job.image, job.seconds

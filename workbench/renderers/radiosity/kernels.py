@@ -216,6 +216,26 @@ def raycast_rows(tris, tri_patch, first_tri, normals, rays, seed, t_min, offset)
 
 
 @njit(cache=True)
+def _unshot_ratio(B, dB, stop):
+    """(every channel has ||dB_c||_inf <= stop ||B_c||_inf, max_c ||dB_c||_inf / ||B_c||_inf)
+    of radiosities B and unshot radiosities dB, both (n, C)."""
+    n, C = B.shape
+    ok = True
+    worst = 0.0
+    for c in range(C):
+        mb = 0.0
+        md = 0.0
+        for j in range(n):
+            mb = max(mb, abs(B[j, c]))
+            md = max(md, abs(dB[j, c]))
+        r = md / mb if mb > 0.0 else 0.0
+        worst = max(worst, r)
+        if md > stop * mb:
+            ok = False
+    return ok, worst
+
+
+@njit(cache=True)
 def shoot(F, areas, rho, B, dB, max_shots, stop, history):
     """Progressive refinement on an explicit matrix (Cohen et al. 1988), in place.
 
@@ -249,18 +269,7 @@ def shoot(F, areas, rho, B, dB, max_shots, stop, history):
                     inc = rho[j, c] * f * shot[c]
                     B[j, c] += inc
                     dB[j, c] += inc
-        ok = True
-        worst = 0.0
-        for c in range(C):
-            mb = 0.0
-            md = 0.0
-            for j in range(n):
-                mb = max(mb, abs(B[j, c]))
-                md = max(md, abs(dB[j, c]))
-            r = md / mb if mb > 0.0 else 0.0
-            worst = max(worst, r)
-            if md > stop * mb:
-                ok = False
+        ok, worst = _unshot_ratio(B, dB, stop)
         history[s] = worst
         if ok:
             return s + 1
@@ -314,18 +323,7 @@ def shoot_rows(rows, shooters, areas, rho, B, dB, relax, stop, history, start):
                     inc = rho[j, c] * f * shot[c]
                     B[j, c] += inc
                     dB[j, c] += inc
-        ok = True
-        worst = 0.0
-        for c in range(C):
-            mb = 0.0
-            md = 0.0
-            for j in range(n):
-                mb = max(mb, abs(B[j, c]))
-                md = max(md, abs(dB[j, c]))
-            r = md / mb if mb > 0.0 else 0.0
-            worst = max(worst, r)
-            if md > stop * mb:
-                ok = False
+        ok, worst = _unshot_ratio(B, dB, stop)
         history[start + s] = worst
         if ok:
             return s + 1
