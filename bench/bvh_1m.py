@@ -2,7 +2,8 @@
 under 1 GB).
 
 The mesh is the procedural blob at 8 subdivisions (20 * 4^8 = 1,310,720 triangles).  The
-build (binned SAH, :mod:`workbench.renderers.raytrace.bvh`) runs in a child process that
+build the ray tracer runs (binned SAH, collapsed to 4-wide nodes, leaves packed by four:
+:func:`workbench.renderers.raytrace.bvh.build_bvh4`) runs in a child process that
 first loads the triangles and compiles (or loads from the numba cache) the builder on a tiny
 input, so that its peak resident memory before the build is the baseline; the peak after the
 build minus that baseline is the build's own peak memory.  Also traces 640 x 480 primary rays
@@ -26,17 +27,18 @@ RESULTS = ROOT / "bench" / "results"
 CHILD = r"""
 import json, resource, sys, time
 import numpy as np
-from workbench.renderers.raytrace.bvh import build_bvh
+from workbench.renderers.raytrace.bvh import build_bvh4
 tri = np.load(sys.argv[1])
-build_bvh(tri[:64])  # JIT or cache load, outside the measurement
+build_bvh4(tri[:64])  # JIT or cache load, outside the measurement
 base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 t0 = time.perf_counter()
-order, box, meta = build_bvh(tri)
+order, bvh = build_bvh4(tri)
 dt = time.perf_counter() - t0
 peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 print(json.dumps(dict(build_s=dt, baseline_rss_mb=base / 1024, peak_rss_mb=peak / 1024,
-                      build_peak_extra_mb=(peak - base) / 1024, nodes=int(len(box)),
-                      bvh_bytes_mb=(box.nbytes + meta.nbytes + order.nbytes) / 2**20,
+                      build_peak_extra_mb=(peak - base) / 1024, nodes_4wide=int(len(bvh.node)),
+                      leaves=int(len(bvh.leaf)), groups_of_4=int(len(bvh.first)),
+                      bvh_bytes_mb=(sum(a.nbytes for a in bvh) + order.nbytes) / 2**20,
                       triangles_mb=tri.nbytes / 2**20)))
 """
 

@@ -1,7 +1,9 @@
-"""BVH build: complete on degenerate input."""
+"""BVH build: complete on degenerate input; the 4-wide tree of the ray tracer holds every
+triangle once, inside its boxes, and its traversal equals brute force."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 
 def test_a_degenerate_very_deep_tree_builds_completely():
@@ -21,3 +23,90 @@ def test_a_degenerate_very_deep_tree_builds_completely():
     assert depth.max() > 256
     assert np.array_equal(np.sort(order), np.arange(n))
     assert meta[meta[:, 2] == -1, 1].sum() == n
+
+
+def _soup(seed, n):
+    """``n`` random triangles plus nine copies of one (same centroid: a leaf the SAH cannot
+    split, more than one group of four)."""
+    rng = np.random.default_rng(seed)
+    c = rng.uniform(-5, 5, size=(n, 1, 3))
+    tri = c + rng.normal(scale=0.4, size=(n, 3, 3))
+    same = np.repeat(np.array([[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]]), 9, axis=0)
+    return np.concatenate([tri, same]).reshape(-1, 9)
+
+
+def _subtree(bvh, code):
+    """Triangles (BVH order) under child code ``code`` of the 4-wide tree."""
+    if code == -1:
+        return []
+    if code < -1:  # a leaf: its groups' triangles are consecutive
+        g0, ng = bvh.leaf[-2 - code]
+        last = ng + g0 - 1
+        return list(range(bvh.first[g0], bvh.first[last] + _group_size(bvh, last)))
+    return [t for j in range(4) for t in _subtree(bvh, bvh.child[code, j])]
+
+
+def _group_size(bvh, g):
+    """Distinct triangles in group ``g`` (padding lanes repeat the last one)."""
+    lanes = bvh.tv4[g].T
+    return 1 + sum(not np.array_equal(lanes[j], lanes[j - 1]) for j in range(1, 4))
+
+
+@pytest.mark.parametrize("n", [2, 300])
+def test_4wide_tree_holds_each_triangle_once_inside_its_boxes(n):
+    from workbench.renderers.raytrace.bvh import build_bvh4
+    tv = _soup(1, n)
+    order, bvh = build_bvh4(tv)
+    tvo = tv[order]
+    seen = []
+    for q in range(len(bvh.child)):
+        for j in range(4):
+            code = bvh.child[q, j]
+            lo, hi = bvh.node[q, :3, j], bvh.node[q, 3:, j]
+            tris = _subtree(bvh, code)
+            if code == -1:
+                assert (lo == np.inf).all() and (hi == -np.inf).all()
+                continue
+            v = tvo[tris].reshape(-1, 3)
+            assert (v >= lo).all() and (v <= hi).all()
+            if code < -1:
+                seen += tris
+    assert sorted(seen) == list(range(len(tv)))
+    # groups hold the BVH-ordered vertices, lanes side by side
+    for g in range(len(bvh.first)):
+        assert np.array_equal(bvh.tv4[g][:, 0], tvo[bvh.first[g]])
+    assert np.array_equal(bvh.bounds, np.r_[tv.reshape(-1, 3).min(0), tv.reshape(-1, 3).max(0)])
+
+
+def test_4wide_traversal_equals_brute_force_closest_and_any_hit():
+    from workbench.renderers.raytrace import kernels, shapes
+    from workbench.renderers.raytrace.bvh import build_bvh4
+    tv = _soup(2, 400)
+    order, bvh = build_bvh4(tv)
+    tvo = np.ascontiguousarray(tv[order])
+    rng = np.random.default_rng(3)
+    O = rng.uniform(-8, 8, size=(300, 3))
+    D = rng.uniform(-3, 3, size=(300, 3)) - O
+    D[:20] = [0.1, 0.05, 1.0] - O[:20]  # at the nine stacked triangles
+    stack = np.empty((kernels.BVH_STACK, 2))
+    arrays = (bvh.node, bvh.child, bvh.leaf, bvh.first, bvh.tv4)
+    hits = 0
+    for o, d in zip(O, D):
+        tb, _, _ = shapes.triangles(tvo.reshape(-1, 3, 3), o, d)
+        tb = np.where(tb > 1e-9, tb, np.inf)
+        t, tri, b1, b2 = kernels.bvh_hit(tvo, arrays, *o, *d, 1e-9, np.inf, np.bool_(False), stack)
+        if np.isfinite(tb.min()):
+            hits += 1
+            assert t == pytest.approx(tb.min(), rel=1e-9)
+            assert tb[tri] == pytest.approx(t, rel=1e-9)  # the triangle it names is hit there
+            p = o + t * d
+            v = tvo[tri].reshape(3, 3)
+            assert np.allclose((1 - b1 - b2) * v[0] + b1 * v[1] + b2 * v[2], p, atol=1e-9)
+        else:
+            assert tri == -1 and np.isinf(t)
+        # any hit: some triangle within [tmin, tmax] iff brute force has one
+        ta, tria, _, _ = kernels.bvh_hit(tvo, arrays, *o, *d, 1e-9, 0.5, np.bool_(True), stack)
+        assert (tria >= 0) == bool((tb < 0.5).any())
+        if tria >= 0:
+            assert ta < 0.5 and tb[tria] == pytest.approx(ta, rel=1e-9)
+    assert hits > 60

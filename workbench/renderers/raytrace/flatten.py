@@ -24,12 +24,16 @@ sheet (transmission goes straight through).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ...core.errors import NotApplicable, WorkbenchError
 from ...core.tol import tol
 from ...scene import model as m
+
+if TYPE_CHECKING:
+    from .bvh import Bvh4
 
 SPHERE, RECT, BOX, POLYGON, QUADRIC, CSGNODE, MESH = range(7)
 CSG_UNION, CSG_INTERSECTION, CSG_DIFFERENCE = -1, -2, -3
@@ -64,8 +68,7 @@ class SceneData:
     tri_uv: np.ndarray          # (T, 6)
     tri_e: np.ndarray           # (T, 9) vertex emission (radiance)
     tri_prim: np.ndarray        # (T,) the mesh's primitive row
-    bvh_box: np.ndarray         # (Nn, 6) node bounds
-    bvh_meta: np.ndarray        # (Nn, 3) int: leaf (first, count, -1) / inner (right, 0, axis)
+    bvh: Bvh4                   # 4-wide BVH over the triangles (see .bvh)
     materials: list             # Material objects, index = mat
     mat_tab: np.ndarray         # (M, 24) numeric material table (see _material_row)
     lights: np.ndarray          # (L, 14) light table (see _light_rows)
@@ -77,7 +80,7 @@ class SceneData:
         """The geometry tuple passed to every numba kernel."""
         return (self.ptype, self.top, self.xf, self.nm, self.par, self.solid, self.shadow,
                 self.poly_v, self.csg_prog, self.tri_v, self.tri_n, self.tri_uv, self.tri_e,
-                self.tri_prim, self.bvh_box, self.bvh_meta, self.ident)
+                self.tri_prim, *self.bvh, self.ident)
 
 
 def _material_row(mat: m.Material, front_only: bool = False) -> np.ndarray:
@@ -258,14 +261,14 @@ def flatten(scene: m.Scene) -> SceneData:
         return np.ascontiguousarray(np.array([r[key] for r in rows], dtype=dtype))
 
     tri_v, tri_n, tri_uv, tri_e, tri_p = _triangles(b.meshes)
+    from .bvh import build_bvh4, empty_bvh4
     t0 = time.perf_counter()
     if len(tri_v):
-        from .bvh import build_bvh
-        order, bvh_box, bvh_meta = build_bvh(tri_v)
+        order, bvh = build_bvh4(tri_v)
         tri_v, tri_n, tri_uv, tri_e, tri_p = (np.ascontiguousarray(a[order]) for a in
                                               (tri_v, tri_n, tri_uv, tri_e, tri_p))
     else:
-        bvh_box, bvh_meta = np.zeros((1, 6)), np.zeros((1, 3), dtype=np.int64)
+        bvh = empty_bvh4()
     bvh_time = time.perf_counter() - t0
     allb = np.concatenate(b.bounds) if b.bounds else np.zeros((1, 3))
     finite = allb[np.isfinite(allb).all(1)]
@@ -281,7 +284,7 @@ def flatten(scene: m.Scene) -> SceneData:
         poly_v=np.ascontiguousarray(np.concatenate(b.poly_v) if b.poly_v else np.zeros((1, 3))),
         csg_prog=np.array(b.prog if b.prog else [0], dtype=np.int64),
         tri_v=tri_v, tri_n=tri_n, tri_uv=tri_uv, tri_e=tri_e, tri_prim=tri_p,
-        bvh_box=np.ascontiguousarray(bvh_box), bvh_meta=np.ascontiguousarray(bvh_meta),
+        bvh=bvh,
         materials=b.materials, mat_tab=np.ascontiguousarray(mat_tab),
         lights=np.ascontiguousarray(light_rows(scene.point_lights()).reshape(-1, 14)),
         extent=max(extent, tol.zero), n_objects=len(scene.objects), bvh_build_time=bvh_time)
