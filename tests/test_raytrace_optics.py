@@ -187,3 +187,43 @@ def test_raycast_equals_the_local_model(shininess, blinn):
                             sc.point_lights(), sc.ambient, blinn=blinn)
     assert np.allclose(r.image.reshape(-1, 3)[hit], ref, atol=2e-6)
     assert np.allclose(r.image.reshape(-1, 3)[~hit], 0.0)
+
+
+# --------------------------------------------------------------------------- opacity and shadows
+def _occluded_floor(opacity):
+    """A floor lit by a slanted directional light, with a square occluder out of the camera's
+    view whose shadow falls in the middle of the picture; ``opacity``: the occluder's
+    opacity map (None: opaque), or the string "none" for no occluder."""
+    mats = {"floor": {"color": [0.8, 0.8, 0.8], "ka": 0.2, "kd": 0.8},
+            "occ": {"color": [0.5, 0.2, 0.1]} | ({} if opacity in (None, "none") else {"opacity": opacity})}
+    objects = [{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "size": [6, 6], "material": "floor"}]
+    if opacity != "none":
+        objects.append({"type": "plane", "point": [-2, 2, 0], "normal": [0, 1, 0], "size": [1.2, 1.2],
+                        "material": "occ"})
+    return make(objects, mats, lights=[{"type": "directional", "direction": [1, -1, 0]}],
+                camera={"position": [0, 3, 0.5], "look_at": [0, 0, 0], "fov_y": 40, "resolution": [24, 18]},
+                ambient=[0.3, 0.3, 0.3])
+
+
+@pytest.mark.parametrize("method", ["raycast", "raytrace"])
+def test_shadow_of_an_opacity_mapped_surface_lets_one_minus_alpha_through(method):
+    """A shadow feeler crossing a surface of opacity alpha carries 1 - alpha of the light (as
+    the ray it blends with the surface behind); a cut-out (alpha < 0.5) casts no shadow; a grid
+    map casts the grid's shadow: lit under its holes, dark under its bars."""
+    render = lambda op: workbench.render(_occluded_floor(op), method).image  # noqa: E731
+    lit, dark = render("none"), render(None)
+    shadow = np.abs(lit - dark).max(-1) > 1e-3
+    assert 0.05 < shadow.mean() < 0.6  # the shadow is in the picture, not all of it
+    blend = render({"type": "constant", "value": 0.6})
+    assert np.allclose(blend, dark + 0.4 * (lit - dark), atol=1e-9)
+    assert np.allclose(render({"type": "constant", "value": 0.3}), lit, atol=1e-12)
+    grid = render({"type": "grid", "projection": "planar", "scale": 2.0, "width": 0.3,
+                   "pole": [0, 1, 0], "equator": [1, 0, 0]})
+    under_hole = np.isclose(grid, lit, atol=1e-9).all(-1) & shadow
+    under_bar = np.isclose(grid, dark, atol=1e-9).all(-1) & shadow
+    assert under_hole.sum() > 5 and under_bar.sum() > 5
+    assert (under_hole | under_bar)[shadow].mean() > 0.9  # pixels straddling an edge aside
+    # the numba wavefront path against the readable reference
+    sc = _occluded_floor({"type": "constant", "value": 0.6})
+    ref = reference.render(sc, 24, 18, max_depth=1 if method == "raycast" else 5)
+    assert np.allclose(blend, ref, atol=1e-6)

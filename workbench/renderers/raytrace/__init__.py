@@ -77,7 +77,7 @@ def intersect(scene, origins, directions):
     n = len(O)
     h = _alloc(n)
     _kernels().trace_batch(sd.kernel_args(), O, D, np.zeros(n), np.full(n, np.inf), tol.zero,
-                           tol.ray_offset, sd.extent, tol.normal_cancel, h["t"], h["prim"], h["ng"],
+                           tol.ray_offset, sd.extent, tol.normal_cancel, False, h["t"], h["prim"], h["ng"],
                            h["ns"], h["uv"], h["po"], h["ev"])
     hit = h["prim"] >= 0
     obj = np.where(hit, sd.obj[np.maximum(h["prim"], 0)], -1)

@@ -40,6 +40,9 @@ CSG_UNION, CSG_INTERSECTION, CSG_DIFFERENCE = -1, -2, -3
 CSG_DEPTH = 16
 """Interval lists a CSG program may hold at once (the kernels' scratch stack; numba does not
 check bounds, so deeper trees are refused when the scene is flattened)."""
+SHADOW_CROSSINGS = 32
+"""Surfaces a shadow feeler goes on through (transmissive with ``transmissive_shadows``, cut out
+or partly opaque by an opacity map) before it stops with the visibility gathered so far."""
 _CSG_OPS = {"union": CSG_UNION, "intersection": CSG_INTERSECTION, "difference": CSG_DIFFERENCE}
 NPAR = 20
 _IDENTITY_ROWS = np.eye(4)[:3].reshape(-1)

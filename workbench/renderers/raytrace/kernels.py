@@ -26,7 +26,7 @@ import numpy as np
 from numba import prange
 
 from .flatten import (BOX, CSG_DEPTH, CSG_DIFFERENCE, CSG_INTERSECTION, CSG_UNION, CSGNODE, POLYGON,
-                      QUADRIC, RECT, SPHERE)
+                      QUADRIC, RECT, SHADOW_CROSSINGS, SPHERE)
 
 CHUNK = 64
 FAST_MATH = {"nsz", "arcp"}
@@ -747,29 +747,30 @@ def _tasks(nchunks):
 
 
 @nb.njit(cache=True, error_model="numpy", parallel=True)
-def trace_batch(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel,
+def trace_batch(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_only,
                 t_out, prim_out, ng, ns, uv, po, ev):
-    """Closest hits of N rays and their surface data (``prim_out = -1``, ``t = inf`` on a miss)."""
+    """Closest hits of N rays and their surface data (``prim_out = -1``, ``t = inf`` on a miss);
+    with ``shadow_only``, of the primitives that cast shadows (shadow feelers)."""
     n = O.shape[0]
     nchunks = (n + CHUNK - 1) // CHUNK
     nit = _tasks(nchunks)
     for c in prange(nit):
         scr = scratch()
         for q in range(c, nchunks, nit):
-            trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, t_out, prim_out, ng,
-                        ns, uv, po, ev, q * CHUNK, min(n, (q + 1) * CHUNK), scr)
+            trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_only, t_out,
+                        prim_out, ng, ns, uv, po, ev, q * CHUNK, min(n, (q + 1) * CHUNK), scr)
 
 
 @nb.njit(**NO_REFCOUNT)
-def trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, t_out, prim_out, ng, ns, uv,
-                po, ev, i0, i1, scr):
+def trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_only, t_out, prim_out,
+                ng, ns, uv, po, ev, i0, i1, scr):
     """Rays ``i0 .. i1 - 1`` of :func:`trace_batch` (``scr``: :func:`scratch`)."""
     stack, st, sp_, sf, sn = scr
     for i in range(i0, i1):
         ox, oy, oz = O[i, 0], O[i, 1], O[i, 2]
         eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
         t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, D[i, 0], D[i, 1], D[i, 2], tmin[i],
-                                       tmax[i], False, False, zero, eps, stack, st, sp_, sf, sn)
+                                       tmax[i], shadow_only, False, zero, eps, stack, st, sp_, sf, sn)
         t_out[i], prim_out[i] = t, k
         if k >= 0:
             surface(geo, k, f, tri, b1, b2, ox + t * D[i, 0], oy + t * D[i, 1],
@@ -780,10 +781,11 @@ def trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, t_out, pr
 def _transmittance(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmin, tmax, transmissive, zero,
                    eps, stack, st, sp_, sf, sn):
     """Shadow feeler: 1 if nothing blocks the segment, 0 if blocked (any hit ends the search);
-    with ``transmissive``, the product of the ``kt`` of every surface crossed (at most 32)."""
+    with ``transmissive``, the product of the ``kt`` of every surface crossed (at most
+    ``SHADOW_CROSSINGS``)."""
     v = 1.0
     t0 = tmin
-    for _ in range(32):
+    for _ in range(SHADOW_CROSSINGS):
         t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, t0, tmax, True, not transmissive,
                                        zero, eps, stack, st, sp_, sf, sn)
         if k < 0:
@@ -818,6 +820,71 @@ def _ior(mat_tab, stk, ns_):
 
 
 @nb.njit(error_model="numpy", inline="always")
+def _facing(nsh, i, dx, dy, dz):
+    """The shading normal of hit ``i``, turned to face the viewer (two-sided shading)."""
+    nx, ny, nz = nsh[i, 0], nsh[i, 1], nsh[i, 2]
+    if nx * dx + ny * dy + nz * dz > 0.0:
+        return -nx, -ny, -nz
+    return nx, ny, nz
+
+
+@nb.njit(error_model="numpy", inline="always")
+def _light_dir(lights, li, px, py, pz):
+    """Unit direction ``l`` from ``P`` to light ``li``, its distance (``inf`` for a directional
+    light) and the light's factor there (1, ``1 / d^2`` when attenuated, times the spot
+    factor).  Returns ``(lx, ly, lz, dist, scale)``."""
+    if lights[li, 0] > 0.5:
+        return -lights[li, 1], -lights[li, 2], -lights[li, 3], np.inf, 1.0
+    vx, vy, vz = lights[li, 1] - px, lights[li, 2] - py, lights[li, 3] - pz
+    dist = math.sqrt(vx * vx + vy * vy + vz * vz)
+    lx, ly, lz = _normalize(vx, vy, vz)
+    scale = 1.0
+    if lights[li, 7] > 0.5:
+        scale = 1.0 / max(dist * dist, 1e-300)
+    if lights[li, 8] > 0.5:
+        scale *= max(0.0, -(lx * lights[li, 9] + ly * lights[li, 10] + lz * lights[li, 11]))
+    return lx, ly, lz, dist, scale
+
+
+@nb.njit(error_model="numpy", inline="always")
+def _feeler(px, py, pz, gx, gy, gz, lx, ly, lz, dist, off):
+    """The shadow feeler towards ``l``: origin pushed ``off`` off the surface (geometric normal
+    ``g``) on the light's side, and its end short of the light.  Returns ``(qx, qy, qz, tmax)``."""
+    side = 1.0 if gx * lx + gy * ly + gz * lz >= 0.0 else -1.0
+    tmx = dist - 2.0 * off if dist < np.inf else np.inf
+    return px + side * off * gx, py + side * off * gy, pz + side * off * gz, tmx
+
+
+@nb.njit(cache=True, error_model="numpy")
+def feeler_batch(lights, O, D, t, prim, ng, nsh, opts, fo, fd, ftmin, ftmax, want):
+    """The shadow feelers :func:`shade_hit` traces at each hit, one row per (hit ``i``, light
+    ``li``): row ``i L + li`` of ``fo, fd, ftmin, ftmax``; ``want`` is False where it traces
+    none (a miss, the light behind the shading normal, a zero light factor).  For a caller that
+    traces them itself (opacity maps) and passes their visibility to :func:`shade_batch`."""
+    nl = lights.shape[0]
+    ray_off, t_min, extent = opts[8], opts[9], opts[11]
+    for i in range(O.shape[0]):
+        dx, dy, dz = D[i, 0], D[i, 1], D[i, 2]
+        px, py, pz = O[i, 0] + t[i] * dx, O[i, 1] + t[i] * dy, O[i, 2] + t[i] * dz
+        nx, ny, nz = _facing(nsh, i, dx, dy, dz)
+        pm = max(abs(px), abs(py), abs(pz))
+        off = ray_off * max(pm, extent)
+        for li in range(nl):
+            r = i * nl + li
+            want[r] = False
+            if prim[i] < 0:
+                continue
+            lx, ly, lz, dist, scale = _light_dir(lights, li, px, py, pz)
+            if nx * lx + ny * ly + nz * lz <= 0.0 or scale == 0.0:
+                continue
+            qx, qy, qz, tmx = _feeler(px, py, pz, ng[i, 0], ng[i, 1], ng[i, 2], lx, ly, lz, dist, off)
+            fo[r, 0], fo[r, 1], fo[r, 2] = qx, qy, qz
+            fd[r, 0], fd[r, 1], fd[r, 2] = lx, ly, lz
+            ftmin[r], ftmax[r] = t_min * max(pm, extent), tmx
+            want[r] = True
+
+
+@nb.njit(error_model="numpy", inline="always")
 def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, hits, contrib,
               out, s0, counts, scr):
     """Local model with shadow feelers at the hit of ray ``i``, then its reflected and refracted
@@ -826,7 +893,9 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
     passes a call of more than 30 arguments as ``*args``, which numba cannot inline.
 
     The ray is row ``i`` of ``rays = (O, D, w, depth, stk, nstk)`` and its hit row ``i`` of
-    ``hits = (t, prim, ng, nsh, col, ev)``; ``out = (out_o, out_d, out_w, out_stk, out_nstk,
+    ``hits = (t, prim, ng, nsh, col, ev, vis)`` (``vis``: the lights' visibility through the
+    shadow feelers, traced by the caller, or an empty table: traced here by
+    :func:`_transmittance`); ``out = (out_o, out_d, out_w, out_stk, out_nstk,
     out_kind, out_tmin, out_gen)``; ``scr``: :func:`scratch`.  The local colour times the ray's weight goes to ``contrib[i]``, the
     children to slots ``s0`` (reflection) and ``s0 + 1`` (refraction) of the ``out_*`` arrays
     (``out_kind`` 0 = none, 1 reflected, 2 refracted), the counts to ``counts[i]``: shadow
@@ -839,7 +908,7 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
     is evaluated by the caller).
     """
     O, D, w, depth, stk, nstk = rays
-    t, prim, ng, nsh, col, ev = hits
+    t, prim, ng, nsh, col, ev, vis_in = hits
     out_o, out_d, out_w, out_stk, out_nstk, out_kind, out_tmin, out_gen = out
     stack, st, sp_, sf, sn = scr
     max_depth, threshold, fres = int(opts[0]), opts[1], int(opts[2])
@@ -870,9 +939,7 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
         w2 *= math.exp(-mat_tab[ma, 12] * t[i])
     sx, sy, sz = -dx, -dy, -dz
     gx, gy, gz = ng[i, 0], ng[i, 1], ng[i, 2]
-    nx, ny, nz = nsh[i, 0], nsh[i, 1], nsh[i, 2]
-    if nx * sx + ny * sy + nz * sz < 0.0:  # two-sided: shading normal faces the viewer
-        nx, ny, nz = -nx, -ny, -nz
+    nx, ny, nz = _facing(nsh, i, dx, dy, dz)
     front = gx * sx + gy * sy + gz * sz > 0.0
     # side of the surface the ray came from
     fx, fy, fz = (gx, gy, gz) if front else (-gx, -gy, -gz)
@@ -892,31 +959,20 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
     eps = off
     nshadow = 0
     for li in range(nl):
-        if lights[li, 0] > 0.5:
-            lx, ly, lz = -lights[li, 1], -lights[li, 2], -lights[li, 3]
-            dist = np.inf
-            scale = 1.0
-        else:
-            vx, vy, vz = lights[li, 1] - px, lights[li, 2] - py, lights[li, 3] - pz
-            dist = math.sqrt(vx * vx + vy * vy + vz * vz)
-            lx, ly, lz = _normalize(vx, vy, vz)
-            scale = 1.0
-            if lights[li, 7] > 0.5:
-                scale = 1.0 / max(dist * dist, 1e-300)
-            if lights[li, 8] > 0.5:
-                scale *= max(0.0, -(lx * lights[li, 9] + ly * lights[li, 10] + lz * lights[li, 11]))
+        lx, ly, lz, dist, scale = _light_dir(lights, li, px, py, pz)
         ndl = nx * lx + ny * ly + nz * lz
         if ndl <= 0.0 or scale == 0.0:
             continue
         vis = 1.0
         if do_shadow:
-            side = 1.0 if gx * lx + gy * ly + gz * lz >= 0.0 else -1.0
-            qx, qy, qz = px + side * off * gx, py + side * off * gy, pz + side * off * gz
-            tmx = dist - 2.0 * off if dist < np.inf else np.inf
             nshadow += 1
-            vis = _transmittance(geo, mat_of, mat_tab, qx, qy, qz, lx, ly, lz,
-                                 t_min * max(pm, extent), tmx, transmissive, zero, eps,
-                                 stack, st, sp_, sf, sn)
+            if vis_in.shape[0] > 0:  # traced by the caller (opacity maps)
+                vis = vis_in[i, li]
+            else:
+                qx, qy, qz, tmx = _feeler(px, py, pz, gx, gy, gz, lx, ly, lz, dist, off)
+                vis = _transmittance(geo, mat_of, mat_tab, qx, qy, qz, lx, ly, lz,
+                                     t_min * max(pm, extent), tmx, transmissive, zero, eps,
+                                     stack, st, sp_, sf, sn)
             if vis <= 0.0:
                 continue
         spec = 0.0
@@ -1051,10 +1107,12 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
 
 @nb.njit(cache=True, error_model="numpy", parallel=True)
 def shade_batch(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim, ng, nsh, col, ev,
-                w, depth, stk, nstk, pix, opts, contrib, out_o, out_d, out_w, out_stk, out_nstk,
+                vis, w, depth, stk, nstk, pix, opts, contrib, out_o, out_d, out_w, out_stk, out_nstk,
                 out_kind, out_tmin, out_pix, out_gen, counts):
     """:func:`shade_hit` on every ray of a generation (the wavefront path).  Child slots:
-    ``2 i`` (reflection), ``2 i + 1`` (refraction), with the parent's pixel ``out_pix``."""
+    ``2 i`` (reflection), ``2 i + 1`` (refraction), with the parent's pixel ``out_pix``.
+    ``vis``: (N, L) visibility of each light through the shadow feelers, traced by the caller
+    (:func:`feeler_batch`), or (0, L): traced here."""
     n = O.shape[0]
     nchunks = (n + CHUNK - 1) // CHUNK
     nit = _tasks(nchunks)
@@ -1062,17 +1120,17 @@ def shade_batch(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim
         scr = scratch()
         for q in range(c, nchunks, nit):
             shade_chunk(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim, ng, nsh,
-                        col, ev, w, depth, stk, nstk, pix, opts, contrib, out_o, out_d, out_w,
+                        col, ev, vis, w, depth, stk, nstk, pix, opts, contrib, out_o, out_d, out_w,
                         out_stk, out_nstk, out_kind, out_tmin, out_pix, out_gen, counts, q * CHUNK,
                         min(n, (q + 1) * CHUNK), scr)
 
 
 @nb.njit(**NO_REFCOUNT)
 def shade_chunk(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim, ng, nsh, col, ev,
-                w, depth, stk, nstk, pix, opts, contrib, out_o, out_d, out_w, out_stk, out_nstk,
+                vis, w, depth, stk, nstk, pix, opts, contrib, out_o, out_d, out_w, out_stk, out_nstk,
                 out_kind, out_tmin, out_pix, out_gen, counts, i0, i1, scr):
     """Rays ``i0 .. i1 - 1`` of :func:`shade_batch` (``scr``: :func:`scratch`)."""
-    rays, hits = (O, D, w, depth, stk, nstk), (t, prim, ng, nsh, col, ev)
+    rays, hits = (O, D, w, depth, stk, nstk), (t, prim, ng, nsh, col, ev, vis)
     out = (out_o, out_d, out_w, out_stk, out_nstk, out_kind, out_tmin, out_gen)
     for i in range(i0, i1):
         shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, hits, contrib,
@@ -1164,14 +1222,16 @@ def ray_stack(cap):
     """Work arrays of :func:`pixel_block`: ``cap`` pending rays (origin, direction, weight,
     media stack and its size, kind, tmin, generation), then the current ray and its hit (one
     row each: origin, direction, weight, media stack and size, generation, t, primitive,
-    normals, uv, object-space point, emission, colour, contribution, counts), and the block's
-    ray counts (summed here, written once: the threads' count rows share cache lines)."""
+    normals, uv, object-space point, emission, colour, contribution, counts), the block's
+    ray counts (summed here, written once: the threads' count rows share cache lines) and an
+    empty visibility table (:func:`shade_hit` traces the shadow feelers itself)."""
     return (np.empty((cap, 3)), np.empty((cap, 3)), np.empty((cap, 3)), np.zeros((cap, 4), np.int64),
             np.zeros(cap, np.int64), np.zeros(cap, np.int64), np.empty(cap), np.zeros(cap, np.int64),
             np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 3)), np.zeros((1, 4), np.int64),
             np.zeros(1, np.int64), np.zeros(1, np.int64), np.empty(1), np.empty(1, np.int64),
             np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 2)), np.empty((1, 3)), np.empty((1, 3)),
-            np.zeros((1, 3)), np.empty((1, 3)), np.zeros((1, 7), np.int64), np.zeros(7, np.int64))
+            np.zeros((1, 3)), np.empty((1, 3)), np.zeros((1, 7), np.int64), np.zeros(7, np.int64),
+            np.empty((0, 1)))
 
 
 @nb.njit(**NO_REFCOUNT)
@@ -1185,10 +1245,10 @@ def pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts
     zero, rel_eps, extent = opts[10], opts[8], opts[11]
     stack, st, sp_, sf, sn = scr
     (r_o, r_d, r_w, r_stk, r_n, r_kind, r_tmin, r_gen, c_o, c_d, c_w, c_stk, c_n, c_gen, h_t, h_p,
-     h_ng, h_ns, h_uv, h_po, h_ev, h_col, contrib, cnt, tot) = bufs
+     h_ng, h_ns, h_uv, h_po, h_ev, h_col, contrib, cnt, tot, h_vis) = bufs
     row = 0  # the current ray's row
     cur = (c_o, c_d, c_w, c_gen, c_stk, c_n)
-    hits = (h_t, h_p, h_ng, h_ns, h_col, h_ev)
+    hits = (h_t, h_p, h_ng, h_ns, h_col, h_ev, h_vis)
     pending = (r_o, r_d, r_w, r_stk, r_n, r_kind, r_tmin, r_gen)
     for p in range(p0, p1):
         ar, ag, ab = 0.0, 0.0, 0.0

@@ -23,6 +23,7 @@ from ...core.tol import offset_scale, tol
 from ...scene import model as m
 from .. import local_model
 from . import csg, shapes
+from .flatten import SHADOW_CROSSINGS
 from .whitted import MAX_CUTOUTS, OPACITY_CUT
 
 DEFAULTS = dict(max_depth=5, threshold=1e-3, fresnel="none", transmissive_shadows=False,
@@ -167,21 +168,22 @@ def closest(ctx: Context, O, D, tmin, tmax=np.inf, shadow=False) -> Hit | None:
 
 # ----------------------------------------------------------------------------- shading
 def shadow_feeler(ctx, P, Ng, L, dist) -> float:
-    """Visibility of a light from ``P`` (the course's shadow feeler): 1 or 0, or with
-    ``transmissive_shadows`` the product of the ``kt`` of the surfaces crossed."""
+    """Visibility of a light from ``P`` (the course's shadow feeler): 1 or 0; a surface with an
+    opacity map lets ``1 - alpha`` through (all of it where it is cut out, alpha < 0.5, as for
+    the rays it cuts), and with ``transmissive_shadows`` a surface also lets ``alpha kt``
+    through: the product over the surfaces crossed."""
     off = ctx.offset(P)
     side = 1.0 if Ng @ L >= 0 else -1.0
     Q = P + side * off * Ng
     tmax = dist - 2 * off if np.isfinite(dist) else np.inf
     tmin = tol.t_min * max(float(np.abs(P).max()), ctx.extent)
     v = 1.0
-    for _ in range(32):
+    for _ in range(SHADOW_CROSSINGS):
         h = closest(ctx, Q, L, tmin, tmax, shadow=True)
         if h is None:
             return v
-        if not ctx.opts["transmissive_shadows"]:
-            return 0.0
-        v *= h.material.kt
+        a = alpha(ctx, h)
+        v *= 1.0 - a + (a * h.material.kt if ctx.opts["transmissive_shadows"] else 0.0)
         if v <= 0.0:
             return 0.0
         tmin = h.t + tol.ray_offset * max(float(np.abs(Q).max()), ctx.extent)
@@ -256,15 +258,24 @@ def past(ctx, hit) -> float:
     return hit.t + tol.ray_offset * max(float(np.abs(hit.P).max()), ctx.extent)
 
 
+def alpha(ctx, hit) -> float:
+    """Opacity of the surface at a hit: its opacity map's alpha, 0 where below 0.5 (cut out),
+    1 without a map."""
+    if hit.material.opacity is None or ctx.texturing is None:
+        return 1.0
+    uv = None if hit.uv is None else hit.uv[None]
+    a = float(ctx.texturing.alpha(hit.material, hit.P_obj[None], (hit.Ns @ hit.W[:3, :3])[None], uv)[0])
+    return a if a >= OPACITY_CUT else 0.0
+
+
 def visible_hit(ctx, O, D, tmin):
     """The closest hit not cut out by an opacity map (alpha < 0.5), and its alpha."""
     for _ in range(MAX_CUTOUTS):
         hit = closest(ctx, O, D, tmin)
-        if hit is None or hit.material.opacity is None or ctx.texturing is None:
-            return hit, 1.0
-        uv = None if hit.uv is None else hit.uv[None]
-        a = float(ctx.texturing.alpha(hit.material, hit.P_obj[None], (hit.Ns @ hit.W[:3, :3])[None], uv)[0])
-        if a >= OPACITY_CUT:
+        if hit is None:
+            return None, 1.0
+        a = alpha(ctx, hit)
+        if a > 0.0:
             return hit, a
         tmin = past(ctx, hit)
     return None, 1.0

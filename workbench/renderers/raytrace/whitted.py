@@ -39,7 +39,7 @@ from ...core.tol import tol
 from ...scene import features as F
 from ...scene.model import Scene
 from ..base import Knob, Option, RenderResult
-from .flatten import SceneData, flatten
+from .flatten import SHADOW_CROSSINGS, SceneData, flatten
 
 _RAYS_PER_BAND = 1 << 16
 # Opacity maps (model.Opacity): alpha below OPACITY_CUT cuts the surface out; a ray passes
@@ -174,7 +174,7 @@ def ensure_compiled(sd: SceneData, fused: bool = False) -> float:
     otherwise.  Returns the seconds spent (0 if already compiled in this process)."""
     k = _kernels()
     needed = (k.render_pixels,) if fused else (k.trace_batch, k.shade_batch, k.accumulate, k.compact,
-                                               k.column_sums)
+                                               k.column_sums, k.feeler_batch)
     if all(f.signatures for f in needed):
         return 0.0
     t0 = time.perf_counter()
@@ -191,12 +191,15 @@ def ensure_compiled(sd: SceneData, fused: bool = False) -> float:
         return time.perf_counter() - t0
     arr = _alloc(1)
     k.trace_batch(geo, O, D, np.zeros(1), np.full(1, np.inf), tol.zero, tol.ray_offset, 1.0,
-                  tol.normal_cancel, arr["t"], arr["prim"], arr["ng"], arr["ns"], arr["uv"],
+                  tol.normal_cancel, False, arr["t"], arr["prim"], arr["ng"], arr["ns"], arr["uv"],
                   arr["po"], arr["ev"])
     ch = _alloc_children(1)
+    nl = len(sd.lights)
+    k.feeler_batch(sd.lights, O, D, np.ones(1), np.zeros(1, np.int64), D.copy(), D.copy(), kopts,
+                   np.empty((nl, 3)), np.empty((nl, 3)), np.empty(nl), np.empty(nl), np.empty(nl, np.bool_))
     k.shade_batch(geo, sd.mat, sd.mat_tab, sd.lights, np.zeros(3), np.zeros(3), O, D, np.ones(1),
                   np.zeros(1, np.int64), D.copy(), D.copy(), np.ones((1, 3)), np.zeros((1, 3)),
-                  np.ones((1, 3)), np.zeros(1, np.int64), np.zeros((1, 4), np.int64),
+                  np.empty((0, nl)), np.ones((1, 3)), np.zeros(1, np.int64), np.zeros((1, 4), np.int64),
                   np.zeros(1, np.int64), np.zeros(1, np.int64), kopts, np.zeros((1, 3)),
                   ch["o"], ch["d"], ch["w"], ch["stk"], ch["nstk"], ch["kind"], ch["tmin"], ch["pix"],
                   ch["gen"], np.zeros((1, 7), np.int64))
@@ -339,8 +342,10 @@ class _Tracer:
             contrib = np.empty((n, 3))
             ch = _alloc_children(n)
             counts = np.empty((n, 7), np.int64)
+            vis = (self._visibility(O, D, h, ns) if self.has_opacity and self.do_shadow
+                   else np.empty((0, len(sd.lights))))
             k.shade_batch(self.geo, sd.mat, sd.mat_tab, sd.lights, self.ambient, self.col.bg, O, D,
-                          h["t"], prim, h["ng"], ns, C, h["ev"], w, gen, stk, nstk, pix, self.kopts,
+                          h["t"], prim, h["ng"], ns, C, h["ev"], vis, w, gen, stk, nstk, pix, self.kopts,
                           contrib, ch["o"], ch["d"], ch["w"], ch["stk"], ch["nstk"], ch["kind"],
                           ch["tmin"], ch["pix"], ch["gen"], counts)
             _accumulate(acc, pix, contrib)
@@ -354,6 +359,37 @@ class _Tracer:
             n = len(O)
         return acc / spp, depth_map
 
+    def _visibility(self, O, D, h, ns):
+        """(n, L) visibility of each light from each hit through its shadow feeler
+        (:func:`.kernels.feeler_batch`: the feelers :func:`.kernels.shade_hit` would trace),
+        with opacity maps: a surface lets ``1 - alpha`` through (all of it where cut out, as
+        for the rays it cuts), and with ``transmissive_shadows`` also ``alpha kt`` (as
+        :func:`.reference.shadow_feeler`)."""
+        k, sd = _kernels(), self.sd
+        n, nl = len(O), len(sd.lights)
+        fo, fd = np.empty((n * nl, 3)), np.empty((n * nl, 3))
+        tmin, tmax, want = np.empty(n * nl), np.empty(n * nl), np.empty(n * nl, np.bool_)
+        k.feeler_batch(sd.lights, O, D, h["t"], h["prim"], h["ng"], ns, self.kopts, fo, fd, tmin, tmax, want)
+        vis = np.ones(n * nl)
+        kt = sd.mat_tab[sd.mat, 8] if self.kopts[3] > 0.5 else np.zeros(len(sd.mat))
+        todo = np.flatnonzero(want)
+        for _ in range(SHADOW_CROSSINGS):
+            if not len(todo):
+                break
+            s = _alloc(len(todo))
+            k.trace_batch(self.geo, fo[todo], fd[todo], tmin[todo], tmax[todo], tol.zero, tol.ray_offset,
+                          sd.extent, tol.normal_cancel, True, s["t"], s["prim"], s["ng"], s["ns"], s["uv"],
+                          s["po"], s["ev"])
+            hit = s["prim"] >= 0
+            todo, prim = todo[hit], s["prim"][hit]
+            a = self.col.alpha(prim, s["po"][hit], s["ns"][hit], s["uv"][hit])
+            a[a < OPACITY_CUT] = 0.0
+            vis[todo] *= 1.0 - a + a * kt[prim]
+            go = vis[todo] > 0.0
+            todo = todo[go]
+            tmin[todo] = self._past(fo[todo], fd[todo], s["t"][hit][go])
+        return vis.reshape(n, nl)
+
     def _past(self, O, D, t):
         """``tmin`` that restarts rays just beyond their hit at ``t`` (offset scaled with the
         hit point, :func:`workbench.core.tol.offset_scale`)."""
@@ -366,7 +402,7 @@ class _Tracer:
         n = len(O)
         h = _alloc(n)
         k.trace_batch(self.geo, O, D, tmin, np.full(n, np.inf), tol.zero, tol.ray_offset,
-                      self.sd.extent, tol.normal_cancel, h["t"], h["prim"], h["ng"], h["ns"],
+                      self.sd.extent, tol.normal_cancel, False, h["t"], h["prim"], h["ng"], h["ns"],
                       h["uv"], h["po"], h["ev"])
         h["alpha"] = np.ones(n)
         if not self.has_opacity:
@@ -382,7 +418,7 @@ class _Tracer:
             sub = _alloc(len(todo))
             k.trace_batch(self.geo, O[todo], D[todo], self._past(O[todo], D[todo], h["t"][todo]),
                           np.full(len(todo), np.inf), tol.zero, tol.ray_offset, self.sd.extent,
-                          tol.normal_cancel, sub["t"], sub["prim"], sub["ng"], sub["ns"],
+                          tol.normal_cancel, False, sub["t"], sub["prim"], sub["ng"], sub["ns"],
                           sub["uv"], sub["po"], sub["ev"])
             for key, v in sub.items():
                 h[key][todo] = v
