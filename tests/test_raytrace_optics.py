@@ -227,3 +227,54 @@ def test_shadow_of_an_opacity_mapped_surface_lets_one_minus_alpha_through(method
     sc = _occluded_floor({"type": "constant", "value": 0.6})
     ref = reference.render(sc, 24, 18, max_depth=1 if method == "raycast" else 5)
     assert np.allclose(blend, ref, atol=1e-6)
+
+
+# --------------------------------------------------------------------------- camera inside a medium
+CAM_IN_GLASS = np.array([0.8, 0.3, -0.2])
+
+
+def _camera_in_glass(ior, absorption, sphere=True):
+    """The camera off the centre of a glass sphere of radius 2 (no local shading, all
+    transmitted) looking at a white wall outside it."""
+    mats = {"glass": {"color": [1, 1, 1], "ka": 0.0, "kd": 0.0, "ks": 0.0, "kt": 1.0, "ior": ior,
+                      "absorption": [absorption, 0.5 * absorption, 0.0]},
+            "wall": {"color": [0.9, 0.9, 0.9], "ka": 0.3, "kd": 0.7}}
+    objects = [{"type": "plane", "point": [0, 0, 5], "normal": [0, 0, -1], "size": [40, 40], "material": "wall"}]
+    if sphere:
+        objects.append({"type": "sphere", "center": [0, 0, 0], "radius": 2.0, "material": "glass"})
+    return make(objects, mats, lights=[{"type": "point", "position": [0, 3, 0.5], "intensity": 1.0}],
+                camera={"position": CAM_IN_GLASS.tolist(), "look_at": [0.8, 0.3, 1], "fov_y": 50,
+                        "resolution": [16, 12]}, ambient=[0.2, 0.2, 0.2])
+
+
+@pytest.mark.parametrize("path", ["fused", "wavefront"])
+def test_a_camera_inside_an_absorbing_medium_sees_through_it(path, monkeypatch):
+    """Primary rays start inside the solids that enclose the camera: Beer-Lambert applies from
+    the camera: a ray crossing d of glass keeps exp(-a d) of the wall's radiance), and with the
+    same index as air the wall is seen unbent."""
+    from workbench.renderers.raytrace import whitted
+    if path == "wavefront":
+        monkeypatch.setattr(whitted, "fused_textures", lambda scene, sd: None)
+    opts = dict(max_depth=5, threshold=0.0, shadows=False)
+    sc = _camera_in_glass(1.0, 0.3)
+    bare = workbench.render(_camera_in_glass(1.0, 0.3, sphere=False), "raytrace", **opts).image
+    inside = workbench.render(sc, "raytrace", **opts).image
+    _, D = sc.camera.rays()
+    cd = D @ CAM_IN_GLASS
+    d = -cd + np.sqrt(cd ** 2 - CAM_IN_GLASS @ CAM_IN_GLASS + 4.0)  # to the sphere, radius 2
+    expected = bare * np.exp(-np.array([0.3, 0.15, 0.0]) * d[..., None])
+    assert np.allclose(inside, expected, rtol=1e-5, atol=1e-7)  # float32 images
+    assert [m.name for m in reference.enclosing_media(sc, CAM_IN_GLASS)] == ["glass"]
+    assert reference.enclosing_media(sc, [0, 0, 3]) == []
+
+
+def test_camera_inside_refracting_glass_equals_the_reference():
+    """Leaving the glass the ray bends from n = 1.5 to 1 (total internal reflection beyond the
+    critical angle), as in the readable reference."""
+    sc = _camera_in_glass(1.5, 0.2)
+    opts = dict(max_depth=4, threshold=0.0)
+    img = workbench.render(sc, "raytrace", **opts).image
+    ref = reference.render(sc, 16, 12, **opts)
+    assert np.allclose(img, ref, atol=1e-6)
+    flat = workbench.render(_camera_in_glass(1.0, 0.2), "raytrace", **opts).image
+    assert np.abs(img - flat).max() > 1e-3  # the index matters

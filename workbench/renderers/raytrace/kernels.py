@@ -905,7 +905,8 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
     ``opts``: max_depth, threshold, fresnel (0 none, 1 Schlick, 2 exact), transmissive shadows,
     blinn, shadows on, reflection on, refraction on, tol.ray_offset, tol.t_min, tol.zero,
     extent, misses see ``background`` (else they contribute nothing here: an environment map
-    is evaluated by the caller).
+    is evaluated by the caller), then (read by :func:`pixel_block`) the number of media around
+    the camera and their materials, outermost first (4).
     """
     O, D, w, depth, stk, nstk = rays
     t, prim, ng, nsh, col, ev, vis_in = hits
@@ -1261,7 +1262,9 @@ def pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts
                 camera_ray(cam, first + p, r_o, r_d)
             for q in range(3):
                 r_w[0, q] = 1.0
-            r_n[0], r_tmin[0], r_gen[0] = 0, 0.0, 0
+            r_n[0], r_tmin[0], r_gen[0] = int(opts[13]), 0.0, 0  # the media around the camera
+            for q in range(4):
+                r_stk[0, q] = int(opts[14 + q])
             top = 1
             while top > 0:
                 top -= 1

@@ -354,15 +354,48 @@ def shade(ctx, hit: Hit, D, recurs, weight, media, node):
     return color
 
 
+PROBE = np.array([0.5773, 0.5774, 0.5775]) / np.linalg.norm([0.5773, 0.5774, 0.5775])
+"""Direction of the ray that finds the solids around a point (off the axes and diagonals, so
+that it does not run along an edge of an axis-aligned scene)."""
+
+
+def enclosing_media(scene: m.Scene, point) -> list[m.Material]:
+    """Materials of the transmissive solids (``kt > 0``; not planes or polygons) that enclose
+    ``point``, outermost first: the media stack of rays leaving it, e.g. the camera's primary
+    rays inside a glass.  A closed surface encloses the point iff a ray from it crosses the
+    surface an odd number of times (Jordan); the solids are ordered by where the ray leaves
+    them, the last left first."""
+    O = np.asarray(point, dtype=np.float64)
+    found = []
+    for o in scene.objects:
+        if isinstance(o, (m.Plane, m.Polygon)):
+            continue
+        if isinstance(o, m.Mesh):
+            W = np.asarray(o.world_from_object)
+            V = np.asarray(o.vertices) @ W[:3, :3].T + W[:3, 3]
+            t = shapes.triangles(V[np.asarray(o.faces)], O, PROBE)[0]
+            t = np.sort(t[np.isfinite(t) & (t > 0.0)])
+            name = o.material
+        else:  # the first crossing's leaf names the medium of a CSG solid
+            cross = [c for c in intersect(o, np.eye(4), O, PROBE, tol.zero) if c.t > 0.0]
+            t = [c.t for c in cross]
+            name = cross[0].leaf[0].material if cross else o.material
+        mat = scene.materials[name]
+        if len(t) % 2 == 1 and mat.kt > 0.0:
+            found.append((float(t[0]), mat))
+    return [mat for _, mat in sorted(found, key=lambda x: -x[0])]
+
+
 # ----------------------------------------------------------------------------- entry points
 def render(scene: m.Scene, width: int, height: int, **options) -> np.ndarray:
     """The reference image (H, W, 3) float64, one ray per pixel centre (slow: small images)."""
     ctx = Context(scene.with_camera(scene.camera.with_resolution(width, height)), **options)
     O, D = ctx.scene.camera.rays()
+    media = enclosing_media(scene, scene.camera.position)
     img = np.zeros((height, width, 3))
     for i in range(height):
         for j in range(width):
-            img[i, j] = raytrace(ctx, O[i, j], D[i, j])
+            img[i, j] = raytrace(ctx, O[i, j], D[i, j], media=media)
     return img
 
 
@@ -379,7 +412,7 @@ def ray_tree(scene: m.Scene, i: int, j: int, **options) -> dict:
     ctx = Context(scene, **options)
     O, D = scene.camera.rays()
     tree: list = []
-    color = raytrace(ctx, O[i, j], D[i, j], tree=tree)
+    color = raytrace(ctx, O[i, j], D[i, j], media=enclosing_media(scene, scene.camera.position), tree=tree)
     root = tree[0]
     root["color"] = color.tolist()
     return root

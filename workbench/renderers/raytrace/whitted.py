@@ -181,7 +181,7 @@ def ensure_compiled(sd: SceneData, fused: bool = False) -> float:
     O = np.zeros((1, 3))
     D = np.array([[0.0, 0.0, 1.0]])
     geo = sd.kernel_args()
-    kopts = np.zeros(13)
+    kopts = np.zeros(18)
     kopts[0] = 1.0
     if fused:
         k.render_pixels(geo, sd.mat, sd.mat_tab, np.zeros((len(sd.mat_tab), TEX_COLS)), sd.lights,
@@ -276,6 +276,10 @@ class _Tracer:
                                float(opts["transmissive_shadows"]), float(opts["blinn"]),
                                float(self.do_shadow), float(refl), float(refr), tol.ray_offset,
                                tol.t_min, tol.zero, sd.extent, float(not self.env)])
+        from .reference import enclosing_media
+        names = [mt.name for mt in sd.materials]
+        self.media = [names.index(mt.name) for mt in enclosing_media(scene, scene.camera.position)][-4:]
+        self.kopts = np.r_[self.kopts, len(self.media), self.media + [0] * (4 - len(self.media))]
         self.ambient = np.asarray(scene.ambient, dtype=np.float64)
         self.geo = sd.kernel_args()
         self.stats = dict(primary_rays=0, shadow_rays=0, reflected_rays=0, refracted_rays=0,
@@ -318,7 +322,8 @@ class _Tracer:
         w = np.ones((n, 3))
         gen = np.zeros(n, np.int64)
         stk = np.zeros((n, 4), np.int64)
-        nstk = np.zeros(n, np.int64)
+        stk[:, :len(self.media)] = self.media
+        nstk = np.full(n, len(self.media), np.int64)
         tmin = np.zeros(n)
         first = True
         while n > 0:
