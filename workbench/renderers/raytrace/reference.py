@@ -368,7 +368,7 @@ def enclosing_media(scene: m.Scene, point) -> list[m.Material]:
     O = np.asarray(point, dtype=np.float64)
     found = []
     for o in scene.objects:
-        if isinstance(o, (m.Plane, m.Polygon)):
+        if isinstance(o, (m.Plane, m.Polygon)) or (not isinstance(o, m.CSG) and scene.materials[o.material].kt <= 0.0):
             continue
         if isinstance(o, m.Mesh):
             W = np.asarray(o.world_from_object)
