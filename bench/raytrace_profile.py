@@ -1,7 +1,8 @@
 """Where the Whitted ray tracer spends its trace phase, on 1 and 2 threads: the fused kernel
 (whole ray trees per pixel, the path the Whitted scene takes) against the wavefront path
 (the path of scenes with numpy textures), whose numba kernels are timed against the numpy glue
-between ray generations, per generation.
+between ray generations, per generation.  Then the mesh scene (81,920 triangles) on one thread:
+its whole trace phase against the intersection queries of the same rays alone (``mesh``).
 
 The Whitted scene at 640 x 480, depth 5, threshold 1/255 (as ``bench/povray_whitted.py``),
 warm JIT cache, best of 3 renders per thread count and path.  For the wavefront runs the
@@ -97,6 +98,77 @@ def profile(threads: int, repeats: int = 3) -> dict:
                 per_generation=per_gen)
 
 
+def mesh_intersection(repeats: int = 3) -> dict:
+    """The mesh scene on one thread: the trace phase of a render against the intersection
+    queries of its rays alone, through :func:`kernels.closest` (analytic primitives, the
+    mesh's box, the 4-wide BVH) and through the BVH alone (box test + :func:`kernels.bvh_hit`):
+    the primary rays' closest hits, then the shadow feelers :func:`kernels.shade_hit` traces
+    (:func:`kernels.feeler_batch`, any hit).  Best of ``repeats`` each."""
+    import numba
+    import numpy as np
+
+    import workbench
+    from workbench.core.tol import tol
+    from workbench.renderers.raytrace import kernels as K
+    from workbench.renderers.raytrace.flatten import flatten
+    from workbench.renderers.raytrace.whitted import _alloc, camera_rays
+    numba.set_num_threads(1)
+    scene = workbench.load_scene("mesh")
+    r = min((workbench.render(scene, "raytrace", width=W, height=H, threshold=1.0 / 255.0, max_depth=5)
+             for _ in range(repeats)), key=lambda r: r.timings["trace"])
+    sd = flatten(scene)
+    geo = sd.kernel_args()
+    O, D, _ = camera_rays(scene.camera, W, H, 1, 0)
+    n = len(O)
+    h = _alloc(n)
+    K.trace_batch(geo, O, D, np.zeros(n), np.full(n, np.inf), tol.zero, tol.ray_offset, sd.extent,
+                  tol.normal_cancel, False, h["t"], h["prim"], h["ng"], h["ns"], h["uv"], h["po"], h["ev"])
+    kopts = np.zeros(18)
+    kopts[8], kopts[9], kopts[11] = tol.ray_offset, tol.t_min, sd.extent
+    nl = len(sd.lights)
+    fo, fd = np.empty((n * nl, 3)), np.empty((n * nl, 3))
+    ftmin, ftmax, want = np.empty(n * nl), np.empty(n * nl), np.empty(n * nl, np.bool_)
+    K.feeler_batch(sd.lights, O, D, h["t"], h["prim"], h["ng"], h["ns"], kopts, fo, fd, ftmin, ftmax, want)
+    sets = dict(primary=(O, D, np.zeros(n), np.full(n, np.inf), False),
+                shadow=(fo[want], fd[want], ftmin[want], ftmax[want], True))
+
+    @numba.njit(**dict(K.NO_REFCOUNT, cache=False))  # as the kernels: no reference counting
+    def queries(geo, O, D, tmin, tmax, shadow, bvh_only, extent, scr):
+        stack, st, sp_, sf, sn = scr
+        (_, _, _, _, _, _, _, _, _, tv, _, _, _, _, node, child, leaf, first, tv4, bounds, _) = geo
+        hits = 0
+        for i in range(O.shape[0]):
+            ox, oy, oz, dx, dy, dz = O[i, 0], O[i, 1], O[i, 2], D[i, 0], D[i, 1], D[i, 2]
+            if bvh_only:
+                if K._bounds_hit(bounds, ox, oy, oz, dx, dy, dz, tmin[i], tmax[i]):
+                    t = K.bvh_hit(tv, (node, child, leaf, first, tv4), ox, oy, oz, dx, dy, dz, tmin[i],
+                                  tmax[i], shadow, stack)[0]
+                    hits += t < np.inf
+            else:
+                eps = 1e-9 * max(max(abs(ox), abs(oy), abs(oz)), extent)
+                hits += K.closest(geo, ox, oy, oz, dx, dy, dz, tmin[i], tmax[i], shadow, shadow, 0.0, eps,
+                                  stack, st, sp_, sf, sn)[1] >= 0
+        return hits
+
+    scr = numba.njit(lambda: K.scratch())()
+    out = dict(triangles=int(len(sd.tri_v)), bvh_4wide_nodes=int(len(sd.bvh.node)),
+               bvh_leaves=int(len(sd.bvh.leaf)), trace_s=r.timings["trace"], total_rays=r.stats["total_rays"])
+    for name, (o, d, t0, t1, shadow) in sets.items():
+        for what, bvh_only in (("closest", False), ("bvh", True)):
+            queries(geo, o, d, t0, t1, shadow, bvh_only, sd.extent, scr)  # compile
+            best = np.inf
+            for _ in range(repeats):
+                c0 = time.perf_counter()
+                queries(geo, o, d, t0, t1, shadow, bvh_only, sd.extent, scr)
+                best = min(best, time.perf_counter() - c0)
+            out[f"{name}_rays"] = len(o)
+            out[f"{name}_{what}_s"] = best
+    inter = out["primary_closest_s"] + out["shadow_closest_s"]
+    out["intersection_share_of_trace"] = inter / out["trace_s"]
+    out["bvh_share_of_trace"] = (out["primary_bvh_s"] + out["shadow_bvh_s"]) / out["trace_s"]
+    return out
+
+
 LOG: list = []
 
 
@@ -109,6 +181,7 @@ def main() -> dict:
     res = dict(machine=f"{os.cpu_count()} CPUs (shared); load average {os.getloadavg()[0]:.2f} at start",
                numba_threading_layer=numba.threading_layer(), size=f"{W}x{H}",
                fused=[fused(t) for t in (1, 2)])
+    res["mesh"] = mesh_intersection()
     whitted.fused_textures = lambda scene, sd: None  # the wavefront path from here on
     workbench.render(workbench.load_scene("whitted"), "raytrace", width=32, height=24)
     _instrument(kernels, whitted, LOG)
