@@ -6,10 +6,11 @@ import numpy as np
 import pytest
 
 
-def test_a_degenerate_very_deep_tree_builds_completely():
-    # triangles at x = 100 * 2^-k: every SAH split peels one off, a tree over 256 levels deep
-    # (more than the build's first stack holds)
-    from workbench.renderers.raytrace.bvh import build_bvh
+def test_a_degenerate_tree_stops_at_max_depth_and_is_traversed_exactly():
+    # triangles at x = 100 * 2^-k: every SAH split peels one off; the tree stops at MAX_DEPTH
+    # with a large leaf, so that no traversal stack ever overflows, and every hit is found
+    from workbench.renderers.raytrace import kernels, shapes
+    from workbench.renderers.raytrace.bvh import MAX_DEPTH, build_bvh, build_bvh4
     n = 1200
     x = 100.0 * 2.0 ** -np.arange(n)
     tri = np.zeros((n, 3, 3))
@@ -20,9 +21,20 @@ def test_a_degenerate_very_deep_tree_builds_completely():
     for i in range(len(box)):
         if meta[i, 2] != -1:
             depth[i + 1] = depth[meta[i, 0]] = depth[i] + 1
-    assert depth.max() > 256
+    assert depth.max() == MAX_DEPTH
     assert np.array_equal(np.sort(order), np.arange(n))
     assert meta[meta[:, 2] == -1, 1].sum() == n
+    order, bvh = build_bvh4(tri.reshape(n, 9))
+    tvo = np.ascontiguousarray(tri.reshape(n, 9)[order])
+    stack = np.empty((kernels.BVH_STACK, 2))
+    arrays = (bvh.node, bvh.child, bvh.leaf, bvh.first, bvh.tv4)
+    for k in (0, 5, 59, 61, 300, 1000):  # along the x axis through the triangles, from afar
+        o = np.array([-1.0, 2e-4, 2e-4])
+        d = np.array([1.0, 0.0, 0.0])
+        tb = shapes.triangles(tvo.reshape(-1, 3, 3), o, d)[0]
+        t = kernels.bvh_hit(tvo, arrays, *o, *d, x[k] + 1.0 - 1e-12, np.inf, np.bool_(False), stack)[0]
+        expected = np.where(tb > x[k] + 1.0 - 1e-12, tb, np.inf).min()
+        assert t == pytest.approx(expected, rel=1e-12)
 
 
 def _soup(seed, n):

@@ -12,6 +12,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from ..raytrace.bvh import MAX_DEPTH
+
 TWO_PI = 2.0 * np.pi
 
 
@@ -416,7 +418,7 @@ def receiver_rows(shooters, flat, offsets, centres, normals, areas, samples, sam
         f = _ff_one(centres[j], normals[j], flat[offsets[i]:offsets[i + 1]], eps, scale)
         if f <= 0.0:
             continue
-        stack = np.empty(64, dtype=np.int64)
+        stack = np.empty(MAX_DEPTH + 1, dtype=np.int64)  # a pending child per level
         ox = centres[j, 0] + offset * normals[j, 0]
         oy = centres[j, 1] + offset * normals[j, 1]
         oz = centres[j, 2] + offset * normals[j, 2]

@@ -25,6 +25,11 @@ import numpy as np
 
 N_BINS = 16
 MAX_LEAF = 4
+MAX_DEPTH = 60
+"""Deepest binary level: a node there is a leaf whatever its size (only degenerate input, e.g.
+triangles at geometrically shrinking spacing, reaches it).  It bounds the traversal stacks:
+radiosity's visibility test keeps one pending child per level, the ray tracer's 4-wide
+traversal at most three per level (``kernels.BVH_STACK``), so neither ever drops a node."""
 # SAH cost of a traversal step relative to one triangle test (pbrt-v4 uses 1/2 as well).
 TRAVERSAL_COST = 0.5
 
@@ -52,9 +57,8 @@ def _build(tri_v):
     cap = max(2 * T, 1)
     box = np.empty((cap, 6))
     meta = np.zeros((cap, 3), dtype=np.int64)
-    stack = np.empty((256, 4), dtype=np.int64)  # start, end, parent, is_right
-    sp = 0
-    stack[0, 0], stack[0, 1], stack[0, 2], stack[0, 3] = 0, T, -1, 0
+    stack = np.empty((MAX_DEPTH + 2, 5), dtype=np.int64)  # start, end, parent, is_right, depth
+    stack[0, 0], stack[0, 1], stack[0, 2], stack[0, 3], stack[0, 4] = 0, T, -1, 0, 0
     sp = 1
     n_nodes = 0
     bin_box = np.empty((N_BINS, 6))
@@ -63,7 +67,7 @@ def _build(tri_v):
     right_cnt = np.empty(N_BINS, dtype=np.int64)
     while sp > 0:
         sp -= 1
-        s, e, parent, is_right = stack[sp, 0], stack[sp, 1], stack[sp, 2], stack[sp, 3]
+        s, e, parent, is_right, depth = stack[sp, 0], stack[sp, 1], stack[sp, 2], stack[sp, 3], stack[sp, 4]
         node = n_nodes
         n_nodes += 1
         if is_right == 1:
@@ -82,7 +86,7 @@ def _build(tri_v):
                 cmax[a] = max(cmax[a], cen[i, a])
         n = e - s
         ext = cmax - cmin
-        if n <= MAX_LEAF or not max(ext[0], ext[1], ext[2]) > 0.0:
+        if n <= MAX_LEAF or not max(ext[0], ext[1], ext[2]) > 0.0 or depth >= MAX_DEPTH:
             meta[node, 0], meta[node, 1], meta[node, 2] = s, n, -1
             continue
         # bin the centroids along each axis, sweep from the right, then from the left
@@ -143,14 +147,11 @@ def _build(tri_v):
                 hi -= 1
         mid = lo
         meta[node, 1], meta[node, 2] = 0, axis
-        if sp + 2 > stack.shape[0]:  # a degenerate, very deep tree: grow the stack
-            grown = np.empty((2 * stack.shape[0], 4), dtype=np.int64)
-            grown[:sp] = stack[:sp]
-            stack = grown
-        # push right then left: the left child is popped next and gets index node + 1
-        stack[sp, 0], stack[sp, 1], stack[sp, 2], stack[sp, 3] = mid, e, node, 1
+        # push right then left: the left child is popped next and gets index node + 1 (at most
+        # one pending right child per level: the stack holds MAX_DEPTH + 2)
+        stack[sp, 0], stack[sp, 1], stack[sp, 2], stack[sp, 3], stack[sp, 4] = mid, e, node, 1, depth + 1
         sp += 1
-        stack[sp, 0], stack[sp, 1], stack[sp, 2], stack[sp, 3] = s, mid, node, 0
+        stack[sp, 0], stack[sp, 1], stack[sp, 2], stack[sp, 3], stack[sp, 4] = s, mid, node, 0, depth + 1
         sp += 1
     return idx, box[:n_nodes].copy(), meta[:n_nodes].copy()
 

@@ -25,6 +25,7 @@ import numba as nb
 import numpy as np
 from numba import prange
 
+from .bvh import MAX_DEPTH
 from .flatten import (BOX, CSG_DEPTH, CSG_DIFFERENCE, CSG_INTERSECTION, CSG_UNION, CSGNODE, POLYGON,
                       QUADRIC, RECT, SHADOW_CROSSINGS, SPHERE)
 
@@ -39,7 +40,8 @@ NO_REFCOUNT = dict(cache=True, error_model="numpy", _nrt=False, fastmath=FAST_MA
 """Options of the kernels that allocate nothing: compiled without numba's reference counting
 (no atomic increments and decrements of every array they touch, which cost the fused kernel
 40 % of its time); the arrays they use belong to their (reference-counted) callers."""
-BVH_STACK = 128
+BVH_STACK = 3 * MAX_DEPTH + 4
+"""Rows of the 4-wide traversal's stack: at most three pending children per level (``.bvh.MAX_DEPTH``)."""
 CSG_EVENTS = 32
 # Slab exits are enlarged by 1 + 2 gamma_3 (gamma_n = n u / (1 - n u), u = 2^-53) so that
 # rounding never culls a box the ray touches (Ize, "Robust BVH ray traversal", JCGT 2013).
@@ -560,7 +562,7 @@ def bvh_hit(tv, bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     pk = (np.uint64(kx), np.uint64(ky), np.uint64(kz), np.uint64(3 + kx), np.uint64(3 + ky),
           np.uint64(3 + kz), np.uint64(6 + kx), np.uint64(6 + ky), np.uint64(6 + kz))
     best, bg, bl = tmax, -1, 0
-    top = stack.shape[0] - 1  # a full stack drops children (a tree deeper than BVH_STACK / 3)
+    top = stack.shape[0] - 1  # never reached (BVH_STACK); a bound all the same
     code, sp = 0, 0
     while True:
         while code >= 0:  # a 4-wide node
