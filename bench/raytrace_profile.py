@@ -141,7 +141,7 @@ def mesh_intersection(repeats: int = 3) -> dict:
             ox, oy, oz, dx, dy, dz = O[i, 0], O[i, 1], O[i, 2], D[i, 0], D[i, 1], D[i, 2]
             if bvh_only:
                 if K._bounds_hit(bounds, ox, oy, oz, dx, dy, dz, tmin[i], tmax[i]):
-                    t = K.bvh_hit(tv, (node, child, leaf, first, tv4), ox, oy, oz, dx, dy, dz, tmin[i],
+                    t = K.bvh_hit((node, child, leaf, first, tv4), ox, oy, oz, dx, dy, dz, tmin[i],
                                   tmax[i], shadow, stack)[0]
                     hits += t < np.inf
             else:

@@ -32,50 +32,46 @@ def test_a_degenerate_tree_stops_at_max_depth_and_is_traversed_exactly():
         o = np.array([-1.0, 2e-4, 2e-4])
         d = np.array([1.0, 0.0, 0.0])
         tb = shapes.triangles(tvo.reshape(-1, 3, 3), o, d)[0]
-        t = kernels.bvh_hit(tvo, arrays, *o, *d, x[k] + 1.0 - 1e-12, np.inf, np.bool_(False), stack)[0]
+        t = kernels.bvh_hit(arrays, *o, *d, x[k] + 1.0 - 1e-12, np.inf, np.bool_(False), stack)[0]
         expected = np.where(tb > x[k] + 1.0 - 1e-12, tb, np.inf).min()
         assert t == pytest.approx(expected, rel=1e-12)
 
 
 def _soup(seed, n):
-    """``n`` random triangles plus nine copies of one (same centroid: a leaf the SAH cannot
-    split, more than one group of four)."""
+    """``n`` random triangles plus eight copies of one (same centroid: a leaf the SAH cannot
+    split, more than one group of four, its last group full of the same triangle)."""
     rng = np.random.default_rng(seed)
     c = rng.uniform(-5, 5, size=(n, 1, 3))
     tri = c + rng.normal(scale=0.4, size=(n, 3, 3))
-    same = np.repeat(np.array([[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]]), 9, axis=0)
+    same = np.repeat(np.array([[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]]), 8, axis=0)
     return np.concatenate([tri, same]).reshape(-1, 9)
 
 
-def _subtree(bvh, code):
-    """Triangles (BVH order) under child code ``code`` of the 4-wide tree."""
+def _subtree(bvh, leaves, code):
+    """Triangles (BVH order) under child code ``code`` of the 4-wide tree; ``leaves``: the
+    collapse's (first, count) of each leaf."""
     if code == -1:
         return []
-    if code < -1:  # a leaf: its groups' triangles are consecutive
-        g0, ng = bvh.leaf[-2 - code]
-        last = ng + g0 - 1
-        return list(range(bvh.first[g0], bvh.first[last] + _group_size(bvh, last)))
-    return [t for j in range(4) for t in _subtree(bvh, bvh.child[code, j])]
-
-
-def _group_size(bvh, g):
-    """Distinct triangles in group ``g`` (padding lanes repeat the last one)."""
-    lanes = bvh.tv4[g].T
-    return 1 + sum(not np.array_equal(lanes[j], lanes[j - 1]) for j in range(1, 4))
+    if code < -1:
+        first, count = leaves[-2 - code]
+        return list(range(first, first + count))
+    return [t for j in range(4) for t in _subtree(bvh, leaves, bvh.child[code, j])]
 
 
 @pytest.mark.parametrize("n", [2, 300])
 def test_4wide_tree_holds_each_triangle_once_inside_its_boxes(n):
-    from workbench.renderers.raytrace.bvh import build_bvh4
+    from workbench.renderers.raytrace.bvh import _build, _collapse, build_bvh4
     tv = _soup(1, n)
     order, bvh = build_bvh4(tv)
+    leaves = _collapse(*_build(tv)[1:])[2]
+    assert np.array_equal(bvh.leaf[:, 1], (leaves[:, 1] + 3) // 4)  # groups of four per leaf
     tvo = tv[order]
     seen = []
     for q in range(len(bvh.child)):
         for j in range(4):
             code = bvh.child[q, j]
             lo, hi = bvh.node[q, :3, j], bvh.node[q, 3:, j]
-            tris = _subtree(bvh, code)
+            tris = _subtree(bvh, leaves, code)
             if code == -1:
                 assert (lo == np.inf).all() and (hi == -np.inf).all()
                 continue
@@ -84,9 +80,11 @@ def test_4wide_tree_holds_each_triangle_once_inside_its_boxes(n):
             if code < -1:
                 seen += tris
     assert sorted(seen) == list(range(len(tv)))
-    # groups hold the BVH-ordered vertices, lanes side by side
-    for g in range(len(bvh.first)):
-        assert np.array_equal(bvh.tv4[g][:, 0], tvo[bvh.first[g]])
+    # groups hold the BVH-ordered vertices, lanes side by side, a short group repeating its last
+    for (first, count), (g0, ng) in zip(leaves, bvh.leaf):
+        for g in range(g0, g0 + ng):
+            lanes = [min(bvh.first[g] + j, first + count - 1) for j in range(4)]
+            assert np.array_equal(bvh.tv4[g].T, tvo[lanes])
     assert np.array_equal(bvh.bounds, np.r_[tv.reshape(-1, 3).min(0), tv.reshape(-1, 3).max(0)])
 
 
@@ -99,14 +97,14 @@ def test_4wide_traversal_equals_brute_force_closest_and_any_hit():
     rng = np.random.default_rng(3)
     O = rng.uniform(-8, 8, size=(300, 3))
     D = rng.uniform(-3, 3, size=(300, 3)) - O
-    D[:20] = [0.1, 0.05, 1.0] - O[:20]  # at the nine stacked triangles
+    D[:20] = [0.1, 0.05, 1.0] - O[:20]  # at the eight stacked triangles
     stack = np.empty((kernels.BVH_STACK, 2))
     arrays = (bvh.node, bvh.child, bvh.leaf, bvh.first, bvh.tv4)
     hits = 0
     for o, d in zip(O, D):
         tb, _, _ = shapes.triangles(tvo.reshape(-1, 3, 3), o, d)
         tb = np.where(tb > 1e-9, tb, np.inf)
-        t, tri, b1, b2 = kernels.bvh_hit(tvo, arrays, *o, *d, 1e-9, np.inf, np.bool_(False), stack)
+        t, tri, b1, b2 = kernels.bvh_hit(arrays, *o, *d, 1e-9, np.inf, np.bool_(False), stack)
         if np.isfinite(tb.min()):
             hits += 1
             assert t == pytest.approx(tb.min(), rel=1e-9)
@@ -117,7 +115,7 @@ def test_4wide_traversal_equals_brute_force_closest_and_any_hit():
         else:
             assert tri == -1 and np.isinf(t)
         # any hit: some triangle within [tmin, tmax] iff brute force has one
-        ta, tria, _, _ = kernels.bvh_hit(tvo, arrays, *o, *d, 1e-9, 0.5, np.bool_(True), stack)
+        ta, tria, _, _ = kernels.bvh_hit(arrays, *o, *d, 1e-9, 0.5, np.bool_(True), stack)
         assert (tria >= 0) == bool((tb < 0.5).any())
         if tria >= 0:
             assert ta < 0.5 and tb[tria] == pytest.approx(ta, rel=1e-9)

@@ -269,3 +269,32 @@ def test_intersect_rejects_bad_input():
         cast(sc, np.zeros((2, 3)), np.zeros((2, 3)))
     with pytest.raises(workbench.WorkbenchError):
         workbench.raytrace.intersect(sc, np.zeros((2, 2)), np.zeros((2, 2)))
+
+
+def test_rays_in_a_face_plane_of_an_axis_aligned_mesh_are_not_culled():
+    """A ray with zero direction components lying exactly in the plane of a box face (e.g. the
+    middle row of an odd-sized image, the camera level with a face) is inside that slab: the
+    BVH must not cull the box (0 * inf is NaN, not a bound), so the watertight test finds the
+    front face's edge."""
+    g = np.linspace(-1.0, 1.0, 5)
+    V, F = [], []
+    for ax in range(3):  # a closed cube [-1, 1]^3 of 6 x 4 x 4 quads
+        for sign in (-1.0, 1.0):
+            for a0, a1 in zip(g[:-1], g[1:]):
+                for b0, b1 in zip(g[:-1], g[1:]):
+                    quad = []
+                    for a, b in ((a0, b0), (a1, b0), (a1, b1), (a0, b1)):
+                        p = [0.0, 0.0, 0.0]
+                        p[ax], p[(ax + 1) % 3], p[(ax + 2) % 3] = sign, a, b
+                        quad.append(p)
+                    k = len(V)
+                    V += quad
+                    F += [[k, k + 1, k + 2], [k, k + 2, k + 3]]
+    sc = _mesh_scene(np.array(V), np.array(F))
+    xs = np.array([-1.5, -1.0, -0.5, 0.0, 0.5, 1.0, 1.5])
+    X, Y = np.meshgrid(xs, xs)
+    O = np.stack([X.ravel(), Y.ravel(), np.full(X.size, -3.0)], 1)
+    t, n, obj = cast(sc, O, np.tile([0.0, 0.0, 1.0], (len(O), 1)))
+    inside = (np.abs(O[:, 0]) <= 1.0) & (np.abs(O[:, 1]) <= 1.0)
+    assert np.array_equal(np.isfinite(t), inside)
+    assert np.allclose(t[inside], 2.0)

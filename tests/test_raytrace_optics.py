@@ -190,17 +190,19 @@ def test_raycast_equals_the_local_model(shininess, blinn):
 
 
 # --------------------------------------------------------------------------- opacity and shadows
-def _occluded_floor(opacity):
-    """A floor lit by a slanted directional light, with a square occluder out of the camera's
-    view whose shadow falls in the middle of the picture; ``opacity``: the occluder's
-    opacity map (None: opaque), or the string "none" for no occluder."""
+def _occluded_floor(opacity, kt=0.0):
+    """A floor lit by a slanted directional light and a point light, with a square occluder
+    out of the camera's view whose shadows fall in the picture; ``opacity``: the occluder's
+    opacity map (None: opaque), or the string "none" for no occluder; ``kt`` its
+    transmission."""
     mats = {"floor": {"color": [0.8, 0.8, 0.8], "ka": 0.2, "kd": 0.8},
-            "occ": {"color": [0.5, 0.2, 0.1]} | ({} if opacity in (None, "none") else {"opacity": opacity})}
+            "occ": {"color": [0.5, 0.2, 0.1], "kt": kt} | ({} if opacity in (None, "none") else {"opacity": opacity})}
     objects = [{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "size": [6, 6], "material": "floor"}]
     if opacity != "none":
         objects.append({"type": "plane", "point": [-2, 2, 0], "normal": [0, 1, 0], "size": [1.2, 1.2],
                         "material": "occ"})
-    return make(objects, mats, lights=[{"type": "directional", "direction": [1, -1, 0]}],
+    return make(objects, mats, lights=[{"type": "directional", "direction": [1, -1, 0]},
+                                       {"type": "point", "position": [-3.5, 4.0, 1.0], "intensity": 0.7}],
                 camera={"position": [0, 3, 0.5], "look_at": [0, 0, 0], "fov_y": 40, "resolution": [24, 18]},
                 ambient=[0.3, 0.3, 0.3])
 
@@ -223,10 +225,15 @@ def test_shadow_of_an_opacity_mapped_surface_lets_one_minus_alpha_through(method
     under_bar = np.isclose(grid, dark, atol=1e-9).all(-1) & shadow
     assert under_hole.sum() > 5 and under_bar.sum() > 5
     assert (under_hole | under_bar)[shadow].mean() > 0.9  # pixels straddling an edge aside
+    # with transmissive shadows the covered part also lets kt through: 1 - 0.6 + 0.6 x 0.5
+    half = {"type": "constant", "value": 0.6}
+    trans = workbench.render(_occluded_floor(half, kt=0.5), method, transmissive_shadows=True).image
+    assert np.allclose(trans, dark + 0.7 * (lit - dark), atol=1e-6)
     # the numba wavefront path against the readable reference
-    sc = _occluded_floor({"type": "constant", "value": 0.6})
-    ref = reference.render(sc, 24, 18, max_depth=1 if method == "raycast" else 5)
-    assert np.allclose(blend, ref, atol=1e-6)
+    depth = 1 if method == "raycast" else 5
+    assert np.allclose(blend, reference.render(_occluded_floor(half), 24, 18, max_depth=depth), atol=1e-6)
+    ref = reference.render(_occluded_floor(half, kt=0.5), 24, 18, max_depth=depth, transmissive_shadows=True)
+    assert np.allclose(trans, ref, atol=1e-6)
 
 
 # --------------------------------------------------------------------------- camera inside a medium
@@ -278,3 +285,32 @@ def test_camera_inside_refracting_glass_equals_the_reference():
     assert np.allclose(img, ref, atol=1e-6)
     flat = workbench.render(_camera_in_glass(1.0, 0.2), "raytrace", **opts).image
     assert np.abs(img - flat).max() > 1e-3  # the index matters
+
+
+def test_enclosing_media_by_point_in_solid():
+    """The solids around a point, by inside tests: nested spheres outermost first, a CSG shell
+    (glass ball minus an opaque core) only in its glass, a closed glass mesh by its winding
+    number, an open glass pane never (a pane crossed by some ray must not fill the view with
+    glass), nothing on a surface."""
+    from workbench.scene.generate import generate_mesh
+    g = lambda kt=1.0: {"color": [1, 1, 1], "kt": kt, "ior": 1.5}  # noqa: E731
+    mats = {f"g{i}": g() for i in range(1, 6)} | {"opaque": g(0.0)}
+    names = lambda sc, p: [mt.name for mt in reference.enclosing_media(sc, p)]  # noqa: E731
+    nested = make([{"type": "sphere", "center": [0, 0, 0], "radius": r, "material": f"g{r}"} for r in (3, 1, 5, 2, 4)], mats)
+    assert names(nested, [0.1, 0.2, 0.0]) == ["g5", "g4", "g3", "g2", "g1"]
+    assert names(nested, [0.0, 2.5, 0.0]) == ["g5", "g4", "g3"]
+    assert names(nested, [0.0, 2.0, 0.0]) == ["g5", "g4", "g3"]  # on the radius-2 sphere: outside it
+    shell = make([{"type": "csg", "op": "difference", "material": "g1",
+                   "left": {"type": "sphere", "radius": 3, "material": "g1"},
+                   "right": {"type": "sphere", "radius": 1, "material": "opaque"}}], mats)
+    for p in ([2, 0, 0], [-2, 0, 0], [0, 0, -2.5]):
+        assert names(shell, p) == ["g1"]
+    assert names(shell, [0.5, 0, 0]) == [] and names(shell, [4, 0, 0]) == []
+    blob = generate_mesh("blob", subdivisions=2)
+    closed = make([{"type": "mesh", "vertices": np.asarray(blob.vertices).tolist(),
+                    "faces": np.asarray(blob.faces).tolist(), "material": "g2",
+                    "transform": {"translate": [1.0, 0.0, 0.0]}}], mats)
+    assert names(closed, [1.1, 0.1, 0.0]) == ["g2"] and names(closed, [3.0, 0.0, 0.0]) == []
+    pane = make([{"type": "mesh", "vertices": [[-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]],
+                  "faces": [[0, 1, 2], [0, 2, 3]], "material": "g3"}], mats)
+    assert names(pane, [0.0, 0.0, 0.0]) == [] and names(pane, [0.0, 0.0, 2.0]) == []

@@ -4,7 +4,8 @@ spawning step of a hit (:func:`shade_hit`), and the two drivers: the fused kerne
 (:func:`trace_batch`, :func:`shade_batch`: each generation of rays is traced, then shaded, then
 its reflected and refracted children form the next generation).
 
-Everything is scalar code over flat arrays (:mod:`.flatten`); the drivers are ``parallel=True``
+Everything is scalar code over flat arrays (:mod:`.flatten`), but for the BVH traversal, which
+tests four boxes and four triangles side by side (:func:`bvh_hit`); the drivers are ``parallel=True``
 over chunks of rays or blocks of pixels (``prange``), each with its own scratch arrays (BVH
 stack, CSG interval stacks, ray stack), and hand each chunk to a worker compiled without
 reference counting (:data:`NO_REFCOUNT`).  Helpers marked ``inline="always"`` are inlined into
@@ -402,13 +403,12 @@ def csg_hit(start, length, prog, ptype, xf, par, ox, oy, oz, dx, dy, dz, tmin, t
 
 
 @nb.njit(error_model="numpy", inline="always")
-def tri_lane(tv4, g, j, pk, okx, oky, okz, sx, sy, sz, tmin, tmax):
-    """Watertight ray / triangle test (Woop, Benthin & Wald, JCGT 2013) of triangle ``j`` of
-    group ``g`` (:func:`.bvh.build_bvh4`), in the ray's permuted axes (``pk``: the rows of
-    vertex 0's ``kx, ky, kz``, then vertex 1's, vertex 2's; ``kz`` the dominant axis of the
-    direction; ``ok*`` the origin along them, ``s*`` the shear).  Written without branches,
-    so that the four triangles of a group are tested side by side.  Returns ``t``, ``inf`` on
-    a miss."""
+def _edge_functions(tv4, g, j, pk, okx, oky, okz, sx, sy, sz):
+    """The watertight ray / triangle test's edge functions ``U, V, W`` of triangle ``j`` of
+    group ``g`` (:func:`.bvh.build_bvh4`) and its vertices' sheared depths (Woop, Benthin &
+    Wald, JCGT 2013), in the ray's permuted axes: ``pk`` the rows of vertex 0's ``kx, ky, kz``,
+    then vertex 1's and vertex 2's (``kz`` the dominant axis of the direction); ``ok*`` the
+    origin along them, ``s*`` the shear."""
     az, bz, cz = tv4[g, pk[2], j] - okz, tv4[g, pk[5], j] - okz, tv4[g, pk[8], j] - okz
     ax = (tv4[g, pk[0], j] - okx) - sx * az
     ay = (tv4[g, pk[1], j] - oky) - sy * az
@@ -416,9 +416,15 @@ def tri_lane(tv4, g, j, pk, okx, oky, okz, sx, sy, sz, tmin, tmax):
     by = (tv4[g, pk[4], j] - oky) - sy * bz
     cx = (tv4[g, pk[6], j] - okx) - sx * cz
     cy = (tv4[g, pk[7], j] - oky) - sy * cz
-    U = cx * by - cy * bx
-    V = ax * cy - ay * cx
-    W = bx * ay - by * ax
+    return cx * by - cy * bx, ax * cy - ay * cx, bx * ay - by * ax, az, bz, cz
+
+
+@nb.njit(error_model="numpy", inline="always")
+def tri_lane(tv4, g, j, pk, okx, oky, okz, sx, sy, sz, tmin, tmax):
+    """Watertight ray / triangle test of triangle ``j`` of group ``g`` (see
+    :func:`_edge_functions`), without branches, so that the four triangles of a group are
+    tested side by side.  Returns ``t``, ``inf`` on a miss."""
+    U, V, W, az, bz, cz = _edge_functions(tv4, g, j, pk, okx, oky, okz, sx, sy, sz)
     # the edge functions' signs differ: the ray passes outside
     outside = ((U < 0.0) | (V < 0.0) | (W < 0.0)) & ((U > 0.0) | (V > 0.0) | (W > 0.0))
     det = U + V + W
@@ -427,31 +433,18 @@ def tri_lane(tv4, g, j, pk, okx, oky, okz, sx, sy, sz, tmin, tmax):
 
 
 @nb.njit(error_model="numpy", inline="always")
-def tri_barycentric(tv, i, kx, ky, kz, okx, oky, okz, sx, sy, sz):
-    """Barycentric weights ``(b1, b2)`` of vertices 1 and 2 of triangle ``i`` at the ray's
-    hit (the edge functions of :func:`tri_lane` over their sum)."""
-    az, bz, cz = tv[i, kz] - okz, tv[i, 3 + kz] - okz, tv[i, 6 + kz] - okz
-    ax = (tv[i, kx] - okx) - sx * az
-    ay = (tv[i, ky] - oky) - sy * az
-    bx = (tv[i, 3 + kx] - okx) - sx * bz
-    by = (tv[i, 3 + ky] - oky) - sy * bz
-    cx = (tv[i, 6 + kx] - okx) - sx * cz
-    cy = (tv[i, 6 + ky] - oky) - sy * cz
-    U = cx * by - cy * bx
-    V = ax * cy - ay * cx
-    W = bx * ay - by * ax
-    det = U + V + W
-    return V / det, W / det
-
-
-@nb.njit(error_model="numpy", inline="always")
-def _inverse(dx, dy, dz):
-    """``1 / d`` per component, a zero component as ``+-1e300`` (a slab distance then is
-    ``+-inf`` or huge, never the NaN of ``0 * inf``)."""
-    big = 1e300
-    return (1.0 / dx if dx != 0.0 else (big if dx >= 0.0 else -big),
-            1.0 / dy if dy != 0.0 else (big if dy >= 0.0 else -big),
-            1.0 / dz if dz != 0.0 else (big if dz >= 0.0 else -big))
+def _slab_interval(nx, ny, nz, fx, fy, fz):
+    """Entry and exit distances of a ray in a box from its three slabs' near and far plane
+    distances.  A ray parallel to a slab has ``+-inf`` distances (``1 / 0``), and NaN where it
+    lies in the slab's plane (``0 * inf``): NaN fails every comparison, so that slab is
+    ignored (the ray is inside it), as in pbrt's ray-box test."""
+    tn = nx if nx > -np.inf else -np.inf
+    tn = ny if ny > tn else tn
+    tn = nz if nz > tn else tn
+    tf = fx if fx < np.inf else np.inf
+    tf = fy if fy < tf else tf
+    tf = fz if fz < tf else tf
+    return tn, tf
 
 
 @nb.njit(error_model="numpy", inline="always")
@@ -459,12 +452,12 @@ def _bounds_hit(b, ox, oy, oz, dx, dy, dz, tmin, tmax):
     """Whether the ray meets the box ``b`` (min xyz, max xyz) within ``[tmin, tmax]``: the
     test before a BVH traversal (the call, and its set-up, cost more than the test; most
     rays of a scene with a small mesh miss its box)."""
-    ix, iy, iz = _inverse(dx, dy, dz)
-    t0, t1 = (b[0] - ox) * ix, (b[3] - ox) * ix
-    t2, t3 = (b[1] - oy) * iy, (b[4] - oy) * iy
-    t4, t5 = (b[2] - oz) * iz, (b[5] - oz) * iz
-    tn = max(min(t0, t1), min(t2, t3), min(t4, t5))
-    tf = min(max(t0, t1), max(t2, t3), max(t4, t5))
+    ix, iy, iz = 1.0 / dx, 1.0 / dy, 1.0 / dz
+    cx = 0 if ix >= 0.0 else 3
+    cy = 1 if iy >= 0.0 else 4
+    cz = 2 if iz >= 0.0 else 5
+    tn, tf = _slab_interval((b[cx] - ox) * ix, (b[cy] - oy) * iy, (b[cz] - oz) * iz,
+                            (b[3 - cx] - ox) * ix, (b[5 - cy] - oy) * iy, (b[7 - cz] - oz) * iz)
     return tn <= tf * BOX_GAMMA and tf >= tmin and tn <= tmax
 
 
@@ -476,8 +469,9 @@ def box_lane(node, nd, j, pl, ox, oy, oz, ix, iy, iz, tmin, best):
     one: no min / max sorts each slab's two distances; Williams et al., "An efficient and
     robust ray-box intersection algorithm", JGT 2005); exits are enlarged by ``BOX_GAMMA``
     (Ize, JCGT 2013).  Without branches: the four children are tested side by side."""
-    tn = max((node[nd, pl[0], j] - ox) * ix, (node[nd, pl[1], j] - oy) * iy, (node[nd, pl[2], j] - oz) * iz)
-    tf = min((node[nd, pl[3], j] - ox) * ix, (node[nd, pl[4], j] - oy) * iy, (node[nd, pl[5], j] - oz) * iz)
+    tn, tf = _slab_interval((node[nd, pl[0], j] - ox) * ix, (node[nd, pl[1], j] - oy) * iy,
+                            (node[nd, pl[2], j] - oz) * iz, (node[nd, pl[3], j] - ox) * ix,
+                            (node[nd, pl[4], j] - oy) * iy, (node[nd, pl[5], j] - oz) * iz)
     return tn if ((tn <= tf * BOX_GAMMA) & (tf >= tmin) & (tn <= best)) else np.inf
 
 
@@ -511,18 +505,21 @@ def _slp_vectorized(dispatcher):
     the four box tests of a 4-wide node, and the four triangle tests of a leaf group, into
     vector instructions (:func:`bvh_hit`).  numba leaves it off by default, and rightly for the
     rest of these kernels: on for everything, it slowed the Whitted scene's trace by 9 %
-    (measured).  numba reads the setting when it creates a function's code library, so it is
-    on only while this function compiles; callers link the vectorized code.  No result
-    changes: each lane rounds as the scalar code would."""
+    (measured).  numba reads the setting when it optimises a function, inside ``compile``, so it
+    is on only while this function compiles (under numba's compiler lock, which is re-entrant:
+    no other thread compiles meanwhile); callers link the vectorized code.  No result changes:
+    each lane rounds as the scalar code would."""
+    from numba.core.compiler_lock import global_compiler_lock
     compile_scalar = dispatcher.compile
 
     def compile_vectorized(sig):
-        saved = nb.config.SLP_VECTORIZE
-        nb.config.SLP_VECTORIZE = 1
-        try:
-            return compile_scalar(sig)
-        finally:
-            nb.config.SLP_VECTORIZE = saved
+        with global_compiler_lock:
+            saved = nb.config.SLP_VECTORIZE
+            nb.config.SLP_VECTORIZE = 1
+            try:
+                return compile_scalar(sig)
+            finally:
+                nb.config.SLP_VECTORIZE = saved
 
     dispatcher.compile = compile_vectorized
     return dispatcher
@@ -530,15 +527,14 @@ def _slp_vectorized(dispatcher):
 
 @_slp_vectorized
 @nb.njit(**NO_REFCOUNT)
-def bvh_hit(tv, bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
+def bvh_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     """Closest (or any) triangle hit through the 4-wide BVH (:func:`.bvh.build_bvh4`): at each
     node the four children's boxes are tested together, the nearest hit child is visited next
     and the others wait on ``stack`` (rows ``(entry distance, child)``, nearest on top), skipped
     when popped if the best hit is now nearer than their box; a leaf's triangles are tested four
-    at a time.  ``tv``: the (T, 9) vertices, for the barycentrics of the hit.  Returns
-    ``(t, tri, b1, b2)``."""
+    at a time.  Returns ``(t, tri, b1, b2)``."""
     node, child, leaf, first, tv4 = bvh
-    ix, iy, iz = _inverse(dx, dy, dz)
+    ix, iy, iz = 1.0 / dx, 1.0 / dy, 1.0 / dz  # +-inf for a zero component: see _slab_interval
     cx = 0 if ix >= 0.0 else 3
     cy = 1 if iy >= 0.0 else 4
     cz = 2 if iz >= 0.0 else 5
@@ -605,9 +601,9 @@ def bvh_hit(tv, bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
             break
     if bg < 0:
         return np.inf, -1, 0.0, 0.0
-    tri = first[bg] + bl
-    b1, b2 = tri_barycentric(tv, tri, kx, ky, kz, okx, oky, okz, sx, sy, sz)
-    return best, tri, b1, b2
+    # barycentric weights of vertices 1 and 2: the edge functions over their sum
+    U, V, W, _, _, _ = _edge_functions(tv4, bg, bl, pk, okx, oky, okz, sx, sy, sz)
+    return best, first[bg] + bl, V / (U + V + W), W / (U + V + W)
 
 
 @nb.njit(error_model="numpy", inline="always")
@@ -644,7 +640,7 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
             return best, bp, bf, btri, bb1, bb2
     if tri_v.shape[0] > 0 and _bounds_hit(bvh_bounds, ox, oy, oz, dx, dy, dz, tmin, best):
         # np.bool_: a runtime flag, not a literal True/False (one compiled bvh_hit for all)
-        t, tri, b1, b2 = bvh_hit(tri_v, (bvh_node, bvh_child, bvh_leaf, bvh_first, bvh_tv4),
+        t, tri, b1, b2 = bvh_hit((bvh_node, bvh_child, bvh_leaf, bvh_first, bvh_tv4),
                                  ox, oy, oz, dx, dy, dz, tmin, best,
                                  np.bool_(any_hit), stack)
         if tri >= 0:
@@ -730,7 +726,7 @@ def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_
 @nb.njit(error_model="numpy", inline="always")
 def scratch():
     """Per-thread work arrays of :func:`closest`: the BVH traversal stack (rows: entry distance,
-    node) and the CSG stack of interval lists (times, signed primitive codes, faces, counts)."""
+    child code: a 4-wide node or a leaf) and the CSG stack of interval lists (times, signed primitive codes, faces, counts)."""
     return (np.empty((BVH_STACK, 2)), np.empty((CSG_DEPTH, CSG_EVENTS)),
             np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64),
             np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64), np.empty(CSG_DEPTH, dtype=np.int64))

@@ -354,36 +354,81 @@ def shade(ctx, hit: Hit, D, recurs, weight, media, node):
     return color
 
 
-PROBE = np.array([0.5773, 0.5774, 0.5775]) / np.linalg.norm([0.5773, 0.5774, 0.5775])
-"""Direction of the ray that finds the solids around a point (off the axes and diagonals, so
-that it does not run along an edge of an axis-aligned scene)."""
+def _containing_leaf(node: m.SceneObject, W: np.ndarray, p) -> str | None:
+    """The material of the leaf of solid ``node`` (parent transform ``W``) whose inside holds
+    ``p`` and is part of the solid (not subtracted), None if ``p`` is not inside.  Inside:
+    sphere, box, a quadric's ``P^T Q P < 0`` within its bounds, a mesh's generalised winding
+    number above 1/2 (Jacobson et al. 2013: open patches and stray triangles count for about
+    0), CSG by its boolean; planes and polygons have no inside.  Points on a surface are
+    outside (strict inequalities)."""
+    if isinstance(node, m.CSG):
+        Wn = W @ np.asarray(node.world_from_object)
+        left, right = _containing_leaf(node.left, Wn, p), _containing_leaf(node.right, Wn, p)
+        if node.op == "union":
+            return left or right
+        if node.op == "intersection":
+            return left if left and right else None
+        return left if left and not right else None
+    Wl = W @ np.asarray(node.world_from_object)
+    inv = np.linalg.inv(Wl)
+    q = inv[:3, :3] @ p + inv[:3, 3]
+    if isinstance(node, m.Sphere):
+        inside = np.linalg.norm(q - np.asarray(node.center)) < node.radius
+    elif isinstance(node, m.Box):
+        inside = bool(np.all(q > node.min) and np.all(q < node.max))
+    elif isinstance(node, m.Quadric):
+        P = np.r_[q, 1.0]
+        inside = P @ np.asarray(node.Q) @ P < 0.0 and bool(np.all(q >= node.bounds_min) and np.all(q <= node.bounds_max))
+    elif isinstance(node, m.Mesh):
+        a, b, c = (np.asarray(node.vertices)[np.asarray(node.faces)[:, k]] - q for k in range(3))
+        la, lb, lc = (np.linalg.norm(v, axis=1) for v in (a, b, c))
+        # solid angle of each triangle seen from q (Van Oosterom & Strackee 1983)
+        num = np.einsum("ij,ij->i", a, np.cross(b, c))
+        den = la * lb * lc + np.einsum("ij,ij->i", a, b) * lc + np.einsum("ij,ij->i", b, c) * la \
+            + np.einsum("ij,ij->i", c, a) * lb
+        inside = abs(np.sum(2.0 * np.arctan2(num, den))) / (4.0 * np.pi) > 0.5
+    else:
+        inside = False
+    return node.material if inside else None
 
 
 def enclosing_media(scene: m.Scene, point) -> list[m.Material]:
-    """Materials of the transmissive solids (``kt > 0``; not planes or polygons) that enclose
-    ``point``, outermost first: the media stack of rays leaving it, e.g. the camera's primary
-    rays inside a glass.  A closed surface encloses the point iff a ray from it crosses the
-    surface an odd number of times (Jordan); the solids are ordered by where the ray leaves
-    them, the last left first."""
-    O = np.asarray(point, dtype=np.float64)
+    """Materials of the transmissive solids (``kt > 0``) whose inside holds ``point``,
+    outermost first: the media stack of rays leaving it, e.g. the camera's primary rays inside
+    a glass.  Nested solids are ordered by the volume of their world bounding boxes (a solid
+    inside another has the smaller box)."""
+    p = np.asarray(point, dtype=np.float64)
     found = []
     for o in scene.objects:
-        if isinstance(o, (m.Plane, m.Polygon)) or (not isinstance(o, m.CSG) and scene.materials[o.material].kt <= 0.0):
-            continue
-        if isinstance(o, m.Mesh):
-            W = np.asarray(o.world_from_object)
-            V = np.asarray(o.vertices) @ W[:3, :3].T + W[:3, 3]
-            t = shapes.triangles(V[np.asarray(o.faces)], O, PROBE)[0]
-            t = np.sort(t[np.isfinite(t) & (t > 0.0)])
-            name = o.material
-        else:  # the first crossing's leaf names the medium of a CSG solid
-            cross = [c for c in intersect(o, np.eye(4), O, PROBE, tol.zero) if c.t > 0.0]
-            t = [c.t for c in cross]
-            name = cross[0].leaf[0].material if cross else o.material
-        mat = scene.materials[name]
-        if len(t) % 2 == 1 and mat.kt > 0.0:
-            found.append((float(t[0]), mat))
+        if not isinstance(o, m.CSG) and scene.materials[o.material].kt <= 0.0:
+            continue  # (a mesh's winding number costs a pass over its triangles)
+        name = _containing_leaf(o, np.eye(4), p)
+        if name is not None and scene.materials[name].kt > 0.0:
+            lo, hi = _world_bounds(o, np.eye(4))
+            found.append((float(np.prod(hi - lo)), scene.materials[name]))
     return [mat for _, mat in sorted(found, key=lambda x: -x[0])]
+
+
+def _world_bounds(node: m.SceneObject, W: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Axis-aligned world box of a solid (of its leaves' boxes, for CSG)."""
+    if isinstance(node, m.CSG):
+        Wn = W @ np.asarray(node.world_from_object)
+        boxes = [_world_bounds(c, Wn) for c in (node.left, node.right)]
+        return np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
+    Wl = W @ np.asarray(node.world_from_object)
+    if isinstance(node, m.Sphere):
+        c, r = np.asarray(node.center), node.radius
+        lo, hi = c - r, c + r
+    elif isinstance(node, m.Box):
+        lo, hi = np.asarray(node.min, float), np.asarray(node.max, float)
+    elif isinstance(node, m.Quadric):
+        lo, hi = np.asarray(node.bounds_min, float), np.asarray(node.bounds_max, float)
+    else:
+        v = np.asarray(node.vertices, float)
+        lo, hi = v.min(0), v.max(0)
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    w = corners @ Wl[:3, :3].T + Wl[:3, 3]
+    return w.min(0), w.max(0)
 
 
 # ----------------------------------------------------------------------------- entry points
