@@ -133,9 +133,9 @@ def mesh_intersection(repeats: int = 3) -> dict:
                 shadow=(fo[want], fd[want], ftmin[want], ftmax[want], True))
 
     @numba.njit(**dict(K.NO_REFCOUNT, cache=False))  # as the kernels: no reference counting
-    def queries(geo, O, D, tmin, tmax, shadow, bvh_only, extent, scr):
+    def queries(geo, O, D, tmin, tmax, shadow, bvh_only, extent, scr, rel_eps, zero):
         stack, st, sp_, sf, sn = scr
-        (_, _, _, _, _, _, _, _, _, tv, _, _, _, _, node, child, leaf, first, tv4, bounds, _) = geo
+        (_, _, _, _, _, _, _, _, _, _, _, _, _, _, node, child, leaf, first, tv4, bounds, _) = geo
         hits = 0
         for i in range(O.shape[0]):
             ox, oy, oz, dx, dy, dz = O[i, 0], O[i, 1], O[i, 2], D[i, 0], D[i, 1], D[i, 2]
@@ -145,8 +145,8 @@ def mesh_intersection(repeats: int = 3) -> dict:
                                   tmax[i], shadow, stack)[0]
                     hits += t < np.inf
             else:
-                eps = 1e-9 * max(max(abs(ox), abs(oy), abs(oz)), extent)
-                hits += K.closest(geo, ox, oy, oz, dx, dy, dz, tmin[i], tmax[i], shadow, shadow, 0.0, eps,
+                eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
+                hits += K.closest(geo, ox, oy, oz, dx, dy, dz, tmin[i], tmax[i], shadow, shadow, zero, eps,
                                   stack, st, sp_, sf, sn)[1] >= 0
         return hits
 
@@ -155,11 +155,11 @@ def mesh_intersection(repeats: int = 3) -> dict:
                bvh_leaves=int(len(sd.bvh.leaf)), trace_s=r.timings["trace"], total_rays=r.stats["total_rays"])
     for name, (o, d, t0, t1, shadow) in sets.items():
         for what, bvh_only in (("closest", False), ("bvh", True)):
-            queries(geo, o, d, t0, t1, shadow, bvh_only, sd.extent, scr)  # compile
+            queries(geo, o, d, t0, t1, shadow, bvh_only, sd.extent, scr, tol.ray_offset, tol.zero)  # compile
             best = np.inf
             for _ in range(repeats):
                 c0 = time.perf_counter()
-                queries(geo, o, d, t0, t1, shadow, bvh_only, sd.extent, scr)
+                queries(geo, o, d, t0, t1, shadow, bvh_only, sd.extent, scr, tol.ray_offset, tol.zero)
                 best = min(best, time.perf_counter() - c0)
             out[f"{name}_rays"] = len(o)
             out[f"{name}_{what}_s"] = best
