@@ -17,7 +17,13 @@ frames) and the results go to ``bench/results/ui_fps.json``:
   (``cpu_jobs_started`` counts the restarts during the count: 0);
 * ``drag_gl_only``: the same drag with the three GL panels only;
 * ``raytrace_without_window``: the same 512 x 512, 16 spp ray trace rendered by the library in
-  a plain process (numba's default threads), for the completion-time comparison.
+  a plain process (numba's default threads), for the completion-time comparison;
+* ``material_drag``: the camera rests while the chosen material's ``kd`` slider moves every
+  frame (``scripts.SliderFps``; three GL panels), ``slider_drag``: the same with light 0's
+  position slider moving every frame too; ``programs_compiled`` counts the GL programs the
+  panels' sessions compiled during the count.
+
+``--cases a,b`` runs only those cases and keeps the other entries of the results file.
 
 ``gui_ms_mean`` is the time in the frame's Python callbacks (panel updates + widgets); the rest
 of a frame is imgui's rendering of the window on llvmpipe and the buffer swap.  The window is
@@ -100,15 +106,25 @@ def main() -> None:
     p.add_argument("--scene", default="whitted")
     p.add_argument("--size", type=int, default=512)
     p.add_argument("--window", default="1600x860", help="WIDTHxHEIGHT of the UI window")
+    p.add_argument("--cases", default="", help="comma-separated cases to run (default: all); "
+                   "the results file keeps the others' entries")
     a = p.parse_args()
-    res = {"static_camera_raytrace_running":
-           measure(a.scene, a.size, a.window, True, "fps_static"),
-           "drag_with_raytrace_panel": measure(a.scene, a.size, a.window, True, "fps"),
-           "drag_gl_only": measure(a.scene, a.size, a.window, False, "fps"),
-           "raytrace_without_window": raytrace_without_window(a.scene, a.size),
-           "cpu_count": os.cpu_count(), "machine": platform.machine(),
-           "processor": platform.processor() or platform.uname().processor}
+    cases = {"static_camera_raytrace_running": lambda: measure(a.scene, a.size, a.window, True, "fps_static"),
+             "drag_with_raytrace_panel": lambda: measure(a.scene, a.size, a.window, True, "fps"),
+             "drag_gl_only": lambda: measure(a.scene, a.size, a.window, False, "fps"),
+             "material_drag": lambda: measure(a.scene, a.size, a.window, False, "fps_material_drag"),
+             "slider_drag": lambda: measure(a.scene, a.size, a.window, False, "fps_slider_drag"),
+             "raytrace_without_window": lambda: raytrace_without_window(a.scene, a.size)}
+    chosen = [c for c in a.cases.split(",") if c] or list(cases)
+    bad = [c for c in chosen if c not in cases]
+    if bad:
+        p.error(f"unknown cases {bad}; known: {', '.join(cases)}")
     out = ROOT / "bench" / "results" / "ui_fps.json"
+    res = json.loads(out.read_text()) if a.cases and out.exists() else {}
+    for c in chosen:
+        res[c] = cases[c]()
+    res.update({"cpu_count": os.cpu_count(), "machine": platform.machine(),
+                "processor": platform.processor() or platform.uname().processor})
     tmp = out.with_suffix(".json.tmp")
     tmp.write_text(json.dumps(res, indent=1))
     tmp.replace(out)

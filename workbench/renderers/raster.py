@@ -23,6 +23,14 @@ re-upload.  A UI that owns a window context calls ``gl.use_context(ui_ctx)`` bef
 the session; ``draw_to`` needs an FBO with a depth attachment.  ``session.release()`` frees
 the GL objects.
 
+Live edits: material and light constants are compiled into the programs as literals (llvmpipe
+reads a uniform per fragment).  A UI slider that edits them calls ``session.update(scene)``
+instead of building a new session: the edited materials' draws (every lit draw for a light)
+switch to *live* program variants that read those values from uniforms (``LIVE_MATERIAL``,
+``LIVE_LIGHTS`` in :func:`.raster_shaders.material_defines`), compiled once and then only fed
+new uniforms, on the same vertex buffers; ``session.settle()`` compiles the values back in
+once the edit rests.  Both variants give the same image within float32 rounding.
+
 Vertex work: every mode draws indexed, shared vertices; flat gives each triangle its own
 provoking vertex carrying the polygon's normal and centroid
 (:func:`~workbench.scene.tessellate_topology.provoking_layout`).  Objects whose parts are
@@ -41,7 +49,7 @@ from __future__ import annotations
 
 import time
 from collections import OrderedDict
-from dataclasses import dataclass
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
@@ -54,7 +62,8 @@ from ..scene.tessellate_topology import closed_outward, provoking_layout
 from . import gl
 from . import texturing as tx
 from .base import Knob, Option, RenderResult
-from .raster_shaders import ProgramCache, base_defines, material_defines
+from .raster_shaders import (LIVE_MATERIAL_FIELDS, ProgramCache, base_defines, light_kind,
+                             light_uniforms, material_defines, material_uniforms)
 
 #: The near plane is never closer than this fraction of the far plane when chosen
 #: automatically (keeps 24-bit depth resolution usable when the camera is inside the bounds).
@@ -124,6 +133,40 @@ class _Draw:
     #: index into RasterSession.cull_boxes when the part belongs to a closed, outward-wound
     #: opaque object (its back faces are culled while the camera is outside its box), else -1
     cull: int = -1
+    #: the scene material's name (None: an area light's polygon or the background)
+    name: str | None = None
+    has_uv: bool = False
+    #: (vertex buffer, format, attribute names, index buffer) of the part
+    buffers: tuple = ()
+    #: vertex array of each program variant the part was drawn with (by id of the program)
+    vaos: dict = field(default_factory=dict)
+    #: (live material, live lights) of ``prog``, its uniforms other than live values, and
+    #: whether it reads the lights from uniforms
+    variant: tuple | None = None
+    fixed: _Uniforms | None = None
+    light_uniforms: bool = False
+
+
+#: Material fields :meth:`RasterSession.update` takes without a new session.
+_VALUE_FIELDS = LIVE_MATERIAL_FIELDS + ("kt", "ior", "absorption")
+
+
+def _same(a, b) -> bool:
+    """Equal values (identity, ``==``, or field by field for dataclasses holding arrays)."""
+    if a is b:
+        return True
+    if type(a) is not type(b):
+        return False
+    if isinstance(a, np.ndarray):
+        return a.shape == b.shape and bool(np.array_equal(a, b))
+    if hasattr(a, "__dataclass_fields__"):
+        return all(_same(getattr(a, f.name), getattr(b, f.name)) for f in fields(a))
+    if isinstance(a, (tuple, list)):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
+    try:
+        return bool(a == b)
+    except (ValueError, TypeError):
+        return False
 
 
 def _area_light_parts(scene: Scene) -> list[tuple[Part, Material]]:
@@ -188,25 +231,31 @@ class RasterSession:
             raise WorkbenchError(f"unknown raster mode {mode!r}")
         if depth_bits not in DEPTH_CHOICES:
             raise WorkbenchError(f"depth_bits must be one of {DEPTH_CHOICES}, got {depth_bits}")
-        self.scene, self.mode, self.depth_bits = scene, mode, depth_bits
+        self.scene, self.mode, self.depth_bits, self.blinn = scene, mode, depth_bits, blinn
+        #: materials (names) and whether the lights are drawn by live programs
+        #: (:meth:`update`; :meth:`settle` compiles their values back in)
+        self.live_materials: set[str] = set()
+        self.live_lights = False
         self.ctx = ctx or gl.context()
         self.programs = ProgramCache(self.ctx)
         self.timings: dict[str, float] = {}
         t0 = time.perf_counter()
-        pairs = [(p, scene.materials[p.material]) for p in _parts(scene, tessellation)]
-        pairs += _area_light_parts(scene)
+        pairs = [(p, scene.materials[p.material], p.material) for p in _parts(scene, tessellation)]
+        pairs += [(p, m, None) for p, m in _area_light_parts(scene)]
         self.timings["tessellate"] = time.perf_counter() - t0
-        self.n_triangles = sum(p.n_triangles for p, _ in pairs)
-        pts = np.vstack([p.positions for p, _ in pairs])
+        self.n_triangles = sum(p.n_triangles for p, _, _ in pairs)
+        pts = np.vstack([p.positions for p, _, _ in pairs])
         self.bounds = (pts.min(0), pts.max(0))
         self.lights = scene.point_lights()
+        self._light_values = light_uniforms(self.lights)
+        self._needs = scene.needs()  # its texture entry does not change with update()
         self._gl_images: dict[tuple, object] = {}
         self._gl_objects: list = []  # vertex arrays and buffers, freed by release()
         self._fbos: OrderedDict = OrderedDict()
         self._uniforms_of: dict[int, _Draw] = {}  # program -> draw whose uniforms it holds
         self._camera_of: dict[int, bytes] = {}    # program -> clip matrix it holds
         t0 = time.perf_counter()
-        self.draws = [self._upload(p, m, blinn) for p, m in pairs]
+        self.draws = [self._upload(p, m, name) for p, m, name in pairs]
         self.cull_boxes = self._cull_groups() if backface_culling else np.zeros((0, 8, 3))
         self.background = None
         if scene.environment is not None:
@@ -217,7 +266,23 @@ class RasterSession:
         t0 = time.perf_counter()
         self.draw(scene.camera.with_resolution(1, 1))
         self.timings["compile"] = self.programs.compile_seconds + time.perf_counter() - t0
-        self.left_out, self.features_used = self._report()
+
+    @property
+    def left_out(self) -> list[str]:
+        """Features of the scene this session does not draw, and why."""
+        return self._reported()[0]
+
+    @property
+    def features_used(self) -> list[str]:
+        """Features of the scene this session draws."""
+        return self._reported()[1]
+
+    def _reported(self) -> tuple[list[str], list[str]]:
+        """:meth:`_report` of the current scene (computed once per scene)."""
+        held = getattr(self, "_report_of", None)
+        if held is None or held[0] is not self.scene:
+            held = self._report_of = (self.scene, self._report())
+        return held[1]
 
     # ------------------------------------------------------------------ building
     def _image_texture(self, path: str, repeat_v: bool = True, data: bool = False):
@@ -251,13 +316,9 @@ class RasterSession:
         self._gl_objects.append(vao)
         return _Draw(None, None, prog, vao, False, np.zeros(3), images, u)
 
-    def _upload(self, part: Part, mat: Material, blinn: bool) -> _Draw:
+    def _upload(self, part: Part, mat: Material, name: str | None) -> _Draw:
         ctx = self.ctx
         has_uv = part.uvs is not None
-        defines = material_defines(self.scene, mat, self.mode, n_lights=len(self.lights),
-                                   has_uv=has_uv, blinn=blinn, depth_bits=self.depth_bits,
-                                   allow_bump=self.mode == "phong")
-        prog = self.programs.get("raster", defines)
         F = part.faces
         if self.mode == "flat":
             # indexed, each triangle with its own provoking (last) vertex carrying the polygon's
@@ -275,8 +336,7 @@ class RasterSession:
         names = ["in_position", "in_normal", "in_obj_position"] + (["in_uv"] if has_uv else []) \
             + (["in_centroid"] if self.mode == "flat" else [])
         vbo = ctx.buffer(np.ascontiguousarray(data, dtype="f4").tobytes())
-        vao = ctx.vertex_array(prog, [(vbo, fmt, *names)], index, index_element_size=4, skip_errors=True)
-        self._gl_objects += [vao, vbo, index]
+        self._gl_objects += [vbo, index]
         images = {}
         if mat.texture is not None and mat.texture.kind == "image":
             images["u_tex_image"] = self._image_texture(mat.texture.path)
@@ -285,12 +345,49 @@ class RasterSession:
         if mat.opacity is not None and mat.opacity.kind == "image":
             images["u_op_image"] = self._image_texture(mat.opacity.path, data=True)
         env = self.scene.environment
-        if "ENV_MAP" in defines and env is not None and env.kind == "image":
+        # bound whenever a variant may read it (the literal one with kr > 0, the live one)
+        if mat.environment and env is not None and env.kind == "image":
             images["u_env_image"] = self._image_texture(env.path, repeat_v=False)
         op = mat.opacity
         blended = op is not None and (op.kind == "image" or (op.kind == "constant" and op.value < 1.0))
-        uniforms = self._static_uniforms(prog, part, mat)
-        return _Draw(part, mat, prog, vao, blended, part.positions.mean(0), images, uniforms)
+        d = _Draw(part, mat, None, None, blended, part.positions.mean(0), images, None,
+                  name=name, has_uv=has_uv, buffers=(vbo, fmt, names, index))
+        self._bind(d)
+        return d
+
+    def _bind(self, d: _Draw) -> None:
+        """Give draw ``d`` the program of its variant (literal, or live while its material or
+        the lights are being edited: :meth:`update`), a vertex array for it (one per variant,
+        on the same buffers) and its uniforms.  A live program does not depend on the values
+        it reads, so a draw whose variant is unchanged keeps its program and only gets the
+        new values."""
+        live_mat = d.name is not None and d.name in self.live_materials
+        if d.variant != (live_mat, self.live_lights):
+            defines = material_defines(self.scene, d.material, self.mode, n_lights=len(self.lights),
+                                       has_uv=d.has_uv, blinn=self.blinn, depth_bits=self.depth_bits,
+                                       allow_bump=self.mode == "phong", live_material=live_mat,
+                                       live_lights=self.live_lights, needs=self._needs)
+            prog = self.programs.get("raster", defines)
+            vao = d.vaos.get(id(prog))
+            if vao is None:
+                vbo, fmt, names, index = d.buffers
+                vao = d.vaos[id(prog)] = self.ctx.vertex_array(prog, [(vbo, fmt, *names)], index,
+                                                               index_element_size=4, skip_errors=True)
+            d.prog, d.vao, d.variant = prog, vao, (live_mat, self.live_lights)
+            d.fixed = self._static_uniforms(prog, d.part, d.material)
+            d.light_uniforms = "LIVE_LIGHTS" in defines
+        if not live_mat and not d.light_uniforms:
+            d.uniforms = d.fixed
+            return
+        u = _Uniforms(d.prog)
+        u.items = list(d.fixed.items)
+        if live_mat:
+            for k, v in material_uniforms(d.material).items():
+                u.set(k, v)
+        if d.light_uniforms:
+            for k, v in self._light_values.items():
+                u.set(k, v)
+        d.uniforms = u
 
     def _static_uniforms(self, prog, part: Part, mat: Material) -> _Uniforms:
         """Samplers, the bump gradient's transform, the sky colours and the depth levels of one
@@ -352,9 +449,87 @@ class RasterSession:
         used = sorted(f for f in needs if f not in NOT_RASTER and not (f == ft.BUMP and self.mode != "phong"))
         return left, used
 
+    # ------------------------------------------------------------------ live edits
+    @property
+    def live(self) -> bool:
+        """Some draws use live programs (values in uniforms): :meth:`settle` compiles them in."""
+        return any(d.variant != (False, False) for d in self.draws)
+
+    def update(self, scene: Scene) -> bool:
+        """Take ``scene`` if it differs from the session's only in values that live programs
+        read from uniforms: materials' colour, emission, ka, kd, ks, kr, shininess (and kt,
+        ior, absorption, which no raster method uses), point and directional lights' position
+        or direction, colour and intensity.  The edited materials' draws (all lit draws for a
+        light edit) switch to live programs (compiled once per variant, then only uniforms
+        change: no recompile, no upload); :meth:`settle` compiles the values back in.
+        Returns False, changing nothing, for any other difference (new objects, environment,
+        ambient, area lights, light kinds...): the caller builds a new session."""
+        old = self.scene
+        if scene is old:
+            return True
+        for f in fields(scene):
+            if f.name not in ("materials", "lights", "camera", "name", "description", "source") \
+                    and not _same(getattr(scene, f.name), getattr(old, f.name)):
+                return False
+        if scene.materials.keys() != old.materials.keys() or len(scene.lights) != len(old.lights):
+            return False
+        edited = set()
+        for name, m in scene.materials.items():
+            o = old.materials[name]
+            if m is o or m == o:
+                continue
+            if replace(o, **{k: getattr(m, k) for k in _VALUE_FIELDS}) != m:
+                return False
+            edited.add(name)
+        for a, b in zip(scene.lights, old.lights):
+            if isinstance(a, AreaLight) or isinstance(b, AreaLight):
+                if not _same(a, b):  # its polygon is geometry: a new session
+                    return False
+        lights = scene.point_lights()
+        if [light_kind(x) for x in lights] != [light_kind(x) for x in self.lights]:
+            return False
+        lights_edited = any(not _same(a, b) for a, b in zip(lights, self.lights))
+        self.scene, self.lights = scene, lights
+        if lights_edited:
+            self._light_values = light_uniforms(lights)
+        self.live_materials |= edited
+        self.live_lights = self.live_lights or lights_edited
+        for d in self.draws:
+            if d.name is not None:
+                d.material = scene.materials[d.name]
+            if d.name in edited or lights_edited:
+                self._bind(d)  # a live program (cached after its first use), new uniforms
+        self._uniforms_of.clear()
+        return True
+
+    def settle(self, budget: int | None = None) -> bool:
+        """Compile the current values back into literal programs (the fast static variant),
+        at most ``budget`` programs per call (None: all; llvmpipe compiles a program's machine
+        code at its first draw, so a caller that draws after each call spreads the work over
+        frames); once no draw is live, release the literal programs no draw uses any more
+        (live ones are kept for the next edit).  Returns True when no draw is live."""
+        self.live_materials, self.live_lights = set(), False
+        start = self.programs.compiles
+        for d in self.draws:
+            if d.variant != (False, False):
+                if budget is not None and self.programs.compiles - start >= budget:
+                    break
+                self._bind(d)
+        self._uniforms_of.clear()
+        if self.live:
+            return False
+        used = [d.prog for d in self.draws] + ([self.background.prog] if self.background else [])
+        gone = {id(p) for p in self.programs.release_unused(used)}
+        for d in self.draws:
+            for k in [k for k in d.vaos if k in gone]:
+                d.vaos.pop(k).release()
+        self._camera_of.clear()
+        return True
+
     def release(self) -> None:
         """Free the session's GL objects (buffers, vertex arrays, programs, textures, FBOs)."""
-        for obj in self._gl_objects + list(self._gl_images.values()) + list(self.programs.programs.values()):
+        vaos = [v for d in self.draws for v in d.vaos.values()]
+        for obj in vaos + self._gl_objects + list(self._gl_images.values()) + list(self.programs.programs.values()):
             obj.release()
         for _, free in self._fbos.values():
             free()

@@ -10,7 +10,8 @@ only text processing is:
   ``#line 2 0``.
 
 :func:`material_defines` is the one function that decides, from the scene's needs and the
-material, which code is compiled; :class:`ProgramCache` keys programs by (shader name,
+material, which code is compiled (values as literals, or as uniforms in the live variants
+drawn while a slider edits them: :func:`material_uniforms`, :func:`light_uniforms`); :class:`ProgramCache` keys programs by (shader name,
 defines).
 """
 from __future__ import annotations
@@ -116,29 +117,71 @@ def base_defines() -> dict[str, object]:
             "TOL_BUMP_STEP": f"{tol.bump_step:.6e}"}
 
 
-def light_list(lights) -> str:
+def light_values(light) -> tuple[np.ndarray, np.ndarray]:
+    """(pos, color) of one point or directional light as the shaders use them: the position,
+    or the direction towards a directional light; ``color * intensity``."""
+    color = np.asarray(light.color, dtype=np.float64) * light.intensity
+    if isinstance(light, DirectionalLight):
+        return -np.asarray(light.direction, dtype=np.float64), color
+    return np.asarray(light.position, dtype=np.float64), color
+
+
+def light_kind(light) -> tuple:
+    """What a light compiles to besides its values (:func:`light_values`): the flags POINT,
+    INV_SQ, LOBE and the lobe normal.  Lights of equal kinds share a live program."""
+    if isinstance(light, DirectionalLight):
+        return (False, False, None)
+    lobe = light.cosine_normal
+    return (True, light.falloff == "inverse_square", None if lobe is None else tuple(float(x) for x in lobe))
+
+
+def light_list(lights, live: bool = False) -> str:
     """Body of the ``FOR_EACH_LIGHT(X)`` macro: ``X(POINT, INV_SQ, LOBE, pos, color,
     lobe_normal)`` per light, as GLSL literals (``lighting.glsl`` folds them: each light
     compiles to its own arithmetic, with no uniform read).  ``pos`` is the position, or the
-    direction towards a directional light; ``color`` is ``color * intensity``."""
+    direction towards a directional light; ``color`` is ``color * intensity``
+    (:func:`light_values`).  ``live``: ``pos`` and ``color`` of light ``i`` are the uniforms
+    ``u_light_pos[i]`` and ``u_light_color[i]`` instead (:func:`light_uniforms`; the flags and
+    the lobe normal stay literals)."""
     def flag(b: bool) -> str:
         return "true" if b else "false"
     items = []
-    for light in lights:
-        color = np.asarray(light.color, dtype=np.float64) * light.intensity
-        if isinstance(light, DirectionalLight):
-            point, inv_sq, lobe = False, False, None
-            pos = -np.asarray(light.direction, dtype=np.float64)
-        else:
-            point, inv_sq, lobe = True, light.falloff == "inverse_square", light.cosine_normal
-            pos = np.asarray(light.position, dtype=np.float64)
-        items.append(f"X({flag(point)}, {flag(inv_sq)}, {flag(lobe is not None)}, {_vec3(pos)}, "
-                     f"{_vec3(color)}, {_vec3(np.zeros(3) if lobe is None else lobe)})")
+    for i, light in enumerate(lights):
+        point, inv_sq, lobe = light_kind(light)
+        pos, color = light_values(light)
+        where, what = ((f"u_light_pos[{i}]", f"u_light_color[{i}]") if live
+                       else (_vec3(pos), _vec3(color)))
+        items.append(f"X({flag(point)}, {flag(inv_sq)}, {flag(lobe is not None)}, {where}, "
+                     f"{what}, {_vec3(np.zeros(3) if lobe is None else lobe)})")
     return " ".join(items)
 
 
+#: Material fields a live program reads from uniforms (``u_mat_<field>``).
+LIVE_MATERIAL_FIELDS = ("color", "emission", "ka", "kd", "ks", "kr", "shininess")
+
+
+def material_uniforms(material: Material) -> dict[str, object]:
+    """Uniform values of a live-material program (``LIVE_MATERIAL``, :func:`material_defines`)."""
+    out: dict[str, object] = {}
+    for k in LIVE_MATERIAL_FIELDS:
+        v = getattr(material, k)
+        out[f"u_mat_{k}"] = tuple(float(x) for x in v) if k in ("color", "emission") else float(v)
+    return out
+
+
+def light_uniforms(lights) -> dict[str, np.ndarray]:
+    """Uniform values of a live-lights program (``LIVE_LIGHTS``): (N, 3) float32 arrays."""
+    pos = np.zeros((len(lights), 3), np.float32)
+    color = np.zeros((len(lights), 3), np.float32)
+    for i, light in enumerate(lights):
+        pos[i], color[i] = light_values(light)
+    return {"u_light_pos": pos, "u_light_color": color}
+
+
 def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: int,
-                     has_uv: bool, blinn: bool, depth_bits: int, allow_bump: bool) -> dict[str, object]:
+                     has_uv: bool, blinn: bool, depth_bits: int, allow_bump: bool,
+                     live_material: bool = False, live_lights: bool = False,
+                     needs: frozenset[str] | None = None) -> dict[str, object]:
     """The ``#define``s of one draw: what the scene needs and this material uses, nothing else.
 
     ``MODE_*`` (flat, gouraud, phong); the scene's ambient and the material's constants as
@@ -152,18 +195,35 @@ def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: i
     (only when ``allow_bump``: per-fragment normals), ``OPACITY_KIND/OPACITY_PROJ``,
     ``ENV_MAP`` + ``ENV_KIND`` for environment-mapped materials, ``DEPTH_LEVELS`` for an
     emulated 16-bit depth buffer.
+
+    Live variants, drawn while a slider edits values (the program then serves every value, so
+    an edit sets uniforms instead of compiling): ``live_material`` makes the ``MAT_*``
+    constants the uniforms ``u_mat_*`` (``LIVE_MATERIAL``, :func:`material_uniforms`) and
+    compiles what any value of them needs (the lights, ``SPECULAR``, ``ENV_MAP`` for an
+    environment-mapped material, whatever kd, ks and kr are); ``live_lights`` reads the lights'
+    positions and colours from uniform arrays (``LIVE_LIGHTS``, :func:`light_uniforms`).
+    ``needs``: ``scene.needs()`` when the caller has it.
     """
-    needs = scene.needs()
+    needs = scene.needs() if needs is None else needs
     d = base_defines()
     d[MODES[mode]] = ""
     d["SCENE_AMBIENT"] = _vec3(scene.ambient)
-    d["MAT_COLOR"], d["MAT_EMISSION"] = _vec3(material.color), _vec3(material.emission)
-    for k in ("ka", "kd", "ks", "kr", "shininess"):
-        d[f"MAT_{k.upper()}"] = _float(getattr(material, k))
+    if live_material:
+        d["LIVE_MATERIAL"] = ""
+        for k in LIVE_MATERIAL_FIELDS:
+            d[f"MAT_{k.upper()}"] = f"u_mat_{k}"
+    else:
+        d["MAT_COLOR"], d["MAT_EMISSION"] = _vec3(material.color), _vec3(material.emission)
+        for k in ("ka", "kd", "ks", "kr", "shininess"):
+            d[f"MAT_{k.upper()}"] = _float(getattr(material, k))
     d["N_LIGHTS"] = n_lights
-    if material.kd > 0 or material.ks > 0:
-        d["FOR_EACH_LIGHT(X)"] = light_list(scene.point_lights()[:n_lights])
-    if material.ks > 0:
+    if (live_material or material.kd > 0 or material.ks > 0) and n_lights > 0:
+        d["FOR_EACH_LIGHT(X)"] = light_list(scene.point_lights()[:n_lights], live=live_lights)
+        if live_lights:
+            d["LIVE_LIGHTS"] = ""
+    elif material.kd > 0 or material.ks > 0:
+        d["FOR_EACH_LIGHT(X)"] = ""
+    if live_material or material.ks > 0:
         d["SPECULAR"] = ""
         if blinn:
             d["BLINN"] = ""
@@ -175,7 +235,7 @@ def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: i
         d.update(_mapping_defines("BUMP", material.bump))
     if material.opacity is not None:
         d.update(_mapping_defines("OPACITY", material.opacity))
-    if material.environment and material.kr > 0:
+    if material.environment and (material.kr > 0 or live_material):
         d["ENV_MAP"] = ""
         d["ENV_KIND"] = ENV_KIND[scene.environment.kind if scene.environment else "sky"]
     if depth_bits == 16:
@@ -191,6 +251,7 @@ class ProgramCache:
         self.ctx = ctx
         self.programs: dict[tuple, object] = {}
         self.compile_seconds = 0.0
+        self.compiles = 0  # programs compiled so far (tests: no compile per slider frame)
 
     def get(self, name: str, defines: dict[str, object]):
         import time
@@ -205,5 +266,20 @@ class ProgramCache:
                 raise WorkbenchError(f"shader {name} failed to compile with {dict(key[1])}: {e}\n"
                                      f"(source strings: {source_names(name + '.frag')})") from None
             self.programs[key] = prog
+            self.compiles += 1
             self.compile_seconds += time.perf_counter() - t0
         return prog
+
+    def release_unused(self, used) -> list:
+        """Release the programs that are not in ``used`` (programs, by identity) and are not
+        live variants (those serve every value: kept for the next edit); returns the released
+        programs."""
+        keep = {id(p) for p in used}
+        gone = []
+        for key, prog in list(self.programs.items()):
+            live = any(k in ("LIVE_MATERIAL", "LIVE_LIGHTS") for k, _ in key[1])
+            if id(prog) not in keep and not live:
+                gone.append(self.programs.pop(key))
+        for prog in gone:
+            prog.release()
+        return gone

@@ -1,11 +1,15 @@
 """Each panel's picture, kept on the GPU and redrawn only when what it shows changes.
 
 * Raster methods (flat, Gouraud, Phong) draw through a cached
-  :class:`~workbench.renderers.raster.RasterSession` (one per scene version, method and
+  :class:`~workbench.renderers.raster.RasterSession` (one per scene, method and
   tessellation; replaced sessions are released) into the session's float framebuffer, in the
   window's own moderngl context, and only when the panel's inputs change: the scene version
   (materials, lights), the tessellation knob and the shared camera (which carries the panel
-  size).  A frame in which nothing changed draws nothing.
+  size).  A frame in which nothing changed draws nothing.  A material or light slider keeps
+  the session (``RasterSession.update``): the edited values are drawn by live programs that
+  read them from uniforms (compiled once, no geometry upload), and once the values have
+  rested for :data:`LIVE_REST_SECONDS` they are compiled back in (``settle``: the literal
+  programs, the fast static variant), one program per frame.
 * Every panel's linear image has a GPU copy (:func:`linear_source`: a raster panel's
   framebuffer, else a float texture uploaded once per change of the image) and reaches the
   screen through GPU passes (:class:`DisplayPasses`, ``shaders/display*``): sRGB encoding
@@ -28,6 +32,9 @@ import numpy as np
 
 from .state import CHILD, RASTER, AppState, shown_image
 
+LIVE_REST_SECONDS = 0.5
+"""How long edited material or light values must stay unchanged before a GL panel compiles
+them back into its programs (until then it draws them from uniforms)."""
 TILED = ("raycast", "raytrace")
 """CPU methods that accept ``on_tile`` (partial images)."""
 
@@ -215,12 +222,14 @@ class RasterPanel:
     """A raster panel's session and what it last drew.
 
     ``session_key`` is (scene version, tessellation); ``drawn`` the camera of the last draw
-    (None: never drawn); ``draws`` counts draws (tests and the benchmark read it)."""
+    (None: never drawn or values changed); ``draws`` counts draws (tests and the benchmark
+    read it); ``edited`` when values last changed in place (:data:`LIVE_REST_SECONDS`)."""
 
     session: object
     session_key: tuple
     drawn: object = None
     draws: int = 0
+    edited: float = 0.0
 
 
 @dataclass
@@ -240,6 +249,10 @@ class PanelGPU:
     """texture name -> key of the image it was last made from."""
     stats: dict[str, tuple] = field(default_factory=dict)
     """image name -> (version, maximum, mean) (:func:`image_stats`)."""
+    compiled: int = 0
+    """GL programs compiled by raster sessions since released (tests count compiles)."""
+    settle_frame: int = -1
+    """The frame of the last ``RasterSession.settle`` step (one per frame)."""
 
 
 def gpu(state: AppState) -> PanelGPU:
@@ -309,12 +322,24 @@ def refresh_raster(state: AppState, method: str) -> bool:
     tess = int(state.options[method]["tessellation"])
     key = (state.scene_version, tess)
     panel = g.raster.get(method)
-    if panel is None or panel.session_key != key:
+    if (panel is not None and panel.session_key != key and panel.session_key[1] == tess
+            and panel.session.update(state.scene)):
+        # only material or light values changed: same session, live programs
+        panel.session_key, panel.drawn, panel.edited = key, None, time.perf_counter()
+    elif panel is None or panel.session_key != key:
         if panel is not None:
+            g.compiled += panel.session.programs.compiles
             panel.session.release()
         panel = g.raster[method] = RasterPanel(
             RasterSession(state.scene, method, tessellation=tess, ctx=state.ctx), key)
         state.status[method] = f"{panel.session.n_triangles} triangles"
+    if (panel.session.live and time.perf_counter() - panel.edited > LIVE_REST_SECONDS
+            and g.settle_frame != state.frame):
+        # the values rested: compiled back in (the static variant), one program per frame
+        # over all panels (each costs llvmpipe ~0.1 s, most of it at its first draw)
+        g.settle_frame = state.frame
+        panel.session.settle(budget=1)
+        panel.drawn = None
     cam = state.camera
     if panel.drawn == cam and method in state.images:
         return False

@@ -243,17 +243,20 @@ class Fps:
         if self.step:
             state.camera = cam.orbit(state.camera, self.step, 0.0)
         if state.frame == self.warmup:
-            self.t0, self.busy_frames, self.gui = time.perf_counter(), 0, 0.0
+            self.t0, self.busy_frames, self.gui, self.frame_ms = time.perf_counter(), 0, 0.0, []
             self.counts, self.starts = _gpu_counts(state), len(state.jobs.started)
         elif self.t0 is not None and "fps" not in self.log:
             busy = state.jobs.busy()
             self.busy_frames += busy
             self.gui += state.gui_seconds
+            self.frame_ms.append(state.frame_seconds * 1e3)
             dt = time.perf_counter() - self.t0
             if dt >= self.seconds or (self.wait_cpu and not busy):
                 n = state.frame - self.warmup
                 (d0, r0), (d1, r1) = self.counts, _gpu_counts(state)
+                q = np.percentile(self.frame_ms, [10, 50, 90, 99]).round(1).tolist()
                 self.log.update(frames=n, seconds=dt, fps=n / dt, gui_ms_mean=self.gui / n * 1e3,
+                                frame_ms_p10_50_90_99=q,
                                 frames_with_cpu_job_running=self.busy_frames,
                                 gl_panel_draws=d1 - d0, read_backs=r1 - r0,
                                 cpu_jobs_started=len(state.jobs.started) - self.starts,
@@ -268,6 +271,86 @@ class Fps:
             self.log.update(raytrace_seconds=None if job is None else job.seconds,
                             raytrace_options=state.options["raytrace"])
             state.quit = True
+
+
+def _compiles(state: AppState) -> int:
+    """GL programs compiled so far by the GL panels' sessions, released ones included."""
+    if state.gpu is None:
+        return 0
+    return getattr(state.gpu, "compiled", 0) + sum(getattr(p.session.programs, "compiles", 0)
+                                                   for p in state.gpu.raster.values())
+
+
+def slider_step(state: AppState, k: int, edit: str) -> None:
+    """One frame of a slider drag (what ``panels.parameters`` and ``lights.light_controls``
+    call while a slider moves): ``edit`` "material" sets the chosen material's ``kd``, and
+    "material+light" also moves light 0 (its position, direction or centre), to values that
+    change with the frame number ``k``."""
+    from .state import light_fields, light_value, set_light_value
+    phase = (k % 40) / 40.0
+    tri = 2.0 * min(phase, 1.0 - phase)  # 0 -> 1 -> 0 every 40 frames
+    set_material_value(state, state.material, "kd", 0.2 + 0.7 * tri)
+    if edit == "material+light" and state.base_scene.lights:
+        light = state.base_scene.lights[0]
+        where = light_fields(light)[0]
+        p = np.asarray(light_value(light, where), float)
+        offset = np.array([1.0, 0.5, 0.0]) * (tri - 0.5) * (0.2 if where == "direction" else 2.0)
+        set_light_value(state, 0, where, tuple(p + offset))
+
+
+class SliderFps(Fps):
+    """:class:`Fps` without camera motion while a material slider (``edit`` "material") or a
+    material and a light slider (``edit`` "material+light") move every frame
+    (:func:`slider_step`); also logs the GL programs compiled during the count."""
+
+    def __init__(self, out: Path, edit: str = "material+light", seconds: float = 10.0):
+        super().__init__(out, seconds=seconds, step=0.0)
+        self.edit = edit
+
+    def __call__(self, state: AppState) -> None:
+        if "fps" not in self.log:
+            slider_step(state, state.frame, self.edit)
+        if state.frame == self.warmup:
+            self.compiles0 = _compiles(state)
+        super().__call__(state)
+        if "fps" in self.log and "programs_compiled" not in self.log:
+            self.log.update(edit=self.edit, programs_compiled=_compiles(state) - self.compiles0)
+
+
+class SliderFrames:
+    """GL panels during a slider drag: frame 2 records each panel's image, frames 3 to 8 each
+    change the chosen material's ``kd`` and light 0's position (:func:`slider_step`, edit k =
+    the frame number) and the next frame records the images drawn with them (``edit{k}_M.npy``)
+    with the programs compiled and the draws so far; then the values rest until the panels
+    have compiled them back in (``frames.LIVE_REST_SECONDS``), the images are recorded again
+    (``settled_M.npy``) and the script quits."""
+
+    def __init__(self, out: Path):
+        self.out, self.log, self.t_rest = out, {"frames": []}, None
+
+    def _note(self, state: AppState, name: str) -> None:
+        _record(state, self.out, name)
+        self.log["frames"].append({"name": name, "frame": state.frame, "compiles": _compiles(state),
+                                   "draws": {m: p.draws for m, p in state.gpu.raster.items()},
+                                   "live": {m: p.session.live for m, p in state.gpu.raster.items()}})
+
+    def __call__(self, state: AppState) -> None:
+        f = state.frame
+        if f == 2:
+            self._note(state, "start")
+        if 4 <= f <= 9:
+            self._note(state, f"edit{f - 1}")
+        if 3 <= f <= 8:
+            slider_step(state, f, "material+light")
+        elif f == 9:
+            self.t_rest = time.perf_counter()
+        elif f > 9:
+            self.log.setdefault("rest_frame_ms", []).append(round(state.frame_seconds * 1e3, 1))
+            if (not any(p.session.live for p in state.gpu.raster.values())
+                    or time.perf_counter() - self.t_rest > 30.0):
+                self._note(state, "settled")  # drawn in this frame's update
+                self.log["rest_seconds"] = time.perf_counter() - self.t_rest
+                state.quit = True
 
 
 class GpuPanels:
@@ -310,4 +393,6 @@ class GpuPanels:
 SCRIPTS = {"check": Check, "features": Features, "radiosity": Radiosity, "pyrender": Pyrender,
            "fps": Fps,
            "fps_static": lambda out: Fps(out, step=0.0, raytrace_spp=16, wait_cpu=True),
-           "gpu_panels": GpuPanels}
+           "gpu_panels": GpuPanels, "slider_frames": SliderFrames,
+           "fps_material_drag": lambda out: SliderFps(out, "material"),
+           "fps_slider_drag": lambda out: SliderFps(out, "material+light")}
