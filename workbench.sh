@@ -39,7 +39,7 @@ if [ "$what" = test ]; then
 fi
 
 echo "== main job: quick error-vs-time study and side-by-side comparison of every method on the default scene (whitted)"
-echo "   (the first run also compiles the ray tracer's numba kernels, about 40 s; later runs load them from .numba_cache)"
+echo "   (the first run also compiles the ray tracer's numba kernels, about 40-70 s; later runs load them from .numba_cache)"
 .venv/bin/workbench study whitted --quick --out out/report
 .venv/bin/workbench compare whitted --out out/report
 echo "== report: $PWD/out/report/report.html"

@@ -8,17 +8,19 @@
 
 Rays per second, counted the same way for both: every ray each program actually traced, by
 kind.  POV-Ray: its "Rays" (eye + reflected + refracted) plus its "Shadow Ray Tests", over its
-"Trace Time" (which excludes its start-up and parsing; best of 5 runs) and over the
-CPU-seconds it reports for the trace (a fairer measure on a shared, loaded machine).  Ours:
-primary + shadow feelers + reflected + refracted rays over our trace phase
-(``timings["trace"]``: camera rays, tracing, shading; and its CPU seconds
-``timings["trace_cpu"]``; warm JIT cache, best of 5: the second thread of this shared
-machine comes and goes, so that 2-thread trace times of the same render vary by up to 50 %).
+"Trace Time" (which excludes its start-up and parsing) and over the CPU-seconds it reports
+for the trace (a fairer measure on a shared, loaded machine).  Ours: primary + shadow feelers
++ reflected + refracted rays over our trace phase (``timings["trace"]``: camera rays, tracing,
+shading; and its CPU seconds ``timings["trace_cpu"]``; warm JIT cache).  Each is the best of 7
+runs, POV-Ray's and ours alternating (:func:`alternate`): the second thread of this shared
+machine comes and goes, and its speed drifts over minutes, so that 2-thread trace times of
+the same render vary by up to 50 % between runs taken minutes apart.
 The two programs do not trace the same number of rays for the same picture (which shadow tests each skips and how each applies the
 bail-out differ in detail: POV-Ray reports about 18 % more rays on the Whitted scene), so the JSON also gives the ratio
 of the trace times for the same image (``trace_time_ratio``), which does not depend on how
 rays are counted.  Whole commands: POV-Ray's process wall time against ``workbench render
-...`` as a process (Python start-up, imports, scene loading, warm numba cache, PNG writing).
+...`` as a process (Python start-up, imports, scene loading, warm numba cache, PNG writing),
+best of the same 7 alternating runs each.
 Our commands run with Python's bytecode cache on, as for a user (``PYTHONDONTWRITEBYTECODE``
 is removed from their environment).  Cold compile: the same render in a fresh process with an
 empty numba cache directory (it
@@ -48,11 +50,6 @@ THRESHOLD = 1.0 / 255.0
 PY = sys.executable
 
 
-def povray(pov: Path, out: Path, repeats: int = 5) -> dict:
-    """POV-Ray's statistics, best trace time of ``repeats`` runs (as for ours)."""
-    return min((_povray_once(pov, out) for _ in range(repeats)), key=lambda d: d["trace_s"])
-
-
 def _povray_once(pov: Path, out: Path) -> dict:
     """Run POV-Ray once; parse its statistics."""
     cmd = ["povray", f"+W{W}", f"+H{H}", "-A", "+MV3.7", "Work_Threads=2", "-D", f"+O{out}", f"+I{pov}"]
@@ -76,25 +73,35 @@ def _povray_once(pov: Path, out: Path) -> dict:
                 mrays_per_cpu_s=(rays + shadow) / max(cpu, 1e-9) / 1e6)
 
 
-def ours_in_process(scene_name: str, repeats: int = 5) -> dict:
+def alternate(pov_file: Path, scene_name: str, tmp: Path, warm_cache: str | None = None,
+              repeats: int = 7) -> tuple[dict, dict, dict | None]:
+    """POV-Ray and ours run alternately ``repeats`` times each: a POV-Ray command, our render
+    in this process (warm JIT cache) and, with ``warm_cache``, our whole command.  The shared
+    machine's speed drifts over minutes (other guests on the host): alternating exposes both
+    programs to the same drift.  Returns POV-Ray's statistics of its best trace (its ``wall_s``
+    the best whole command), ours of our best trace, and our best whole command (or None)."""
     import numba
 
     import workbench
     numba.set_num_threads(2)
     scene = workbench.load_scene(scene_name)
     workbench.render(scene, "raytrace", width=32, height=24)  # JIT (or cache load)
-    best = None
-    for _ in range(repeats):
-        r = workbench.render(scene, "raytrace", width=W, height=H, threshold=THRESHOLD, max_depth=5)
-        if best is None or r.timings["trace"] < best.timings["trace"]:
-            best = r
+    povs, ours, cmds = [], [], []
+    for i in range(repeats):
+        povs.append(_povray_once(pov_file, tmp / f"{scene_name}_pov.png"))
+        ours.append(workbench.render(scene, "raytrace", width=W, height=H, threshold=THRESHOLD, max_depth=5))
+        if warm_cache is not None:
+            cmds.append(ours_command(scene_name, warm_cache, tmp / f"{scene_name}_{i}.png"))
+    pov = dict(min(povs, key=lambda d: d["trace_s"]), wall_s=min(d["wall_s"] for d in povs))
+    best = min(ours, key=lambda r: r.timings["trace"])
     st = best.stats
-    return dict(trace_s=best.timings["trace"], trace_cpu_s=best.timings["trace_cpu"], total_s=best.timings["total"],
+    mine = dict(trace_s=best.timings["trace"], trace_cpu_s=best.timings["trace_cpu"], total_s=best.timings["total"],
                 bvh_build_s=best.timings.get("bvh_build", 0.0), total_rays=st["total_rays"],
                 primary=st["primary_rays"], shadow_rays=st["shadow_rays"],
                 reflected=st["reflected_rays"], refracted=st["refracted_rays"],
                 mrays_per_s=st["total_rays"] / best.timings["trace"] / 1e6,
                 mrays_per_cpu_s=st["total_rays"] / best.timings["trace_cpu"] / 1e6)
+    return pov, mine, (min(cmds, key=lambda d: d["wall_s"]) if cmds else None)
 
 
 def ours_command(scene: str, cache_dir: str, out: Path) -> dict:
@@ -173,13 +180,10 @@ def main() -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         # --- Whitted
-        pov = povray(ROOT / "bench" / "whitted.pov", tmp / "pov.png")
         cold = ours_command("whitted", str(tmp / "cold_cache"), tmp / "cold.png")
         warm_cache = str(ROOT / ".numba_cache")
         ours_command("whitted", warm_cache, tmp / "w0.png")  # make sure the cache is warm
-        warm = min((ours_command("whitted", warm_cache, tmp / f"w{i}.png") for i in range(1, 3)),
-                   key=lambda d: d["wall_s"])
-        inproc = ours_in_process("whitted")
+        pov, inproc, warm = alternate(ROOT / "bench" / "whitted.pov", "whitted", tmp, warm_cache)
         res["whitted"] = dict(
             povray=pov, ours_trace=inproc, ours_command_warm=warm, ours_command_cold=cold,
             numba_cold_compile_s=cold["compile_s"],
@@ -192,8 +196,7 @@ def main() -> dict:
         # --- mesh
         mesh_pov = tmp / "mesh_blob.pov"
         export_mesh_pov(mesh_pov)
-        povm = povray(mesh_pov, tmp / "povm.png")
-        oursm = ours_in_process("mesh")
+        povm, oursm, _ = alternate(mesh_pov, "mesh", tmp)
         warm_m = ours_command("mesh", warm_cache, tmp / "m.png")
         res["mesh"] = dict(
             triangles=81920, povray=povm, ours_trace=oursm, ours_command_warm=warm_m,
