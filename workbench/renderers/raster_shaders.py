@@ -107,7 +107,7 @@ def _mapping_defines(prefix: str, m) -> dict[str, object]:
         d["BUMP_STRENGTH"] = _float(m.strength)
     else:
         d["OPACITY_VALUE"] = _float(m.value)
-        d["OPACITY_HAS_ALPHA"] = _float(m.kind == "image" and tx.image(m.path, data=True)[..., 3].min() < 1.0)
+        d["OPACITY_HAS_ALPHA"] = _float(m.kind == "image" and tx.has_alpha(m.path))
     return d
 
 

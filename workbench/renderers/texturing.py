@@ -226,6 +226,13 @@ def image(path: str, data: bool = False) -> np.ndarray:
     return img
 
 
+@lru_cache(maxsize=16)
+def has_alpha(path: str) -> bool:
+    """Whether an opacity image's alpha channel is used (some pixel below 1), else its
+    luminance is."""
+    return bool(image(path, data=True)[..., 3].min() < 1.0)
+
+
 def sample_image(img: np.ndarray, uv: np.ndarray, wrap_v: bool = True) -> np.ndarray:
     """Bilinear lookup (GL_LINEAR, texel centres, repeat in u; repeat or clamp in v) of an
     (H, W, C) image, ``v = 0`` at the bottom row.  Returns (N, C)."""
@@ -351,7 +358,7 @@ def alpha(material: Material, P_obj: np.ndarray, N_obj: np.ndarray,
     if op.kind == "image":
         img = image(op.path, data=True)
         rgba = sample_image(img, project(op, P, uv) * op.scale)
-        if img[..., 3].min() < 1.0:
+        if has_alpha(op.path):
             return rgba[:, 3]
         return rgba[:, :3] @ np.array([0.2126, 0.7152, 0.0722])
     s = pattern_coords(op, P, uv)

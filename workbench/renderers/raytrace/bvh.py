@@ -65,6 +65,7 @@ def _build(tri_v):
     bin_cnt = np.zeros(N_BINS, dtype=np.int64)
     right_area = np.empty(N_BINS)
     right_cnt = np.empty(N_BINS, dtype=np.int64)
+    acc = np.empty(6)  # running box of the sweeps
     while sp > 0:
         sp -= 1
         s, e, parent, is_right, depth = stack[sp, 0], stack[sp, 1], stack[sp, 2], stack[sp, 3], stack[sp, 4]
@@ -106,9 +107,8 @@ def _build(tri_v):
                 for a in range(3):
                     bin_box[b, a] = min(bin_box[b, a], tb[i, a])
                     bin_box[b, 3 + a] = max(bin_box[b, 3 + a], tb[i, 3 + a])
-            acc = np.full(6, np.inf)
             for a in range(3):
-                acc[3 + a] = -np.inf
+                acc[a], acc[3 + a] = np.inf, -np.inf
             cnt = 0
             for b in range(N_BINS - 1, 0, -1):
                 for a in range(3):
@@ -229,10 +229,11 @@ def _collapse(box, meta):
 
 
 @nb.njit(cache=True)
-def _pack_leaves(tri_v, leaf):
-    """Each leaf's triangles by groups of four, coordinates side by side: ``(G, 9, 4)``; a
-    group of fewer than four repeats its last triangle (the same hit, never a new one).
-    Returns the groups, each group's first triangle ``(G,)`` and each leaf's
+def _pack_leaves(tri_v, order, leaf):
+    """Each leaf's triangles (``tri_v[order[first:first + count]]``) by groups of four,
+    coordinates side by side: ``(G, 9, 4)``; a group of fewer than four repeats its last
+    triangle (the same hit, never a new one).  Returns the groups, each group's first triangle
+    (BVH order) ``(G,)`` and each leaf's
     ``(first group, group count)`` ``(L, 2)``."""
     L = leaf.shape[0]
     ng = 0
@@ -248,7 +249,7 @@ def _pack_leaves(tri_v, leaf):
         for s in range(s0, s0 + cnt, 4):
             c = min(4, s0 + cnt - s)
             for j in range(4):
-                i = s + min(j, c - 1)
+                i = order[s + min(j, c - 1)]
                 for a in range(9):
                     tv4[g, a, j] = tri_v[i, a]
             first[g] = s
@@ -284,7 +285,7 @@ def build_bvh4(tri_v: np.ndarray) -> tuple[np.ndarray, Bvh4]:
     node, child, leaf = _collapse(box, meta)
     bounds = box[0].copy()
     del box, meta
-    tv4, first, groups = _pack_leaves(np.ascontiguousarray(tri_v[order]), leaf)
+    tv4, first, groups = _pack_leaves(tri_v, order, leaf)
     return order, Bvh4(node, child, groups, first, tv4, bounds)
 
 

@@ -381,10 +381,7 @@ class _Tracer:
         for _ in range(SHADOW_CROSSINGS):
             if not len(todo):
                 break
-            s = _alloc(len(todo))
-            k.trace_batch(self.geo, fo[todo], fd[todo], tmin[todo], tmax[todo], tol.zero, tol.ray_offset,
-                          sd.extent, tol.normal_cancel, True, s["t"], s["prim"], s["ng"], s["ns"], s["uv"],
-                          s["po"], s["ev"])
+            s = self._trace(fo[todo], fd[todo], tmin[todo], tmax[todo], shadow_only=True)
             hit = s["prim"] >= 0
             todo, prim = todo[hit], s["prim"][hit]
             a = self.col.alpha(prim, s["po"][hit], s["ns"][hit], s["uv"][hit])
@@ -401,14 +398,18 @@ class _Tracer:
         P = O + t[:, None] * D
         return t + tol.ray_offset * np.maximum(np.abs(P).max(1), self.sd.extent)
 
+    def _trace(self, O, D, tmin, tmax, shadow_only=False):
+        """Closest hits of rays and their surface data (:func:`.kernels.trace_batch`)."""
+        h = _alloc(len(O))
+        _kernels().trace_batch(self.geo, O, D, tmin, tmax, tol.zero, tol.ray_offset, self.sd.extent,
+                               tol.normal_cancel, shadow_only, h["t"], h["prim"], h["ng"], h["ns"],
+                               h["uv"], h["po"], h["ev"])
+        return h
+
     def _hits(self, O, D, tmin):
         """Closest hits; surfaces cut out by an opacity map (alpha < 0.5) are passed through."""
-        k = _kernels()
         n = len(O)
-        h = _alloc(n)
-        k.trace_batch(self.geo, O, D, tmin, np.full(n, np.inf), tol.zero, tol.ray_offset,
-                      self.sd.extent, tol.normal_cancel, False, h["t"], h["prim"], h["ng"], h["ns"],
-                      h["uv"], h["po"], h["ev"])
+        h = self._trace(O, D, tmin, np.full(n, np.inf))
         h["alpha"] = np.ones(n)
         if not self.has_opacity:
             return h
@@ -420,11 +421,8 @@ class _Tracer:
             todo = sel[a < OPACITY_CUT]
             if not len(todo):
                 break
-            sub = _alloc(len(todo))
-            k.trace_batch(self.geo, O[todo], D[todo], self._past(O[todo], D[todo], h["t"][todo]),
-                          np.full(len(todo), np.inf), tol.zero, tol.ray_offset, self.sd.extent,
-                          tol.normal_cancel, False, sub["t"], sub["prim"], sub["ng"], sub["ns"],
-                          sub["uv"], sub["po"], sub["ev"])
+            sub = self._trace(O[todo], D[todo], self._past(O[todo], D[todo], h["t"][todo]),
+                              np.full(len(todo), np.inf))
             for key, v in sub.items():
                 h[key][todo] = v
         h["alpha"][h["alpha"] < OPACITY_CUT] = 0.0
