@@ -1,0 +1,51 @@
+"""The child process of the ``mitsuba`` method: ``python -m workbench.renderers.mitsuba_child FOLDER``.
+
+Reads ``FOLDER/plan.json`` (``variant``, ``scene`` = the exporter's dictionary, ``passes`` =
+a list of ``[spp, seed]``), renders each pass with ``mi.render`` and writes ``passes.npy``
+((P, H, W, 3) float32, one image per pass) and ``result.json`` (timings).  Mitsuba is only
+ever imported here: ``mi.set_variant`` is process-wide state, and an LLVM back end that
+aborts takes only this process down.
+"""
+from __future__ import annotations
+
+import json
+import os
+import resource
+import sys
+import time
+
+import numpy as np
+
+
+def to_mitsuba(value, mi):
+    """The exporter's plain dictionary with every ``to_world`` 4x4 list made a
+    ``mi.ScalarTransform4f`` (recursively)."""
+    if isinstance(value, dict):
+        return {k: (mi.ScalarTransform4f(v) if k == "to_world" else to_mitsuba(v, mi)) for k, v in value.items()}
+    return value
+
+
+def main(folder: str) -> None:
+    with open(os.path.join(folder, "plan.json"), encoding="utf-8") as f:
+        plan = json.load(f)
+    t0 = time.perf_counter()
+    import mitsuba as mi
+    mi.set_variant(plan["variant"])
+    t_import = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    scene = mi.load_dict(to_mitsuba(plan["scene"], mi))
+    t_load = time.perf_counter() - t0
+    images, times = [], []
+    for spp, seed in plan["passes"]:
+        t0 = time.perf_counter()
+        images.append(np.asarray(mi.render(scene, spp=int(spp), seed=int(seed)), dtype=np.float32))
+        times.append(time.perf_counter() - t0)
+    np.save(os.path.join(folder, "passes.npy"), np.stack(images))
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # Linux: KiB
+    with open(os.path.join(folder, "result.json"), "w", encoding="utf-8") as f:
+        json.dump({"import": t_import, "load": t_load, "passes": times, "peak_rss_bytes": peak,
+                   "mitsuba_version": mi.__version__}, f)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1])
