@@ -31,6 +31,12 @@ def atomic_write_text(path, text: str) -> Path:
     return Path(path)
 
 
+def atomic_write_bytes(path, data: bytes) -> Path:
+    """Write a binary file atomically (same rules as the images)."""
+    _atomic_write(Path(path), lambda t: Path(t).write_bytes(data))
+    return Path(path)
+
+
 def _atomic_write(path: Path, write):
     """Write through a temporary file in the same folder, then rename: never a half-written file."""
     path = Path(path)

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import os
-import resource
 import sys
 import time
 
@@ -23,6 +22,19 @@ def to_mitsuba(value, mi):
     if isinstance(value, dict):
         return {k: (mi.ScalarTransform4f(v) if k == "to_world" else to_mitsuba(v, mi)) for k, v in value.items()}
     return value
+
+
+def peak_rss_bytes() -> int | None:
+    """This process's peak resident set (Linux ``VmHWM``; unlike ``getrusage``'s ``ru_maxrss`` it
+    does not carry the parent's peak across ``exec``), or None where /proc is absent."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        return None
+    return None
 
 
 def main(folder: str) -> None:
@@ -41,7 +53,7 @@ def main(folder: str) -> None:
         images.append(np.asarray(mi.render(scene, spp=int(spp), seed=int(seed)), dtype=np.float32))
         times.append(time.perf_counter() - t0)
     np.save(os.path.join(folder, "passes.npy"), np.stack(images))
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # Linux: KiB
+    peak = peak_rss_bytes()
     with open(os.path.join(folder, "result.json"), "w", encoding="utf-8") as f:
         json.dump({"import": t_import, "load": t_load, "passes": times, "peak_rss_bytes": peak,
                    "mitsuba_version": mi.__version__}, f)
