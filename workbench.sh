@@ -3,7 +3,7 @@
 #   bash workbench.sh demo   install what is missing, then run the main job on the default scene
 #   bash workbench.sh test   install what is missing, then run the test suite
 # Installing: Debian packages (Mesa EGL/llvmpipe, OSMesa, Xvfb, GLFW, POV-Ray) when missing, and
-# a virtual environment .venv with the package and its test/bench extras.  Safe to re-run.
+# a virtual environment .venv with the package and its test/bench/reference extras.  Safe to re-run.
 set -euo pipefail
 cd "$(dirname "$0")"
 what="${1:-}"
@@ -28,7 +28,7 @@ if [ ! -f "$stamp" ]; then
   echo "== installing Python packages into .venv (first run takes a few minutes)"
   # (pip's notes about this machine's unused local index folders are filtered out)
   { .venv/bin/python -m pip install -q --upgrade pip &&
-    .venv/bin/python -m pip install -q -e '.[test,bench]'; } 2>&1 | { grep -v -e 'is ignored: it is neither' || true; }
+    .venv/bin/python -m pip install -q -e '.[test,bench,reference]'; } 2>&1 | { grep -v -e 'is ignored: it is neither' || true; }
   rm -f .venv/.installed-*; touch "$stamp"
 fi
 export NUMBA_CACHE_DIR="$PWD/.numba_cache"

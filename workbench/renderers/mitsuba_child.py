@@ -48,14 +48,16 @@ def main(folder: str) -> None:
     scene = mi.load_dict(to_mitsuba(plan["scene"], mi))
     t_load = time.perf_counter() - t0
     images, times = [], []
+    cpu0 = time.process_time()
     for spp, seed in plan["passes"]:
         t0 = time.perf_counter()
         images.append(np.asarray(mi.render(scene, spp=int(spp), seed=int(seed)), dtype=np.float32))
         times.append(time.perf_counter() - t0)
+    cpu = time.process_time() - cpu0
     np.save(os.path.join(folder, "passes.npy"), np.stack(images))
     peak = peak_rss_bytes()
     with open(os.path.join(folder, "result.json"), "w", encoding="utf-8") as f:
-        json.dump({"import": t_import, "load": t_load, "passes": times, "peak_rss_bytes": peak,
+        json.dump({"import": t_import, "load": t_load, "passes": times, "cpu": cpu, "peak_rss_bytes": peak,
                    "mitsuba_version": mi.__version__}, f)
 
 

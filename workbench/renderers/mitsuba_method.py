@@ -231,7 +231,7 @@ class MitsubaRenderer:
                  "integrator": f"path (max_depth -1, Russian roulette from depth {RR_DEPTH})",
                  "pixel_filter": "box (pixel's box-filtered average), not clipped",
                  "samples_per_second": spp * width * height / max(t_render, tol.zero),
-                 "child_peak_rss_bytes": info["peak_rss_bytes"],
+                 "render_cpu_seconds": info["cpu"], "child_peak_rss_bytes": info["peak_rss_bytes"],
                  "stderr": stderr, "stderr_rms": float(np.sqrt(np.mean(stderr.astype(np.float64) ** 2)))}
         needs = scene.needs()
         used = sorted(f for f in needs if not any(x.startswith(f + ":") for x in ex.left_out))

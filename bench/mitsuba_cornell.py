@@ -1,0 +1,134 @@
+"""Mitsuba 3 on the Cornell box: run time and samples per second of the ``mitsuba`` method.
+
+* ``mitsuba``: ``cornell`` at 256x256, 64 spp (two passes of 32, box filter, path integrator with
+  unbounded depth), ``--repeat`` renders; records the render time (Mitsuba's ``mi.render``
+  calls only), the whole method's time (child process start, export, scene load), samples
+  per second = spp x pixels / render time, samples per CPU-second (steadier than wall time
+  on a shared host), the variant that ran and why, the noise estimate.
+* ``pathtrace`` (``--with-pathtrace``, once the ``pathtrace`` method is registered): the same
+  scene, size and spp in the same run, the two methods alternating, then
+  :func:`validate_pathtrace` (per-pixel consistency with the combined noise, mean radiance).
+
+Usage: ``.venv/bin/python bench/mitsuba_cornell.py [--size 256] [--spp 64] [--repeat 2]
+[--with-pathtrace]`` writes ``bench/results/mitsuba_cornell.json`` and prints it.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+OUT = ROOT / "bench" / "results" / "mitsuba_cornell.json"
+
+
+def noise_image(result) -> np.ndarray | None:
+    """The per-pixel standard error a method put in its stats: the first (H, W[, 3]) array whose
+    key names ``stderr`` or ``noise`` (``mitsuba`` uses ``stderr``), broadcast to (H, W, 3)."""
+    H, W = result.image.shape[:2]
+    for k, v in result.stats.items():
+        if isinstance(v, np.ndarray) and v.shape[:2] == (H, W) and ("stderr" in k or "noise" in k):
+            v = np.asarray(v, dtype=np.float64)
+            return np.broadcast_to(v if v.ndim == 3 else v[..., None], (H, W, 3))
+    return None
+
+
+def run_once(scene, method: str, size: int, spp: int, seed: int = 0) -> tuple[dict, object]:
+    import workbench
+    r = workbench.render(scene, method, width=size, height=size, spp=spp, seed=seed)
+    t_render = r.timings.get("render", r.timings["total"])
+    entry = {"total_s": round(r.timings["total"], 3), "render_s": round(t_render, 3),
+             "samples_per_second": round(spp * size * size / t_render),
+             "timings": {k: round(v, 4) for k, v in r.timings.items()},
+             "noise_rms": None if noise_image(r) is None else float(np.sqrt(np.mean(noise_image(r) ** 2)))}
+    cpu = r.stats.get("render_cpu_seconds")
+    if cpu:
+        entry["samples_per_cpu_second"] = round(spp * size * size / cpu)
+    for k in ("variant", "variant_reason", "mitsuba_version", "render_cpu_seconds", "child_peak_rss_bytes",
+              "threads"):
+        if k in r.stats:
+            entry[k] = r.stats[k]
+    return entry, r
+
+
+def validate_pathtrace(pt, mi) -> dict:
+    """Agreement of two independent estimates of the same image.
+
+    Statistic: per pixel and channel ``z = (a - b) / sqrt(se_a^2 + se_b^2)`` with each method's
+    own standard-error estimate; for consistent unbiased estimates ``mean(z^2)`` is about 1
+    (each se is itself a noisy estimate, so heavy tails are expected where few samples hit the
+    light), and the fraction with ``|z| > 3`` is small.  Also the mean radiance ratio (all
+    pixels, no clipping; both images are box-filtered pixel averages).
+    """
+    a, b = np.asarray(pt.image, np.float64), np.asarray(mi.image, np.float64)
+    out = {"mean_radiance_pathtrace": a.mean(axis=(0, 1)).tolist(), "mean_radiance_mitsuba": b.mean(axis=(0, 1)).tolist(),
+           "mean_ratio": float(a.mean() / b.mean()), "rmse": float(np.sqrt(np.mean((a - b) ** 2)))}
+    se_a, se_b = noise_image(pt), noise_image(mi)
+    if se_a is None or se_b is None:
+        out["z"] = "no per-pixel noise estimate in one of the results"
+        return out
+    s = np.sqrt(se_a ** 2 + se_b ** 2)
+    ok = s > 0
+    z = (a - b)[ok] / s[ok]
+    out.update(mean_z2=float(np.mean(z ** 2)), median_abs_z=float(np.median(np.abs(z))),
+               frac_abs_z_gt_3=float(np.mean(np.abs(z) > 3)), pixels_with_zero_noise=int((~ok).sum()))
+    return out
+
+
+def pathtrace_vs_mitsuba(scene_name: str = "cornell", size: int = 256, spp: int = 64, repeat: int = 2) -> dict:
+    """Both methods on the same scene, size and spp in the same run, alternating (best time of
+    ``repeat`` each), plus :func:`validate_pathtrace` on the last images."""
+    import workbench
+    from workbench.renderers.base import available
+    if "pathtrace" not in available():
+        return {"status": "pathtrace method not registered in this tree"}
+    scene = workbench.load_scene(scene_name)
+    runs = {"pathtrace": [], "mitsuba": []}
+    last = {}
+    workbench.render(scene, "pathtrace", width=16, height=16, spp=2)  # JIT compile, apart
+    for _ in range(repeat):
+        for m in ("pathtrace", "mitsuba"):
+            e, last[m] = run_once(scene, m, size, spp)
+            runs[m].append(e)
+    best = {m: min(v, key=lambda e: e["render_s"]) for m, v in runs.items()}
+    return {"scene": scene_name, "size": size, "spp": spp, "runs": runs, "best": best,
+            "samples_per_second_ratio_pathtrace_over_mitsuba":
+                best["pathtrace"]["samples_per_second"] / best["mitsuba"]["samples_per_second"],
+            "validation": validate_pathtrace(last["pathtrace"], last["mitsuba"])}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--size", type=int, default=256)
+    ap.add_argument("--spp", type=int, default=64)
+    ap.add_argument("--repeat", type=int, default=2)
+    ap.add_argument("--with-pathtrace", action="store_true")
+    a = ap.parse_args()
+    import workbench
+    scene = workbench.load_scene("cornell")
+    res = {"date": time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()),
+           "load_average_1min_before": os.getloadavg()[0], "machine": f"{os.cpu_count()} CPUs (shared)",
+           "scene": "cornell", "size": a.size, "spp": a.spp,
+           "image_definition": "box-filtered pixel average, linear float32, not clipped",
+           "mitsuba": []}
+    for i in range(a.repeat):
+        e, r = run_once(scene, "mitsuba", a.size, a.spp, seed=i)
+        res["mitsuba"].append(e)
+    res["mitsuba_best"] = min(res["mitsuba"], key=lambda e: e["render_s"])
+    res["mitsuba_mean_radiance"] = r.image.mean(axis=(0, 1)).tolist()
+    if a.with_pathtrace:
+        res["pathtrace_vs_mitsuba"] = pathtrace_vs_mitsuba("cornell", a.size, a.spp, a.repeat)
+    res["load_average_1min_after"] = os.getloadavg()[0]
+    OUT.parent.mkdir(parents=True, exist_ok=True)
+    OUT.write_text(json.dumps(res, indent=1))
+    print(json.dumps(res, indent=1))
+
+
+if __name__ == "__main__":
+    main()
