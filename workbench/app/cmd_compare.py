@@ -8,7 +8,7 @@ def add_parser(sub):
     p = sub.add_parser("compare", help="render a scene with every method; grid, heat maps, JSON and HTML report")
     p.add_argument("scene", help="scene file or bundled scene name")
     p.add_argument("--out", required=True, help="output folder (report.html, report.json, grid.png, ...)")
-    p.add_argument("--methods", type=methods_list, help="comma-separated methods (default: every registered one)")
+    p.add_argument("--methods", type=methods_list, help="comma-separated methods (default: every registered one except mitsuba)")
     p.add_argument("--size", type=size, help="WIDTHxHEIGHT (default: the scene camera's)")
     p.add_argument("--reference", help="force the reference method (default: the documented rule)")
     p.add_argument("--repeat", type=int, default=1, help="warm timed runs per method after the cold one (default 1)")

@@ -22,7 +22,7 @@ def add_parser(sub):
     p = sub.add_parser("study", help="sweep each method's quality knob: error against run time (CSV, JSON, plot)")
     p.add_argument("scene", help="scene file or bundled scene name")
     p.add_argument("--out", required=True, help="output folder (study.csv, study.json, study.png, study.html)")
-    p.add_argument("--methods", type=methods_list, help="comma-separated methods (default: every registered one)")
+    p.add_argument("--methods", type=methods_list, help="comma-separated methods (default: every registered one except mitsuba)")
     p.add_argument("--size", type=size, help="WIDTHxHEIGHT (default: 160 wide with --quick, else the camera's)")
     p.add_argument("--quick", action="store_true", help="small sweep: at most 4 knob values, 2 warm runs, 160 px wide")
     p.add_argument("--repeat", type=int, help="warm runs per point (default 2 quick, 5 otherwise)")

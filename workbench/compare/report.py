@@ -26,7 +26,7 @@ import numpy as np
 
 from ..core.errors import WorkbenchError
 from ..core.imageio import save_npy, save_png, save_png8
-from ..renderers.base import available
+from ..renderers.base import available, default_methods
 from ..scene.model import Scene
 from . import figures
 from .html import esc, img_tag, page, table
@@ -70,8 +70,9 @@ def compare(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
 
     Parameters
     ----------
-    methods : registered method names (default: all registered; those that raise
-        ``NotApplicable`` are listed with their reason).
+    methods : registered method names (default: all registered except the opt-in outside
+        references, ``base.default_methods()``; those that raise ``NotApplicable`` are listed
+        with their reason).
     size : (width, height); the scene camera's resolution by default.
     reference : force the reference method (default: the rule of :mod:`.reference`).
     repeat : warm runs per method after the cold one (0: time = cold - compile).
@@ -80,7 +81,7 @@ def compare(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
     -------
     The ``report.json`` content as a dict.
     """
-    names = list(available()) if not methods else list(methods)
+    names = default_methods() if not methods else list(methods)
     unknown = [m for m in names if m not in available()]
     if unknown:
         raise WorkbenchError(f"unknown method(s) {', '.join(unknown)} (available: {', '.join(available())})")

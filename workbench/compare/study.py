@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from ..core.errors import WorkbenchError
-from ..renderers.base import available, get_renderer
+from ..renderers.base import available, default_methods, get_renderer
 from ..scene.model import Scene
 from .html import esc, img_tag, page, table
 from .metrics import metrics
@@ -89,7 +89,8 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
 
     Parameters
     ----------
-    methods : method names (default: every registered one).
+    methods : method names (default: every registered one except the opt-in outside references,
+        ``base.default_methods()``).
     size : (width, height); default 160 pixels wide (quick) or the camera's resolution, at
         the camera's aspect ratio.
     repeat : warm runs per point (default 2 quick, 5 otherwise); time = their median.
@@ -100,7 +101,7 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
         (e.g. radiosity's ``hemicube_resolution``), values cheapest first.
     jobs : worker processes for the error evaluation (after all timing is done).
     """
-    names = list(available()) if not methods else list(methods)
+    names = default_methods() if not methods else list(methods)
     unknown = [m for m in names if m not in available()]
     if unknown:
         raise WorkbenchError(f"unknown method(s) {', '.join(unknown)} (available: {', '.join(available())})")

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..core.errors import WorkbenchError
 from ..scene.model import Scene
-from .registry import BUILTIN
+from .registry import BUILTIN, OPT_IN
 
 
 @dataclass(frozen=True)
@@ -79,6 +79,12 @@ _instances: dict[str, Renderer] = {}
 def available() -> list[str]:
     """Names of the registered methods."""
     return list(BUILTIN)
+
+
+def default_methods() -> list[str]:
+    """The methods ``compare`` and ``study`` run when none are named: every registered one except
+    the opt-in outside references (``registry.OPT_IN``)."""
+    return [m for m in BUILTIN if m not in OPT_IN]
 
 
 def get_renderer(method: str) -> Renderer:

@@ -2,6 +2,11 @@
 heavy imports (moderngl, numba, pyrender) happen only when it is used (Mitsuba's plugins by name).
 
 Only methods that exist are listed here: a method that is not implemented is absent.
+
+``OPT_IN`` methods are registered (``workbench methods`` lists them, any command takes them by
+name) but are left out of the default method lists of ``compare`` and ``study``: an outside
+path-traced reference takes seconds to minutes per image and its knob reaches thousands of
+samples per pixel, so it runs when named (``--methods ...,mitsuba``), not in every report.
 """
 
 BUILTIN: dict[str, str] = {
@@ -15,3 +20,5 @@ BUILTIN: dict[str, str] = {
     "hybrid": "workbench.renderers.radiosity.hybrid:HybridRenderer",
     "mitsuba": "workbench.renderers.mitsuba_method:MitsubaRenderer",
 }
+
+OPT_IN: frozenset[str] = frozenset({"mitsuba"})
