@@ -8,6 +8,8 @@
 * ``pathtrace`` (``--with-pathtrace``, once the ``pathtrace`` method is registered): the same
   scene, size and spp in the same run, the two methods alternating, then
   :func:`validate_pathtrace` (per-pixel consistency with the combined noise, mean radiance).
+* ``--rmse-study``: :func:`rmse_against_shared_reference`, error against run time of each
+  method against one shared high-spp Mitsuba reference (cached on disk).
 
 Usage: ``.venv/bin/python bench/mitsuba_cornell.py [--size 256] [--spp 64] [--repeat 2]
 [--with-pathtrace]`` writes ``bench/results/mitsuba_cornell.json`` and prints it.
@@ -41,7 +43,9 @@ def noise_image(result) -> np.ndarray | None:
 
 def run_once(scene, method: str, size: int, spp: int, seed: int = 0) -> tuple[dict, object]:
     import workbench
-    r = workbench.render(scene, method, width=size, height=size, spp=spp, seed=seed)
+    from workbench.renderers.base import get_renderer
+    opts = {"seed": seed} if "seed" in get_renderer(method).options else {}
+    r = workbench.render(scene, method, width=size, height=size, spp=spp, **opts)
     t_render = r.timings.get("render", r.timings["total"])
     entry = {"total_s": round(r.timings["total"], 3), "render_s": round(t_render, 3),
              "samples_per_second": round(spp * size * size / t_render),
@@ -103,12 +107,40 @@ def pathtrace_vs_mitsuba(scene_name: str = "cornell", size: int = 256, spp: int 
             "validation": validate_pathtrace(last["pathtrace"], last["mitsuba"])}
 
 
+def rmse_against_shared_reference(scene_name: str = "cornell", size: int = 128, reference_spp: int = 4096,
+                                  spps: tuple = (4, 16, 64, 256), methods: tuple = ("pathtrace", "mitsuba")) -> dict:
+    """Error against run time of each method against one shared high-spp Mitsuba reference (kept
+    in the reference cache, so a second call does not re-render it): per method and spp the
+    render time and the RMSE (linear, not clipped), from which the time each needs to reach an
+    equal RMSE is read off.  Methods not registered are reported as such."""
+    import workbench
+    from workbench.compare.reference_cache import cached_render
+    from workbench.renderers.base import available
+    scene = workbench.load_scene(scene_name)
+    ref = cached_render(scene, "mitsuba", size, size, spp=reference_spp, seed=1000)
+    out = {"scene": scene_name, "size": size, "reference": {"method": "mitsuba", "spp": reference_spp,
+           "stderr_rms": ref.stats.get("stderr_rms"), "cache": ref.stats.get("cache")}, "methods": {}}
+    for m in methods:
+        if m not in available():
+            out["methods"][m] = "not registered in this tree"
+            continue
+        rows = []
+        for spp in spps:
+            e, r = run_once(scene, m, size, spp)
+            e.update(spp=spp, rmse=float(np.sqrt(np.mean((r.image.astype(np.float64) - ref.image) ** 2))))
+            rows.append(e)
+        out["methods"][m] = rows
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", type=int, default=256)
     ap.add_argument("--spp", type=int, default=64)
     ap.add_argument("--repeat", type=int, default=2)
     ap.add_argument("--with-pathtrace", action="store_true")
+    ap.add_argument("--rmse-study", action="store_true",
+                    help="also error against time vs a shared 4096-spp Mitsuba reference at 128x128 (cached)")
     a = ap.parse_args()
     import workbench
     scene = workbench.load_scene("cornell")
@@ -124,6 +156,8 @@ def main() -> None:
     res["mitsuba_mean_radiance"] = r.image.mean(axis=(0, 1)).tolist()
     if a.with_pathtrace:
         res["pathtrace_vs_mitsuba"] = pathtrace_vs_mitsuba("cornell", a.size, a.spp, a.repeat)
+    if a.rmse_study:
+        res["rmse_against_shared_reference"] = rmse_against_shared_reference()
     res["load_average_1min_after"] = os.getloadavg()[0]
     OUT.parent.mkdir(parents=True, exist_ok=True)
     OUT.write_text(json.dumps(res, indent=1))
