@@ -133,6 +133,11 @@ def test_camera_frame_is_mitsubas_looking_down_plus_z_with_x_to_the_left():
 def test_a_scene_without_light_is_not_applicable(tmp_path):
     with pytest.raises(NotApplicable, match="no light"):
         mx.export_scene(_small_scene(lights=()), str(tmp_path), 4)
+    lit_by_sky = _small_scene(lights=(), background=(0.2, 0.3, 0.5))
+    d = mx.export_scene(lit_by_sky, str(tmp_path), 4)
+    assert d.scene_dict["background"]["radiance"]["value"] == [0.2, 0.3, 0.5]
+    with pytest.raises(NotApplicable, match="no light"):
+        mx.export_scene(lit_by_sky, str(tmp_path), 4, background_light=False)
 
 
 @pytest.mark.parametrize("name,expected", [

@@ -45,7 +45,8 @@ point light         ``point``, intensity ``pi I color`` (inverse square); ``fall
                     r0 from the light to the centre of the scene's bounds), noted in left_out
 directional light   ``directional``, irradiance ``pi I color``
 background          ``constant`` emitter of that radiance when not black (it then also lights
-                    the scene, unlike the ray tracer's background: noted in left_out)
+                    the scene, unlike the ray tracer's background: noted in left_out); option
+                    ``background_light = false``: not exported (black)
 integrator          ``path``, ``max_depth = -1`` (unbounded, Russian roulette from depth 5)
 =================== ==========================================================================
 
@@ -234,13 +235,14 @@ def _scene_bounds(parts_pts: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     return P.min(0), P.max(0)
 
 
-def has_light(scene: m.Scene) -> bool:
+def has_light(scene: m.Scene, background_light: bool = True) -> bool:
     """Whether anything in the scene emits light (lights, emissive materials, background)."""
-    return bool(scene.lights) or max(scene.background) > 0.0 or any(
+    return bool(scene.lights) or (background_light and max(scene.background) > 0.0) or any(
         scene.materials[o.material].is_emitter for o in scene.objects)
 
 
-def export_scene(scene: m.Scene, folder: str, tessellation: int, spp: int = 16) -> Export:
+def export_scene(scene: m.Scene, folder: str, tessellation: int, spp: int = 16,
+                 background_light: bool = True) -> Export:
     """Mitsuba scene dictionary of ``scene`` (its camera and resolution), meshes written to ``folder``.
 
     Parameters
@@ -250,13 +252,15 @@ def export_scene(scene: m.Scene, folder: str, tessellation: int, spp: int = 16) 
     tessellation : level for curved surfaces that are not analytic spheres (quadrics, CSG,
         non-uniformly scaled spheres).
     spp : the sensor's sample count (the renderer passes its own to ``mi.render``).
+    background_light : export a non-black background as a ``constant`` emitter (it then lights
+        the scene); False: black, as far as light is concerned.
 
     Raises
     ------
     NotApplicable
         When nothing in the scene emits light (the image would be black).
     """
-    if not has_light(scene):
+    if not has_light(scene, background_light):
         raise NotApplicable("method 'mitsuba': the scene has no light (no lights, emissive materials "
                             "or background): the image would be black")
     cam = scene.camera
@@ -340,10 +344,12 @@ def export_scene(scene: m.Scene, folder: str, tessellation: int, spp: int = 16) 
             if light.cosine_normal is not None:
                 left.append(f"{F.POINT_LIGHTS}: a point light's cosine lobe is not exported (isotropic)")
             d[f"light_{k:03d}"] = {"type": "point", "position": [float(x) for x in p], "intensity": rgb(col)}
-    if max(scene.background) > 0.0:
+    if max(scene.background) > 0.0 and background_light:
         d["background"] = {"type": "constant", "radiance": rgb(scene.background)}
         left.append("background: a constant environment emitter in Mitsuba, so it also lights the "
                     "scene (the ray tracer only shows it)")
+    elif max(scene.background) > 0.0:
+        left.append("background: not exported (background_light = false): rays leaving the scene see black")
     if scene.environment is not None:
         left.append(f"{F.ENVIRONMENT}: {MODEL_NOTES[F.ENVIRONMENT]}")
     if max(scene.ambient) > 0.0 and any(mt.ka > 0.0 for mt in scene.materials.values()):

@@ -151,6 +151,8 @@ class MitsubaRenderer:
                           VARIANTS),
         "tessellation": Option(int, 16, f"tessellation level of quadrics and CSG, 1..{MAX_LEVEL} "
                                         "(spheres are analytic)"),
+        "background_light": Option(bool, True, "a non-black background becomes a constant environment "
+                                               "emitter that lights the scene (false: black)"),
         "timeout": Option(float, 3600.0, "seconds before the child render is stopped"),
     }
 
@@ -190,7 +192,8 @@ class MitsubaRenderer:
         return int(CHILD_BASE_BYTES + BYTES_PER_PIXEL * width * height + BYTES_PER_TRIANGLE * tris)
 
     def render(self, scene: Scene, width: int, height: int, *, spp: int = 64, seed: int = 0,
-               variant: str = "auto", tessellation: int = 16, timeout: float = 3600.0) -> RenderResult:
+               variant: str = "auto", tessellation: int = 16, background_light: bool = True,
+               timeout: float = 3600.0) -> RenderResult:
         if not mitsuba_installed():
             raise WorkbenchError(f"method 'mitsuba': {INSTALL_HINT}")
         if spp < 2:
@@ -208,7 +211,7 @@ class MitsubaRenderer:
         passes_spec = [[n1, 2 * seed], [spp - n1, 2 * seed + 1]]
         with tempfile.TemporaryDirectory(prefix="workbench-mitsuba-") as folder:
             t0 = time.perf_counter()
-            ex = export_scene(scene, folder, tessellation, spp)
+            ex = export_scene(scene, folder, tessellation, spp, background_light)
             t_export = time.perf_counter() - t0
             plan = {"variant": run_variant, "scene": ex.scene_dict, "passes": passes_spec}
             t0 = time.perf_counter()
