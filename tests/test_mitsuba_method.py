@@ -72,7 +72,7 @@ def test_cornell_mean_radiance_agrees_with_radiosity_and_reports_its_noise():
     assert mit.left_out == [] and "area_lights" in mit.features_used
 
 
-def test_mirror_glass_csg_quadrics_and_meshes_render_finite():
+def test_mirror_glass_csg_quadrics_and_opacity_render_finite():
     """Every BSDF combination (nested blends, dielectric, thin dielectric, mask) and every shape
     kind the exporter writes loads in Mitsuba and gives a finite image."""
     for name in ("cornell_spheres", "csg", "quadrics", "envmap"):
@@ -129,3 +129,21 @@ def test_mitsuba_is_registered_but_not_in_the_default_method_lists():
     from workbench.renderers.base import available, default_methods
     assert "mitsuba" in available() and "mitsuba" not in default_methods()
     assert set(default_methods()) == set(available()) - {"mitsuba"}
+
+
+def test_cli_and_reports_summarise_the_noise_image_instead_of_dumping_it(tmp_path):
+    """Before: ``workbench render -m mitsuba`` printed the whole (H, W, 3) stderr array and a
+    comparison report would have written it as a nested list into report.json."""
+    import json
+    import subprocess
+    import sys
+    from workbench.renderers.base import stats_for_display
+    r = subprocess.run([sys.executable, "-m", "workbench.app.cli", "render", "cornell", "-m", "mitsuba",
+                        "--set", "spp=4", "--size", "24x20", "-o", str(tmp_path / "a.png"),
+                        "--json", str(tmp_path / "a.json")], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    line = [ln for ln in r.stdout.splitlines() if ln.strip().startswith("stderr:")]
+    assert len(line) == 1 and "array (20, 24, 3) float32, RMS" in line[0]
+    assert json.loads((tmp_path / "a.json").read_text())["stats"]["stderr"].startswith("array (20, 24, 3)")
+    shown = stats_for_display({"stderr": np.full((2, 2, 3), 3.0, np.float32), "spp": 4})
+    assert shown == {"stderr": "array (2, 2, 3) float32, RMS 3", "spp": 4}

@@ -27,7 +27,7 @@ def run(args) -> int:
 
     from ..core.errors import WorkbenchError
     from ..core.imageio import atomic_write_text, save_npy, save_png
-    from ..renderers.base import render
+    from ..renderers.base import render, stats_for_display
     from ..scene.io import load_scene
     if not args.output.lower().endswith(".png"):
         raise WorkbenchError(f"output must be a .png file, got {args.output!r}")
@@ -55,14 +55,15 @@ def run(args) -> int:
     t = ", ".join(f"{k} {v:.3f} s" for k, v in result.timings.items())
     print(f"{scene.name} / {result.method}: {result.image.shape[1]}x{result.image.shape[0]} -> {args.output}")
     print(f"  timings: {t}")
-    for k, v in result.stats.items():
+    stats = stats_for_display(result.stats)
+    for k, v in stats.items():
         print(f"  {k}: {v}")
     if result.left_out:
         print(f"  left out: {'; '.join(result.left_out)}")
     if args.json:
         atomic_write_text(args.json, json.dumps({
             "scene": scene.name, "method": result.method, "timings": result.timings,
-            "stats": result.stats, "features_used": result.features_used,
+            "stats": stats, "features_used": result.features_used,
             "left_out": result.left_out, "options": {k: str(v) for k, v in result.options.items()}},
             indent=2, default=str))
     return 0

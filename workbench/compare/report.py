@@ -26,7 +26,7 @@ import numpy as np
 
 from ..core.errors import WorkbenchError
 from ..core.imageio import save_npy, save_png, save_png8
-from ..renderers.base import available, default_methods
+from ..renderers.base import available, default_methods, stats_for_display
 from ..scene.model import Scene
 from . import figures
 from .html import esc, img_tag, page, table
@@ -57,7 +57,7 @@ def _method_entry(run: MethodRun, ref_features: list[str]) -> dict:
         return e
     res = run.result
     e.update(options=res.options, time_s=run.time, cold_s=run.cold, compile_s=run.compile,
-             warm_s=run.warm, timings=res.timings, stats=res.stats,
+             warm_s=run.warm, timings=res.timings, stats=stats_for_display(res.stats),
              features_used=res.features_used, left_out=res.left_out,
              differs_physically=physical_differences(res.left_out, ref_features))
     return e
@@ -114,7 +114,7 @@ def compare(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
         "reference": {"method": ref.method, "options": ref.options, "reason": ref.reason,
                       "time_s": ref.run.time, "cold_s": ref.run.cold, "compile_s": ref.run.compile,
                       "features_used": ref_features, "left_out": ref.run.result.left_out,
-                      "stats": ref.run.result.stats,
+                      "stats": stats_for_display(ref.run.result.stats),
                       "files": {"png": "images/reference.png", "npy": "images/reference.npy"}},
         "heatmap_scales": {"flip": [0.0, 1.0], "abs": [0.0, abs_max]},
         "methods": entries,

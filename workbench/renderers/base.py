@@ -76,6 +76,21 @@ class Renderer(Protocol):
 _instances: dict[str, Renderer] = {}
 
 
+def stats_for_display(stats: dict) -> dict:
+    """``stats`` with every array (e.g. a per-pixel noise image) replaced by a one-line summary
+    ``"array (H, W, 3) float32, RMS x"``: what reports and the CLI print and write to JSON
+    (the arrays themselves stay in ``RenderResult.stats``)."""
+    out = {}
+    for k, v in stats.items():
+        if isinstance(v, np.ndarray) and v.size > 1:
+            a = v.astype(np.float64)
+            rms = float(np.sqrt(np.mean(a * a))) if a.size and np.isfinite(a).all() else float("nan")
+            out[k] = f"array {tuple(v.shape)} {v.dtype}, RMS {rms:.4g}"
+        else:
+            out[k] = v
+    return out
+
+
 def available() -> list[str]:
     """Names of the registered methods."""
     return list(BUILTIN)
