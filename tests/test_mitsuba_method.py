@@ -123,6 +123,9 @@ def test_two_pass_standard_error_is_unbiased():
     assert np.allclose(image, (n1 * a + n2 * b) / (n1 + n2), atol=1e-6)
     ratio = np.mean(err.astype(np.float64) ** 2) / (sigma ** 2 / (n1 + n2))
     assert abs(ratio - 1.0) < 0.02
+    a[0, 0, 0], b[0, 1, 2] = np.nan, np.inf
+    _, err = mm.combine_passes(np.stack([a, b]), [n1, n2])
+    assert np.isfinite(err).all() and err[0, 0, 0] == 0.0 and err[0, 1, 2] == 0.0
 
 
 def test_mitsuba_is_registered_but_not_in_the_default_method_lists():

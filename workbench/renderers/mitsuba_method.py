@@ -109,12 +109,15 @@ def combine_passes(passes: np.ndarray, spp: list[int]) -> tuple[np.ndarray, np.n
     Returns
     -------
     image : (H, W, 3) float32, ``(n1 a + n2 b) / (n1 + n2)``.
-    stderr : (H, W, 3) float32, ``|a - b| / sqrt((1/n1 + 1/n2) (n1 + n2))`` (module docstring).
+    stderr : (H, W, 3) float32, ``|a - b| / sqrt((1/n1 + 1/n2) (n1 + n2))`` (module docstring);
+        0 where a pass is not finite (the image's non-finite pixels are counted by ``render``).
     """
     a, b = (np.asarray(p, dtype=np.float64) for p in passes)
     n1, n2 = (float(n) for n in spp)
     image = (n1 * a + n2 * b) / (n1 + n2)
     stderr = np.abs(a - b) / np.sqrt((1.0 / n1 + 1.0 / n2) * (n1 + n2))
+    # a non-finite pass value: render() zeroes and counts the image's; the noise image gets 0 too
+    stderr = np.where(np.isfinite(stderr), stderr, 0.0)
     return image.astype(np.float32), stderr.astype(np.float32)
 
 
