@@ -35,6 +35,7 @@ from typing import Callable
 import numpy as np
 
 from ..core.errors import NotApplicable, WorkbenchError
+from ..core.resources import data_dir
 from ..renderers.base import available, render
 from ..scene.io import scene_from_dict
 from . import formulas
@@ -42,7 +43,7 @@ from .analytic import interior, sphere_hits
 from .html import esc, page, table
 from .outputs import dumps, machine_info, staged
 
-CATALOGUE = Path(__file__).resolve().parents[2] / "stress" / "cases.toml"
+CATALOGUE = data_dir("stress") / "cases.toml"
 DEFAULT_SIZE = (48, 36)
 
 

@@ -21,11 +21,12 @@ from pathlib import Path
 import numpy as np
 
 from ..core.errors import WorkbenchError
+from ..core.resources import data_dir
 from ..core.tol import tol
 from ..scene import features as ft
 from ..scene.model import DirectionalLight, Material, Scene
 
-SHADER_DIR = Path(__file__).resolve().parents[2] / "shaders"
+SHADER_DIR = data_dir("shaders")
 INCLUDE_DIR = SHADER_DIR / "include"
 
 PROJ = {"uv": 0, "planar": 1, "cylindrical": 2, "spherical": 3, "solid": 4}

@@ -14,6 +14,7 @@ BUILTIN: dict[str, str] = {
     "gouraud": "workbench.renderers.raster:GouraudRenderer",
     "phong": "workbench.renderers.raster:PhongRenderer",
     "pyrender": "workbench.renderers.reference:PyrenderRenderer",
+    "povray": "workbench.renderers.povray:PovrayRenderer",
     "raycast": "workbench.renderers.raytrace.whitted:RaycastRenderer",
     "raytrace": "workbench.renderers.raytrace.whitted:RaytraceRenderer",
     "radiosity": "workbench.renderers.radiosity.method:RadiosityRenderer",

@@ -1,9 +1,12 @@
-"""The bundled scenes (``scenes/*.toml`` at the repository root) and name resolution."""
+"""The bundled scenes (``scenes/*.toml``, found by :func:`workbench.core.resources.data_dir`) and name
+resolution."""
 from __future__ import annotations
 
 from pathlib import Path
 
-SCENES_DIR = Path(__file__).resolve().parents[2] / "scenes"
+from ..core.resources import data_dir
+
+SCENES_DIR = data_dir("scenes")
 DEFAULT_SCENE = "whitted"
 
 

@@ -4,16 +4,16 @@ Gouraud shading through OpenGL (moderngl, FBO; shaders/radiosity_gouraud_*.glsl)
 from __future__ import annotations
 
 import time
-from pathlib import Path
 
 import numpy as np
 
+from ...core.resources import data_dir
 from ...core.tol import tol
 from ...scene.model import Camera
 from .. import gl
 from .patches import PatchSet
 
-SHADERS = Path(__file__).resolve().parents[3] / "shaders"
+SHADERS = data_dir("shaders")
 NEAR_FRACTION = 1e-3    # near plane as a fraction of the farthest vertex depth
 
 

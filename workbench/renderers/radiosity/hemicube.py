@@ -31,17 +31,17 @@ the readable reference) on >= 99.9 % of the pixels (the rest are ties on cell bo
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from ...core import transform as tf
 from ...core.errors import WorkbenchError
+from ...core.resources import data_dir
 from ...core.tol import tol
 from .. import gl
 from .formfactors import Geometry
 
-SHADERS = Path(__file__).resolve().parents[3] / "shaders"
+SHADERS = data_dir("shaders")
 MAX_FACES = 80          # must match MAX_FACES in radiosity_item_vs.glsl
 FACES = 5
 TRI_ROW = 4096          # must match TRI_ROW in radiosity_item_vs.glsl and radiosity_item_fs.glsl
