@@ -124,15 +124,15 @@ def mis_weight(pa, pb, beta):
 
 
 @nb.njit(error_model="numpy", inline="always")
-def phong_lobe(shin, rx, ry, rz, wx, wy, wz):
-    """``(cos^n alpha (n + 2) / (2 pi), cos^n alpha (n + 1) / (2 pi))``: the normalised Phong
-    lobe's value per unit ``ks`` and its sampling density, ``alpha`` the angle between ``w`` and
-    the mirror direction ``r`` (Lafortune & Willems 1994); 0 beyond 90 degrees."""
+def phong_lobe(ks, shin, rx, ry, rz, wx, wy, wz):
+    """``(ks cos^n alpha (n + 2) / (2 pi), cos^n alpha (n + 1) / (2 pi))``: the normalised Phong
+    lobe's value and its sampling density, ``alpha`` the angle between ``w`` and the mirror
+    direction ``r`` (Lafortune & Willems 1994); 0 beyond 90 degrees, and where ``ks = 0``."""
     ca = rx * wx + ry * wy + rz * wz
-    if ca <= 0.0:
+    if ca <= 0.0 or ks <= 0.0:
         return 0.0, 0.0
     c = ca ** shin if shin > 0.0 else 1.0
-    return (shin + 2.0) * INV_2PI * c, (shin + 1.0) * INV_2PI * c
+    return ks * (shin + 2.0) * INV_2PI * c, (shin + 1.0) * INV_2PI * c
 
 
 @nb.njit(**NO_REFCOUNT)
@@ -389,7 +389,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                     cos_s = nx * lx + ny * ly + nz * lz
                     if ((ler > 0.0 or leg > 0.0 or leb > 0.0) and cos_s > 0.0 and cos_l != 0.0
                             and fx * lx + fy * ly + fz * lz > 0.0):
-                        fs, ps = phong_lobe(shin, rx, ry, rz, lx, ly, lz)
+                        fs, ps = phong_lobe(a_s, shin, rx, ry, rz, lx, ly, lz)
                         p_b = P_nd * (m_d * cos_s * INV_PI + a_s * ps) / m_nd
                         p_l = (lpdf_tri[mt] if mt >= 0 else lpdf_prim[em_prim[e]]) * dist * dist / abs(cos_l)
                         if p_l > 0.0:
@@ -399,10 +399,9 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                                                      np.bool_(True), zero, off, scr)
                             if kb < 0:
                                 wl = mis_weight(p_l, p_b, beta_mis) * cos_s / p_l
-                                spec = a_s * fs
-                                Lr += br * (adr * INV_PI + spec) * ler * wl
-                                Lg += bg_ * (adg * INV_PI + spec) * leg * wl
-                                Lb += bb * (adb * INV_PI + spec) * leb * wl
+                                Lr += br * (adr * INV_PI + fs) * ler * wl
+                                Lg += bg_ * (adg * INV_PI + fs) * leg * wl
+                                Lb += bb * (adb * INV_PI + fs) * leb * wl
             for li in range(nl):
                 lx, ly, lz, dist, sc = _light_dir(lights, li, px, py, pz)
                 cos_s = nx * lx + ny * ly + nz * lz
@@ -413,12 +412,11 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                 _, kb, _, _, _, _ = cast(geo, sx_, sy_, sz_, lx, ly, lz, tmin_here, tmx, np.bool_(True), zero, off, scr)
                 if kb >= 0:
                     continue
-                fs, _ = phong_lobe(shin, rx, ry, rz, lx, ly, lz)
-                spec = a_s * fs
+                fs, _ = phong_lobe(a_s, shin, rx, ry, rz, lx, ly, lz)
                 e_ = math.pi * sc * cos_s  # irradiance per unit light value
-                Lr += br * (adr * INV_PI + spec) * lights[li, 4] * e_
-                Lg += bg_ * (adg * INV_PI + spec) * lights[li, 5] * e_
-                Lb += bb * (adb * INV_PI + spec) * lights[li, 6] * e_
+                Lr += br * (adr * INV_PI + fs) * lights[li, 4] * e_
+                Lg += bg_ * (adg * INV_PI + fs) * lights[li, 5] * e_
+                Lb += bb * (adb * INV_PI + fs) * lights[li, 6] * e_
         # ---- Russian roulette
         if bounce + 1 >= rr_start:
             q_rr = min(0.95, max(br, bg_, bb))
@@ -438,14 +436,13 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
             cos_s = nx * wx + ny * wy + nz * wz
             if cos_s <= 0.0 or fx * wx + fy * wy + fz * wz <= 0.0:
                 return Lr, Lg, Lb
-            fs, ps = phong_lobe(shin, rx, ry, rz, wx, wy, wz)
+            fs, ps = phong_lobe(a_s, shin, rx, ry, rz, wx, wy, wz)
             pdf = P_nd * (m_d * cos_s * INV_PI + a_s * ps) / m_nd
             if not pdf > 0.0:
                 return Lr, Lg, Lb
-            spec = a_s * fs
-            br *= (adr * INV_PI + spec) * cos_s / pdf
-            bg_ *= (adg * INV_PI + spec) * cos_s / pdf
-            bb *= (adb * INV_PI + spec) * cos_s / pdf
+            br *= (adr * INV_PI + fs) * cos_s / pdf
+            bg_ *= (adg * INV_PI + fs) * cos_s / pdf
+            bb *= (adb * INV_PI + fs) * cos_s / pdf
             delta_before, pdf_prev = False, pdf
             ox, oy, oz = px + off * fx, py + off * fy, pz + off * fz
             dx, dy, dz = wx, wy, wz

@@ -21,6 +21,7 @@ from ...scene import model as m
 from ..raytrace.flatten import flatten, light_rows
 from ..raytrace.whitted import TEX_COLS, camera_frame, fused_textures
 from .emitters import build_emitters
+from .geometry import triangulated
 
 FRESNEL = {"none": 0, "schlick": 1, "exact": 2}
 MIS = {"balance": 1.0, "power": 2.0}
@@ -54,6 +55,8 @@ class PathTraceSession:
     seed : int, >= 0.  fresnel : ``none`` | ``schlick`` | ``exact`` (split of kr, kt as the ray
     tracer's option).  rr_start : bounce from which Russian roulette plays (>= 1).
     max_bounces : hard stop of a path (>= 1).  mis : ``power`` (exponent 2) or ``balance``.
+    triangulate : trace plain opaque polygons and rectangles as triangles through the BVH
+    (:mod:`.geometry`; the same surfaces, faster), else as the ray tracer's polygons.
 
     Raises
     ------
@@ -63,7 +66,7 @@ class PathTraceSession:
     """
 
     def __init__(self, scene: m.Scene, width: int, height: int, *, seed: int = 0, fresnel: str = "none",
-                 rr_start: int = 3, max_bounces: int = 1000, mis: str = "power"):
+                 rr_start: int = 3, max_bounces: int = 1000, mis: str = "power", triangulate: bool = True):
         if seed < 0:
             raise WorkbenchError(f"pathtrace: seed must be >= 0, got {seed}")
         if rr_start < 1 or max_bounces < 1:
@@ -74,7 +77,7 @@ class PathTraceSession:
         t0 = time.perf_counter()
         self.scene = scene.with_camera(scene.camera.with_resolution(width, height))
         self.width, self.height, self.seed = int(width), int(height), int(seed)
-        sd = flatten(self.scene)
+        sd = flatten(triangulated(self.scene) if triangulate else self.scene)
         self.sd = sd
         self.emitters = build_emitters(sd)
         point = [lt for lt in scene.lights if not isinstance(lt, m.AreaLight)]
@@ -161,3 +164,38 @@ class PathTraceSession:
                 "samples_per_s": n / trace if trace > 0 else 0.0,
                 "noise_rmse": self.noise_rmse, "emitter_triangles": len(self.emitters.cdf),
                 "triangles": int(len(self.sd.tri_v)), "scene_extent": self.sd.extent}
+
+
+def run_to_noise(session: PathTraceSession, target: float, *, max_spp: int = 1 << 16,
+                 time_limit: float | None = None, first: int = 8, on_pass=None) -> PathTraceSession:
+    """Add samples to ``session`` until its ``noise_rmse`` is at most ``target`` (or ``max_spp``
+    samples per pixel, or ``time_limit`` seconds of tracing in this call), and return it.
+
+    The noise of a mean falls as ``1 / sqrt(N)``: after ``first`` samples, each pass asks for
+    the ``N (noise / target)^2`` samples the target needs (at most doubling ``N`` per pass, so
+    a poor early estimate cannot overshoot far, and so the time limit is checked often).
+    ``on_pass(session)`` is called after each pass (progress).
+    """
+    if not target > 0.0:
+        raise WorkbenchError(f"pathtrace: the target noise must be > 0, got {target}")
+    t0 = time.perf_counter()
+    while session.samples < max_spp:
+        n = session.samples
+        if n < 2:
+            want = max(first, 2) - n
+        else:
+            noise = session.noise_rmse
+            if noise <= target:
+                break
+            want = min(n, max(1, int(np.ceil(n * (noise / target) ** 2)) - n))
+        if time_limit is not None and n >= 2:
+            spent = time.perf_counter() - t0
+            rate = session.timings["trace"] / n  # seconds per sample per pixel
+            if spent + want * rate > time_limit:
+                want = int((time_limit - spent) / rate)
+                if want < 1:
+                    break
+        session.add_samples(min(want, max_spp - n))
+        if on_pass is not None:
+            on_pass(session)
+    return session
