@@ -233,3 +233,12 @@ def test_memory_estimate_bounds_the_allocations():
     finally:
         tracemalloc.stop()
     assert 0 < peak <= get_renderer("pathtrace").estimate_bytes(sc, 96, 64)
+
+
+def test_run_to_noise_stops_at_the_target_or_the_cap():
+    from workbench.renderers.pathtrace.session import run_to_noise
+    sc = workbench.load_scene("furnace")
+    ses = run_to_noise(PathTraceSession(sc, 6, 6), 0.02, max_spp=4096)
+    assert ses.noise_rmse <= 0.02 and ses.samples < 4096
+    capped = run_to_noise(PathTraceSession(sc, 6, 6), 1e-6, max_spp=24)
+    assert capped.samples == 24 and capped.noise_rmse > 1e-6

@@ -34,9 +34,9 @@ class PathTraceRenderer:
     """Unbiased path tracing with next-event estimation and MIS (Kajiya 1986; Veach 1997)."""
 
     name = "pathtrace"
-    knob = Knob("spp", (4, 16, 64, 256, 1024), 64, "samples per pixel")
+    knob = Knob("spp", (2, 4, 16, 64, 256), 16, "samples per pixel")
     options = {
-        "spp": Option(int, 64, "samples per pixel (uniform jitter: the box-filtered pixel)"),
+        "spp": Option(int, 16, "samples per pixel (uniform jitter: the box-filtered pixel; >= 2 for a noise estimate)"),
         "seed": Option(int, 0, "seed of the random numbers (>= 0; same seed, same image)"),
         "fresnel": Option(str, "none", "reflection/transmission split: none (constant kr, kt), schlick or exact dielectric", tuple(FRESNEL)),
         "mis": Option(str, "power", "multiple importance sampling heuristic", tuple(MIS)),

@@ -105,7 +105,8 @@ class PathTraceSession:
         self.sumsq = np.zeros((npix, 3))
         self.counts = np.zeros(_kernels().NCOUNTS, np.int64)
         self.samples = 0
-        self.timings = {"build": time.perf_counter() - t0, "bvh_build": sd.bvh_build_time, "trace": 0.0}
+        self.timings = {"build": time.perf_counter() - t0, "bvh_build": sd.bvh_build_time, "trace": 0.0,
+                        "trace_cpu": 0.0}
         self.timings["compile"] = self._ensure_compiled()
 
     def _ensure_compiled(self) -> float:
@@ -123,10 +124,11 @@ class PathTraceSession:
         if n < 0:
             raise WorkbenchError(f"pathtrace: the number of samples to add must be >= 0, got {n}")
         if n:
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             _kernels().render_samples(self.geo, self.shading, self.emitters.arrays(), self.cam, self.opts,
                                       self.seed, self.samples, int(n), self.sums, self.sumsq, self.counts)
             self.timings["trace"] += time.perf_counter() - t0
+            self.timings["trace_cpu"] += time.process_time() - c0  # CPU seconds, all threads
             self.samples += int(n)
         return self.image
 
@@ -162,6 +164,7 @@ class PathTraceSession:
                 "escaped_paths": int(c[4]), "nonfinite_samples": int(c[5]), "ended_by_bounce_cap": int(c[6]),
                 "mean_path_length": float(c[0] + c[1]) / max(int(c[0]), 1),
                 "samples_per_s": n / trace if trace > 0 else 0.0,
+                "samples_per_cpu_s": n / self.timings["trace_cpu"] if self.timings["trace_cpu"] > 0 else 0.0,
                 "noise_rmse": self.noise_rmse, "emitter_triangles": len(self.emitters.cdf),
                 "triangles": int(len(self.sd.tri_v)), "scene_extent": self.sd.extent}
 
