@@ -56,7 +56,7 @@ def _world(W, pts):
     return pts @ W[:3, :3].T + W[:3, 3]
 
 
-def _fan(poly):
+def fan_triangles(poly):
     """Fan triangles (n - 2, 9) of a convex polygon, or None if it is not convex."""
     v0, a, b = poly[0], poly[1:-1], poly[2:]
     cr = np.cross(a - v0, b - v0)
@@ -76,7 +76,7 @@ def _prim_triangles(sd: SceneData, k: int):
     W, par, kind = sd.wfo[k], sd.par[k], sd.ptype[k]
     if kind == POLYGON:
         s, n = int(par[4]), int(par[5])
-        tris = _fan(_world(W, sd.poly_v[s:s + n]))
+        tris = fan_triangles(_world(W, sd.poly_v[s:s + n]))
         return tris
     if kind == RECT:
         p, u, v, hu, hv = par[0:3], par[3:6], par[6:9], par[12], par[13]

@@ -16,11 +16,11 @@ from dataclasses import replace
 import numpy as np
 
 from ...scene import model as m
-from .emitters import _fan
+from .emitters import fan_triangles
 
 
 def _as_mesh(o, vertices):
-    tris = _fan(np.asarray(vertices, dtype=np.float64))
+    tris = fan_triangles(np.asarray(vertices, dtype=np.float64))
     if tris is None:
         return o
     V = tris.reshape(-1, 3)
