@@ -242,3 +242,46 @@ def test_run_to_noise_stops_at_the_target_or_the_cap():
     assert ses.noise_rmse <= 0.02 and ses.samples < 4096
     capped = run_to_noise(PathTraceSession(sc, 6, 6), 1e-6, max_spp=24)
     assert capped.samples == 24 and capped.noise_rmse > 1e-6
+
+
+def test_normalised_phong_lobe_under_a_directional_light(tmp_path):
+    """A purely glossy plane (kd = 0, ks, n) seen through a tiny field of view at 10 degrees from
+    the light's mirror direction: one bounce, no variance, the normalised lobe
+    ks (n + 2) / (2 pi) cos^n(alpha) times the irradiance pi I cos(theta); and the course's
+    ks cos^n(alpha) I in the Whitted tracer: their ratio is (n + 2) cos(theta) / 2 (DESIGN.md)."""
+    a = np.radians(10.0)
+    r = np.array([0.6, 0.8, 0.0])                                   # mirror of the light direction
+    v = np.array([r[0] * np.cos(a) - r[1] * np.sin(a), r[0] * np.sin(a) + r[1] * np.cos(a), 0.0])
+    cam = 10.0 * v
+    sc = _scene(tmp_path, f"""
+[scene]
+name = "gloss"
+background = [0.0, 0.0, 0.0]
+ambient = [0.0, 0.0, 0.0]
+[camera]
+position = [{cam[0]}, {cam[1]}, {cam[2]}]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 0.01
+resolution = [4, 4]
+[[lights]]
+type = "directional"
+direction = [0.6, -0.8, 0.0]
+intensity = 0.9
+[materials.gloss]
+color = [1.0, 1.0, 1.0]
+ka = 0.0
+kd = 0.0
+ks = 0.8
+shininess = 20.0
+[[objects]]
+type = "plane"
+material = "gloss"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 1.0, 0.0]
+size = [1000.0, 1000.0]
+""")
+    pt = workbench.render(sc, "pathtrace", spp=8)
+    wh = workbench.render(sc, "raytrace", spp=1)
+    course = 0.8 * np.cos(a) ** 20 * 0.9
+    assert np.allclose(wh.image, course, rtol=1e-3)
+    assert np.allclose(pt.image, course * (20 + 2) / 2 * 0.8, rtol=1e-3)
