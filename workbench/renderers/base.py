@@ -53,6 +53,8 @@ class RenderResult:
     features_used / left_out : features of the scene this method built, and those it did not
         (not needed by the scene, or not supported by the method: each with the reason).
     depth : (H, W) float32 camera-space depth along the view axis (inf where nothing), if given.
+    std_error : (H, W, 3) float32 per-pixel standard error of the mean of a Monte Carlo image
+        (its own noise estimate), if given; its RMS is ``stats["noise_rmse"]``.
     """
 
     method: str
@@ -63,6 +65,7 @@ class RenderResult:
     left_out: list[str] = field(default_factory=list)
     options: dict[str, Any] = field(default_factory=dict)
     depth: np.ndarray | None = None
+    std_error: np.ndarray | None = None
 
 
 class Renderer(Protocol):
