@@ -12,6 +12,7 @@ import numpy as np
 
 from ...core.tol import tol
 from ...scene import model as m
+from ...scene.polygon_pieces import convex_pieces
 
 
 def solve_quadratic(A: float, B: float, C: float) -> list[float]:
@@ -116,9 +117,15 @@ def rectangle(p: m.Plane, O, D) -> list[tuple[float, int]]:
 
 
 def polygon(vertices, O, D) -> list[tuple[float, int]]:
-    """Convex planar polygon: plane hit, then the point is left of every edge (seen from the
-    front, vertices counter-clockwise)."""
-    v = np.asarray(vertices)
+    """Planar polygon: the closest hit of its convex pieces (the polygon itself, or the
+    triangles of a concave one, :func:`~workbench.scene.polygon_pieces.convex_pieces`)."""
+    hits = [h for piece in convex_pieces(vertices) for h in _convex_polygon(piece, O, D)]
+    return [min(hits)] if hits else []
+
+
+def _convex_polygon(v, O, D) -> list[tuple[float, int]]:
+    """Convex planar polygon (k, 3): plane hit, then the point is left of every edge (seen
+    from the front, vertices counter-clockwise)."""
     n = np.cross(v[1:-1] - v[0], v[2:] - v[0]).sum(0)
     n = n / np.linalg.norm(n)
     den = D @ n
