@@ -119,3 +119,22 @@ def test_automatic_clip_planes_keep_the_near_object(extra, gl_ctx):
     assert same.mean() >= 0.97, same.mean()
     # and the ray caster agrees on every pixel covered by something
     assert iou(coverage(both, "raycast", 64, 48), np.isfinite(r.depth)) >= 0.97
+
+
+@pytest.mark.parametrize("position", [[1800.0, 273.0, 280.0], [-1300.0, 273.0, 280.0], [278.0, 273.0, 1800.0]],
+                         ids=["outside_left", "outside_right", "outside_back"])
+def test_hybrid_does_not_light_the_outside_of_the_cornell_walls(position):
+    """Before: the radiosity patches' vertex emission was seen from both sides, so the outer
+    faces of the walls glowed red/green (0.15, 0.006, 0.0005) where Phong, the ray tracer and
+    radiosity give 0.  The inside, seen from the scene's own camera, stays lit."""
+    from dataclasses import replace
+
+    import workbench
+    sc = workbench.load_scene("scenes/cornell_spheres.toml")
+    cam = replace(sc.camera, position=tuple(position), look_at=(278.0, 273.0, 280.0), fov_y=5.0,
+                  width=16, height=16)
+    out = workbench.render(replace(sc, camera=cam), "hybrid", patch_size=0.2)
+    assert np.isfinite(out.depth).all()  # the whole image is a wall's outer face
+    assert out.image.max() == 0.0
+    inside = workbench.render(sc, "hybrid", width=16, height=16, patch_size=0.2).image
+    assert inside.mean() > 0.05

@@ -963,7 +963,9 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
     else:
         cr, cg, cb = mat_tab[mi, 0], mat_tab[mi, 1], mat_tab[mi, 2]
     ka, kd, ks, shin = mat_tab[mi, 3], mat_tab[mi, 4], mat_tab[mi, 5], mat_tab[mi, 6]
-    er, eg, eb = ev[i, 0], ev[i, 1], ev[i, 2]
+    # vertex emission (radiosity patches of the hybrid method) leaves the front side only: the
+    # back of a one-sided patch received no light (Mesh.vertex_emission)
+    er, eg, eb = (ev[i, 0], ev[i, 1], ev[i, 2]) if front else (0.0, 0.0, 0.0)
     if mat_tab[mi, 16] < 0.5 or front:
         er, eg, eb = er + mat_tab[mi, 13], eg + mat_tab[mi, 14], eb + mat_tab[mi, 15]
     lr = ka * cr * ambient[0] + er
