@@ -138,3 +138,52 @@ def test_hybrid_does_not_light_the_outside_of_the_cornell_walls(position):
     assert out.image.max() == 0.0
     inside = workbench.render(sc, "hybrid", width=16, height=16, patch_size=0.2).image
     assert inside.mean() > 0.05
+
+
+def _cube_ply(tmp_path) -> str:
+    import trimesh
+    path = tmp_path / "cube.ply"
+    trimesh.creation.box(extents=(2.0, 2.0, 2.0)).export(path)  # 8 shared vertices
+    return str(path)
+
+
+def test_crease_normals_split_a_cube_and_keep_a_sphere_smooth(tmp_path):
+    import trimesh
+
+    from workbench.scene.mesh_normals import crease_normals
+    sc = scene_from_dict(scene_dict([{"type": "mesh", "path": _cube_ply(tmp_path), "material": "m"}]))
+    cube = sc.objects[0]
+    assert len(cube.vertices) == 24  # 8 corners x 3 faces
+    fn = np.cross(cube.vertices[cube.faces[:, 1]] - cube.vertices[cube.faces[:, 0]],
+                  cube.vertices[cube.faces[:, 2]] - cube.vertices[cube.faces[:, 0]])
+    fn /= np.linalg.norm(fn, axis=1, keepdims=True)
+    for k in range(3):  # every corner's normal is its face's normal
+        assert np.allclose(cube.normals[cube.faces[:, k]], fn, atol=1e-12)
+    ico = trimesh.creation.icosphere(subdivisions=3)
+    V, F, N, _ = crease_normals(ico.vertices, ico.faces)
+    assert len(V) == len(ico.vertices) and F is not None
+    assert np.allclose(N, ico.vertices / np.linalg.norm(ico.vertices, axis=1, keepdims=True), atol=0.02)
+    V, F, N, _ = crease_normals(ico.vertices, ico.faces, crease_angle=0.0)  # faceted
+    fn = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    fn /= np.linalg.norm(fn, axis=1, keepdims=True)
+    assert len(V) > 2 * len(ico.vertices)
+    for k in range(3):
+        assert np.allclose(N[F[:, k]], fn, atol=1e-9)
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("method", ["raycast", "phong", "gouraud"])
+def test_cube_mesh_faces_shade_flat(tmp_path, method):
+    """Before: the cube's 8 shared vertices had averaged normals (the diagonal), so each face
+    was shaded as a rounded patch.  Directional light, no specular: a flat face is one colour."""
+    import workbench
+    lights = [{"type": "directional", "direction": [-0.3, -0.5, -1.0]}]
+    cam = {"position": [3.0, 2.5, 4.0], "look_at": [0, 0, 0], "fov_y": 40.0, "resolution": [64, 48]}
+    sc = scene_from_dict(scene_dict([{"type": "mesh", "path": _cube_ply(tmp_path), "material": "m"}],
+                                    camera=cam, lights=lights))
+    r = workbench.render(sc, method)
+    seen = np.isfinite(r.depth)
+    lum = r.image.sum(-1)[seen]
+    # three visible faces: at most three distinct shades (edge pixels aside)
+    hist = np.unique(np.round(lum, 3), return_counts=True)[1]
+    assert np.sort(hist)[-3:].sum() >= 0.95 * seen.sum(), np.sort(hist)[-6:]
