@@ -54,9 +54,9 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 
 from ..core.errors import WorkbenchError
-from ..core.tol import tol
 from ..scene import features as ft
 from ..scene.model import AreaLight, Camera, Environment, Material, Scene
+from ..scene.clip_planes import auto_near_far
 from ..scene.tessellate import DEFAULT_LEVEL, MAX_LEVEL, Part, tessellate_scene
 from ..scene.tessellate_topology import closed_outward, provoking_layout
 from . import gl
@@ -65,9 +65,6 @@ from .base import Knob, Option, RenderResult
 from .raster_shaders import (LIVE_MATERIAL_FIELDS, ProgramCache, base_defines, light_kind,
                              light_uniforms, material_defines, material_uniforms)
 
-#: The near plane is never closer than this fraction of the far plane when chosen
-#: automatically (keeps 24-bit depth resolution usable when the camera is inside the bounds).
-NEAR_FAR_RATIO = 1e-3
 DEPTH_CHOICES = (16, 24, 32)
 #: Object kinds tessellated as closed, outward-wound surfaces.
 CLOSED_KINDS = ("sphere", "box", "csg")
@@ -199,18 +196,6 @@ def _parts(scene: Scene, level: int) -> list[Part]:
     return hit[1]
 
 
-def auto_near_far(camera: Camera, points: np.ndarray) -> tuple[float, float]:
-    """Clip planes enclosing ``points`` (N, 3) seen from ``camera`` (its own near/far win)."""
-    lo, hi = points.min(0), points.max(0)
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-    depth = camera.project(corners)[1]
-    far = camera.far or float(max(depth.max(), tol.zero) * 1.01)
-    near = camera.near or float(max(depth.min() * 0.99, far * NEAR_FAR_RATIO))
-    if far <= near:
-        far = near / NEAR_FAR_RATIO
-    return near, far
-
-
 class RasterSession:
     """A scene tessellated and uploaded for one shading mode (see the module docstring).
 
@@ -244,8 +229,8 @@ class RasterSession:
         pairs += [(p, m, None) for p, m in _area_light_parts(scene)]
         self.timings["tessellate"] = time.perf_counter() - t0
         self.n_triangles = sum(p.n_triangles for p, _, _ in pairs)
-        pts = np.vstack([p.positions for p, _, _ in pairs])
-        self.bounds = (pts.min(0), pts.max(0))
+        #: (K, 2, 3) world box of every part: the automatic clip planes (.scene.clip_planes)
+        self.part_boxes = np.array([[p.positions.min(0), p.positions.max(0)] for p, _, _ in pairs])
         self.lights = scene.point_lights()
         self._light_values = light_uniforms(self.lights)
         self._needs = scene.needs()  # its texture entry does not change with update()
@@ -540,8 +525,7 @@ class RasterSession:
 
     # ------------------------------------------------------------------ drawing
     def near_far(self, camera: Camera) -> tuple[float, float]:
-        lo, hi = self.bounds
-        return auto_near_far(camera, np.array([lo, hi]))
+        return auto_near_far(camera, self.part_boxes)
 
     def framebuffer(self, width: int, height: int):
         """A cached float32 RGBA colour + depth FBO of this size (depth format per

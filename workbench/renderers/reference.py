@@ -53,6 +53,7 @@ import numpy as np
 from ..core.errors import WorkbenchError
 from ..core.tol import tol
 from ..scene import features as ft
+from ..scene.clip_planes import auto_near_far
 from ..scene.model import AreaLight, DirectionalLight, Scene
 from ..scene.tessellate import DEFAULT_LEVEL, MAX_LEVEL, tessellate_scene
 from . import gl
@@ -136,8 +137,6 @@ def build_scene(scene: Scene, level: int):
 
 
 BAKE_SIZE = 1024
-#: Automatic near plane never closer than this fraction of the far plane (as the raster methods).
-NEAR_FAR_RATIO = 1e-3
 
 
 def _baked_texture(tex, part):
@@ -176,13 +175,8 @@ def _pose_looking(position: np.ndarray, direction: np.ndarray) -> np.ndarray:
 
 
 def _near_far(scene: Scene, ps) -> tuple[float, float]:
-    cam = scene.camera
-    lo, hi = ps.bounds
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-    d = cam.project(corners)[1]
-    far = cam.far or float(max(d.max(), tol.zero) * 1.01)
-    near = cam.near or float(max(d.min() * 0.99, far * NEAR_FAR_RATIO))
-    return near, far
+    """Clip planes from each mesh's world box (the raster methods' rule, .scene.clip_planes)."""
+    return auto_near_far(scene.camera, np.array([mesh.bounds for mesh in ps.meshes]))
 
 
 def _render_here(scene: Scene, width: int, height: int, level: int, frames: int = 1) -> dict:

@@ -373,7 +373,7 @@ def _object(ctx, t, w, materials, *, in_csg=False, inherited=None) -> m.SceneObj
         _check_keys(ctx, t, w, _COMMON | {"vertices"}, {"vertices"})
         return m.Polygon(**common, vertices=m._ro(_polygon_vertices(ctx, t, w)))
     if kind == "mesh":
-        _check_keys(ctx, t, w, _COMMON | {"path", "generate", "vertices", "faces"})
+        _check_keys(ctx, t, w, _COMMON | {"path", "generate", "vertices", "faces", "crease_angle"})
         return _mesh(ctx, t, w, common)
     _check_keys(ctx, t, w, _COMMON | {"op", "left", "right"}, {"op", "left", "right"})
     op = _str(ctx, t, w, "op", choices=("union", "intersection", "difference"))
@@ -430,8 +430,11 @@ def _mesh(ctx, t, w, common):
     vis = getattr(tm, "visual", None)
     if vis is not None and getattr(vis, "uv", None) is not None and len(vis.uv) == len(tm.vertices):
         uvs = m._ro(vis.uv)
-    return m.Mesh(**common, vertices=m._ro(tm.vertices), faces=np.asarray(tm.faces, dtype=np.int64),
-                  normals=m._ro(tm.vertex_normals), uvs=uvs, source=source)
+    from .mesh_normals import DEFAULT_CREASE_ANGLE, crease_normals
+    crease = _num(ctx, t, w, "crease_angle", DEFAULT_CREASE_ANGLE, lo=0.0, hi=180.0)
+    V, F, N, uvs = crease_normals(tm.vertices, tm.faces, crease, uvs)
+    return m.Mesh(**common, vertices=m._ro(V), faces=np.asarray(F, dtype=np.int64),
+                  normals=m._ro(N), uvs=None if uvs is None else m._ro(uvs), source=source)
 
 
 def _environment(ctx, t):

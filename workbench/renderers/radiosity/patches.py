@@ -26,6 +26,7 @@ from ...core import transform as tf
 from ...core.errors import WorkbenchError
 from ...core.tol import tol
 from ...scene import model as m
+from ...scene.polygon_pieces import convex_pieces
 
 MAX_CURVED_LEVEL = 24   # finest tessellation level asked of workbench.scene.tessellate
 
@@ -274,7 +275,7 @@ def _surfaces(scene: m.Scene, h: float) -> tuple[list, list[str]]:
         emis = np.asarray(mat.emission, dtype=np.float64)
         polys: list[np.ndarray] = []
         if isinstance(obj, m.Polygon):
-            polys = [obj.vertices]
+            polys = convex_pieces(obj.vertices)
         elif isinstance(obj, m.Plane):
             polys = [obj.corners()]
         elif isinstance(obj, m.Box):
