@@ -12,7 +12,6 @@ import pytest
 import compare_fakes
 from workbench.compare import report as report_mod
 from workbench.compare.metrics import metrics
-from workbench.renderers.base import available
 
 
 def _check_numbers(out, rep):
@@ -94,9 +93,6 @@ def test_unknown_method_is_a_clear_cli_error(tmp_path):
 
 @pytest.mark.gl
 def test_real_methods_against_the_ray_tracer(tmp_path):
-    needed = {"phong", "raytrace"}
-    if not needed <= set(available()):
-        pytest.skip(f"needs {needed} registered")
     out = tmp_path / "rep"
     rep = report_mod.compare(compare_fakes.sphere_scene(), out, methods=["flat", "phong", "raytrace"],
                              size=(48, 36), repeat=0)

@@ -20,7 +20,9 @@ def run(args) -> int:
     from pathlib import Path
 
     from ..compare.report import compare
+    from ..core.output_paths import check_output_dir
     from ..scene.io import load_scene
+    check_output_dir(args.out, "--out")
     scene = load_scene(args.scene)
     rep = compare(scene, args.out, methods=args.methods, size=args.size, reference=args.reference,
                   repeat=args.repeat, command=" ".join(["workbench"] + sys.argv[1:]))

@@ -48,7 +48,7 @@ import numpy as np
 
 from ..core.errors import WorkbenchError
 from ..core.imageio import atomic_write_bytes
-from ..renderers.base import RenderResult, _convert_options, get_renderer, render
+from ..renderers.base import RenderResult, convert_options, get_renderer, render
 from ..scene.model import Scene
 from .outputs import jsonable
 
@@ -145,7 +145,7 @@ def _versions() -> dict:
 
 
 def _key_and_options(scene: Scene, method: str, width: int, height: int, options: dict) -> tuple[str, dict]:
-    opts = _convert_options(get_renderer(method), options)
+    opts = convert_options(get_renderer(method), options)
     h = hashlib.sha256()
     _feed(h, {"format": CACHE_FORMAT, "method": method, "options": opts, "size": [int(width), int(height)],
               "versions": _versions(), "code": code_fingerprint()})

@@ -19,7 +19,6 @@ Timing: each method is called once cold (compilation happens there and is report
 from __future__ import annotations
 
 import datetime as _dt
-import json
 from pathlib import Path
 
 import numpy as np
@@ -31,7 +30,7 @@ from ..scene.model import Scene
 from . import figures
 from .html import esc, img_tag, page, table
 from .metrics import metrics_and_maps
-from .outputs import dumps, machine_info, staged
+from .outputs import dumps, jsonable, loads, machine_info, staged
 from .reference import choose_reference, physical_differences
 from .runs import MethodRun, timed_run
 
@@ -147,7 +146,7 @@ def compare(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
         save_png8(stage / "grid.png", figures.grid(tiles, notes=notes))
         (stage / "report.json").write_text(dumps(report))
         (stage / "report.html").write_text(render_html(report, stage, Path(out_dir)))
-    return json.loads(dumps(report))
+    return jsonable(report, strict=False)
 
 
 def _list(items) -> str:
@@ -207,7 +206,7 @@ def _study_section(out_dir: Path) -> str:
     if not (js.is_file() and png.is_file()):
         return ("<h2>Error against run time</h2><p class='muted'>No study in this folder "
                 "(run <code>workbench study SCENE --out DIR</code> first to include it).</p>")
-    study = json.loads(js.read_text())
+    study = loads(js.read_text())
     rows = [[p["method"], f"{p['knob']}={p['value']}", p["time_s"], p["rmse"], p["flip"]]
             for p in study["points"] if p.get("pareto")]
     return ("<h2>Error against run time</h2>" + img_tag(png, "study") +

@@ -21,18 +21,17 @@ from __future__ import annotations
 import csv
 import datetime as _dt
 import io
-import json
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
 from ..core.errors import WorkbenchError
-from ..renderers.base import available, default_methods, get_renderer
+from ..renderers.base import available, convert_options, default_methods, get_renderer
 from ..scene.model import Scene
 from .html import esc, img_tag, page, table
 from .metrics import metrics
-from .outputs import dumps, machine_info, staged
+from .outputs import dumps, jsonable, machine_info, staged
 from .reference import SAMPLING_NOTE, choose_reference
 from .runs import timed_run
 
@@ -112,6 +111,13 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
         if option not in get_renderer(m).options:
             raise WorkbenchError(f"--sweep {m}:{option}: {m} has no option {option!r} "
                                  f"(accepted: {', '.join(sorted(get_renderer(m).options))})")
+        if not values:
+            raise WorkbenchError(f"--sweep {m}:{option}: no values to sweep")
+        for v in values:    # every value converted now: a bad one fails before any render
+            try:
+                convert_options(get_renderer(m), {option: v})
+            except WorkbenchError as e:
+                raise WorkbenchError(f"--sweep {m}:{option}: {e}") from None
     repeat = (2 if quick else 5) if repeat is None else int(repeat)
     if repeat < 1:
         raise WorkbenchError(f"a study needs at least one warm run per point, got repeat={repeat}")
@@ -165,6 +171,9 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
     for (i, _), mt in zip(images, evaluate([im for _, im in images], ref_img, jobs)):
         points[i].update(mt)
     ok = [p for p in points if p["status"] == "ok"]
+    if not ok:
+        why = sorted({f"{p['method']}: {p['status']} ({p['reason']})" for p in points})
+        raise WorkbenchError(f"nothing to study on {scene.name}: no setting rendered ({'; '.join(why)})")
     for key in ("rmse", "flip"):
         for p, f in zip(ok, pareto([p["time_s"] for p in ok], [p[key] for p in ok])):
             p[f"pareto_{key}"] = f
@@ -188,7 +197,7 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
         (stage / "study.csv").write_text(to_csv(points))
         (stage / "study.json").write_text(dumps(result))
         (stage / "study.html").write_text(render_html(result, stage))
-    return json.loads(dumps(result))
+    return jsonable(result, strict=False)
 
 
 def to_csv(points: list[dict]) -> str:

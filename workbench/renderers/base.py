@@ -115,7 +115,7 @@ def get_renderer(method: str) -> Renderer:
     return _instances[method]
 
 
-def _convert_options(r: Renderer, options: dict) -> dict:
+def convert_options(r: Renderer, options: dict) -> dict:
     out = {k: o.default for k, o in r.options.items()}
     for k, v in options.items():
         if k not in r.options:
@@ -140,6 +140,16 @@ def _convert_options(r: Renderer, options: dict) -> dict:
     return out
 
 
+def _pixels(name: str, value, default: int) -> int:
+    """An image size given to :func:`render`: an integer (not a bool, a float or a string)."""
+    if value is None:
+        return int(default)
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise WorkbenchError(f"render: {name} must be an integer number of pixels, got "
+                             f"{type(value).__name__} {value!r:.80}")
+    return int(value)
+
+
 def render(scene: Scene, method: str, *, width: int | None = None, height: int | None = None,
            **options) -> RenderResult:
     """Render ``scene`` with the method registered as ``method``.
@@ -152,12 +162,18 @@ def render(scene: Scene, method: str, *, width: int | None = None, height: int |
     **options
         Method options (see ``workbench methods``); unknown ones are an error.
     """
+    if not isinstance(scene, Scene):
+        raise WorkbenchError(f"render: scene must be a Scene (from workbench.load_scene), got "
+                             f"{type(scene).__name__} {scene!r:.80}")
+    if not isinstance(method, str):
+        raise WorkbenchError(f"render: method must be a registered method's name (str), got "
+                             f"{type(method).__name__} {method!r:.80}")
     r = get_renderer(method)
-    w = int(width if width is not None else scene.camera.width)
-    h = int(height if height is not None else scene.camera.height)
+    w = _pixels("width", width, scene.camera.width)
+    h = _pixels("height", height, scene.camera.height)
     if not (1 <= w <= 16384 and 1 <= h <= 16384):
         raise WorkbenchError(f"image size must be within 1..16384 pixels, got {w}x{h}")
-    opts = _convert_options(r, options)
+    opts = convert_options(r, options)
     t0 = time.perf_counter()
     result = r.render(scene.with_camera(scene.camera.with_resolution(w, h)), w, h, **opts)
     result.timings["total"] = time.perf_counter() - t0
