@@ -62,6 +62,8 @@ class Broken:
     name = "broken"
     knob = compare_fakes.Facets.knob
     options = compare_fakes.Facets.options
+    memory_options = compare_fakes.Facets.memory_options
+    estimate_bytes = compare_fakes.Facets.estimate_bytes
 
     def render(self, scene, width, height, n=8):
         raise RuntimeError("kaboom")

@@ -59,6 +59,10 @@ class NaNs:
     name = "nans"
     knob = Knob("q", (1,), 1)
     options = {"q": Option(int, 1)}
+    memory_options = ("q",)
+
+    def estimate_bytes(self, scene, width, height, q=1):
+        return 24 * width * height
 
     def render(self, scene, width, height, q=1):
         img = np.full((height, width, 3), 0.5)

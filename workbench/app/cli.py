@@ -45,6 +45,11 @@ def build_parser() -> argparse.ArgumentParser:
     sub.required = True
     for name in COMMANDS:
         importlib.import_module(f"workbench.app.{name}").add_parser(sub)
+    for command in {id(c): c for c in sub.choices.values()}.values():  # aliases share a parser
+        command.add_argument("--max-memory", metavar="SIZE", default=None,
+                             help="memory limit of each render, e.g. 8G or 512M (sets "
+                                  "WORKBENCH_MAX_MEMORY for this command; default: that variable, "
+                                  "else half the physical memory)")
     return p
 
 
@@ -65,6 +70,9 @@ def _run(argv: list[str] | None) -> int:
     from ..core.errors import WorkbenchError
     try:
         args = build_parser().parse_args(argv)
+        if args.max_memory is not None:  # one limit for this process and its children
+            from ..core.memory import ENV, parse_size
+            os.environ[ENV] = str(parse_size(args.max_memory, "--max-memory"))
         return int(args.run(args) or 0)
     except (UsageError, WorkbenchError) as e:
         return _error(str(e))

@@ -5,6 +5,14 @@ a dictionary of accepted ``options`` and a ``render(scene, width, height, **opti
 returning a :class:`RenderResult`.  ``render()`` validates the method and options, times the
 call, and guarantees that the returned image is finite (non-finite pixels are counted in
 ``stats["nonfinite_pixels"]`` and replaced by 0, so a NaN is reported, never shown).
+
+Memory: every renderer also has ``estimate_bytes(scene, width, height, **options) -> int``, an
+upper bound of the peak memory the render will allocate (patches, form factors, hemicube
+buffers, triangles, ray generations, BVH, images...), computed cheaply before anything big is
+allocated, and ``memory_options``, the names of the options the estimate grows with.
+``render()`` refuses a render whose estimate exceeds the limit of
+:func:`workbench.core.memory.memory_limit` with one :class:`WorkbenchError` line that names
+the estimate, the limit, the options to lower and how to raise the limit.
 """
 from __future__ import annotations
 
@@ -16,6 +24,8 @@ from typing import Any, Callable, Protocol
 import numpy as np
 
 from ..core.errors import WorkbenchError
+from ..core.memory import ENV as MEMORY_ENV
+from ..core.memory import gib, memory_limit
 from ..scene.model import Scene
 from .registry import BUILTIN, OPT_IN
 
@@ -72,8 +82,11 @@ class Renderer(Protocol):
     name: str
     knob: Knob
     options: dict[str, Option]
+    memory_options: tuple[str, ...]
 
     def render(self, scene: Scene, width: int, height: int, **options) -> RenderResult: ...
+
+    def estimate_bytes(self, scene: Scene, width: int, height: int, **options) -> int: ...
 
 
 _instances: dict[str, Renderer] = {}
@@ -150,8 +163,33 @@ def _pixels(name: str, value, default: int) -> int:
     return int(value)
 
 
+def check_memory(r: Renderer, scene: Scene, width: int, height: int, options: dict,
+                 max_memory=None) -> int:
+    """``r.estimate_bytes(...)`` (converted options), checked against
+    :func:`~workbench.core.memory.memory_limit` (``max_memory``, else the environment variable
+    ``WORKBENCH_MAX_MEMORY``, else a share of physical memory).  Returns the estimate.
+
+    Raises
+    ------
+    WorkbenchError
+        One line naming the estimate, the limit, the options to lower and the ways to raise
+        the limit, when the estimate exceeds it.
+    """
+    limit = memory_limit(max_memory)
+    est = r.estimate_bytes(scene, width, height, **options)
+    if not isinstance(est, (int, np.integer)) or est <= 0:
+        raise TypeError(f"{type(r).__name__}.estimate_bytes returned {est!r}, not a positive int")
+    if est > limit:
+        knobs = "".join(f"{k}={options[k]!r}, " for k in r.memory_options)
+        raise WorkbenchError(
+            f"method {r.name!r}: {width}x{height} needs about {gib(est)} of memory, above the limit "
+            f"of {gib(limit)}: change {knobs}or the image size, or raise the limit "
+            f"(--max-memory, {MEMORY_ENV} or max_memory=)")
+    return int(est)
+
+
 def render(scene: Scene, method: str, *, width: int | None = None, height: int | None = None,
-           **options) -> RenderResult:
+           max_memory=None, **options) -> RenderResult:
     """Render ``scene`` with the method registered as ``method``.
 
     Parameters
@@ -159,6 +197,11 @@ def render(scene: Scene, method: str, *, width: int | None = None, height: int |
     width, height : int, optional
         Image size; the scene camera's resolution by default.  The camera (and its vertical
         field of view) is otherwise the scene's: every method sees the same view.
+    max_memory : int or str, optional
+        Memory limit of this render in bytes or as ``"8G"``; by default the environment
+        variable ``WORKBENCH_MAX_MEMORY``, else half the physical memory
+        (:mod:`workbench.core.memory`).  The method's ``estimate_bytes`` is checked against it
+        before anything is allocated (:func:`check_memory`).
     **options
         Method options (see ``workbench methods``); unknown ones are an error.
     """
@@ -174,11 +217,14 @@ def render(scene: Scene, method: str, *, width: int | None = None, height: int |
     if not (1 <= w <= 16384 and 1 <= h <= 16384):
         raise WorkbenchError(f"image size must be within 1..16384 pixels, got {w}x{h}")
     opts = convert_options(r, options)
+    sized = scene.with_camera(scene.camera.with_resolution(w, h))
+    estimate = check_memory(r, sized, w, h, opts, max_memory)
     t0 = time.perf_counter()
-    result = r.render(scene.with_camera(scene.camera.with_resolution(w, h)), w, h, **opts)
+    result = r.render(sized, w, h, **opts)
     result.timings["total"] = time.perf_counter() - t0
     result.timings.setdefault("compile", 0.0)
     result.options = opts
+    result.stats["memory_estimate_bytes"] = estimate
     img = np.asarray(result.image, dtype=np.float32)
     bad = ~np.isfinite(img)
     result.stats["nonfinite_pixels"] = int(bad.any(-1).sum())

@@ -58,6 +58,7 @@ from ..scene import features as ft
 from ..scene.model import AreaLight, Camera, Environment, Material, Scene
 from ..scene.clip_planes import auto_near_far
 from ..scene.tessellate import DEFAULT_LEVEL, MAX_LEVEL, Part, tessellate_scene
+from .estimates import raster_bytes
 from ..scene.tessellate_topology import closed_outward, provoking_layout
 from . import gl
 from . import texturing as tx
@@ -692,6 +693,15 @@ def session_for(scene: Scene, mode: str, tessellation: int, blinn: bool, depth_b
     return session, True
 
 
+_BYTES_PER_TRIANGLE = 1024
+"""A triangle's tessellated part (float64), its vertex and index buffers (unshared vertices
+for flat shading) and the draws' copies (about 280 B measured at tessellation 48)."""
+_BYTES_PER_PIXEL = 160
+"""Colour and depth attachments, read-backs and the float32 image and depth."""
+_FIXED_BYTES = 64 * 2 ** 20
+"""GL context, programs, textures."""
+
+
 class _RasterRenderer:
     """Shared implementation of the three registered raster methods."""
 
@@ -707,6 +717,17 @@ class _RasterRenderer:
         "near": Option(float, 0.0, "near clip plane (0: the camera's, or from the scene bounds)"),
         "far": Option(float, 0.0, "far clip plane (0: the camera's, or from the scene bounds)"),
     }
+
+    memory_options = ("tessellation",)
+
+    def estimate_bytes(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
+                       **_) -> int:
+        """Triangles (:func:`.estimates.triangle_bound` at ``tessellation``) and pixels."""
+        if not 1 <= tessellation <= MAX_LEVEL:
+            raise WorkbenchError(f"method {self.name!r}: tessellation must be within 1..{MAX_LEVEL}, "
+                                 f"got {tessellation}")
+        return raster_bytes(scene, width, height, tessellation, _BYTES_PER_TRIANGLE, _BYTES_PER_PIXEL,
+                            _FIXED_BYTES)
 
     def render(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
                blinn: bool = False, depth_bits: int = 24, view: str = "color", near: float = 0.0,
