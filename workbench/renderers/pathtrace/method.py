@@ -46,6 +46,8 @@ class PathTraceRenderer:
         "on_pass": Option(_callback, None, "callback on_pass(spp_so_far, image, std_error) after each pass"),
     }
 
+    memory_options = ()  # memory grows with the image size only (sums per pixel), not with spp
+
     def estimate_bytes(self, scene: Scene, width: int, height: int, **options) -> int:
         """Upper bound of the bytes a render allocates (:func:`.session.estimate_bytes`)."""
         return estimate_bytes(scene, width, height)
