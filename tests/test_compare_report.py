@@ -101,4 +101,11 @@ def test_real_methods_against_the_ray_tracer(tmp_path):
     assert rep["reference"]["method"] == "raytrace"  # the rule: no emitters, ray tracer registered
     assert _check_numbers(out, rep) == 3
     m = {e["method"]: e["metrics"]["rmse"] for e in rep["methods"]}
-    assert m["raytrace"] < 1e-6 < m["phong"] < m["flat"]  # same local model; flat is the coarsest
+    assert m["raytrace"] < m["phong"] < m["flat"]  # same local model; flat is the coarsest
+    # the reference is the box-filtered image (16 stratified samples): the ray tracer's
+    # pixel-centre image differs only at edges, and equals its matched reference (pixel centres)
+    assert rep["reference"]["options"]["spp"] == 16 and 0 < m["raytrace"] < 0.05
+    matched = {e["method"]: e["matched"] for e in rep["methods"]}
+    assert matched["raytrace"]["metrics"]["rmse"] == 0.0
+    assert matched["phong"]["reference"]["options"] == {"shadows": False, "spp": 1}
+    assert rep["reference"]["noise_rmse"] > 0 and "samples per pixel" in rep["reference"]["noise_note"]

@@ -12,11 +12,13 @@ part of their discretisation error, as the course's aliasing is.
 
 Full reference (what the scene *is*)
 ------------------------------------
-1. ``--reference METHOD`` (at its finest knob value) when the user names one;
+1. ``--reference METHOD`` when the user names one: that method at its finest knob value and
+   otherwise default options (e.g. ``raytrace`` at depth 12 and one sample per pixel);
 2. scenes with emitters (area lights or emissive materials): ``pathtrace``, unbiased path
    tracing (Kajiya 1986) run until the RMS of its per-pixel standard error, on the display
-   range, is at most :data:`TARGET_NOISE` or :data:`TIME_BUDGET` seconds are spent; its noise is
-   stated with the reference, and errors below it are not resolved;
+   range, is at most :data:`TARGET_NOISE` or :data:`SAMPLE_BUDGET` samples are spent (a count,
+   not a time, so the same scene always gets the same reference); its noise is stated with the
+   reference, and errors below it are not resolved;
 3. scenes lit by point and directional lights only: ``raytrace`` (Whitted) at its deepest
    recursion, which is exact for the course's model (local model + shadows + ideal reflection and
    refraction), at :data:`CONVERGED_SPP` samples per pixel;
@@ -28,7 +30,7 @@ Matched reference (what the method *would* give at an infinitely fine knob)
 (e.g. Phong's limit: the same local model ray-cast analytically without shadows; radiosity's:
 path tracing restricted to diffuse transport).  Error against it is the method's
 discretisation error; error against the full reference is its total error; the gap is the cost
-of the physics it leaves out.  Outside renderers (pyrender, Mitsuba) have no matched reference.
+of the physics it leaves out (and, for methods that sample pixel centres, of the pixel filter).  Outside renderers (pyrender, Mitsuba) have no matched reference.
 
 References are rendered through the disk cache (:mod:`.reference_cache`), so ``compare``,
 ``study`` and the UI render each one once.
@@ -57,26 +59,30 @@ CONVERGED_SPP = 16
 """Stratified samples per pixel (4 x 4) of a deterministic ray tracer's reference."""
 TARGET_NOISE = 0.01
 """RMS of the path-traced reference's standard error on the display range that ends its sampling."""
-TIME_BUDGET = 60.0
-"""Seconds of path tracing a reference may take (the reference then states the noise it reached)."""
+SAMPLE_BUDGET = 1 << 25
+"""Path-traced samples (pixels x spp) a reference may take: about a minute on two cores here (the
+reference then states the noise it reached)."""
 PILOT_SPP = 16
-MAX_SPP = 16384
 
-#: method -> (reference method, options, what that reference computes)
-_RAYCAST_LOCAL = ("raycast", {"shadows": False, "spp": CONVERGED_SPP},
-                  "the same local model ray-cast on the analytic surfaces, no shadows, box-filtered")
+#: method -> (reference method, options, what that reference computes).  A matched reference is
+#: the limit of the method along its knob: methods that sample pixel centres whatever their knob
+#: (raster, radiosity's display, the ray tracers at spp = 1) are matched at pixel centres, so
+#: their gap to the (box-filtered) full reference holds the pixel filter besides the physics.
+_RAYCAST_LOCAL = ("raycast", {"shadows": False, "spp": 1},
+                  "the same local model ray-cast on the analytic surfaces, no shadows, pixel centres")
 MATCHED: dict[str, tuple[str, dict, str]] = {
     "flat": _RAYCAST_LOCAL, "gouraud": _RAYCAST_LOCAL, "phong": _RAYCAST_LOCAL,
-    "raycast": ("raycast", {"spp": CONVERGED_SPP}, "the ray caster itself, box-filtered"),
-    "raytrace": ("raytrace", {"max_depth": 12, "spp": CONVERGED_SPP},
-                 "the Whitted ray tracer at depth 12, box-filtered"),
-    "povray": ("raytrace", {"max_depth": 12, "spp": CONVERGED_SPP, "transmissive_shadows": True},
-               "the Whitted ray tracer (POV-Ray's model) at depth 12, box-filtered"),
-    "radiosity": ("pathtrace", {"transport": "diffuse"},
-                  "path tracing of diffuse transport only (Lambertian kd * colour, emitters only)"),
-    "hybrid": ("pathtrace", {"transport": "eye_specular"},
-               "path tracing: mirror and glass from the eye, diffuse transport after (no caustics)"),
-    "pathtrace": ("pathtrace", {}, "the path tracer itself, converged"),
+    "raycast": ("raycast", {"spp": CONVERGED_SPP}, "the ray caster itself, box-filtered (its knob is spp)"),
+    "raytrace": ("raytrace", {"max_depth": 12}, "the Whitted ray tracer at depth 12, pixel centres"),
+    "povray": ("raytrace", {"max_depth": 12, "transmissive_shadows": True},
+               "the Whitted ray tracer (POV-Ray's model) at depth 12, pixel centres"),
+    "radiosity": ("pathtrace", {"transport": "diffuse", "pixel_filter": "center"},
+                  "path tracing of diffuse transport only (Lambertian kd * colour, emitters only), "
+                  "pixel centres"),
+    "hybrid": ("pathtrace", {"transport": "eye_specular", "pixel_filter": "center"},
+               "path tracing: mirror and glass from the eye, diffuse transport after (no caustics), "
+               "pixel centres"),
+    "pathtrace": ("pathtrace", {}, "the path tracer itself, converged (box-filtered)"),
 }
 OUTSIDE = {"pyrender": "an outside renderer with its own PBR model: no matched reference in the workbench",
            "mitsuba": "an outside renderer: judged against the full reference only"}
@@ -161,19 +167,19 @@ def _cached_run(scene: Scene, method: str, width: int, height: int, options: dic
 
 
 def _converged_pathtrace(scene: Scene, width: int, height: int, options: dict,
-                         target: float, budget: float) -> tuple[MethodRun, float]:
-    """The path tracer run to a display-range noise ``target`` within ``budget`` seconds: a
-    pilot of :data:`PILOT_SPP` samples measures the noise and the time per sample, and the
-    final sample count is what ``noise ~ 1 / sqrt(spp)`` needs, cut to the budget (both renders
-    cached, so the choice is deterministic and a rerun costs nothing)."""
+                         target: float, budget: int) -> tuple[MethodRun, float]:
+    """The path tracer run to a display-range noise ``target`` within ``budget`` samples: a
+    pilot of :data:`PILOT_SPP` samples per pixel measures the noise, and the final count is the
+    power of two that ``noise ~ 1 / sqrt(spp)`` needs, cut to the budget (both renders cached
+    and the choice deterministic, so a rerun costs nothing)."""
     pilot = _cached_run(scene, "pathtrace", width, height, {**options, "spp": PILOT_SPP})
     if pilot.status != "ok":
         return pilot, 0.0
     noise = display_noise(pilot.result.std_error, pilot.image)
-    spp = PILOT_SPP if noise <= target else PILOT_SPP * (noise / target) ** 2
-    per_spp = max(pilot.result.timings.get("trace", pilot.cold), 1e-9) / PILOT_SPP
-    spp = int(min(spp, budget / per_spp, MAX_SPP))
-    spp = 1 << max(4, int(math.floor(math.log2(max(spp, PILOT_SPP)))))  # a power of two >= 16
+    need = PILOT_SPP * max(1.0, (noise / target) ** 2)
+    spp = 1 << math.ceil(math.log2(need))
+    while spp > PILOT_SPP and spp * width * height > budget:
+        spp //= 2
     if spp == PILOT_SPP:
         return pilot, noise
     run = _cached_run(scene, "pathtrace", width, height, {**options, "spp": spp})
@@ -194,14 +200,14 @@ def _stratified_noise(scene: Scene, method: str, width: int, height: int, option
 
 
 def render_reference(scene: Scene, width: int, height: int, method: str, options: dict, reason: str,
-                     what: str = "", *, target: float = TARGET_NOISE, budget: float = TIME_BUDGET) -> Reference:
+                     what: str = "", *, target: float = TARGET_NOISE, budget: int = SAMPLE_BUDGET) -> Reference:
     """Render one reference (cached) and measure its own noise; ``options`` of ``pathtrace``
     without ``spp`` mean 'converged' (see :func:`_converged_pathtrace`)."""
     t0 = time.perf_counter()
     if method == "pathtrace" and "spp" not in options:
         run, noise = _converged_pathtrace(scene, width, height, options, target, budget)
         note = (f"RMS of the per-pixel standard error on the display range ({run.options.get('spp', '?')} "
-                f"samples per pixel; target {target}, budget {budget:g} s)")
+                f"samples per pixel; target {target}, budget {budget} samples)")
     else:
         run = _cached_run(scene, method, width, height, options)
         noise, note = 0.0, "deterministic"
@@ -242,6 +248,8 @@ def choose_reference(scene: Scene, width: int, height: int, method: str | None =
         except ImportError as e:  # registered but its module is broken
             tried.append(f"{m}: cannot be loaded ({e})")
             continue
+        if method is not None and m != "pathtrace":
+            opts = finest_options(m)    # the user's method as it is, at its finest knob
         ref = render_reference(scene, width, height, m, opts, why, what=_what(m, scene))
         if ref.run.status == "ok":
             return ref

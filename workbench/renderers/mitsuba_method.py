@@ -246,4 +246,4 @@ class MitsubaRenderer:
                  "stderr": stderr, "stderr_rms": float(np.sqrt(np.mean(stderr.astype(np.float64) ** 2)))}
         needs = scene.needs()
         used = sorted(f for f in needs if not any(x.startswith(f + ":") for x in ex.left_out))
-        return RenderResult(self.name, image, timings, stats, used, list(ex.left_out))
+        return RenderResult(self.name, image, timings, stats, used, list(ex.left_out), std_error=stderr)
