@@ -23,7 +23,7 @@ the user's code (GLSL compilers ignore unknown pragmas, so the file stays plain 
 The user's text is appended to the fragment stage after a ``#line 1 <n>`` directive (``n``
 its source-string number), so that a compiler message ``n:LINE(COL): error: ...`` (Mesa's
 format) maps to the user's own line: :meth:`ShadingProgram.compile_error` turns it into one
-line ``FILE:LINE:COL: error: ...``, never the generated source.
+line ``FILE:LINE: error: ...``, never the generated source.
 
 A method name ``glsl:PATH`` is resolved by :func:`workbench.renderers.base.get_renderer`
 (a new renderer per call: nothing is registered or cached here; the raster session cache
@@ -106,7 +106,8 @@ class ShadingProgram:
         whatever ``#line`` said, so the user's line cannot always be told from the log of
         the whole shader: the model is compiled again alone (``shaders/user_check.frag``, the
         user's text as source string 0 after a fixed prelude), where every message about
-        source 0 is the user's.  The first becomes ``FILE:LINE:COL: error: ...``; a call that
+        source 0 is the user's.  The first becomes ``FILE:LINE: error: ...`` (no column: Mesa's
+        columns are not the characters' (a token 4 spaces in is reported at 2)); a call that
         links to no ``shade`` names the required signature; a model that compiles alone but
         not inside the workbench's shader (e.g. a macro clashing with the workbench's) gets
         the first error of the whole shader with the source string it hit.
@@ -117,7 +118,7 @@ class ShadingProgram:
             errors = _MESA_ERROR.findall(alone)
             for src, line, col, kind, text in errors:
                 if int(src) == 0:
-                    return ShaderSourceError(f"{path}:{line}:{col}: {kind}: {text.strip()}")
+                    return ShaderSourceError(f"{path}:{line}: {kind}: {text.strip()}")
             detail = next((ln.strip() for ln in alone.splitlines() if "error" in ln.lower()), "")
             if FUNCTION in detail or not errors:
                 return ShaderSourceError(f"{path}: {FUNCTION}() must be defined as {SIGNATURE} "
