@@ -195,8 +195,9 @@ def test_pytest_plugin(tmp_path):
     assert "> tolerance 0.002" in line and "Traceback" not in r.stdout
     assert (tmp_path / "snapshots" / "ball.phong.diff.png").is_file()
     assert (tmp_path / "snapshots" / "ball.phong.heat.png").is_file()
+    before = np.load(tmp_path / "snapshots" / "ball.phong.npy")
     assert pytest_run(env={"WORKBENCH_SNAPSHOT_UPDATE": "1"}).returncode == 0
-    assert pytest_run().returncode == 0
+    assert np.abs(np.load(tmp_path / "snapshots" / "ball.phong.npy") - before).max() > 0.1  # rewritten
     assert not (tmp_path / "snapshots" / "ball.phong.diff.png").exists()
 
 
