@@ -18,7 +18,7 @@ import importlib
 import os
 import sys
 
-COMMANDS = ["cmd_scenes", "cmd_info", "cmd_methods", "cmd_render", "cmd_colour", "cmd_compare", "cmd_study", "cmd_stress", "cmd_ui"]
+COMMANDS = ["cmd_scenes", "cmd_info", "cmd_methods", "cmd_render", "cmd_colour", "cmd_compare", "cmd_study", "cmd_stress", "cmd_snapshot", "cmd_ui"]
 
 
 class UsageError(Exception):

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..core.errors import WorkbenchError
 from ..core.imageio import save_npy, save_png, save_png8
-from ..renderers.base import available, default_methods, stats_for_display
+from ..renderers.base import check_methods, default_methods, file_stem, stats_for_display
 from ..scene.model import Scene
 from . import figures
 from .html import esc, img_tag, page, table
@@ -82,9 +82,7 @@ def compare(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
     The ``report.json`` content as a dict.
     """
     names = default_methods() if not methods else list(methods)
-    unknown = [m for m in names if m not in available()]
-    if unknown:
-        raise WorkbenchError(f"unknown method(s) {', '.join(unknown)} (available: {', '.join(available())})")
+    check_methods(names)  # unknown names, unusable glsl: files
     if repeat < 0:
         raise WorkbenchError(f"repeat must be >= 0, got {repeat}")
     w, h = size if size else (scene.camera.width, scene.camera.height)
@@ -134,8 +132,9 @@ def compare(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
             if r.status != "ok":
                 notes.append(f"{r.method}: {r.status.replace('_', ' ')}: {r.reason}")
                 continue
-            files = {"png": f"images/{r.method}.png", "npy": f"images/{r.method}.npy",
-                     "heat_flip": f"heat/{r.method}_flip.png", "heat_abs": f"heat/{r.method}_abs.png"}
+            stem = file_stem(r.method)
+            files = {"png": f"images/{stem}.png", "npy": f"images/{stem}.npy",
+                     "heat_flip": f"heat/{stem}_flip.png", "heat_abs": f"heat/{stem}_abs.png"}
             save_png(stage / files["png"], r.image)
             save_npy(stage / files["npy"], r.image)
             fmap, amap = maps[r.method]

@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from ..core.errors import WorkbenchError
-from ..renderers.base import available, convert_options, default_methods, get_renderer
+from ..renderers.base import check_methods, convert_options, default_methods, get_renderer
 from ..scene.model import Scene
 from .html import esc, img_tag, page, table
 from .metrics import metrics
@@ -104,9 +104,7 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
     jobs : worker processes for the error evaluation (after all timing is done).
     """
     names = default_methods() if not methods else list(methods)
-    unknown = [m for m in names if m not in available()]
-    if unknown:
-        raise WorkbenchError(f"unknown method(s) {', '.join(unknown)} (available: {', '.join(available())})")
+    check_methods(names)  # unknown names, unusable glsl: files
     sweeps = sweeps or {}
     for m, (option, values) in sweeps.items():
         if m not in names:

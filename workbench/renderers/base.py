@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import importlib
 import time
+from pathlib import Path
 from dataclasses import dataclass, field
 from typing import Any, Callable, Protocol
 
@@ -118,14 +119,49 @@ def default_methods() -> list[str]:
     return [m for m in BUILTIN if m not in OPT_IN]
 
 
+#: Method names ``glsl:PATH``: a user's shading model in the file PATH (:mod:`.user_shading`).
+USER_PREFIX = "glsl:"
+
+
 def get_renderer(method: str) -> Renderer:
-    """The (cached) renderer instance registered as ``method``."""
+    """The (cached) renderer instance registered as ``method``; for ``glsl:PATH`` a new
+    renderer of the user's shading model in PATH (checked: a missing or invalid file raises
+    :class:`WorkbenchError`), not registered nor cached."""
+    if method.startswith(USER_PREFIX):
+        from .user_shading import renderer_from_path
+        return renderer_from_path(method[len(USER_PREFIX):], name=method)
     if method not in BUILTIN:
         raise WorkbenchError(f"unknown method {method!r} (available: {', '.join(available())})")
     if method not in _instances:
         mod, attr = BUILTIN[method].split(":")
         _instances[method] = getattr(importlib.import_module(mod), attr)()
     return _instances[method]
+
+
+def check_methods(names: list[str]) -> None:
+    """Raise one :class:`WorkbenchError` naming every unknown method of ``names``, or the
+    first ``glsl:`` file that cannot be used."""
+    unknown = [m for m in names if m not in BUILTIN and not m.startswith(USER_PREFIX)]
+    if unknown:
+        raise WorkbenchError(f"unknown method(s) {', '.join(unknown)} (available: {', '.join(available())}, "
+                             f"or {USER_PREFIX}FILE for a shading model in GLSL)")
+    for m in names:
+        if m.startswith(USER_PREFIX):
+            get_renderer(m)
+    stems = [file_stem(m) for m in names]
+    clash = sorted({s for s in stems if stems.count(s) > 1})
+    if clash:
+        raise WorkbenchError(f"methods {', '.join(m for m in names if file_stem(m) in clash)} would write "
+                             f"the same files ({', '.join(clash)}): name the shading models' files apart")
+
+
+def file_stem(method: str) -> str:
+    """A file-name-safe stem for a method's output files: the name of a registered method,
+    ``glsl_<file stem>`` for a user's shading model ``glsl:PATH``."""
+    if not method.startswith(USER_PREFIX):
+        return method
+    stem = "".join(c if c.isalnum() or c in "_.-" else "_" for c in Path(method[len(USER_PREFIX):]).stem)
+    return f"glsl_{stem or 'model'}"
 
 
 def convert_options(r: Renderer, options: dict) -> dict:

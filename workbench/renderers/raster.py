@@ -209,12 +209,18 @@ class RasterSession:
     depth_bits : 16 (emulated fixed point), 24 (fixed point) or 32 (float) depth buffer.
     backface_culling : cull the back faces of closed opaque objects while the camera is
         outside them (:meth:`_cull_groups`; the image is the same, the triangle work halves).
+    shading : a user's shading model in place of the local model (Phong only; a
+        :class:`~.user_shading.ShadingProgram`, see :mod:`.user_shading`).
     """
 
     def __init__(self, scene: Scene, mode: str, *, tessellation: int = DEFAULT_LEVEL,
-                 blinn: bool = False, depth_bits: int = 24, ctx=None, backface_culling: bool = True):
+                 blinn: bool = False, depth_bits: int = 24, ctx=None, backface_culling: bool = True,
+                 shading=None):
         if mode not in ("flat", "gouraud", "phong"):
             raise WorkbenchError(f"unknown raster mode {mode!r}")
+        if shading is not None and mode != "phong":
+            raise WorkbenchError(f"a user's shading model needs Phong shading, not {mode!r}")
+        self.shading = shading
         if depth_bits not in DEPTH_CHOICES:
             raise WorkbenchError(f"depth_bits must be one of {DEPTH_CHOICES}, got {depth_bits}")
         self.scene, self.mode, self.depth_bits, self.blinn = scene, mode, depth_bits, blinn
@@ -352,8 +358,9 @@ class RasterSession:
             defines = material_defines(self.scene, d.material, self.mode, n_lights=len(self.lights),
                                        has_uv=d.has_uv, blinn=self.blinn, depth_bits=self.depth_bits,
                                        allow_bump=self.mode == "phong", live_material=live_mat,
-                                       live_lights=self.live_lights, needs=self._needs)
-            prog = self.programs.get("raster", defines)
+                                       live_lights=self.live_lights, needs=self._needs,
+                                       user_model=self.shading is not None)
+            prog = self.programs.get("raster", defines, user=self.shading)
             vao = d.vaos.get(id(prog))
             if vao is None:
                 vbo, fmt, names, index = d.buffers
@@ -676,17 +683,20 @@ _SESSIONS: OrderedDict = OrderedDict()
 _MAX_SESSIONS = 6
 
 
-def session_for(scene: Scene, mode: str, tessellation: int, blinn: bool, depth_bits: int) -> tuple[RasterSession, bool]:
-    """A cached :class:`RasterSession` for the scene's content (camera excluded); returns
+def session_for(scene: Scene, mode: str, tessellation: int, blinn: bool, depth_bits: int,
+                shading=None) -> tuple[RasterSession, bool]:
+    """A cached :class:`RasterSession` for the scene's content (camera excluded) and shading
+    model (``shading``: a user's, by its source text and parameter values); returns
     ``(session, created)``."""
     ctx = gl.context()
     key = (id(ctx), id(scene.objects), id(scene.materials), id(scene.lights), id(scene.environment),
-           scene.ambient, mode, tessellation, blinn, depth_bits)
+           scene.ambient, mode, tessellation, blinn, depth_bits, None if shading is None else shading.key)
     hit = _SESSIONS.get(key)
     if hit is not None and hit[1] is scene.objects:
         _SESSIONS.move_to_end(key)
         return hit[0], False
-    session = RasterSession(scene, mode, tessellation=tessellation, blinn=blinn, depth_bits=depth_bits, ctx=ctx)
+    session = RasterSession(scene, mode, tessellation=tessellation, blinn=blinn, depth_bits=depth_bits, ctx=ctx,
+                            shading=shading)
     _SESSIONS[key] = (session, scene.objects)
     if len(_SESSIONS) > _MAX_SESSIONS:
         _SESSIONS.popitem(last=False)[1][0].release()
@@ -703,9 +713,11 @@ _FIXED_BYTES = 64 * 2 ** 20
 
 
 class _RasterRenderer:
-    """Shared implementation of the three registered raster methods."""
+    """Shared implementation of the three registered raster methods (and of the users' shading
+    models, :mod:`.user_shading`: Phong with ``shading``)."""
 
     name = ""
+    mode = ""
     knob = Knob("tessellation", (1, 2, 3, 4, 6, 8, 12, 16, 24, 32), DEFAULT_LEVEL,
                 "tessellation level of analytic primitives (sphere: 4L x 8L, see tessellate)")
     options = {
@@ -731,13 +743,13 @@ class _RasterRenderer:
 
     def render(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
                blinn: bool = False, depth_bits: int = 24, view: str = "color", near: float = 0.0,
-               far: float = 0.0) -> RenderResult:
+               far: float = 0.0, shading=None) -> RenderResult:
         if not 1 <= tessellation <= MAX_LEVEL:
             raise WorkbenchError(f"method {self.name!r}: tessellation must be within 1..{MAX_LEVEL}, "
                                  f"got {tessellation}")
         if near < 0 or far < 0 or (near and far and far <= near):
             raise WorkbenchError(f"method {self.name!r}: need 0 < near < far, got near={near}, far={far}")
-        session, created = session_for(scene, self.name, tessellation, blinn, depth_bits)
+        session, created = session_for(scene, self.mode or self.name, tessellation, blinn, depth_bits, shading)
         t0 = time.perf_counter()
         image, depth, (n, f) = session.draw(scene.camera.with_resolution(width, height),
                                             near=near or None, far=far or None, with_depth=True)
