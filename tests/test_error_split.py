@@ -58,7 +58,7 @@ def test_matched_specs_name_existing_options():
             continue
         m, opts, what = spec
         assert m in available() and set(opts) <= set(get_renderer(m).options) and what
-    assert R.matched_spec("glsl:anything.glsl")[0] == "raycast"
+    assert R.matched_spec("glsl:anything.glsl") is None and "user" in R.matched_reason("glsl:x.glsl")
 
 
 @pytest.mark.gl

@@ -268,9 +268,7 @@ def _what(method: str, scene: Scene) -> str:
 
 def matched_spec(method: str) -> tuple[str, dict, str] | None:
     """``(reference method, options, what it computes)`` matching ``method``'s physics, or None
-    for outside renderers and methods without one (user GLSL models match the raster's)."""
-    if method.startswith("glsl:"):
-        return _RAYCAST_LOCAL
+    for outside renderers and methods without one (a user's GLSL model has no ray-cast twin)."""
     spec = MATCHED.get(method)
     if spec is None:
         return None
@@ -285,6 +283,8 @@ def matched_spec(method: str) -> tuple[str, dict, str] | None:
 
 def matched_reason(method: str) -> str:
     """Why ``method`` has no matched reference (for reports)."""
+    if method.startswith("glsl:"):
+        return "a user's shading model: the ray caster does not evaluate it, no matched reference"
     return OUTSIDE.get(method, "no matched reference for this method")
 
 
