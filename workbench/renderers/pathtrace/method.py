@@ -85,10 +85,10 @@ class PathTraceRenderer:
         timings = dict(ses.timings)
         timings["setup"] = time.perf_counter() - t0 - timings["trace"]
         stats = ses.stats()
-        if ses.std_error is not None:  # kept with the stats' arrays by the reference cache
-            stats["stderr"], stats["stderr_rms"] = ses.std_error, ses.noise_rmse
-        return RenderResult(self.name, ses.image, timings, stats, *self._features(scene, ses),
-                            std_error=ses.std_error)
+        se = ses.std_error
+        if se is not None:  # kept with the stats' arrays by the reference cache
+            stats["stderr"], stats["stderr_rms"] = se, stats["noise_rmse"]
+        return RenderResult(self.name, ses.image, timings, stats, *self._features(scene, ses), std_error=se)
 
     def _features(self, scene: Scene, ses: PathTraceSession):
         needs = scene.needs()
