@@ -283,3 +283,18 @@ def test_eye_sees_the_front_radiance_on_a_back_face(tmp_path):
     b, sb = front.image[1, 1].astype(np.float64), front.std_error[1, 1]
     assert a.sum() > 0.1
     assert np.all(np.abs(a - b) <= 5.0 * np.hypot(sa, sb))
+
+
+def test_noise_image_survives_the_reference_cache(tmp_path):
+    """The per-pixel standard error travels in ``stats["stderr"]`` (and its RMS in
+    ``stderr_rms``), so a cached path-traced reference keeps its noise estimate."""
+    from workbench.compare.reference_cache import cached_render
+    sc = workbench.load_scene("cornell")
+    miss = cached_render(sc, "pathtrace", 8, 8, directory=tmp_path, spp=4, transport="diffuse",
+                         pixel_filter="center")
+    hit = cached_render(sc, "pathtrace", 8, 8, directory=tmp_path, spp=4, transport="diffuse",
+                        pixel_filter="center")
+    assert miss.stats["cache"] == "miss" and hit.stats["cache"] == "hit"
+    assert np.array_equal(hit.stats["stderr"], miss.std_error) and hit.stats["stderr"].max() > 0.0
+    assert hit.stats["stderr_rms"] == pytest.approx(miss.stats["noise_rmse"], rel=1e-12)
+    assert hit.options["transport"] == "diffuse" and hit.options["pixel_filter"] == "center"
