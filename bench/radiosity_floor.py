@@ -75,8 +75,11 @@ def segments(scene) -> dict:
             contacts += [e for e in edges if abs(e[0][1]) < 1e-9 and abs(e[1][1]) < 1e-9]
         elif name in ROOM:
             others = np.concatenate([polys[n] for n in ROOM if n != name])
-            near = lambda p: np.min(np.linalg.norm(others - p, axis=1)) < 5.0  # mm: the box is not square
-            junctions += [e for e in edges if near(e[0]) and near(e[1])]
+            # both ends within 5 mm of another room polygon's corner (the box is not square)
+            shared = [np.min(np.linalg.norm(others - a, axis=1)) < 5.0 and np.min(np.linalg.norm(others - b, axis=1)) < 5.0
+                      for a, b in edges]
+            open_front = [abs(a[2]) < 1e-9 and abs(b[2]) < 1e-9 for a, b in edges]  # the box's open side, z = 0
+            junctions += [e for e, sh, fr in zip(edges, shared, open_front) if sh and not fr]
     return {"contacts": np.array(contacts), "junctions": np.array(junctions)}
 
 
