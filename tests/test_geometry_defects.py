@@ -27,7 +27,6 @@ def test_ear_clipping_covers_the_polygon_exactly(verts):
     assert len(tris) == len(verts) - 2
     total = sum(_area(np.asarray(verts, dtype=np.float64)[t]) for t in tris)
     assert abs(total - _area(verts)) <= 1e-12 * _area(verts)
-    n = np.cross(np.subtract(verts[1], verts[0]), np.subtract(verts[2], verts[0]))
     for t in tris:  # every triangle wound like the polygon (its normal +z)
         a, b, c = np.asarray(verts, dtype=np.float64)[t]
         assert np.cross(b - a, c - a)[2] > 0.0
