@@ -131,3 +131,25 @@ def test_quadric_matrix_checks_at_every_scale(s):
     _refused(_scene(s, {"type": "quadric", "Q": skew, "bounds": bounds}), ".Q", "not symmetric")
     none = [[0.0] * 4 for _ in range(3)] + [[0, 0, 0, -1.0]]
     _refused(_scene(s, {"type": "quadric", "Q": none, "bounds": bounds}), ".Q", "degenerate quadric")
+
+
+@pytest.mark.parametrize("s", [1e-6, 1e6])
+def test_general_quadric_tessellates_to_the_scaled_mesh(s):
+    """A quadric given by Q (hyperboloid of one sheet) scaled by ``s`` tessellates to the mesh
+    of scale 1, scaled.  Before: the level set's gradient floor was ``diagonal * 1e-6`` (a
+    length where a gradient is inverse length), which at 1e6 replaced every gradient and
+    moved the vertices (the phong image covered 864 pixels instead of 859)."""
+    from workbench.scene.tessellate import tessellate_object
+
+    def part(s):
+        a = 1.0 / s ** 2
+        Q = [[a, 0, 0, 0], [0, -a, 0, 0], [0, 0, a, 0], [0, 0, 0, -0.25]]
+        sc = scene_from_dict(_scene(s, {"type": "quadric", "Q": Q, "bounds": {"min": [-s] * 3, "max": [s] * 3}}))
+        (p,) = tessellate_object(sc.objects[0], 3)
+        return p
+
+    ref, got = part(1.0), part(s)
+    assert len(ref.faces) > 100 and np.array_equal(got.faces, ref.faces)
+    # manifold3d hands its points back in float32 (relative rounding 6e-8), at every scale
+    assert np.abs(got.positions / s - ref.positions).max() <= 1e-6
+    assert np.abs(got.normals - ref.normals).max() <= 1e-5
