@@ -1,6 +1,6 @@
 """The path tracer against Mitsuba 3 (``scalar_rgb``) on the Cornell box, same run, same host.
 
-* ``throughput``: ``cornell`` at 256x256, 64 spp, both methods alternating ``--repeat`` times
+* ``throughput``: ``cornell`` at 256x256, 64 spp, the methods alternating ``--repeat`` times
   (numba on 2 threads; Mitsuba's own thread pool, one thread per core: 2 here); per render the
   wall time of the sampling phase (pathtrace ``timings["trace"]``, Mitsuba ``timings["render"]``,
   the ``mi.render`` calls), the CPU seconds of that phase, the whole call's wall time, and the
@@ -16,6 +16,8 @@
   varies from seed to seed), and from ``c`` and the measured sampling time per spp the time
   each method needs to reach the excess RMSE ``c_pathtrace / 8`` (pathtrace at 64 spp), and
   their ratio; the same off the light's own pixels.
+* Each part runs ``pathtrace`` (default: Russian roulette from the 3rd bounce), ``mitsuba``
+  (``scalar_rgb``, Russian roulette from depth 5) and ``pathtrace_rr5`` (``rr_start = 5``).
 * ``reference``: the pathtrace image of ``cornell`` at 256x256 run to the noise level
   ``--target`` (RMS of the per-pixel standard error), timed (wall and CPU), load average.
 
@@ -37,6 +39,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 OUT = ROOT / "bench" / "results" / "pathtrace_vs_mitsuba.json"
 THREADS = 2
+#: What is compared: label -> (method, options).  ``pathtrace_rr5`` starts Russian roulette at
+#: the 5th bounce, as Mitsuba's path integrator does (the method's default is the 3rd).
+VARIANTS = {"pathtrace": ("pathtrace", {}), "mitsuba": ("mitsuba", {"variant": "scalar_rgb"}),
+            "pathtrace_rr5": ("pathtrace", {"rr_start": 5})}
 
 
 def load() -> float:
@@ -50,16 +56,14 @@ def sample_time(r) -> tuple[float, float]:
     return r.timings["render"], r.stats["render_cpu_seconds"]
 
 
-def render(scene, method: str, size: int, spp: int, seed: int):
+def render(scene, label: str, size: int, spp: int, seed: int):
     import workbench
-    opts = {"seed": seed}
-    if method == "mitsuba":
-        opts["variant"] = "scalar_rgb"
+    method, opts = VARIANTS[label]
     l0 = load()
-    r = workbench.render(scene, method, width=size, height=size, spp=spp, **opts)
+    r = workbench.render(scene, method, width=size, height=size, spp=spp, seed=seed, **opts)
     wall, cpu = sample_time(r)
     n = spp * size * size
-    return r, {"method": method, "spp": spp, "size": size, "sample_wall_s": round(wall, 3),
+    return r, {"method": label, "spp": spp, "size": size, "sample_wall_s": round(wall, 3),
                "sample_cpu_s": round(cpu, 3), "call_wall_s": round(r.timings["total"], 3),
                "samples_per_s": round(n / wall), "samples_per_cpu_s": round(n / cpu),
                "load_before": l0, "load_after": load()}
@@ -68,13 +72,13 @@ def render(scene, method: str, size: int, spp: int, seed: int):
 def throughput(scene, size: int, spp: int, repeat: int) -> dict:
     runs = []
     for k in range(repeat):
-        for m in ("pathtrace", "mitsuba"):
+        for m in VARIANTS:
             runs.append(render(scene, m, size, spp, seed=k)[1])
-    best = {m: max((e for e in runs if e["method"] == m), key=lambda e: e["samples_per_s"])
-            for m in ("pathtrace", "mitsuba")}
+    best = {m: max((e for e in runs if e["method"] == m), key=lambda e: e["samples_per_s"]) for m in VARIANTS}
     return {"scene": scene.name, "size": size, "spp": spp, "threads": THREADS, "runs": runs, "best": best,
             "ratio_samples_per_s": best["pathtrace"]["samples_per_s"] / best["mitsuba"]["samples_per_s"],
-            "ratio_samples_per_cpu_s": best["pathtrace"]["samples_per_cpu_s"] / best["mitsuba"]["samples_per_cpu_s"]}
+            "ratio_samples_per_cpu_s": best["pathtrace"]["samples_per_cpu_s"] / best["mitsuba"]["samples_per_cpu_s"],
+            "ratio_samples_per_s_rr5": best["pathtrace_rr5"]["samples_per_s"] / best["mitsuba"]["samples_per_s"]}
 
 
 def equal_rmse(scene, size: int, ref_spp: int, spps=(16, 64, 256), seeds=(7, 8, 9)) -> dict:
@@ -93,7 +97,7 @@ def equal_rmse(scene, size: int, ref_spp: int, spps=(16, 64, 256), seeds=(7, 8, 
     per: dict = {}
     for spp in spps:
         for seed in seeds:
-            for m in ("pathtrace", "mitsuba"):
+            for m in VARIANTS:
                 r, e = render(scene, m, size, spp, seed=seed)
                 err2 = (r.image.astype(np.float64) - ref.image) ** 2
                 mse, mse_off = float(np.mean(err2)), float(np.mean(err2[off]))
@@ -116,12 +120,15 @@ def equal_rmse(scene, size: int, ref_spp: int, spps=(16, 64, 256), seeds=(7, 8, 
         f.update(spp_to_target=spp_needed, wall_s_to_target=spp_needed * f["wall_s_per_spp"],
                  cpu_s_to_target=spp_needed * f["cpu_s_per_spp"],
                  efficiency_per_cpu_s=1.0 / (f["c"] ** 2 * f["cpu_s_per_spp"]))
-    P, M = fit["pathtrace"], fit["mitsuba"]
-    out.update(target_excess_rmse=target, fit=fit,
-               ratio_wall_time_to_equal_rmse_pathtrace_over_mitsuba=P["wall_s_to_target"] / M["wall_s_to_target"],
-               ratio_cpu_time_to_equal_rmse_pathtrace_over_mitsuba=P["cpu_s_to_target"] / M["cpu_s_to_target"],
-               ratio_cpu_time_to_equal_rmse_off_light=(P["c_off_light"] ** 2 * P["cpu_s_per_spp"])
-               / (M["c_off_light"] ** 2 * M["cpu_s_per_spp"]))
+    M = fit["mitsuba"]
+    ratios = {}
+    for m in ("pathtrace", "pathtrace_rr5"):
+        P = fit[m]
+        ratios[m] = {"wall_time_to_equal_rmse_over_mitsuba": P["wall_s_to_target"] / M["wall_s_to_target"],
+                     "cpu_time_to_equal_rmse_over_mitsuba": P["cpu_s_to_target"] / M["cpu_s_to_target"],
+                     "cpu_time_to_equal_rmse_off_light_over_mitsuba":
+                         (P["c_off_light"] ** 2 * P["cpu_s_per_spp"]) / (M["c_off_light"] ** 2 * M["cpu_s_per_spp"])}
+    out.update(target_excess_rmse=target, fit=fit, ratios=ratios)
     return out
 
 
