@@ -4,8 +4,8 @@ Cornell box and the Cornell box with a mirror and a glass sphere.
 One image definition on both sides: a pixel is the box-filtered average of the radiance over
 its square (pathtrace: uniform jitter; Mitsuba: ``box`` reconstruction filter), linear RGB,
 not clipped.  Both describe the same scene: no Phong lobe (ks = 0 in both scenes, checked: a
-scene with ks > 0 would be compared on a copy with ks = 0, Mitsuba has no normalised Phong
-lobe), no ambient term (ka = 0 and a black ambient), the glass with the exact Fresnel split
+scene with ks > 0 would have to be compared on a copy with ks = 0, Mitsuba has no normalised
+Phong lobe), no ambient term (ka = 0 and a black ambient), the glass with the exact Fresnel split
 (pathtrace ``fresnel = "exact"`` = Mitsuba's ``dielectric``), the area light emitting from
 its front face and black (a black BSDF in the export, an opaque black surface in the path
 tracer); each side's ``left_out`` is checked to hold nothing else.
@@ -18,8 +18,6 @@ estimate, and the mean radiance within 1 % where the test's own noise makes 1 % 
 least 3 standard errors (off the light's own pixels; all pixels where the noise allows).
 """
 from __future__ import annotations
-
-from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -39,17 +37,11 @@ ALLOWED_LEFT_OUT = {"pathtrace": ("ambient: off",),
                     "mitsuba": ("refraction: exact Fresnel split only",)}
 
 
-def same_physics(scene):
-    """The scene as both methods can describe it: the Phong lobe removed (ks = 0) where a
-    material has one (Mitsuba has no normalised Phong BSDF); the bundled Cornell scenes have
-    none, so they come back unchanged."""
-    if all(mt.ks == 0.0 for mt in scene.materials.values()):
-        return scene
-    return replace(scene, materials={k: replace(mt, ks=0.0) for k, mt in scene.materials.items()})
-
-
-def compare_scene(name: str, size: int, spp: int, block: int = 4) -> tuple[dict, dict]:
-    scene = same_physics(workbench.load_scene(name))
+def compare_scene(name: str, size: int, spp: int, block: int = 4) -> dict:
+    scene = workbench.load_scene(name)
+    # no Phong lobe (Mitsuba has no normalised Phong BSDF): a scene with ks > 0 would be
+    # compared on a copy with ks = 0; the Cornell scenes have none
+    assert all(mt.ks == 0.0 for mt in scene.materials.values())
     pt = workbench.render(scene, "pathtrace", width=size, height=size, spp=spp, seed=1, fresnel="exact")
     mi = workbench.render(scene, "mitsuba", width=size, height=size, spp=spp, seed=0)
     for method, res in (("pathtrace", pt), ("mitsuba", mi)):
@@ -57,7 +49,7 @@ def compare_scene(name: str, size: int, spp: int, block: int = 4) -> tuple[dict,
         assert not extra, f"{method} leaves out part of {name}: {extra}"
     st = ag.noise_agreement(pt.image, pt.std_error, spp - 1, mi.image, mi.stats["stderr"], 1,
                             block=block, exclude=ag.light_pixels(scene, size, size))
-    return st, {"pathtrace": pt, "mitsuba": mi}
+    return st
 
 
 def check_agreement(st: dict) -> None:
@@ -85,23 +77,24 @@ def test_export_gives_the_area_light_a_black_bsdf_and_both_sides_the_same_glass(
 
 
 def test_pathtrace_agrees_with_mitsuba_on_cornell():
-    st, _ = compare_scene("cornell", 48, 256)
+    st = compare_scene("cornell", 48, 256)
     check_agreement(st)
 
 
 def test_pathtrace_agrees_with_mitsuba_on_cornell_spheres_exact_fresnel():
-    st, _ = compare_scene("cornell_spheres", 40, 2048)
+    st = compare_scene("cornell_spheres", 40, 2048)
     check_agreement(st)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name,spp", [("cornell", 1024), ("cornell_spheres", 4096)])
 def test_pathtrace_agrees_with_mitsuba_at_64x64(name, spp):
-    st, _ = compare_scene(name, 64, spp)
+    st = compare_scene(name, 64, spp)
+    print(name, spp, {k: v for k, v in st.items() if not isinstance(v, dict)}, st["mean"], st["mean_off"])
     check_agreement(st)
 
 
-def test_the_statistics_see_a_one_percent_bias():
+def test_the_statistics_see_a_two_percent_bias():
     """The same noisy images, one scaled by 1.02: the block chi-square and the mean leave their
     bands (the statistics can fail), while the unscaled pair stays inside."""
     rng = np.random.default_rng(3)
