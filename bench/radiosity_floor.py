@@ -278,15 +278,15 @@ def table(out: dict) -> str:
 
     a, b, f = out["reference"], out["b_pixel_filter"], out["f_missing_physics"]
     n = len(ps)
-    lines = [f"| component | measured as (RMSE of the difference image, clipped to [0, 1]) | "
+    lines = ["| component | measured as (RMSE of the difference image, clipped to [0, 1]) | "
              + " | ".join(f"patch_size {p}" for p in ps) + " |",
              "|---|---|" + "---|" * n,
-             f"| | patches | " + " | ".join(str(R[p]["patches"]) for p in ps) + " |",
+             "| | patches | " + " | ".join(str(R[p]["patches"]) for p in ps) + " |",
              row("total (issue 13)", "radiosity vs Mitsuba 3, 4096 spp, box (quoted)", "total_vs_mitsuba_issue13"),
              row("total", f"radiosity vs `pathtrace`, {out['spp']} spp, box", "total_vs_reference"),
              row("total off the light", f"the same over the pixels off the light (all but {out['masks_pixels']['light']})",
                  "total_vs_reference_off_light"),
-             f"| (a) reference noise | RMS per-pixel standard error of the reference (pixels below 1) | "
+             "| (a) reference noise | RMS per-pixel standard error of the reference (pixels below 1) | "
              + " | ".join([f"{a['noise_rmse_clipped']:.4f}"] * n) + " |",
              f"| (b) pixel filter | `pixel_filter=center` vs `box` path tracer (noise of that difference "
              f"{b['noise_of_that_difference']:.4f}) | " + " | ".join([f"{b['rmse_center_vs_box']:.4f}"] * n) + " |",
