@@ -46,10 +46,10 @@ import numpy as np
 from ..core.errors import WorkbenchError
 from ..scene import model as m
 
-#: Two-sided tail probabilities P(|T| > 3) of the reference distributions named above.
-P_Z3_GAUSS = math.erfc(3.0 / math.sqrt(2.0))
+#: P(|t_1| > 3) for Student's t with 1 degree of freedom (Cauchy): the largest fraction of
+#: pixel values with |z| > 3 two agreeing images give when one side's noise estimate has one
+#: degree of freedom.
 P_Z3_T1 = 1.0 - 2.0 * math.atan(3.0) / math.pi
-P_Z3_T2 = 1.0 - 3.0 / math.sqrt(11.0)
 #: Width of the acceptance bands in standard deviations.
 BAND_SD = 4.0
 
@@ -90,17 +90,28 @@ def _mean_part(a, b, s2, keep) -> dict:
 
 def noise_agreement(a, se_a, dof_a: float, b, se_b, dof_b: float, *, block: int = 4,
                     exclude: np.ndarray | None = None) -> dict:
-    """The statistics of the module docstring for images ``a, b`` (H, W, 3) with standard
-    errors ``se_a, se_b`` (H, W, 3) of ``dof_a, dof_b`` degrees of freedom.
+    """The statistics of the module docstring.
 
-    ``block`` : block edge in pixels (H and W are cut to multiples of it for the block test).
-    ``exclude`` : (H, W) bool, pixels left out of the ``mean_off`` part (e.g.
-    :func:`light_pixels`); every other statistic uses all pixels.
+    Parameters
+    ----------
+    a, b : (H, W, 3) the two images (box-filtered pixel averages, linear, not clipped).
+    se_a, se_b : (H, W, 3) their per-pixel standard errors.
+    dof_a, dof_b : degrees of freedom of those estimates (>= 1).
+    block : block edge in pixels for the block test (H and W are cut to multiples of it).
+    exclude : (H, W) bool or None, pixels left out of the ``mean_off`` part (e.g.
+        :func:`light_pixels`); every other statistic uses all pixels.
 
-    Returns a dict: ``ratio, ratio_sd, ratio_ok, n_eff, zero_noise_values, frac_abs_z_gt_3``,
-    ``block_chi2, block_chi2_band, block_count, block_frac_abs_z_gt_3, block_chi2_ok``,
-    ``mean`` (all pixels) and ``mean_off`` (without ``exclude``), each with ``rel_diff`` and
-    ``rel_diff_se``.
+    Returns
+    -------
+    dict with ``ratio, ratio_sd, ratio_ok, n_eff, frac_abs_z_gt_3`` (pixel level),
+    ``block_count, block_chi2, block_chi2_band, block_chi2_ok, block_frac_abs_z_gt_3``,
+    ``zero_noise_values, max_abs_diff_at_zero_noise``, and ``mean`` (all pixels) and
+    ``mean_off`` (without ``exclude``), each ``{pixels, mean_a, mean_b, rel_diff, rel_diff_se}``.
+
+    Raises
+    ------
+    WorkbenchError
+        Shapes that differ, non-finite values, dof < 1, a block larger than the image.
     """
     a = np.asarray(a, dtype=np.float64)
     if a.ndim != 3 or a.shape[2] != 3:
