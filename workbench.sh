@@ -44,6 +44,7 @@ echo "   every method applies, judged against the converged path tracer; its ref
 echo "   (the first run also compiles the numba kernels, a minute or two; later runs load them from .numba_cache)"
 .venv/bin/workbench study whitted --quick --out out/report
 .venv/bin/workbench compare whitted --out out/report
-.venv/bin/workbench study cornell_spheres --quick --out out/report_cornell_spheres
-.venv/bin/workbench compare cornell_spheres --size 256x256 --out out/report_cornell_spheres
+# (same size for both: the comparison reads the study's path-traced references back from the cache)
+.venv/bin/workbench study cornell_spheres --quick --size 128x128 --methods phong,raycast,raytrace,radiosity,hybrid,pathtrace --out out/report_cornell_spheres
+.venv/bin/workbench compare cornell_spheres --size 128x128 --out out/report_cornell_spheres
 echo "== reports: $PWD/out/report/report.html and $PWD/out/report_cornell_spheres/report.html"
