@@ -63,6 +63,9 @@ SAMPLE_BUDGET = 1 << 25
 """Path-traced samples (pixels x spp) a reference may take: about a minute on two cores here (the
 reference then states the noise it reached)."""
 PILOT_SPP = 16
+MAX_SPP = 4096
+"""Most samples per pixel of a path-traced reference (small images would otherwise spend the
+whole sample budget on the few pixels that straddle a light's edge)."""
 
 #: method -> (reference method, options, what that reference computes).  A matched reference is
 #: the limit of the method along its knob: methods that sample pixel centres whatever their knob
@@ -178,7 +181,7 @@ def _converged_pathtrace(scene: Scene, width: int, height: int, options: dict,
     noise = display_noise(pilot.result.std_error, pilot.image)
     need = PILOT_SPP * max(1.0, (noise / target) ** 2)
     spp = 1 << math.ceil(math.log2(need))
-    while spp > PILOT_SPP and spp * width * height > budget:
+    while spp > PILOT_SPP and (spp * width * height > budget or spp > MAX_SPP):
         spp //= 2
     if spp == PILOT_SPP:
         return pilot, noise

@@ -64,6 +64,7 @@ import numpy as np
 from numba import prange
 
 from ..raytrace.kernels import (MAX_TASKS, NO_REFCOUNT, _feeler, _light_dir, checker_color, closest,
+                                fresnel_reflectance,
                                 scratch, surface)
 
 BLOCK = 32
@@ -389,15 +390,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                 tx, ty, tz = _unit(eta * dx + (eta * cf - cost) * fx, eta * dy + (eta * cf - cost) * fy,
                                    eta * dz + (eta * cf - cost) * fz)
                 if fres > 0:
-                    if fres == 1:
-                        r0 = (n1 - n2) / (n1 + n2)
-                        r0 *= r0
-                        cc = cf if n1 <= n2 else cost
-                        F = r0 + (1.0 - r0) * (1.0 - cc) ** 5
-                    else:
-                        rs = (n1 * cf - n2 * cost) / (n1 * cf + n2 * cost)
-                        rp = (n2 * cf - n1 * cost) / (n2 * cf + n1 * cost)
-                        F = 0.5 * (rs * rs + rp * rp)
+                    F = fresnel_reflectance(fres, n1, n2, cf, cost)
                     a_r, a_t = a_r + a_t * F, a_t * (1.0 - F)
         lobes = m_nd + a_r + a_t
         if lobes <= 0.0:

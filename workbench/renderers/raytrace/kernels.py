@@ -834,6 +834,22 @@ def _ior(mat_tab, stk, ns_):
 
 
 @nb.njit(error_model="numpy", inline="always")
+def fresnel_reflectance(fres, n1, n2, cosi, cost):
+    """Reflected share F of light crossing from index ``n1`` to ``n2`` (``cosi``, ``cost``: the
+    cosines of incidence and refraction): Schlick's approximation for ``fres == 1`` (cosine on the
+    lower-index side; Schlick 1994), else the exact unpolarised Fresnel equations (mean of the
+    s and p reflectances)."""
+    if fres == 1:
+        r0 = (n1 - n2) / (n1 + n2)
+        r0 *= r0
+        cc = cosi if n1 <= n2 else cost
+        return r0 + (1.0 - r0) * (1.0 - cc) ** 5
+    rs = (n1 * cosi - n2 * cost) / (n1 * cosi + n2 * cost)
+    rp = (n2 * cosi - n1 * cost) / (n2 * cosi + n1 * cost)
+    return 0.5 * (rs * rs + rp * rp)
+
+
+@nb.njit(error_model="numpy", inline="always")
 def _facing(nsh, i, dx, dy, dz):
     """The shading normal of hit ``i``, turned to face the viewer (two-sided shading)."""
     nx, ny, nz = nsh[i, 0], nsh[i, 1], nsh[i, 2]
@@ -1055,15 +1071,7 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
                                     eta * dy + (eta * cosi - cost) * fy,
                                     eta * dz + (eta * cosi - cost) * fz)
             if fres > 0:
-                if fres == 1:
-                    r0 = (n1 - n2) / (n1 + n2)
-                    r0 *= r0
-                    cc = cosi if n1 <= n2 else cost
-                    F = r0 + (1.0 - r0) * (1.0 - cc) ** 5
-                else:
-                    rs = (n1 * cosi - n2 * cost) / (n1 * cosi + n2 * cost)
-                    rp = (n2 * cosi - n1 * cost) / (n2 * cosi + n1 * cost)
-                    F = 0.5 * (rs * rs + rp * rp)
+                F = fresnel_reflectance(fres, n1, n2, cosi, cost)
                 wr, wt = kr + kt * F, kt * (1.0 - F)
     for branch in range(2):
         kb = wr if branch == 0 else wt
