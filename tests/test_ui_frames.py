@@ -135,20 +135,65 @@ def test_job_restarts_wait_for_the_request_to_settle():
     board = JobBoard(settle=0.3)
     c0 = scene.camera.with_resolution(16, 16)
     first = board.request(scene, c0, "raycast", {}, tiled=True)
-    assert len(board.started) == 1 and not first.cancelled.is_set()
+    assert board.count == 1 and not first.cancelled.is_set()
     first.thread.join(60)
     t0 = time.perf_counter()
     for k in range(1, 4):  # three different cameras in a row: the first job is cancelled
         job = board.request(scene, cam.orbit(c0, 0.1 * k, 0.0), "raycast", {}, tiled=True)
         assert job is first and first.cancelled.is_set()
-    assert len(board.started) == 1 and board.busy()  # a restart is pending
+    assert board.count == 1 and board.busy()  # a restart is pending
     last = cam.orbit(c0, 0.3, 0.0)
     while board.request(scene, last, "raycast", {}, tiled=True) is first:
         time.sleep(0.01)
-    assert time.perf_counter() - t0 >= 0.3 and len(board.started) == 2
+    assert time.perf_counter() - t0 >= 0.3 and board.count == 2
     assert board.current["raycast"].key[1] == last
     board.join_all(60)
     assert not any(j.thread.is_alive() for j in board.started)
+
+
+def test_job_board_forgets_ended_jobs_and_notifies():
+    """A long session starts hundreds of jobs: the board keeps only the current ones and those
+    still running (each holds its scene and images), and ``notify`` is called from the job's
+    thread when tiles and the image arrive (the window wakes its idle loop with it)."""
+    import threading
+
+    from workbench.app.ui.jobs import JobBoard
+    scene = workbench.load_scene("whitted")
+    calls = []
+    board = JobBoard(notify=lambda: calls.append(threading.current_thread().name))
+    c0 = scene.camera.with_resolution(8, 8)
+    for k in range(12):
+        job = board.request(scene, cam.orbit(c0, 0.05 * k, 0.0), "raycast", {}, tiled=True)
+        job.thread.join(60)
+        assert job.image is not None
+        board.request(scene, cam.orbit(c0, 0.05 * k, 0.0), "raycast", {}, tiled=True)
+    assert board.count == 12 and len(board.started) == 1
+    assert board.started[0] is board.current["raycast"]
+    assert len(calls) >= 12 and set(calls) == {"ui-job-raycast"}
+    board.join_all(60)
+
+
+def test_a_request_back_at_a_cancelled_job_starts_it_again():
+    """The error plot's reference stayed on "rendering the reference..." after a drag and a
+    camera reset: the reset camera's request matched the job cancelled by the drag, and the
+    board kept answering with that stopped job.  Now a cancelled job that had not ended is
+    started again; one that had ended gives its image (and is no longer counted busy)."""
+    from workbench.app.ui.jobs import JobBoard
+    scene = workbench.load_scene("whitted")
+    board = JobBoard()
+    c0 = scene.camera.with_resolution(64, 64)
+    first = board.request(scene, c0, "raytrace", {}, tiled=True)
+    first.cancelled.set()  # the camera moved away (the plot's track cancels)
+    first.thread.join(60)
+    assert first.image is None
+    again = board.request(scene, c0, "raytrace", {}, tiled=True)  # camera reset
+    assert again is not first and not again.cancelled.is_set()
+    again.thread.join(60)
+    assert again.image is not None
+    again.cancelled.set()  # cancelled after it ended
+    assert board.request(scene, c0, "raytrace", {}, tiled=True) is again
+    assert not board.busy()
+    board.join_all(60)
 
 
 def test_probe_reads_one_pixel_not_the_panel(gpu_session):

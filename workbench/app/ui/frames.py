@@ -397,6 +397,16 @@ def update_images(state: AppState) -> None:
             refresh_cpu(state, m)
 
 
+def in_progress(state: AppState) -> bool:
+    """Something on screen changes by itself this frame: a background job or the pyrender child
+    is working, the error plot waits for its reference or evaluations, or a GL panel has edited
+    values still to compile back in.  The loop then runs at full rate (capped while a job runs,
+    :func:`.main.frame_rest`); otherwise it idles."""
+    proc = state.pyrender
+    return (state.jobs.busy() or (proc is not None and proc.busy) or state.errors.busy(state.frame)
+            or (state.gpu is not None and any(p.session.live for p in state.gpu.raster.values())))
+
+
 def panel_texture(state: AppState, method: str):
     """The RGBA8 texture showing ``method``'s panel through its display mode; rebuilt only
     when the image or the mode changed."""

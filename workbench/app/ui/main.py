@@ -18,6 +18,10 @@ from ..args import size
 from .state import AppState, new_state
 
 WINDOW_SIZE = (1280, 760)
+IDLE_FPS = 3.0
+"""Frames per second while nothing changes and no input comes (hello_imgui's idling: it sleeps
+between frames; an input event, :func:`hello_imgui.request_refresh` from a background job that
+delivers, or :func:`.frames.in_progress` wakes it at once)."""
 
 
 def frame_rest(last: float | None, now: float, cap: float, job_running: bool) -> float:
@@ -39,7 +43,7 @@ def run(state: AppState, max_frames: int | None = None, script=None,
 
     from ...renderers import gl
     from . import window_style
-    from .frames import blit_panels, release_gl, update_images
+    from .frames import blit_panels, in_progress, release_gl, update_images
     from .layout import docking_params
     from .panels import status_bar
     from .plot import track
@@ -49,6 +53,7 @@ def run(state: AppState, max_frames: int | None = None, script=None,
         state.ctx = moderngl.create_context()  # the window's current GLFW context
         gl.use_context(state.ctx)
         state.gl_renderer = gl.renderer_name(state.ctx)
+        state.jobs.notify = hello_imgui.request_refresh  # a job's new tiles wake the loop
 
     def show_gui():
         now = time.perf_counter()
@@ -63,6 +68,8 @@ def run(state: AppState, max_frames: int | None = None, script=None,
         track(state)
         if script is not None:
             script(state)
+        if in_progress(state) or getattr(script, "keeps_awake", script is not None):
+            hello_imgui.request_refresh()
 
     def end_frame():  # after every dockable window's gui, before ImGui renders
         state.gui_seconds = time.perf_counter() - clock["t"]
@@ -77,7 +84,8 @@ def run(state: AppState, max_frames: int | None = None, script=None,
     params = hello_imgui.RunnerParams()
     params.app_window_params.window_title = f"workbench ui: {state.scene_path.stem}"
     params.app_window_params.window_geometry.size = window
-    params.fps_idling.enable_idling = False
+    params.fps_idling.enable_idling = True
+    params.fps_idling.fps_idle = IDLE_FPS
     # hello_imgui asks for an 8x multisampled window by default: on llvmpipe that makes every
     # frame ~4x dearer (imgui anti-aliases its own shapes and text without it)
     params.renderer_backend_options.open_gl_options.anti_aliasing_samples = 0

@@ -57,8 +57,16 @@ class ErrorPlot:
     failed: dict = field(default_factory=dict)
     metric: str = "rmse"
     shown: int = -2
+    gave_up: bool = False
     board: object = None
     pool: ProcessPoolExecutor | None = None
+
+    def busy(self, frame: int) -> bool:
+        """Something will arrive without any input: evaluations in the worker, or, while the
+        plot is shown (drawn in frame ``frame`` or the one before), its reference."""
+        if self.pending:
+            return True
+        return self.shown >= frame - 1 and self.ref_image is None and not self.gave_up
 
     def shutdown(self) -> None:
         """Cancel the reference render and end the worker process (joined)."""
@@ -112,7 +120,7 @@ def _reference(state: AppState, plot: ErrorPlot) -> np.ndarray | None:
             break
         plot.candidates.pop(0)  # does not apply to this scene: the next in the rule's order
     else:
-        plot.message = "no reference: no method renders this scene"
+        plot.message, plot.gave_up = "no reference: no method renders this scene", True
         return None
     if job.image is None:
         plot.message = f"rendering the reference ({plot.reference} {plot.ref_options})..."
@@ -137,6 +145,7 @@ def track(state: AppState) -> None:
             for job in plot.board.current.values():
                 job.cancelled.set()
         plot.key, plot.since, plot.ref_image, plot.candidates = key, time.perf_counter(), None, []
+        plot.gave_up = False
         plot.points, plot.pending, plot.failed = {}, {}, {}
     for (m, opts), fut in list(plot.pending.items()):
         if fut.done():
