@@ -18,7 +18,7 @@ from ..args import size
 from .state import AppState, new_state
 
 WINDOW_SIZE = (1280, 760)
-IDLE_FPS = 3.0
+IDLE_FPS = 2.0
 """Frames per second while nothing changes and no input comes (hello_imgui's idling: it sleeps
 between frames; an input event, :func:`hello_imgui.request_refresh` from a background job that
 delivers, or :func:`.frames.in_progress` wakes it at once)."""
@@ -123,16 +123,20 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m workbench.app.ui.main")
     p.add_argument("scene", nargs="?", default="whitted")
     p.add_argument("--methods", default="", help="comma-separated, 1 to 6")
-    p.add_argument("--size", type=int, default=256, help="panel width and height in pixels")
+    p.add_argument("--size", type=int, default=256,
+                   help="panel resolution: pixels along the longer side (the other side keeps "
+                        "the scene camera's aspect)")
     p.add_argument("--frames", type=int, default=None, help="stop after this many frames")
     p.add_argument("--window", type=size, default=WINDOW_SIZE, metavar="WxH",
                    help="window size in pixels (default %(default)s)")
     p.add_argument("--test-script", default=None, help="check or fps (see scripts.py)")
     p.add_argument("--out", type=Path, default=None, help="folder for the script's outputs")
     args = p.parse_args(argv)
+    if not 8 <= args.size <= 4096:
+        p.error(f"--size {args.size}: the panels' resolution must be 8 to 4096 pixels")
     from .scripts import SCRIPTS
     state = new_state(args.scene, [m for m in args.methods.split(",") if m] or None,
-                      (args.size, args.size))
+                      args.size)
     script = None
     if args.test_script:
         args.out = args.out or Path("out/ui")
@@ -148,7 +152,7 @@ def main(argv: list[str] | None = None) -> int:
             Image.fromarray(shot[..., :3]).save(args.out / "ui.png")
         summary = {"frames": state.frame, "seconds": time.perf_counter() - t0,
                    "gl_renderer": state.gl_renderer, "methods": state.methods,
-                   "scene": state.scene_path.stem, "panel_size": list(state.panel_size),
+                   "scene": state.scene_path.stem, "panel_size": [state.camera.width, state.camera.height],
                    "timings": state.timings,
                    "threads": [t.name for t in threading.enumerate()],
                    "child_processes": [c.name for c in multiprocessing.active_children()],

@@ -10,8 +10,8 @@ from .frames import (difference_on_gpu, image_stats, panel_texture, show_image, 
 from .inspect import export, pixel_under_mouse, probe_tooltip, select_ray_tree
 from .layout import focus
 from .patch_view import select_patch
-from .state import (DISPLAY_MODES, HARMONIES, MATERIAL_FIELDS, MAX_PANELS, AppState,
-                    choosable_methods, set_display, set_material_value, set_option, set_scene)
+from .state import (DISPLAY_MODES, HARMONIES, MATERIAL_FIELDS, AppState, choosable_methods,
+                    set_display, set_material_value, set_option, set_scene, toggle_method)
 
 ORBIT_SPEED = 0.01
 """Radians of orbit per pixel of mouse drag."""
@@ -63,17 +63,17 @@ def scene_picker(state: AppState) -> None:
 
 
 def method_list(state: AppState) -> None:
-    """Checkboxes over the methods (1 to 6 selected), two per row."""
+    """Checkboxes over the methods (1 to 6 selected), two per row; a refused change says why."""
     for k, m in enumerate(choosable_methods()):
         if k % 2:
             imgui.same_line(imgui.get_window_width() / 2)
-        on = m in state.methods
-        changed, on = imgui.checkbox(m, on)
+        changed, on = imgui.checkbox(m, m in state.methods)
         if changed:
-            if on and len(state.methods) < MAX_PANELS:
-                state.methods.append(m)
-            elif not on and len(state.methods) > 1:
-                state.methods.remove(m)
+            toggle_method(state, m, on)
+    if "methods" in state.status:
+        imgui.push_text_wrap_pos(0.0)
+        imgui.text_colored(imgui.ImVec4(1.0, 0.6, 0.3, 1.0), state.status["methods"])
+        imgui.pop_text_wrap_pos()
 
 
 def parameters(state: AppState) -> None:
@@ -110,39 +110,64 @@ def handle_mouse(state: AppState) -> None:
         return
     io = imgui.get_io()
     dx, dy = io.mouse_delta.x, io.mouse_delta.y
+    size = imgui.get_item_rect_size()  # the image as shown (scaled from the camera's pixels)
     if io.key_ctrl:  # Ctrl+click selects a pixel, no camera move
         return
     if io.key_shift:  # Shift: linked 2D zoom (wheel) and pan (left drag) of all panels
         lo, mouse = imgui.get_item_rect_min(), imgui.get_mouse_pos()
         (u0, v0), (u1, v1) = cam.view_window(state.view)
-        fx, fy = (mouse.x - lo.x) / state.camera.width, (mouse.y - lo.y) / state.camera.height
+        fx, fy = (mouse.x - lo.x) / size.x, (mouse.y - lo.y) / size.y
         if io.mouse_wheel:
             at = (u0 + fx * (u1 - u0), v0 + fy * (v1 - v0))
             state.view = cam.zoom_view(state.view, 1.25 ** io.mouse_wheel, at)
         if imgui.is_mouse_dragging(imgui.MouseButton_.left) and (dx or dy):
-            state.view = cam.pan_view(state.view, dx / state.camera.width,
-                                      dy / state.camera.height)
+            state.view = cam.pan_view(state.view, dx / size.x, dy / size.y)
         return
     if imgui.is_mouse_dragging(imgui.MouseButton_.left) and (dx or dy):
         state.camera = cam.orbit(state.camera, -dx * ORBIT_SPEED, dy * ORBIT_SPEED)
     elif imgui.is_mouse_dragging(imgui.MouseButton_.right) and (dx or dy):
-        h = state.camera.height
-        state.camera = cam.pan(state.camera, -dx / h, dy / h)
+        state.camera = cam.pan(state.camera, -dx / size.y, dy / size.y)
     if io.mouse_wheel:
         state.camera = cam.zoom(state.camera, ZOOM_STEP ** io.mouse_wheel)
 
 
+def fit_text(text: str, width: float) -> str:
+    """``text`` cut to ``width`` pixels of the current font (an ellipsis marks the cut)."""
+    if imgui.calc_text_size(text).x <= width:
+        return text
+    lo, hi = 0, len(text)
+    while lo < hi:  # the longest prefix that fits with its ellipsis
+        mid = (lo + hi + 1) // 2
+        if imgui.calc_text_size(text[:mid] + "...").x <= width:
+            lo = mid
+        else:
+            hi = mid - 1
+    return text[:lo] + "..."
+
+
+def text_in_width(text: str, width: float, disabled: bool = False) -> None:
+    """One line of ``text`` cut to ``width`` pixels; the whole text as a tooltip when cut."""
+    shown = fit_text(text, width)
+    (imgui.text_disabled if disabled else imgui.text)(shown)
+    if shown != text and imgui.is_item_hovered():
+        imgui.set_tooltip(text)
+
+
 def image_panels(state: AppState) -> None:
-    """One image per selected method, side by side, wrapping to the available width."""
-    w, h = state.camera.width, state.camera.height
-    avail = imgui.get_content_region_avail().x
-    per_row = max(1, int(avail // (w + 8)))
+    """One image per selected method at the scene camera's aspect, as large as the window
+    allows, in as many rows as fit best (:func:`~.layout.panel_grid`); each image is shown
+    scaled from the panels' render resolution."""
+    from .layout import PANEL_GAP, PANEL_LINES, panel_grid
+    avail = imgui.get_content_region_avail()
+    chrome = PANEL_LINES * imgui.get_frame_height_with_spacing()
+    cols, w, h = panel_grid(len(state.methods), avail.x, avail.y,
+                            state.camera.width / state.camera.height, chrome)
     for k, m in enumerate(state.methods):
-        if k % per_row:
-            imgui.same_line()
+        if k % cols:
+            imgui.same_line(0, PANEL_GAP)
         imgui.begin_group()
         t = state.timings.get(m)
-        imgui.text(f"{m}  {'' if t is None else f'{t * 1e3:.1f} ms'}")
+        text_in_width(f"{m}  {'' if t is None else f'{t * 1e3:.1f} ms'}", w)
         if m in state.images:
             tex = panel_texture(state, m)
             show_image(state, m, tex, imgui.ImVec2(w, h), *cam.view_window(state.view))
@@ -158,7 +183,9 @@ def image_panels(state: AppState) -> None:
                         and imgui.is_mouse_clicked(imgui.MouseButton_.left)):
                     select_patch(state, *ij)
                     focus("Patch view")
-        imgui.text_disabled(state.status.get(m, "")[:40])
+        else:
+            imgui.dummy(imgui.ImVec2(w, h))
+        text_in_width(state.status.get(m, ""), w, disabled=True)
         mode = state.display.get(m, "direct24")
         modes = list(DISPLAY_MODES) if mode in DISPLAY_MODES else [mode, *DISPLAY_MODES]
         imgui.set_next_item_width(w)
@@ -175,13 +202,17 @@ def difference_panel(state: AppState) -> None:
     ms = state.methods
     a, b = (x if x in ms else ms[0] for x in state.diff_pair)
     kinds = ["abs", "flip"]
-    imgui.set_next_item_width(120)
+    # the two selectors share the window's width, the kind on its own line: nothing is cut
+    # off in a narrow window (at 1280 wide, B and the kind were past the right edge)
+    style = imgui.get_style()
+    label = imgui.calc_text_size("A").x + style.item_inner_spacing.x
+    half = max(40.0, (imgui.get_content_region_avail().x - style.item_spacing.x) / 2 - label)
+    imgui.set_next_item_width(half)
     _, ia = imgui.combo("A", ms.index(a), ms)
     imgui.same_line()
-    imgui.set_next_item_width(120)
+    imgui.set_next_item_width(half)
     _, ib = imgui.combo("B", ms.index(b), ms)
-    imgui.same_line()
-    imgui.set_next_item_width(80)
+    imgui.set_next_item_width(max(40.0, min(120.0, half)))
     _, ik = imgui.combo("kind", kinds.index(state.diff_kind), kinds)
     state.diff_pair, state.diff_kind = (ms[ia], ms[ib]), kinds[ik]
     a, b = state.diff_pair
@@ -198,7 +229,12 @@ def difference_panel(state: AppState) -> None:
     tex = state.textures["difference"]
     vmax, mean = image_stats(state, "difference")
     vmax = max(vmax, 1e-6)
-    size = imgui.ImVec2(state.camera.width, state.camera.height)
+    # the window's width at the camera's aspect, leaving room for the scale's two lines
+    avail = imgui.get_content_region_avail()
+    room_h = avail.y - 2 * imgui.get_frame_height_with_spacing()
+    aspect = state.camera.width / state.camera.height
+    w = max(32.0, min(avail.x, room_h * aspect))
+    size = imgui.ImVec2(w, w / aspect)
     show_image(state, "difference", tex, size, *cam.view_window(state.view))
     if "colour_scale" not in state.textures:
         upload(state, "colour_scale",
@@ -206,7 +242,7 @@ def difference_panel(state: AppState) -> None:
     tb = state.textures["colour_scale"]
     imgui.text("0")
     imgui.same_line()
-    imgui.image(imgui.ImTextureRef(tb.glo), imgui.ImVec2(size.x - 60, 10))
+    imgui.image(imgui.ImTextureRef(tb.glo), imgui.ImVec2(max(10.0, size.x - 60), 10))
     imgui.same_line()
     imgui.text(f"{vmax:.3g}")
     imgui.text(f"mean {mean:.4f}")
