@@ -39,6 +39,9 @@ def test_idle_window_draws_at_the_idle_rate_and_jobs_still_deliver(xvfb, tmp_pat
     # the knob changed from the script while idling (no input event): the new job's image shows
     after = log["job_after_idle"]
     assert after["done"] and after["shown_is_job_image"], after
+    # the title follows a scene switch (before: it kept the first scene's name)
+    assert log["title_before"] == "workbench ui: whitted"
+    assert log["title_after"] == "workbench ui: csg"
 
 
 @pytest.mark.slow

@@ -77,3 +77,36 @@ def test_a_seventh_panel_is_refused_with_a_message():
     one = new_state("whitted", ["phong"])
     assert not toggle_method(one, "phong", False) and one.methods == ["phong"]
     assert "at least one" in one.status["methods"]
+
+
+def test_a_scene_switch_leaves_nothing_of_the_old_scene():
+    """Before: the ray tree, the picked patch, the run times and the browser's "opened" line
+    still showed the previous scene."""
+    from workbench.app.ui.file_browser import open_scene
+    from workbench.scene.library import resolve
+    state = new_state("whitted", ["phong", "raytrace"])
+    assert open_scene(state, resolve("whitted")) and "whitted" in state.browser.message
+    state.ray_tree, state.patch_pick = {"pixel": [1, 2], "tree": {}}, object()
+    state.timings.update(phong=0.01, raytrace=2.0)
+    state.status["patch pick"] = "pixel (1, 2) shows no patch"
+    set_scene(state, "csg")
+    assert state.ray_tree is None and state.patch_pick is None
+    assert state.timings == {} and "patch pick" not in state.status
+    assert state.browser.message == ""
+
+
+def test_plot_header_legend_and_markers():
+    """Before: the header was a cut Python dict, a removed panel stayed in the legend and
+    markers cycled through shapes from frame to frame."""
+    from workbench.app.ui.plot import MARKERS, ErrorPlot, marker_of, options_text, plotted_lines
+    assert options_text({"max_depth": 12}) == "max_depth=12"
+    assert options_text({"patch_size": 0.05, "spp": 4}) == "patch_size=0.05, spp=4"
+    plot = ErrorPlot()
+    pt = {"seconds": 0.5, "rmse": 0.1, "flip": 0.2}
+    plot.points = {"phong": {(("tessellation", 6),): pt}, "flat": {(("tessellation", 6),): pt}}
+    lines = plotted_lines(plot, ["phong", "raytrace"], "rmse")
+    assert list(lines) == ["phong"]  # flat was removed from the panels: not in the legend
+    assert lines["phong"][0].tolist() == [500.0]
+    shapes = [marker_of(m) for m in choosable_methods()]
+    assert shapes == [marker_of(m) for m in choosable_methods()]  # the same every call
+    assert len(set(shapes[:len(MARKERS)])) == min(len(shapes), len(MARKERS))

@@ -33,6 +33,30 @@ def frame_rest(last: float | None, now: float, cap: float, job_running: bool) ->
     return max(0.0, last + 1.0 / cap - now)
 
 
+def window_title(state: AppState) -> str:
+    """The window's title: the scene shown."""
+    return f"workbench ui: {state.scene_path.stem}"
+
+
+def _glfw():
+    """The window's GLFW library (imgui-bundle's), with the title functions typed."""
+    import ctypes
+
+    import imgui_bundle
+    glfw = ctypes.CDLL(str(Path(imgui_bundle.__file__).parent / "libglfw.so.3"))
+    glfw.glfwGetCurrentContext.restype = ctypes.c_void_p
+    glfw.glfwSetWindowTitle.argtypes = [ctypes.c_void_p, ctypes.c_char_p]
+    glfw.glfwGetWindowTitle.argtypes = [ctypes.c_void_p]
+    glfw.glfwGetWindowTitle.restype = ctypes.c_char_p
+    return glfw
+
+
+def shown_title() -> str:
+    """The title the window has now (GLFW's), for scripts and tests."""
+    glfw = _glfw()
+    return (glfw.glfwGetWindowTitle(glfw.glfwGetCurrentContext()) or b"").decode()
+
+
 def run(state: AppState, max_frames: int | None = None, script=None,
         window: tuple[int, int] = WINDOW_SIZE) -> None:
     """Open the window (``window`` = (width, height) pixels) and loop until it is closed,
@@ -47,7 +71,7 @@ def run(state: AppState, max_frames: int | None = None, script=None,
     from .layout import docking_params
     from .panels import status_bar
     from .plot import track
-    clock = {"t": None}
+    clock = {"t": None, "title": window_title(state)}
 
     def post_init():
         state.ctx = moderngl.create_context()  # the window's current GLFW context
@@ -66,6 +90,10 @@ def run(state: AppState, max_frames: int | None = None, script=None,
         clock["t"] = now
         update_images(state)
         track(state)
+        if window_title(state) != clock["title"]:  # the scene changed: so does the title
+            clock["title"] = window_title(state)
+            glfw = _glfw()
+            glfw.glfwSetWindowTitle(glfw.glfwGetCurrentContext(), clock["title"].encode())
         if script is not None:
             script(state)
         if in_progress(state) or getattr(script, "keeps_awake", script is not None):
@@ -82,7 +110,7 @@ def run(state: AppState, max_frames: int | None = None, script=None,
         release_gl(state)
 
     params = hello_imgui.RunnerParams()
-    params.app_window_params.window_title = f"workbench ui: {state.scene_path.stem}"
+    params.app_window_params.window_title = window_title(state)
     params.app_window_params.window_geometry.size = window
     params.fps_idling.enable_idling = True
     params.fps_idling.fps_idle = IDLE_FPS

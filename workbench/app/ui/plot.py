@@ -123,11 +123,42 @@ def _reference(state: AppState, plot: ErrorPlot) -> np.ndarray | None:
         plot.message, plot.gave_up = "no reference: no method renders this scene", True
         return None
     if job.image is None:
-        plot.message = f"rendering the reference ({plot.reference} {plot.ref_options})..."
+        plot.message = f"rendering the reference: {plot.reference} ({options_text(plot.ref_options)})..."
         return None
     plot.ref_image = job.image
-    plot.message = f"reference: {plot.reference} {plot.ref_options} ({job.seconds:.2f} s)"
+    plot.message = (f"reference: {plot.reference} ({options_text(plot.ref_options)}), "
+                    f"{job.seconds:.2f} s")
     return plot.ref_image
+
+
+def options_text(options: dict) -> str:
+    """``{"max_depth": 12}`` -> ``"max_depth=12"`` (the plot's header and labels)."""
+    return ", ".join(f"{k}={v}" for k, v in options.items())
+
+
+MARKERS = ("circle", "square", "diamond", "up", "down", "left", "right", "cross", "plus",
+           "asterisk")
+"""implot marker of each method, by its place in the registry (the same shape every frame)."""
+
+
+def marker_of(method: str) -> str:
+    """The name of ``method``'s marker in :data:`MARKERS` (stable: by registry order)."""
+    from .state import choosable_methods
+    allowed = choosable_methods()
+    k = allowed.index(method) if method in allowed else len(allowed)
+    return MARKERS[k % len(MARKERS)]
+
+
+def plotted_lines(plot: ErrorPlot, methods, metric: str) -> dict:
+    """{method: (run times in ms, errors)} of the methods on screen (a removed panel's line
+    leaves the legend), each sorted by run time, errors at least :data:`FLOOR`."""
+    lines = {}
+    for m in methods:
+        rows = sorted(plot.points.get(m, {}).values(), key=lambda p: p["seconds"])
+        if rows:
+            lines[m] = (np.array([p["seconds"] * 1e3 for p in rows]),
+                        np.maximum(np.array([p[metric] for p in rows]), FLOOR))
+    return lines
 
 
 def _evaluate(image: np.ndarray, reference: np.ndarray) -> dict:
@@ -203,12 +234,10 @@ def error_plot(state: AppState) -> None:
     if changed:
         plot.metric = METRICS[k]
     imgui.same_line()
+    imgui.push_text_wrap_pos(0.0)
     imgui.text_disabled(plot.message)
-    lines = {}
-    for m, pts in plot.points.items():
-        rows = sorted(pts.values(), key=lambda p: p["seconds"])
-        lines[m] = (np.array([p["seconds"] * 1e3 for p in rows]),
-                    np.maximum(np.array([p[plot.metric] for p in rows]), FLOOR))
+    imgui.pop_text_wrap_pos()
+    lines = plotted_lines(plot, state.methods, plot.metric)
     for name in CLEAR_FILLS:
         implot.push_style_color(getattr(implot.Col_, name), imgui.ImVec4(0.0, 0.0, 0.0, 0.0))
     if implot.begin_plot("##error against run time", imgui.ImVec2(-1, -1)):
@@ -222,7 +251,7 @@ def error_plot(state: AppState) -> None:
         else:  # 1 ms to 1 s, errors 1e-3 to 1
             implot.setup_axes_limits(1.0, 1e3, 1e-3, 1.0, implot.Cond_.always)
         for m, (xs, ys) in lines.items():
-            implot.plot_line(m, xs, ys)
-            implot.plot_scatter(m, xs, ys)
+            spec = implot.Spec(marker=getattr(implot.Marker_, marker_of(m)), marker_size=5)
+            implot.plot_line(m, xs, ys, spec)
         implot.end_plot()
     implot.pop_style_color(len(CLEAR_FILLS))

@@ -411,7 +411,7 @@ class Idle:
     hello_imgui's time active after the last event), count the frames drawn and the
     process CPU time over ``seconds``; then change the ray tracer's knob from the script (no
     input event) and wait for the restarted job's image, which must reach its panel although
-    the window was idling.  Scripts keep the loop awake unless, like this one, they say not."""
+    the window was idling; then switch to csg and read the window's title.  Scripts keep the loop awake unless, like this one, they say not."""
 
     keeps_awake = False
 
@@ -451,7 +451,15 @@ class Idle:
                     "shown_is_job_image": bool(job is not None and job.image is not None
                                                and np.array_equal(shown, job.image)),
                     "frames": state.frame - self.frame0, "seconds": now - self.t0}
-                state.quit = True
+                from .main import shown_title
+                from .state import set_scene
+                self.log["title_before"] = shown_title()
+                set_scene(state, "csg")
+                self.step = 3
+        elif self.step == 3:
+            from .main import shown_title
+            self.log["title_after"] = shown_title()
+            state.quit = True
 
 
 class Soak:

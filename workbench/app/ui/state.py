@@ -160,6 +160,14 @@ def set_scene(state: AppState, scene_name: str) -> None:
     state.overrides, state.light_overrides = {}, {}
     state.material = next(iter(state.scene.materials))
     state.scene_version += 1
+    # what showed the old scene goes: the ray tree, the picked patch, the run times (a CPU
+    # panel's time is its new job's), the file browser's last outcome
+    state.ray_tree = state.patch_pick = None
+    state.timings.clear()
+    for k in ("patch pick", "lights", "export"):
+        state.status.pop(k, None)
+    if state.browser is not None:
+        state.browser.message, state.browser.failed = "", False
 
 
 def _apply_overrides(state: AppState) -> None:
