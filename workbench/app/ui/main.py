@@ -118,6 +118,9 @@ def run(state: AppState, max_frames: int | None = None, script=None,
     # frame ~4x dearer (imgui anti-aliases its own shapes and text without it)
     params.renderer_backend_options.open_gl_options.anti_aliasing_samples = 0
     params.imgui_window_params.show_status_bar = True
+    # hello_imgui's own FPS and idling toggle sat under the status text in a narrow window
+    # (1024 x 600); the status text gives the frame time, and idling is always on
+    params.imgui_window_params.show_status_fps = False
     params.imgui_window_params.default_imgui_window_type = \
         hello_imgui.DefaultImGuiWindowType.provide_full_screen_dock_space
     params.docking_params = docking_params(state, window[1])

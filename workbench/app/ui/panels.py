@@ -56,10 +56,12 @@ def scene_picker(state: AppState) -> None:
         state.view = (1.0, 0.5, 0.5)
     imgui.same_line()
     if imgui.button("export"):
-        folder = state.export_dir / f"{state.scene_path.stem}_{state.frame:06d}"
+        folder = (state.export_dir / f"{state.scene_path.stem}_{state.frame:06d}").resolve()
         state.status["export"] = f"saved {len(export(state, folder))} files to {folder}"
     if "export" in state.status:
+        imgui.push_text_wrap_pos(0.0)
         imgui.text_disabled(state.status["export"])
+        imgui.pop_text_wrap_pos()
 
 
 def method_list(state: AppState) -> None:
@@ -96,7 +98,9 @@ def parameters(state: AppState) -> None:
         values = list(knob.values)
         cur = state.options[m][knob.name]
         idx = values.index(cur) if cur in values else 0
-        changed, idx = imgui.slider_int(f"{m} {knob.name}", idx, 0, len(values) - 1,
+        imgui.text(f"{m}: {knob.name}")  # its own line: a label beside the slider was cut
+        imgui.set_next_item_width(-1)
+        changed, idx = imgui.slider_int(f"##knob {m}", idx, 0, len(values) - 1,
                                         format=str(values[idx]))
         if changed:
             set_option(state, m, knob.name, values[idx])
@@ -273,5 +277,6 @@ def status_text(state: AppState) -> str:
 
 
 def status_bar(state: AppState) -> None:
-    """The status bar line (:func:`status_text`)."""
-    imgui.text(status_text(state))
+    """The status bar line (:func:`status_text`), cut to the window's width (whole in a
+    tooltip)."""
+    text_in_width(status_text(state), imgui.get_content_region_avail().x)
