@@ -1,6 +1,7 @@
 #version 330 core
 // Fragment stage of flat, Gouraud and Phong shading: texture colour C per fragment, then
-// I = E + C * diffuse + specular (local model, lighting.glsl), + kr * environment(reflected)
+// I = E + C * diffuse + specular (local model, lighting.glsl; or a user's model, USER_MODEL:
+// user_model.glsl), + kr * environment(reflected)
 // for environment-mapped materials; opacity maps cut out (alpha < 0.5) or blend.
 // Output: linear RGB and alpha into a float32 colour attachment.
 #include "varyings.glsl"
@@ -25,6 +26,9 @@ const bool HAS_UV_ATTR = false;
 
 #include "lighting.glsl"
 #include "texturing.glsl"
+#ifdef USER_MODEL
+#include "user_model.glsl"
+#endif
 #if defined(MODE_FLAT)
 flat in vec3 v_diffuse;
 flat in vec3 v_specular;
@@ -62,6 +66,10 @@ void main() {
 #endif
     N = face_viewer(N, S);
 #endif
+#if defined(USER_MODEL)
+    // a user's shading model (user_model.glsl) in place of the local model
+    vec3 color = MAT_EMISSION + C * (MAT_KA * SCENE_AMBIENT) + user_terms(v_world, N, S, C);
+#else
 #ifdef MODE_PHONG
     vec3 diffuse, specular;
     local_terms(v_world, N, S, diffuse, specular);
@@ -70,6 +78,7 @@ void main() {
     vec3 specular = v_specular;
 #endif
     vec3 color = MAT_EMISSION + C * diffuse + specular;
+#endif
 #if defined(ENV_MAP) && defined(ENV_KIND)
     color += MAT_KR * environment(2.0 * dot(N, S) * N - S);
 #endif

@@ -30,6 +30,10 @@ class Facets:
     name = "facets"
     knob = Knob("n", (4, 8, 16, 32, 64), 8, "latitude bands")
     options = {"n": Option(int, 8, "latitude bands")}
+    memory_options = ("n",)
+
+    def estimate_bytes(self, scene, width, height, n=8):
+        return 1024 * width * height + 2 ** 20   # rays, hits and image, float64
 
     def render(self, scene, width, height, n=8):
         from workbench.compare.analytic import ray_sphere
@@ -56,6 +60,10 @@ class Never:
     name = "never"
     knob = Knob("q", (1, 2), 1)
     options = {"q": Option(int, 1)}
+    memory_options = ("q",)
+
+    def estimate_bytes(self, scene, width, height, q=1):
+        return 1
 
     def render(self, scene, width, height, q=1):
         raise NotApplicable("this fake applies to no scene")

@@ -13,6 +13,19 @@ import pytest
 os.environ.setdefault("NUMBA_CACHE_DIR", str(Path(__file__).resolve().parents[1] / ".numba_cache"))
 
 
+@pytest.fixture(scope="session", autouse=True)
+def reference_cache(tmp_path_factory):
+    """One reference cache for the whole run (warm within it, nothing left in ~/.cache)."""
+    folder = tmp_path_factory.mktemp("reference-cache")
+    old = os.environ.get("WORKBENCH_REFERENCE_CACHE")
+    os.environ["WORKBENCH_REFERENCE_CACHE"] = str(folder)
+    yield folder
+    if old is None:
+        os.environ.pop("WORKBENCH_REFERENCE_CACHE", None)
+    else:
+        os.environ["WORKBENCH_REFERENCE_CACHE"] = old
+
+
 @pytest.fixture
 def gl_ctx():
     """The thread's moderngl context; asserts the GL error flag is clear before and after."""

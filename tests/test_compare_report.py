@@ -12,7 +12,6 @@ import pytest
 import compare_fakes
 from workbench.compare import report as report_mod
 from workbench.compare.metrics import metrics
-from workbench.renderers.base import available
 
 
 def _check_numbers(out, rep):
@@ -63,6 +62,8 @@ class Broken:
     name = "broken"
     knob = compare_fakes.Facets.knob
     options = compare_fakes.Facets.options
+    memory_options = compare_fakes.Facets.memory_options
+    estimate_bytes = compare_fakes.Facets.estimate_bytes
 
     def render(self, scene, width, height, n=8):
         raise RuntimeError("kaboom")
@@ -94,13 +95,17 @@ def test_unknown_method_is_a_clear_cli_error(tmp_path):
 
 @pytest.mark.gl
 def test_real_methods_against_the_ray_tracer(tmp_path):
-    needed = {"phong", "raytrace"}
-    if not needed <= set(available()):
-        pytest.skip(f"needs {needed} registered")
     out = tmp_path / "rep"
     rep = report_mod.compare(compare_fakes.sphere_scene(), out, methods=["flat", "phong", "raytrace"],
                              size=(48, 36), repeat=0)
     assert rep["reference"]["method"] == "raytrace"  # the rule: no emitters, ray tracer registered
     assert _check_numbers(out, rep) == 3
     m = {e["method"]: e["metrics"]["rmse"] for e in rep["methods"]}
-    assert m["raytrace"] < 1e-6 < m["phong"] < m["flat"]  # same local model; flat is the coarsest
+    assert m["raytrace"] < m["phong"] < m["flat"]  # same local model; flat is the coarsest
+    # the reference is the box-filtered image (16 stratified samples): the ray tracer's
+    # pixel-centre image differs only at edges, and equals its matched reference (pixel centres)
+    assert rep["reference"]["options"]["spp"] == 16 and 0 < m["raytrace"] < 0.05
+    matched = {e["method"]: e["matched"] for e in rep["methods"]}
+    assert matched["raytrace"]["metrics"]["rmse"] == 0.0
+    assert matched["phong"]["reference"]["options"] == {"shadows": False, "spp": 1}
+    assert rep["reference"]["noise_rmse"] > 0 and "samples per pixel" in rep["reference"]["noise_note"]

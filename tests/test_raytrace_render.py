@@ -164,7 +164,8 @@ def test_tiles_depth_and_spp():
 def test_vertex_emission_is_interpolated():
     V = [[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]]
     E = np.array([[1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0], [1.0, 1.0, 1.0]])
-    sc = scene_from_dict({"camera": {"position": [0, 0, -5], "look_at": [0, 0, 0], "resolution": [5, 5], "fov_y": 10.0},
+    # seen from the front (+z: the triangles' counter-clockwise side); the back emits nothing
+    sc = scene_from_dict({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "resolution": [5, 5], "fov_y": 10.0},
                           "materials": {"m": {"ka": 0.0, "kd": 0.0}},
                           "objects": [{"type": "mesh", "vertices": V, "faces": [[0, 1, 2], [0, 2, 3]], "material": "m"}]})
     from dataclasses import replace
@@ -180,6 +181,9 @@ def test_vertex_emission_is_interpolated():
                    (1 - v)[:, None] * E[0] + (v - u)[:, None] * E[3] + u[:, None] * E[2])
     assert np.allclose(r.image.reshape(-1, 3), exp, atol=1e-6)
     assert np.allclose(reference.render(sc, 5, 5).reshape(-1, 3), exp, atol=1e-6)
+    back = sc.with_camera(replace(sc.camera, position=(0.0, 0.0, -5.0)))
+    assert workbench.render(back, "raycast").image.max() == 0.0
+    assert reference.render(back, 5, 5).max() == 0.0
 
 
 def test_ray_tree_of_a_glass_pixel():

@@ -118,3 +118,67 @@ def test_area_light_stand_ins_carry_its_power():
     total = sum(p.intensity for p in stand)
     assert total == pytest.approx(light.intensity * light.area / np.pi)
     assert np.allclose(light.normal, [0, -1, 0])
+
+
+@pytest.mark.parametrize("data, key, expect", [
+    (_with(["objects", 0, "radius"], 1e39), "[[objects]] #1.radius", "outside the float32 range"),
+    (_with(["lights", 0, "position"], [0, -1e39, 0]), "[[lights]] #1.position[1]", "float32 range"),
+    (_with(["materials", "m", "emission"], [0, 0, 4e38]), "[materials.m].emission[2]", "float32 range"),
+    (_with(["objects", 0, "transform"], {"matrix": [[1e39, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]}),
+     "[[objects]] #1.transform.matrix[0][0]", "float32 range"),
+    (_with(["objects", 0, "radius"], float("nan")), "[[objects]] #1.radius", "finite"),
+    (_with(["objects", 0, "radius"], 2 ** 64), "[[objects]] #1.radius", "too large"),
+    (_with(["camera", "resolution"], [2 ** 64, 10]), "[camera].resolution[0]", "too large"),
+    (_with(["objects", 0, "tessellation"], -(2 ** 70)), "[[objects]] #1.tessellation", "too large"),
+    (_with(["objects", 0], {"type": "mesh", "material": "m", "generate": {"kind": "blob", "seed": 2 ** 40}}),
+     ".generate.seed", "<= 4294967295"),
+    (_with(["materials", "m", "kr"], 0.5) | {"materials": {"m": {"kr": 0.5, "kt": 0.6}}}, "[materials.m].kt",
+     "kr + kt = 0.5 + 0.6 = 1.1 > 1"),
+])
+def test_values_that_would_fail_later_are_refused_at_load(data, key, expect):
+    """Float32 range for what the GPU sees, integer sizes, kr + kt <= 1 (DESIGN erratum 9)."""
+    with pytest.raises(SceneError) as e:
+        scene_from_dict(data, source="bad.toml")
+    msg = str(e.value)
+    assert msg.startswith("bad.toml: ") and key in msg and expect in msg, msg
+
+
+def test_kr_plus_kt_equal_to_one_is_accepted():
+    s = scene_from_dict(_with(["materials", "m"], {"kr": 0.25, "kt": 0.75}))
+    assert s.materials["m"].kr + s.materials["m"].kt == 1.0
+
+
+def test_huge_integer_in_a_file_is_one_line(tmp_path):
+    p = tmp_path / "big.toml"
+    p.write_text("[camera]\nposition = [0, 0, -5]\nlook_at = [0, 0, 0]\nresolution = [18446744073709551616, 2]\n"
+                 "[[objects]]\ntype = \"sphere\"\nradius = 1\n")
+    with pytest.raises(SceneError, match=r"big.toml: \[camera\].resolution\[0\]: integer 18446744073709551616 is too large"):
+        load_scene(p)
+
+
+@pytest.mark.parametrize("table", ["texture", "bump", "opacity", "environment"])
+def test_image_maps_must_be_readable_images_at_load(table, tmp_path):
+    bad = tmp_path / "notes.png"
+    bad.write_text("this is not an image")
+    trunc = tmp_path / "trunc.png"
+    from PIL import Image
+    Image.new("RGB", (64, 64), (200, 10, 10)).save(trunc)
+    trunc.write_bytes(trunc.read_bytes()[:60])
+    for path in (bad, trunc):
+        spec = {"type": "image", "path": str(path)}
+        if table == "environment":
+            data = copy.deepcopy(BASE) | {"environment": spec}
+            key = "[environment].path"
+        else:
+            data = _with(["materials", "m", table], spec | {"projection": "spherical"})
+            key = f"[materials.m].{table}.path"
+        with pytest.raises(SceneError) as e:
+            scene_from_dict(data, source="bad.toml")
+        assert key in str(e.value) and "not a readable image" in str(e.value), str(e.value)
+
+
+def test_mesh_file_vertices_must_fit_float32(tmp_path):
+    (tmp_path / "huge.obj").write_text("v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n")
+    data = _with(["objects", 0], {"type": "mesh", "material": "m", "path": str(tmp_path / "huge.obj")})
+    with pytest.raises(SceneError, match="outside the float32 range"):
+        scene_from_dict(data, source="bad.toml")

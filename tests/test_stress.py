@@ -18,7 +18,16 @@ from workbench.compare.stress import CATALOGUE, Catalogue, stress
 from workbench.core.errors import WorkbenchError
 from workbench.renderers.base import Knob, Option, RenderResult
 
-VERDICT = re.compile(r"^(ok|inaccurate: by \S+|breaks: .+|unavailable: .+|ok: rejected with a clear error: .+)")
+VERDICT = re.compile(r"^(ok|inaccurate: by \S+ \(tolerance \S+\)|unavailable: .+|ok: rejected with a clear error: .+)$")
+# The catalogue's expected verdicts: every other row is "ok" (or a clear rejection).  These
+# inaccuracies are inherent to the method (README, "Stress"); a change here must be looked at.
+EXPECTED_INACCURATE = {
+    ("huge-near-sphere", "flat"), ("huge-near-sphere", "gouraud"), ("huge-near-sphere", "phong"),
+    ("ff-parallel-hemicube-16", "radiosity"), ("ff-parallel-hemicube-256", "radiosity"),
+    ("ff-contact-perpendicular", "radiosity"), ("ff-hemicube-aliasing", "radiosity"),
+    ("ff-reciprocity-sizes", "radiosity"),
+}
+NO_EMITTERS = re.compile(r"^unavailable: (radiosity|hybrid) does not apply: .*the scene has no emitters")
 
 
 def test_full_catalogue_no_case_skipped(tmp_path):
@@ -28,7 +37,14 @@ def test_full_catalogue_no_case_skipped(tmp_path):
     assert [(r["case"], r["method"]) for r in res["rows"]] == expected
     assert len({c["id"] for c in cat.cases}) >= 25
     for r in res["rows"]:
-        assert VERDICT.match(r["verdict"]), r
+        assert VERDICT.match(r["verdict"]), r                     # never "breaks"
+        key = (r["case"], r["method"])
+        if key in EXPECTED_INACCURATE:
+            assert r["verdict"].startswith("inaccurate: by"), r
+        elif r["verdict"].startswith("unavailable"):
+            assert NO_EMITTERS.match(r["verdict"]), r           # the one documented reason
+        else:
+            assert r["verdict"] == "ok" or r["verdict"].startswith("ok: rejected with a clear error"), r
         if r["verdict"].startswith(("ok", "inaccurate")) and not r["verdict"].startswith("ok: rejected"):
             assert r["expected"] and r["measured"], r
     for name in ("stress.csv", "stress.md", "stress.html"):
@@ -43,6 +59,10 @@ class NaNs:
     name = "nans"
     knob = Knob("q", (1,), 1)
     options = {"q": Option(int, 1)}
+    memory_options = ("q",)
+
+    def estimate_bytes(self, scene, width, height, q=1):
+        return 24 * width * height
 
     def render(self, scene, width, height, q=1):
         img = np.full((height, width, 3), 0.5)

@@ -23,7 +23,8 @@ def test_spherical_matches_course_formula_away_from_poles():
     uv = tx.project(tex, N)
     phi = np.arccos(-(N @ pole))  # course: phi = arccos(-N.Sp), v = phi / pi
     theta = np.arccos(np.clip(-(N @ eq) / np.sin(phi), -1, 1)) / (2 * np.pi)
-    u = np.where(N @ np.cross(pole, eq) > 0, theta, 1 - theta)
+    u_course = np.where(N @ np.cross(pole, eq) > 0, theta, 1 - theta)
+    u = 1.0 - u_course  # DESIGN errata 8: the course's u runs clockwise seen from the pole
     assert np.allclose(uv[:, 1], phi / np.pi, atol=1e-12)
     assert np.allclose(uv[:, 0], u, atol=1e-7)
 

@@ -27,10 +27,11 @@ def _directions_globe(w: int, h: int) -> np.ndarray:
     U, V = np.meshgrid(u, v)
     phi = V * np.pi  # 0 at the -pole
     theta = U * 2.0 * np.pi
-    # inverse of texturing.project: d.Sp = -cos(phi), d.(-Se) = sin(phi) cos(theta), d.W = sin(phi) sin(theta)
+    # inverse of texturing.project: d.Sp = -cos(phi), d.(-Se) = sin(phi) cos(theta),
+    # d.(-W) = sin(phi) sin(theta) (u increases eastward, DESIGN errata 8)
     sp, se, w_ = tx.frame((0.0, 1.0, 0.0), (1.0, 0.0, 0.0))
     d = (-np.cos(phi)[..., None] * sp - (np.sin(phi) * np.cos(theta))[..., None] * se
-         + (np.sin(phi) * np.sin(theta))[..., None] * w_)
+         - (np.sin(phi) * np.sin(theta))[..., None] * w_)
     return d.reshape(-1, 3)
 
 

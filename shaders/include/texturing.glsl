@@ -39,10 +39,11 @@ float wrap01(float u) {
     return u >= 1.0 ? 0.0 : u;
 }
 
-// u = atan2(d.W, -d.Se) / 2pi in [0, 1); 0 on the axis.
+// u = atan2(-d.W, -d.Se) / 2pi in [0, 1), increasing eastward (counter-clockwise seen from the
+// pole, DESIGN errata 8); 0 on the axis.
 float longitude(vec3 d, Mapping m) {
     float x = -dot(d, m.se);
-    float y = dot(d, m.w);
+    float y = -dot(d, m.w);
     bool on_axis = x * x + y * y <= TOL_ZERO * TOL_ZERO * max(1.0, dot(d, d));
     return wrap01(on_axis ? 0.0 : atan(y, x) / TWO_PI);
 }

@@ -18,11 +18,26 @@ import importlib
 import os
 import sys
 
-COMMANDS = ["cmd_scenes", "cmd_info", "cmd_methods", "cmd_render", "cmd_colour", "cmd_compare", "cmd_study", "cmd_stress", "cmd_ui"]
+COMMANDS = ["cmd_scenes", "cmd_info", "cmd_methods", "cmd_render", "cmd_colour", "cmd_compare", "cmd_study", "cmd_stress", "cmd_snapshot", "cmd_ui"]
+
+
+class UsageError(Exception):
+    """A command line argparse refuses; its message is printed as one line by :func:`_run`."""
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse, with its errors raised as :class:`UsageError` (one line and status 2 from
+    :func:`_run`, like every other user error) instead of a usage block printed and
+    ``sys.exit`` called inside the parser.  Sub-command parsers are of this class too
+    (``add_subparsers`` creates parsers of the parent's class)."""
+
+    def error(self, message: str):
+        sub = self.prog.split(" ", 1)[1] if " " in self.prog else ""
+        raise UsageError(f"{sub}: {message}" if sub else message)
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
+    p = Parser(
         prog="workbench",
         description="Rendering workbench: classic image-synthesis methods side by side on one "
                     "scene and camera, with run times and errors.")
@@ -30,6 +45,11 @@ def build_parser() -> argparse.ArgumentParser:
     sub.required = True
     for name in COMMANDS:
         importlib.import_module(f"workbench.app.{name}").add_parser(sub)
+    for command in {id(c): c for c in sub.choices.values()}.values():  # aliases share a parser
+        command.add_argument("--max-memory", metavar="SIZE", default=None,
+                             help="memory limit of each render, e.g. 8G or 512M (sets "
+                                  "WORKBENCH_MAX_MEMORY for this command; default: that variable, "
+                                  "else half the physical memory)")
     return p
 
 
@@ -47,20 +67,29 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _run(argv: list[str] | None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
     from ..core.errors import WorkbenchError
     try:
+        args = build_parser().parse_args(argv)
+        if args.max_memory is not None:  # one limit for this process and its children
+            from ..core.memory import ENV, parse_size
+            os.environ[ENV] = str(parse_size(args.max_memory, "--max-memory"))
         return int(args.run(args) or 0)
-    except WorkbenchError as e:
-        print(f"workbench: error: {e}", file=sys.stderr)
-        return 2
+    except (UsageError, WorkbenchError) as e:
+        return _error(str(e))
     except BrokenPipeError:  # output piped into head & co.
         sys.stderr.close()
         return 0
+    except OSError as e:          # a file that vanished or a full disk, after the checks
+        return _error(f"{str(e.filename) + ': ' if e.filename else ''}{e.strerror or e}")
     except KeyboardInterrupt:
         print("workbench: interrupted", file=sys.stderr)
         return 130
+
+
+def _error(message: str) -> int:
+    """Print one line ``workbench: error: ...`` (line breaks folded) and return status 2."""
+    print("workbench: error: " + " ".join(message.split()), file=sys.stderr)
+    return 2
 
 
 if __name__ == "__main__":

@@ -35,9 +35,8 @@ def add_parser(sub):
 
 
 def _png_output(path: str) -> None:
-    from ..core.errors import WorkbenchError
-    if not path.lower().endswith(".png"):
-        raise WorkbenchError(f"output must be a .png file, got {path!r}")
+    from ..core.output_paths import check_output_file
+    check_output_file(path, "-o", ".png")
 
 
 def run_wheel(args) -> int:

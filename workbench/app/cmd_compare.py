@@ -20,17 +20,22 @@ def run(args) -> int:
     from pathlib import Path
 
     from ..compare.report import compare
+    from ..core.output_paths import check_output_dir
     from ..scene.io import load_scene
+    check_output_dir(args.out, "--out")
     scene = load_scene(args.scene)
     rep = compare(scene, args.out, methods=args.methods, size=args.size, reference=args.reference,
                   repeat=args.repeat, command=" ".join(["workbench"] + sys.argv[1:]))
     ref = rep["reference"]
-    print(f"{scene.name}: reference {ref['method']} ({ref['time_s']:.3g} s) - {ref['reason']}")
+    print(f"{scene.name}: reference {ref['method']} ({ref['time_s']:.3g} s, own error {ref['noise_rmse']:.2g}) "
+          f"- {ref['reason']}")
     for e in rep["methods"]:
         if e["status"] == "ok":
             m = e["metrics"]
             print(f"  {e['method']:<10} {e['time_s']:8.3g} s  compile {e['compile_s']:6.3g} s  "
-                  f"RMSE {m['rmse']:.4g}  PSNR {m['psnr']:.4g} dB  FLIP {m['flip']:.4g}")
+                  f"RMSE {m['rmse']:.4g}  PSNR {m['psnr']:.4g} dB  FLIP {m['flip']:.4g}  "
+                  + (f"vs matched {e['matched']['reference']['method']}: RMSE {e['matched']['metrics']['rmse']:.4g}"
+                     if "metrics" in e["matched"] else "no matched reference"))
         else:
             print(f"  {e['method']:<10} {e['status']}: {e['reason']}")
     print(f"report: {(Path(args.out) / 'report.html').resolve()}")

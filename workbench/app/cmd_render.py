@@ -23,17 +23,16 @@ def add_parser(sub):
 
 def run(args) -> int:
     import json
-    from pathlib import Path
 
-    from ..core.errors import WorkbenchError
-    from ..core.imageio import atomic_write_text, save_npy, save_png
+    from ..core.imageio import npy_writer, png_writer, text_writer
+    from ..core.output_paths import check_distinct, check_output_file, write_together
     from ..renderers.base import render, stats_for_display
     from ..scene.io import load_scene
-    if not args.output.lower().endswith(".png"):
-        raise WorkbenchError(f"output must be a .png file, got {args.output!r}")
+    check_output_file(args.output, "-o", ".png")         # every output checked before any work
     for opt, target in (("--npy", args.npy), ("--json", args.json)):
-        if target and Path(target).parent.exists() and not Path(target).parent.is_dir():
-            raise WorkbenchError(f"{opt}: {Path(target).parent} is not a folder")
+        if target:
+            check_output_file(target, opt)
+    check_distinct({"-o": args.output, "--npy": args.npy, "--json": args.json})
     from ..core.display import apply_display_mode, display_mode
     display_mode(args.display)  # refuse a bad mode before rendering
     scene = load_scene(args.scene)
@@ -49,23 +48,24 @@ def run(args) -> int:
         image = apply_display_mode(image, args.display)
         m = metrics(image, reference)
         print(f"  display {args.display} vs direct24: rmse {m['rmse']:.4g}, psnr {m['psnr']:.2f} dB, flip {m['flip']:.4f}")
-    save_png(args.output, image)
+    stats = stats_for_display(result.stats)
+    files = [(args.output, png_writer(image))]
     if args.npy:
-        save_npy(args.npy, result.image)
+        files.append((args.npy, npy_writer(result.image)))
+    if args.json:
+        files.append((args.json, text_writer(json.dumps({
+            "scene": scene.name, "method": result.method, "timings": result.timings,
+            "stats": stats, "features_used": result.features_used,
+            "left_out": result.left_out, "options": {k: str(v) for k, v in result.options.items()}},
+            indent=2, default=str))))
+    write_together(files)                                 # all of them or none
     t = ", ".join(f"{k} {v:.3f} s" for k, v in result.timings.items())
     print(f"{scene.name} / {result.method}: {result.image.shape[1]}x{result.image.shape[0]} -> {args.output}")
     print(f"  timings: {t}")
-    stats = stats_for_display(result.stats)
     for k, v in stats.items():
         print(f"  {k}: {v}")
     if result.left_out:
         print(f"  left out: {'; '.join(result.left_out)}")
-    if args.json:
-        atomic_write_text(args.json, json.dumps({
-            "scene": scene.name, "method": result.method, "timings": result.timings,
-            "stats": stats, "features_used": result.features_used,
-            "left_out": result.left_out, "options": {k: str(v) for k, v in result.options.items()}},
-            indent=2, default=str))
     return 0
 
 

@@ -15,6 +15,8 @@ def run(args) -> int:
     from pathlib import Path
 
     from ..compare.stress import CATALOGUE, stress
+    from ..core.output_paths import check_output_dir
+    check_output_dir(args.out, "--out")
     res = stress(args.out, only=args.only, catalogue=args.catalogue or CATALOGUE, progress=sys.stderr.isatty(),
                  command=" ".join(["workbench"] + sys.argv[1:]))
     for r in res["rows"]:

@@ -41,9 +41,11 @@ def run(args) -> int:
 
     from ..compare.study import study
     from ..core.errors import WorkbenchError
+    from ..core.output_paths import check_output_dir
     from ..scene.io import load_scene
     if args.jobs < 1:
         raise WorkbenchError(f"--jobs must be >= 1, got {args.jobs}")
+    check_output_dir(args.out, "--out")
     scene = load_scene(args.scene)
     res = study(scene, args.out, methods=args.methods, size=args.size, quick=args.quick, repeat=args.repeat,
                 reference=args.reference, sweeps=dict(args.sweep), jobs=args.jobs, progress=sys.stderr.isatty(),

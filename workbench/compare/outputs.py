@@ -17,30 +17,51 @@ from contextlib import contextmanager
 from pathlib import Path
 
 
-def jsonable(x):
-    """Recursively turn ``x`` into strict JSON data: numpy scalars to Python numbers, non-finite
-    floats to the strings ``"inf"``, ``"-inf"``, ``"nan"``, unknown objects to ``str``."""
+NONFINITE = {"inf": float("inf"), "-inf": float("-inf"), "nan": float("nan")}
+
+
+def jsonable(x, strict: bool = True):
+    """Recursively turn ``x`` into plain Python data: numpy scalars to Python numbers, unknown
+    objects to ``str``.  Non-finite floats (a PSNR of an exact match is ``inf``) become the
+    strings ``"inf"``, ``"-inf"``, ``"nan"`` when ``strict`` (what JSON files hold: strict JSON
+    has no such tokens) and stay floats otherwise (what functions return, so callers format
+    and compare numbers, never strings).  :func:`loads` is the inverse for files."""
     import numpy as np
     if isinstance(x, dict):
-        return {str(k): jsonable(v) for k, v in x.items()}
+        return {str(k): jsonable(v, strict) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
-        return [jsonable(v) for v in x]
+        return [jsonable(v, strict) for v in x]
     if isinstance(x, np.ndarray):
-        return jsonable(x.tolist())
+        return jsonable(x.tolist(), strict)
     if isinstance(x, (bool, np.bool_)):
         return bool(x)
     if isinstance(x, (int, np.integer)):
         return int(x)
     if isinstance(x, (float, np.floating)):
         x = float(x)
-        return x if math.isfinite(x) else ("nan" if math.isnan(x) else ("inf" if x > 0 else "-inf"))
+        if math.isfinite(x) or not strict:
+            return x
+        return "nan" if math.isnan(x) else ("inf" if x > 0 else "-inf")
     if x is None or isinstance(x, str):
         return x
     return str(x)
 
 
 def dumps(data) -> str:
+    """Strict JSON text of ``data`` (non-finite floats as strings, see :func:`jsonable`)."""
     return json.dumps(jsonable(data), indent=2, allow_nan=False)
+
+
+def loads(text: str):
+    """Data of a JSON file written by :func:`dumps`, with ``"inf"``, ``"-inf"`` and ``"nan"``
+    read back as floats."""
+    def back(x):
+        if isinstance(x, dict):
+            return {k: back(v) for k, v in x.items()}
+        if isinstance(x, list):
+            return [back(v) for v in x]
+        return NONFINITE.get(x, x) if isinstance(x, str) else x
+    return back(json.loads(text))
 
 
 def machine_info(gl_renderer: str | None = None) -> dict:

@@ -27,7 +27,8 @@ SHA-256 of a canonical serialisation of:
 Entry
 -----
 ``<key>.npy`` (the (H, W, 3) float32 image), ``<key>.arrays.npz`` (the stats' arrays, e.g. the
-per-pixel standard error ``stderr``; the depth image), ``<key>.json`` (method, options, size,
+per-pixel standard error ``stderr`` of Mitsuba; the depth image; ``std_error``, a Monte Carlo result's
+per-pixel standard error), ``<key>.json`` (method, options, size,
 scene name, timings, scalar stats, left_out, features_used, noise estimate, the image's
 SHA-256).  Every file is written to a temporary name and renamed (atomic); the JSON is
 written last and is the commit mark.  An entry that does not load, whose image does not match
@@ -48,12 +49,12 @@ import numpy as np
 
 from ..core.errors import WorkbenchError
 from ..core.imageio import atomic_write_bytes
-from ..renderers.base import RenderResult, _convert_options, get_renderer, render
+from ..renderers.base import RenderResult, convert_options, get_renderer, render
 from ..scene.model import Scene
 from .outputs import jsonable
 
 #: Bumped whenever the entry layout or the key's content changes.
-CACHE_FORMAT = 1
+CACHE_FORMAT = 2
 ENV_VAR = "WORKBENCH_REFERENCE_CACHE"
 _CODE_PACKAGES = ("core", "scene", "renderers")
 _VERSIONED = ("numpy", "numba", "mitsuba")
@@ -145,7 +146,7 @@ def _versions() -> dict:
 
 
 def _key_and_options(scene: Scene, method: str, width: int, height: int, options: dict) -> tuple[str, dict]:
-    opts = _convert_options(get_renderer(method), options)
+    opts = convert_options(get_renderer(method), options)
     h = hashlib.sha256()
     _feed(h, {"format": CACHE_FORMAT, "method": method, "options": opts, "size": [int(width), int(height)],
               "versions": _versions(), "code": code_fingerprint()})
@@ -196,7 +197,8 @@ def load_entry(key: str, directory: Path | None = None) -> RenderResult | None:
     stats.update({k[len("stats."):]: v for k, v in arrays.items() if k.startswith("stats.")})
     stats["cache"] = "hit"
     return RenderResult(meta["method"], image, dict(meta["timings"]), stats, list(meta["features_used"]),
-                        list(meta["left_out"]), dict(meta["options"]), arrays.get("depth"))
+                        list(meta["left_out"]), dict(meta["options"]), arrays.get("depth"),
+                        std_error=arrays.get("std_error"))
 
 
 def store_entry(key: str, result: RenderResult, scene_name: str, options: dict,
@@ -209,6 +211,8 @@ def store_entry(key: str, result: RenderResult, scene_name: str, options: dict,
     arrays = {f"stats.{k}": np.asarray(v) for k, v in result.stats.items() if isinstance(v, np.ndarray)}
     if result.depth is not None:
         arrays["depth"] = np.asarray(result.depth)
+    if result.std_error is not None:
+        arrays["std_error"] = np.asarray(result.std_error)
     buf = io.BytesIO()
     np.save(buf, image, allow_pickle=False)
     atomic_write_bytes(img_p, buf.getvalue())

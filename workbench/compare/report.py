@@ -19,20 +19,20 @@ Timing: each method is called once cold (compilation happens there and is report
 from __future__ import annotations
 
 import datetime as _dt
-import json
 from pathlib import Path
 
 import numpy as np
 
 from ..core.errors import WorkbenchError
 from ..core.imageio import save_npy, save_png, save_png8
-from ..renderers.base import available, default_methods, stats_for_display
+from ..renderers.base import check_methods, default_methods, file_stem, stats_for_display
 from ..scene.model import Scene
 from . import figures
 from .html import esc, img_tag, page, table
 from .metrics import metrics_and_maps
-from .outputs import dumps, machine_info, staged
-from .reference import choose_reference, physical_differences
+from .outputs import dumps, jsonable, loads, machine_info, staged
+from .metrics import metrics
+from .reference import References, matched_reason, physical_differences
 from .runs import MethodRun, timed_run
 
 
@@ -82,13 +82,12 @@ def compare(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
     The ``report.json`` content as a dict.
     """
     names = default_methods() if not methods else list(methods)
-    unknown = [m for m in names if m not in available()]
-    if unknown:
-        raise WorkbenchError(f"unknown method(s) {', '.join(unknown)} (available: {', '.join(available())})")
+    check_methods(names)  # unknown names, unusable glsl: files
     if repeat < 0:
         raise WorkbenchError(f"repeat must be >= 0, got {repeat}")
     w, h = size if size else (scene.camera.width, scene.camera.height)
-    ref = choose_reference(scene, w, h, reference)
+    refs = References(scene, w, h, reference)
+    ref = refs.full
     ref_img = ref.run.image
     ref_features = list(ref.run.result.features_used)
     runs = [timed_run(scene, m, w, h, repeat=repeat) for m in names]
@@ -99,6 +98,7 @@ def compare(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
         if r.status == "ok":
             e["metrics"], m = metrics_and_maps(r.image, ref_img)
             maps[r.method] = (m["flip"], m["abs"])
+            e["matched"] = _matched_entry(refs, r)
     # shared scale: the median over methods of their 99.5th percentile, at most display white
     # (1.0); larger errors saturate, so one far-off method does not blacken every other map
     abs_max = max(min(1.0, float(np.median([np.percentile(a, 99.5) for _, a in maps.values()] or [1.0]))), 1e-6)
@@ -111,11 +111,11 @@ def compare(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
         "size": [w, h], "repeat": repeat,
         "timing_protocol": "one cold call (compile reported apart) then `repeat` warm calls, "
                            "sequential in one process; time_s = median of the warm calls",
-        "reference": {"method": ref.method, "options": ref.options, "reason": ref.reason,
-                      "time_s": ref.run.time, "cold_s": ref.run.cold, "compile_s": ref.run.compile,
-                      "features_used": ref_features, "left_out": ref.run.result.left_out,
-                      "stats": stats_for_display(ref.run.result.stats),
+        "reference": {**ref.describe(), "stats": stats_for_display(ref.run.result.stats),
                       "files": {"png": "images/reference.png", "npy": "images/reference.npy"}},
+        "error_split": ("metrics: against the full reference (total error); matched.metrics: against "
+                        "the method's matched reference, which computes exactly the method's own physics "
+                        "(discretisation error); missing_physics_rmse = total RMSE - matched RMSE"),
         "heatmap_scales": {"flip": [0.0, 1.0], "abs": [0.0, abs_max]},
         "methods": entries,
         "machine": machine_info(_gl_renderer(runs + [ref.run])),
@@ -125,14 +125,16 @@ def compare(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
         save_npy(stage / "images/reference.npy", ref_img)
         tiles = [{"title": f"reference: {ref.method}",
                   "lines": [_fmt_opts(ref.options) or "default options", f"time {ref.run.time:.3g} s",
-                            "error 0 by definition"], "image": ref_img}]
+                            f"own error {ref.noise:.2g}" if ref.noise else "error 0 by definition"],
+                  "image": ref_img}]
         notes = []
         for r, e in zip(runs, entries):
             if r.status != "ok":
                 notes.append(f"{r.method}: {r.status.replace('_', ' ')}: {r.reason}")
                 continue
-            files = {"png": f"images/{r.method}.png", "npy": f"images/{r.method}.npy",
-                     "heat_flip": f"heat/{r.method}_flip.png", "heat_abs": f"heat/{r.method}_abs.png"}
+            stem = file_stem(r.method)
+            files = {"png": f"images/{stem}.png", "npy": f"images/{stem}.npy",
+                     "heat_flip": f"heat/{stem}_flip.png", "heat_abs": f"heat/{stem}_abs.png"}
             save_png(stage / files["png"], r.image)
             save_npy(stage / files["npy"], r.image)
             fmap, amap = maps[r.method]
@@ -142,12 +144,23 @@ def compare(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
             mt = e["metrics"]
             tiles.append({"title": r.method, "lines": [
                 f"{r.time:.3g} s; compile {r.compile:.2g} s",
-                f"RMSE {mt['rmse']:.3g}  PSNR {mt['psnr']:.3g} dB", f"FLIP {mt['flip']:.3g}"],
+                f"RMSE {mt['rmse']:.3g}  PSNR {mt['psnr']:.3g} dB", f"FLIP {mt['flip']:.3g}",
+                (f"vs matched: RMSE {e['matched']['metrics']['rmse']:.3g}" if "metrics" in e["matched"]
+                 else "no matched reference")],
                 "image": r.image})
         save_png8(stage / "grid.png", figures.grid(tiles, notes=notes))
         (stage / "report.json").write_text(dumps(report))
         (stage / "report.html").write_text(render_html(report, stage, Path(out_dir)))
-    return json.loads(dumps(report))
+    return jsonable(report, strict=False)
+
+
+def _matched_entry(refs: References, run: MethodRun) -> dict:
+    """The run's error against its matched reference and the gap to its total error."""
+    mref = refs.matched(run.method)
+    if mref is None:
+        return {"none": matched_reason(run.method)}
+    mt = metrics(run.image, mref.image)
+    return {"reference": mref.describe(), "metrics": mt}
 
 
 def _list(items) -> str:
@@ -164,24 +177,37 @@ def render_html(report: dict, stage: Path, out_dir: Path) -> str:
          f"{report['size'][0]}x{report['size'][1]} · {esc(report['created'])}</span></p>",
          f"<p>Scene uses: {esc(', '.join(scene['needs']))}</p>",
          f"<h2>Reference: {esc(ref['method'])} ({esc(_fmt_opts(ref['options']) or 'default options')})</h2>",
-         f"<p>{esc(ref['reason'])}. Time {ref['time_s']:.3g} s.</p>",
+         f"<p>{esc(ref['reason'])}. Contains: {esc(ref['what'])}. Time {ref['time_s']:.3g} s "
+         f"(cache: {esc(ref['cache'] or 'not used')}).</p>",
+         f"<p>Its own error: {ref['noise_rmse']:.3g} ({esc(ref['noise_note'])}); differences below "
+         "this are not resolved. Image definition: " + esc(ref['image_definition']) + ".</p>",
          "<h2>Side by side</h2>", img_tag(stage / "grid.png", "grid"),
          f"<p class='muted'>Timing: {esc(report['timing_protocol'])} (repeat = {report['repeat']}).</p>"]
     rows, cls = [], []
     for e in report["methods"]:
         if e["status"] != "ok":
             rows.append([e["method"], ("raw", f"<b>{esc(e['status'])}</b>: {esc(e['reason'])}"),
-                         "", "", "", "", "", "", "", ""])
+                         "", "", "", "", "", "", "", "", "", ""])
             cls.append("warn" if e["status"] == "not_applicable" else "bad")
             continue
-        mt = e["metrics"]
+        mt, mm = e["metrics"], e["matched"]
+        if "metrics" in mm:
+            r = mm["reference"]
+            matched = (mm["metrics"]["rmse"], f"{r['method']} ({_fmt_opts(r['options'])})",
+                       mt["rmse"] - mm["metrics"]["rmse"])
+        else:
+            matched = ("", mm["none"], "")
         rows.append([e["method"], _fmt_opts(e["options"]), e["time_s"], e["compile_s"], mt["rmse"],
+                     matched[0], matched[2], matched[1],
                      mt["psnr"], mt["flip"], ", ".join(e["features_used"]), _list(e["left_out"]),
                      ", ".join(e["differs_physically"]) or "none"])
         cls.append("")
-    b += ["<h2>Numbers</h2>", table(["method", "options", "time (s, warm)", "compile (s)", "RMSE", "PSNR (dB)",
+    b += ["<h2>Numbers</h2>", table(["method", "options", "time (s, warm)", "compile (s)", "RMSE (total)",
+                                     "RMSE vs matched (discretisation)", "gap (missing physics)",
+                                     "matched reference", "PSNR (dB)",
                                      "FLIP", "features used", "left out", "differs physically from reference by"],
-                                    rows, numeric={2, 3, 4, 5, 6}, row_class=cls),
+                                    rows, numeric={2, 3, 4, 5, 6, 8, 9}, row_class=cls),
+          "<p class='muted'>" + esc(report["error_split"]) + ".</p>",
           "<p class='muted'>'differs physically': features the reference computes that the method leaves "
           "out; its error then measures the missing effect, not only discretisation.</p>",
           "<h2>Error heat maps against the reference</h2>",
@@ -207,7 +233,7 @@ def _study_section(out_dir: Path) -> str:
     if not (js.is_file() and png.is_file()):
         return ("<h2>Error against run time</h2><p class='muted'>No study in this folder "
                 "(run <code>workbench study SCENE --out DIR</code> first to include it).</p>")
-    study = json.loads(js.read_text())
+    study = loads(js.read_text())
     rows = [[p["method"], f"{p['knob']}={p['value']}", p["time_s"], p["rmse"], p["flip"]]
             for p in study["points"] if p.get("pareto")]
     return ("<h2>Error against run time</h2>" + img_tag(png, "study") +

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.errors import NotApplicable
+from ..core.errors import NotApplicable, ShaderSourceError
 from ..renderers.base import RenderResult, render
 from ..scene.model import Scene
 
@@ -55,7 +55,8 @@ def timed_run(scene: Scene, method: str, width: int, height: int, repeat: int = 
               options: dict | None = None) -> MethodRun:
     """Render ``repeat + 1`` times (first call = warm-up); never raises for a method's failure.
 
-    A :class:`NotApplicable` gives ``status = "not_applicable"``; any other exception inside the
+    A :class:`NotApplicable` gives ``status = "not_applicable"``; a :class:`ShaderSourceError`
+    (a user's GLSL does not compile) is raised: it is bad input.  Any other exception inside the
     method gives ``status = "failed"`` with its message (the report lists it instead of dying:
     a comparison of many methods must survive one broken method).
     """
@@ -70,6 +71,8 @@ def timed_run(scene: Scene, method: str, width: int, height: int, repeat: int = 
         run.result = res
     except NotApplicable as e:
         run.status, run.reason = "not_applicable", str(e)
+    except ShaderSourceError:  # the user's shader code: bad input, not a method's failure
+        raise
     except Exception as e:  # noqa: BLE001 -- a method's bug is reported, not fatal
         run.status, run.reason = "failed", f"{type(e).__name__}: {e}"
         run.trace = traceback.format_exc()

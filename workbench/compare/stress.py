@@ -25,7 +25,6 @@ import datetime as _dt
 import fnmatch
 import importlib
 import io
-import json
 import time
 import tomllib
 from dataclasses import asdict, dataclass, field
@@ -41,7 +40,7 @@ from ..scene.io import scene_from_dict
 from . import formulas
 from .analytic import interior, sphere_hits
 from .html import esc, page, table
-from .outputs import dumps, machine_info, staged
+from .outputs import dumps, jsonable, machine_info, staged
 
 CATALOGUE = data_dir("stress") / "cases.toml"
 DEFAULT_SIZE = (48, 36)
@@ -558,7 +557,7 @@ def stress(out_dir: str | Path, only: str | None = None, catalogue: str | Path =
         (stage / "stress.md").write_text(to_markdown(rows))
         (stage / "stress.json").write_text(dumps(result))
         (stage / "stress.html").write_text(to_html(result, rows))
-    return json.loads(dumps(result))
+    return jsonable(result, strict=False)
 
 
 def summary(rows: list[Row]) -> dict:

@@ -21,23 +21,23 @@ from __future__ import annotations
 import csv
 import datetime as _dt
 import io
-import json
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
 from ..core.errors import WorkbenchError
-from ..renderers.base import available, default_methods, get_renderer
+from ..renderers.base import check_methods, convert_options, default_methods, get_renderer
 from ..scene.model import Scene
 from .html import esc, img_tag, page, table
 from .metrics import metrics
-from .outputs import dumps, machine_info, staged
-from .reference import SAMPLING_NOTE, choose_reference
+from .outputs import dumps, jsonable, machine_info, staged
+from .reference import SAMPLING_NOTE, References
 from .runs import timed_run
 
 CSV_FIELDS = ["method", "knob", "value", "status", "reason", "time_s", "cold_s", "compile_s", "rmse",
-              "psnr", "flip", "nonfinite_pixels", "is_reference", "pareto_rmse", "pareto_flip"]
+              "psnr", "flip", "rmse_matched", "flip_matched", "matched_reference", "nonfinite_pixels",
+              "is_reference", "pareto_rmse", "pareto_flip"]
 
 
 def sweep_values(values: tuple, quick: bool) -> list:
@@ -51,10 +51,12 @@ def sweep_values(values: tuple, quick: bool) -> list:
 
 def pareto(times: list[float], errors: list[float]) -> list[bool]:
     """Points not dominated by another (no other point at most as slow *and* at most as wrong,
-    one of both strictly).  Points with a non-positive or non-finite error or time are not on
-    the front (they cannot appear on a log-log plot)."""
+    one of both strictly).  A zero error is a valid point (a method that meets the reference
+    exactly is on the front if nothing faster does as well); points with a negative or
+    non-finite error, or a non-positive time, are not on the front.  The reference itself is
+    left out by the caller (its error is zero by definition)."""
     t, e = np.asarray(times, dtype=float), np.asarray(errors, dtype=float)
-    valid = np.isfinite(t) & np.isfinite(e) & (t > 0) & (e > 0)
+    valid = np.isfinite(t) & np.isfinite(e) & (t > 0) & (e >= 0)
     out = []
     for i in range(len(t)):
         if not valid[i]:
@@ -102,9 +104,7 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
     jobs : worker processes for the error evaluation (after all timing is done).
     """
     names = default_methods() if not methods else list(methods)
-    unknown = [m for m in names if m not in available()]
-    if unknown:
-        raise WorkbenchError(f"unknown method(s) {', '.join(unknown)} (available: {', '.join(available())})")
+    check_methods(names)  # unknown names, unusable glsl: files
     sweeps = sweeps or {}
     for m, (option, values) in sweeps.items():
         if m not in names:
@@ -112,9 +112,17 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
         if option not in get_renderer(m).options:
             raise WorkbenchError(f"--sweep {m}:{option}: {m} has no option {option!r} "
                                  f"(accepted: {', '.join(sorted(get_renderer(m).options))})")
+        if not values:
+            raise WorkbenchError(f"--sweep {m}:{option}: no values to sweep")
+        for v in values:    # every value converted now: a bad one fails before any render
+            try:
+                convert_options(get_renderer(m), {option: v})
+            except WorkbenchError as e:
+                raise WorkbenchError(f"--sweep {m}:{option}: {e}") from None
     repeat = (2 if quick else 5) if repeat is None else int(repeat)
     if repeat < 1:
         raise WorkbenchError(f"a study needs at least one warm run per point, got repeat={repeat}")
+    refs = None
     if reference_image is not None:
         ref_img = np.asarray(reference_image[0], dtype=np.float32)
         h, w = ref_img.shape[:2]
@@ -122,10 +130,11 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
     else:
         w, h = size if size else ((160, max(1, round(160 / scene.camera.aspect))) if quick
                                   else (scene.camera.width, scene.camera.height))
-        ref = choose_reference(scene, w, h, reference)
-        ref_img = ref.run.image
-        ref_info = {"method": ref.method, "options": ref.options, "reason": ref.reason,
-                    "time_s": ref.run.time, "compile_s": ref.run.compile}
+        if progress:
+            print(f"study {scene.name}: rendering the reference (cached after the first run)", flush=True)
+        refs = References(scene, w, h, reference)
+        ref_img = refs.full.image
+        ref_info = refs.full.describe()
     load = machine_info()
 
     plan = []
@@ -164,9 +173,16 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
     bar.close()
     for (i, _), mt in zip(images, evaluate([im for _, im in images], ref_img, jobs)):
         points[i].update(mt)
+    matched = _matched_errors(refs, points, images, jobs) if refs is not None else {}
     ok = [p for p in points if p["status"] == "ok"]
+    if not ok:
+        why = sorted({f"{p['method']}: {p['status']} ({p['reason']})" for p in points})
+        raise WorkbenchError(f"nothing to study on {scene.name}: no setting rendered ({'; '.join(why)})")
+    front = [p for p in ok if not p["is_reference"]]
     for key in ("rmse", "flip"):
-        for p, f in zip(ok, pareto([p["time_s"] for p in ok], [p[key] for p in ok])):
+        for p in ok:
+            p[f"pareto_{key}"] = False
+        for p, f in zip(front, pareto([p["time_s"] for p in front], [p[key] for p in front])):
             p[f"pareto_{key}"] = f
     for p in ok:
         p["pareto"] = p["pareto_rmse"]
@@ -175,12 +191,12 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
         "kind": "study", "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "command": command, "quick": quick, "repeat": repeat, "size": [w, h], "jobs": jobs,
         "scene": {"name": scene.name, "source": scene.source, "needs": sorted(scene.needs())},
-        "reference": ref_info,
+        "reference": ref_info, "matched_references": matched,
         "timing_protocol": "per point: 1 cold call (compile reported apart) + `repeat` warm calls, all "
                            "sequential in one process; time_s = median of warm wall times; error "
                            f"evaluation afterwards ({'in %d worker processes' % jobs if jobs > 1 else 'in-process'})",
         "points": points, "machine": load,
-        "notes": [SAMPLING_NOTE] if any(p["knob"] == "spp" for p in points) else [],
+        "notes": [SAMPLING_NOTE, ERROR_SPLIT_NOTE],
     }
     with staged(out_dir, last=("study.json", "study.html")) as stage:
         plot(points, stage / "study.png", f"{scene.name} {w}x{h}: error against warm run time "
@@ -188,7 +204,32 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
         (stage / "study.csv").write_text(to_csv(points))
         (stage / "study.json").write_text(dumps(result))
         (stage / "study.html").write_text(render_html(result, stage))
-    return json.loads(dumps(result))
+    return jsonable(result, strict=False)
+
+
+ERROR_SPLIT_NOTE = ("Two errors per point: against the full reference (total error) and against the "
+                    "method's matched reference, which computes exactly the method's own physics "
+                    "(discretisation error: it falls along the knob). Their gap is the cost of the physics "
+                    "the method leaves out. Dashed lines in the plot are the matched errors.")
+
+
+def _matched_errors(refs: References, points: list[dict], images: list, jobs: int) -> dict:
+    """Each rendered point's error against its method's matched reference (``rmse_matched``,
+    ``flip_matched``, ``matched_reference``); returns the matched references' descriptions."""
+    out, todo = {}, []
+    for i, im in images:
+        p = points[i]
+        ref = refs.matched(p["method"])
+        if ref is None:
+            p["matched_reference"] = ""
+            continue
+        label = f"{ref.method} ({', '.join(f'{k}={v}' for k, v in ref.options.items())})"
+        out.setdefault(label, ref.describe())
+        p["matched_reference"] = label
+        todo.append((i, im, ref.image))
+    for (i, _, _), mt in zip(todo, [evaluate([im], r, 1)[0] for _, im, r in todo]):
+        points[i].update(rmse_matched=mt["rmse"], flip_matched=mt["flip"], psnr_matched=mt["psnr"])
+    return out
 
 
 def to_csv(points: list[dict]) -> str:
@@ -201,58 +242,84 @@ def to_csv(points: list[dict]) -> str:
 
 
 def plot(points: list[dict], path: Path, title: str) -> None:
-    """Log-log error against warm run time, one line per method along its knob, the Pareto
-    front over all methods as a dashed step line through ringed points; RMSE and FLIP panels."""
+    """Log-log error against warm run time, one line per method along its knob (solid: against
+    the full reference; dashed: against the method's matched reference), the Pareto front over
+    all methods as a dashed black step line through ringed points; RMSE and FLIP panels.  A zero
+    error cannot sit on a log axis: such points are drawn on a floor line (half the smallest
+    positive error) with a downward triangle and said in the panel's title."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.8))
-    ok = [p for p in points if p["status"] == "ok"]
+    ok = [p for p in points if p["status"] == "ok" and p["time_s"] > 0]
     methods = list(dict.fromkeys(p["method"] for p in ok))
-    for ax, key, label in ((axes[0], "rmse", "RMSE (linear)"), (axes[1], "flip", "mean FLIP")):
-        dropped = 0
+    for ax, key, label in ((axes[0], "rmse", "RMSE (linear, display range)"), (axes[1], "flip", "mean FLIP")):
+        errs = [p[k] for p in ok for k in (key, f"{key}_matched") if k in p and p[k] > 0]
+        floor = 0.5 * min(errs) if errs else 1e-6
+        zeros = 0
         for k, m in enumerate(methods):
-            pts = [p for p in ok if p["method"] == m and p[key] > 0 and p["time_s"] > 0]
-            dropped += sum(1 for p in ok if p["method"] == m) - len(pts)
-            if not pts:
-                continue
-            t, e = [p["time_s"] for p in pts], [p[key] for p in pts]
-            ax.plot(t, e, "o-", color=f"C{k % 10}", label=f"{m} ({pts[0]['knob']})", ms=4)
-            for p in pts:
-                ax.annotate(str(p["value"]), (p["time_s"], p[key]), fontsize=7, xytext=(3, 3),
-                            textcoords="offset points", color=f"C{k % 10}")
-        front = sorted((p["time_s"], p[key]) for p in ok if p.get(f"pareto_{key}"))
+            pts = [p for p in ok if p["method"] == m]
+            colour = f"C{k % 10}"
+            t = [p["time_s"] for p in pts]
+            e = [p[key] if p[key] > 0 else floor for p in pts]
+            zeros += sum(1 for p in pts if p[key] <= 0)
+            ax.plot(t, e, "-", color=colour, label=f"{m} ({pts[0]['knob']})", lw=1.2)
+            for p, ti, ei in zip(pts, t, e):
+                ax.plot([ti], [ei], "v" if p[key] <= 0 else "o", color=colour, ms=4)
+                ax.annotate(str(p["value"]), (ti, ei), fontsize=7, xytext=(3, 3),
+                            textcoords="offset points", color=colour)
+            mpts = [p for p in pts if f"{key}_matched" in p]
+            if mpts:
+                ax.plot([p["time_s"] for p in mpts], [max(p[f"{key}_matched"], floor) for p in mpts],
+                        "s--", color=colour, ms=3, lw=1, alpha=0.8, label=f"{m}: vs matched")
+        front = sorted((p["time_s"], max(p[key], floor)) for p in ok if p.get(f"pareto_{key}"))
         if front:
             ft, fe = zip(*front)
             ax.step(ft, fe, "k--", where="post", lw=1, label="Pareto front")
             ax.plot(ft, fe, "o", mfc="none", mec="k", ms=9)
-        if any(p[key] > 0 and p["time_s"] > 0 for p in ok):
+        if ok:
             ax.set_xscale("log")
             ax.set_yscale("log")
         ax.set_xlabel("warm wall time per image (s)")
         ax.set_ylabel(label)
         ax.grid(True, which="both", alpha=0.3)
-        if dropped:
-            ax.set_title(f"{dropped} point(s) with zero error (the reference) not shown", fontsize=8)
-        ax.legend(fontsize=7)
+        if zeros:
+            ax.set_title(f"{zeros} point(s) with zero error drawn at the floor {floor:.2g} (triangles)", fontsize=8)
+        ax.legend(fontsize=6, ncol=2)
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
 
+def _ref_line(ref: dict) -> str:
+    """One readable line on a reference: method, options, why, what it contains, its noise."""
+    opts = ", ".join(f"{k}={v}" for k, v in ref.get("options", {}).items()) or "default options"
+    line = f"{ref['method']} ({opts}): {ref.get('reason', '')}"
+    if ref.get("what"):
+        line += f"; contains: {ref['what']}"
+    if ref.get("noise_note"):
+        line += f"; its own error: {ref.get('noise_rmse', 0):.3g} ({ref['noise_note']})"
+    return line
+
+
 def render_html(result: dict, stage: Path) -> str:
     rows = [[p["method"], f"{p['knob']}={p['value']}", p["status"] + (f": {p['reason']}" if p["reason"] else ""),
-             p.get("time_s", ""), p.get("compile_s", ""), p.get("rmse", ""), p.get("psnr", ""),
-             p.get("flip", ""), "yes" if p.get("pareto") else ""] for p in result["points"]]
+             p.get("time_s", ""), p.get("compile_s", ""), p.get("rmse", ""), p.get("rmse_matched", ""),
+             p.get("psnr", ""), p.get("flip", ""), p.get("flip_matched", ""),
+             "yes" if p.get("pareto") else ""] for p in result["points"]]
     ref = result["reference"]
+    matched = result.get("matched_references", {})
     body = [f"<h1>{esc(result['scene']['name'])}: error against run time</h1>",
-            f"<p>Reference: {esc(ref['method'])} {esc(ref['options'])}: {esc(ref['reason'])}</p>",
+            f"<p>Full reference: {esc(_ref_line(ref))}</p>",
+            "<p>Matched references:</p><ul>" + "".join(f"<li>{esc(_ref_line(r))}</li>" for r in matched.values())
+            + "</ul>" if matched else "",
             img_tag(stage / "study.png", "study"),
             f"<p class='muted'>{esc(result['timing_protocol'])}</p>",
             "".join(f"<p>{esc(n)}</p>" for n in result["notes"]),
-            table(["method", "setting", "status", "time (s, warm median)", "compile (s)", "RMSE",
-                   "PSNR (dB)", "FLIP", "Pareto (RMSE)"], rows, numeric={3, 4, 5, 6, 7}),
+            table(["method", "setting", "status", "time (s, warm median)", "compile (s)", "RMSE (total)",
+                   "RMSE (vs matched)", "PSNR (dB)", "FLIP (total)", "FLIP (vs matched)", "Pareto (RMSE)"],
+                  rows, numeric={3, 4, 5, 6, 7, 8, 9}),
             "<h2>Features per method</h2>",
             table(["method", "features used", "left out"], _features(result["points"])),
             "<h2>Machine</h2>", table(["key", "value"], [[k, v] for k, v in result["machine"].items()])]

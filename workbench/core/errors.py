@@ -7,3 +7,8 @@ class WorkbenchError(ValueError):
 
 class NotApplicable(WorkbenchError):
     """A method cannot render this scene (e.g. radiosity without emitters); says why."""
+
+
+class ShaderSourceError(WorkbenchError):
+    """A user's shader code does not compile: the message is one line naming the user's file
+    and line.  Bad input, not a method's failure: comparisons stop on it rather than list it."""

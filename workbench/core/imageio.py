@@ -1,11 +1,12 @@
 """Image files: sRGB encoding happens here and only here (images in memory are linear)."""
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
+
+from .output_paths import write_together
 
 
 def srgb_encode(linear: np.ndarray) -> np.ndarray:
@@ -25,57 +26,58 @@ def to_srgb8(linear: np.ndarray) -> np.ndarray:
     return (srgb_encode(linear) * 255.0 + 0.5).astype(np.uint8)
 
 
+def text_writer(text: str) -> Callable[[str], None]:
+    """A writer of ``text`` for :func:`.output_paths.write_together`."""
+    return lambda tmp: Path(tmp).write_text(text)
+
+
+def png_writer(linear: np.ndarray) -> Callable[[str], None]:
+    """A writer of a linear (H, W, 3) image as an sRGB PNG (see :func:`save_png`)."""
+    return png8_writer(to_srgb8(linear))
+
+
+def png8_writer(rgb8: np.ndarray) -> Callable[[str], None]:
+    """A writer of an already-encoded (H, W, 3|4) uint8 image."""
+    from PIL import Image
+    img = Image.fromarray(np.asarray(rgb8, dtype=np.uint8))
+    return lambda tmp: img.save(tmp, format="PNG")
+
+
+def npy_writer(array: np.ndarray) -> Callable[[str], None]:
+    """A writer of linear data as float32 ``.npy`` (exact comparison)."""
+    def write(tmp):
+        with open(tmp, "wb") as f:  # a file object: np.save would append ".npy" to a name
+            np.save(f, np.asarray(array, dtype=np.float32))
+    return write
+
+
 def atomic_write_text(path, text: str) -> Path:
-    """Write a text file atomically (same rules as the images)."""
-    _atomic_write(Path(path), lambda t: Path(t).write_text(text))
+    """Write a text file atomically (temporary file, then rename: never a half-written file)."""
+    write_together([(path, text_writer(text))])
     return Path(path)
 
 
 def atomic_write_bytes(path, data: bytes) -> Path:
-    """Write a binary file atomically (same rules as the images)."""
-    _atomic_write(Path(path), lambda t: Path(t).write_bytes(data))
+    """Write a binary file atomically (through :func:`.output_paths.write_together`)."""
+    write_together([(path, lambda tmp: Path(tmp).write_bytes(data))])
     return Path(path)
-
-
-def _atomic_write(path: Path, write):
-    """Write through a temporary file in the same folder, then rename: never a half-written file."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".tmp-", suffix=path.suffix)
-    os.close(fd)
-    umask = os.umask(0)
-    os.umask(umask)
-    try:
-        write(tmp)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the file the usual mode
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def save_png(path, linear: np.ndarray) -> Path:
     """Save a linear (H, W, 3) image as an sRGB PNG, atomically."""
-    from PIL import Image
-    img = Image.fromarray(to_srgb8(linear))
-    _atomic_write(Path(path), lambda t: img.save(t, format="PNG"))
+    write_together([(path, png_writer(linear))])
     return Path(path)
 
 
 def save_png8(path, rgb8: np.ndarray) -> Path:
     """Save an already-encoded (H, W, 3|4) uint8 image (plots, grids, heat maps), atomically."""
-    from PIL import Image
-    img = Image.fromarray(np.asarray(rgb8, dtype=np.uint8))
-    _atomic_write(Path(path), lambda t: img.save(t, format="PNG"))
+    write_together([(path, png8_writer(rgb8))])
     return Path(path)
 
 
 def save_npy(path, array: np.ndarray) -> Path:
     """Save linear data (float32) for exact comparison, atomically."""
-    def write(tmp):
-        with open(tmp, "wb") as f:  # a file object: np.save would append ".npy" to a name
-            np.save(f, np.asarray(array, dtype=np.float32))
-    _atomic_write(Path(path), write)
+    write_together([(path, npy_writer(array))])
     return Path(path)
 
 

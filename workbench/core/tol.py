@@ -43,6 +43,11 @@ class Tolerances:
         as the Cornell box's red wall is drawn in smaller blocks): seen from the nearest
         other patch centre, half an edge away, it moves a surface by a fifth of a pixel of a
         resolution-128 hemicube.
+    cut : float
+        Relative slack of the bounds a quadric is cut to, when a ray's hit point is tested
+        against them: ``cut * (|O| + |t D|)`` (infinity norms), a bound on the rounding of
+        ``O + t D``, so that a ray through a point on the bounds' faces (an ellipsoid's pole)
+        does not miss.
     bump_step : float
         Finite-difference step of a bump map's height gradient, as a fraction of one pattern
         period (the step in object units is ``bump_step / scale``).
@@ -56,6 +61,7 @@ class Tolerances:
     normal_cancel: float = 1e-6
     hemicube_near: float = 1e-5
     hemicube_flat: float = 1e-3
+    cut: float = 1e-9
     bump_step: float = 1e-3
 
 

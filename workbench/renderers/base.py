@@ -5,17 +5,28 @@ a dictionary of accepted ``options`` and a ``render(scene, width, height, **opti
 returning a :class:`RenderResult`.  ``render()`` validates the method and options, times the
 call, and guarantees that the returned image is finite (non-finite pixels are counted in
 ``stats["nonfinite_pixels"]`` and replaced by 0, so a NaN is reported, never shown).
+
+Memory: every renderer also has ``estimate_bytes(scene, width, height, **options) -> int``, an
+upper bound of the peak memory the render will allocate (patches, form factors, hemicube
+buffers, triangles, ray generations, BVH, images...), computed cheaply before anything big is
+allocated, and ``memory_options``, the names of the options the estimate grows with.
+``render()`` refuses a render whose estimate exceeds the limit of
+:func:`workbench.core.memory.memory_limit` with one :class:`WorkbenchError` line that names
+the estimate, the limit, the options to lower and how to raise the limit.
 """
 from __future__ import annotations
 
 import importlib
 import time
+from pathlib import Path
 from dataclasses import dataclass, field
 from typing import Any, Callable, Protocol
 
 import numpy as np
 
 from ..core.errors import WorkbenchError
+from ..core.memory import ENV as MEMORY_ENV
+from ..core.memory import gib, memory_limit
 from ..scene.model import Scene
 from .registry import BUILTIN, OPT_IN
 
@@ -53,6 +64,8 @@ class RenderResult:
     features_used / left_out : features of the scene this method built, and those it did not
         (not needed by the scene, or not supported by the method: each with the reason).
     depth : (H, W) float32 camera-space depth along the view axis (inf where nothing), if given.
+    std_error : (H, W, 3) float32 per-pixel standard error of the mean of a Monte Carlo image
+        (its own noise estimate), if given; its RMS is ``stats["noise_rmse"]``.
     """
 
     method: str
@@ -63,14 +76,18 @@ class RenderResult:
     left_out: list[str] = field(default_factory=list)
     options: dict[str, Any] = field(default_factory=dict)
     depth: np.ndarray | None = None
+    std_error: np.ndarray | None = None
 
 
 class Renderer(Protocol):
     name: str
     knob: Knob
     options: dict[str, Option]
+    memory_options: tuple[str, ...]
 
     def render(self, scene: Scene, width: int, height: int, **options) -> RenderResult: ...
+
+    def estimate_bytes(self, scene: Scene, width: int, height: int, **options) -> int: ...
 
 
 _instances: dict[str, Renderer] = {}
@@ -102,8 +119,17 @@ def default_methods() -> list[str]:
     return [m for m in BUILTIN if m not in OPT_IN]
 
 
+#: Method names ``glsl:PATH``: a user's shading model in the file PATH (:mod:`.user_shading`).
+USER_PREFIX = "glsl:"
+
+
 def get_renderer(method: str) -> Renderer:
-    """The (cached) renderer instance registered as ``method``."""
+    """The (cached) renderer instance registered as ``method``; for ``glsl:PATH`` a new
+    renderer of the user's shading model in PATH (checked: a missing or invalid file raises
+    :class:`WorkbenchError`), not registered nor cached."""
+    if method.startswith(USER_PREFIX):
+        from .user_shading import renderer_from_path
+        return renderer_from_path(method[len(USER_PREFIX):], name=method)
     if method not in BUILTIN:
         raise WorkbenchError(f"unknown method {method!r} (available: {', '.join(available())})")
     if method not in _instances:
@@ -112,7 +138,33 @@ def get_renderer(method: str) -> Renderer:
     return _instances[method]
 
 
-def _convert_options(r: Renderer, options: dict) -> dict:
+def check_methods(names: list[str]) -> None:
+    """Raise one :class:`WorkbenchError` naming every unknown method of ``names``, or the
+    first ``glsl:`` file that cannot be used."""
+    unknown = [m for m in names if m not in BUILTIN and not m.startswith(USER_PREFIX)]
+    if unknown:
+        raise WorkbenchError(f"unknown method(s) {', '.join(unknown)} (available: {', '.join(available())}, "
+                             f"or {USER_PREFIX}FILE for a shading model in GLSL)")
+    for m in names:
+        if m.startswith(USER_PREFIX):
+            get_renderer(m)
+    stems = [file_stem(m) for m in names]
+    clash = sorted({s for s in stems if stems.count(s) > 1})
+    if clash:
+        raise WorkbenchError(f"methods {', '.join(m for m in names if file_stem(m) in clash)} would write "
+                             f"the same files ({', '.join(clash)}): name the shading models' files apart")
+
+
+def file_stem(method: str) -> str:
+    """A file-name-safe stem for a method's output files: the name of a registered method,
+    ``glsl_<file stem>`` for a user's shading model ``glsl:PATH``."""
+    if not method.startswith(USER_PREFIX):
+        return method
+    stem = "".join(c if c.isalnum() or c in "_.-" else "_" for c in Path(method[len(USER_PREFIX):]).stem)
+    return f"glsl_{stem or 'model'}"
+
+
+def convert_options(r: Renderer, options: dict) -> dict:
     out = {k: o.default for k, o in r.options.items()}
     for k, v in options.items():
         if k not in r.options:
@@ -137,8 +189,43 @@ def _convert_options(r: Renderer, options: dict) -> dict:
     return out
 
 
+def _pixels(name: str, value, default: int) -> int:
+    """An image size given to :func:`render`: an integer (not a bool, a float or a string)."""
+    if value is None:
+        return int(default)
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise WorkbenchError(f"render: {name} must be an integer number of pixels, got "
+                             f"{type(value).__name__} {value!r:.80}")
+    return int(value)
+
+
+def check_memory(r: Renderer, scene: Scene, width: int, height: int, options: dict,
+                 max_memory=None) -> int:
+    """``r.estimate_bytes(...)`` (converted options), checked against
+    :func:`~workbench.core.memory.memory_limit` (``max_memory``, else the environment variable
+    ``WORKBENCH_MAX_MEMORY``, else a share of physical memory).  Returns the estimate.
+
+    Raises
+    ------
+    WorkbenchError
+        One line naming the estimate, the limit, the options to lower and the ways to raise
+        the limit, when the estimate exceeds it.
+    """
+    limit = memory_limit(max_memory)
+    est = r.estimate_bytes(scene, width, height, **options)
+    if not isinstance(est, (int, np.integer)) or est <= 0:
+        raise TypeError(f"{type(r).__name__}.estimate_bytes returned {est!r}, not a positive int")
+    if est > limit:
+        knobs = "".join(f"{k}={options[k]!r}, " for k in r.memory_options) + ("or " if r.memory_options else "")
+        raise WorkbenchError(
+            f"method {r.name!r}: {width}x{height} needs about {gib(est)} of memory, above the limit "
+            f"of {gib(limit)}: change {knobs}the image size, or raise the limit "
+            f"(--max-memory, {MEMORY_ENV} or max_memory=)")
+    return int(est)
+
+
 def render(scene: Scene, method: str, *, width: int | None = None, height: int | None = None,
-           **options) -> RenderResult:
+           max_memory=None, **options) -> RenderResult:
     """Render ``scene`` with the method registered as ``method``.
 
     Parameters
@@ -146,20 +233,34 @@ def render(scene: Scene, method: str, *, width: int | None = None, height: int |
     width, height : int, optional
         Image size; the scene camera's resolution by default.  The camera (and its vertical
         field of view) is otherwise the scene's: every method sees the same view.
+    max_memory : int or str, optional
+        Memory limit of this render in bytes or as ``"8G"``; by default the environment
+        variable ``WORKBENCH_MAX_MEMORY``, else half the physical memory
+        (:mod:`workbench.core.memory`).  The method's ``estimate_bytes`` is checked against it
+        before anything is allocated (:func:`check_memory`).
     **options
         Method options (see ``workbench methods``); unknown ones are an error.
     """
+    if not isinstance(scene, Scene):
+        raise WorkbenchError(f"render: scene must be a Scene (from workbench.load_scene), got "
+                             f"{type(scene).__name__} {scene!r:.80}")
+    if not isinstance(method, str):
+        raise WorkbenchError(f"render: method must be a registered method's name (str), got "
+                             f"{type(method).__name__} {method!r:.80}")
     r = get_renderer(method)
-    w = int(width if width is not None else scene.camera.width)
-    h = int(height if height is not None else scene.camera.height)
+    w = _pixels("width", width, scene.camera.width)
+    h = _pixels("height", height, scene.camera.height)
     if not (1 <= w <= 16384 and 1 <= h <= 16384):
         raise WorkbenchError(f"image size must be within 1..16384 pixels, got {w}x{h}")
-    opts = _convert_options(r, options)
+    opts = convert_options(r, options)
+    sized = scene.with_camera(scene.camera.with_resolution(w, h))
+    estimate = check_memory(r, sized, w, h, opts, max_memory)
     t0 = time.perf_counter()
-    result = r.render(scene.with_camera(scene.camera.with_resolution(w, h)), w, h, **opts)
+    result = r.render(sized, w, h, **opts)
     result.timings["total"] = time.perf_counter() - t0
     result.timings.setdefault("compile", 0.0)
     result.options = opts
+    result.stats["memory_estimate_bytes"] = estimate
     img = np.asarray(result.image, dtype=np.float32)
     bad = ~np.isfinite(img)
     result.stats["nonfinite_pixels"] = int(bad.any(-1).sum())

@@ -52,6 +52,8 @@ from .mitsuba_export import RR_DEPTH, export_scene
 FALLBACK_VARIANT = "scalar_rgb"
 FAST_VARIANT = "llvm_ad_rgb"
 VARIANTS = ("auto", FALLBACK_VARIANT, FAST_VARIANT)
+MAX_SPP = 1 << 20
+"""Largest accepted samples per pixel (a render of 2^20 spp already takes days here)."""
 INSTALL_HINT = ("Mitsuba 3 is not installed: pip install -e '.[reference]' (bash workbench.sh installs it), "
                 "or pip install 'mitsuba>=3.5'")
 
@@ -176,6 +178,8 @@ class MitsubaRenderer:
             return FAST_VARIANT, f"{FAST_VARIANT} probe rendered"
         return FALLBACK_VARIANT, f"{FAST_VARIANT} unusable here ({why}): fell back to {FALLBACK_VARIANT}"
 
+    memory_options = ("tessellation",)
+
     def estimate_bytes(self, scene: Scene, width: int, height: int, **options) -> int:
         """Peak memory of a render (child process and the parent's images), bytes: a fixed child
         base, per pixel and per triangle of the meshes (analytic spheres count as none; curved
@@ -199,8 +203,9 @@ class MitsubaRenderer:
                timeout: float = 3600.0) -> RenderResult:
         if not mitsuba_installed():
             raise WorkbenchError(f"method 'mitsuba': {INSTALL_HINT}")
-        if spp < 2:
-            raise WorkbenchError(f"method 'mitsuba': spp must be >= 2 (two passes for the noise estimate), got {spp}")
+        if not 2 <= spp <= MAX_SPP:
+            raise WorkbenchError(f"method 'mitsuba': spp must be within 2..{MAX_SPP} (two passes for the "
+                                 f"noise estimate), got {spp}")
         if seed < 0:
             raise WorkbenchError(f"method 'mitsuba': seed must be >= 0, got {seed}")
         if not 1 <= tessellation <= MAX_LEVEL:
@@ -241,4 +246,4 @@ class MitsubaRenderer:
                  "stderr": stderr, "stderr_rms": float(np.sqrt(np.mean(stderr.astype(np.float64) ** 2)))}
         needs = scene.needs()
         used = sorted(f for f in needs if not any(x.startswith(f + ":") for x in ex.left_out))
-        return RenderResult(self.name, image, timings, stats, used, list(ex.left_out))
+        return RenderResult(self.name, image, timings, stats, used, list(ex.left_out), std_error=stderr)

@@ -54,10 +54,11 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 
 from ..core.errors import WorkbenchError
-from ..core.tol import tol
 from ..scene import features as ft
 from ..scene.model import AreaLight, Camera, Environment, Material, Scene
+from ..scene.clip_planes import auto_near_far
 from ..scene.tessellate import DEFAULT_LEVEL, MAX_LEVEL, Part, tessellate_scene
+from .estimates import raster_bytes
 from ..scene.tessellate_topology import closed_outward, provoking_layout
 from . import gl
 from . import texturing as tx
@@ -65,9 +66,6 @@ from .base import Knob, Option, RenderResult
 from .raster_shaders import (LIVE_MATERIAL_FIELDS, ProgramCache, base_defines, light_kind,
                              light_uniforms, material_defines, material_uniforms)
 
-#: The near plane is never closer than this fraction of the far plane when chosen
-#: automatically (keeps 24-bit depth resolution usable when the camera is inside the bounds).
-NEAR_FAR_RATIO = 1e-3
 DEPTH_CHOICES = (16, 24, 32)
 #: Object kinds tessellated as closed, outward-wound surfaces.
 CLOSED_KINDS = ("sphere", "box", "csg")
@@ -199,18 +197,6 @@ def _parts(scene: Scene, level: int) -> list[Part]:
     return hit[1]
 
 
-def auto_near_far(camera: Camera, points: np.ndarray) -> tuple[float, float]:
-    """Clip planes enclosing ``points`` (N, 3) seen from ``camera`` (its own near/far win)."""
-    lo, hi = points.min(0), points.max(0)
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-    depth = camera.project(corners)[1]
-    far = camera.far or float(max(depth.max(), tol.zero) * 1.01)
-    near = camera.near or float(max(depth.min() * 0.99, far * NEAR_FAR_RATIO))
-    if far <= near:
-        far = near / NEAR_FAR_RATIO
-    return near, far
-
-
 class RasterSession:
     """A scene tessellated and uploaded for one shading mode (see the module docstring).
 
@@ -223,12 +209,18 @@ class RasterSession:
     depth_bits : 16 (emulated fixed point), 24 (fixed point) or 32 (float) depth buffer.
     backface_culling : cull the back faces of closed opaque objects while the camera is
         outside them (:meth:`_cull_groups`; the image is the same, the triangle work halves).
+    shading : a user's shading model in place of the local model (Phong only; a
+        :class:`~.user_shading.ShadingProgram`, see :mod:`.user_shading`).
     """
 
     def __init__(self, scene: Scene, mode: str, *, tessellation: int = DEFAULT_LEVEL,
-                 blinn: bool = False, depth_bits: int = 24, ctx=None, backface_culling: bool = True):
+                 blinn: bool = False, depth_bits: int = 24, ctx=None, backface_culling: bool = True,
+                 shading=None):
         if mode not in ("flat", "gouraud", "phong"):
             raise WorkbenchError(f"unknown raster mode {mode!r}")
+        if shading is not None and mode != "phong":
+            raise WorkbenchError(f"a user's shading model needs Phong shading, not {mode!r}")
+        self.shading = shading
         if depth_bits not in DEPTH_CHOICES:
             raise WorkbenchError(f"depth_bits must be one of {DEPTH_CHOICES}, got {depth_bits}")
         self.scene, self.mode, self.depth_bits, self.blinn = scene, mode, depth_bits, blinn
@@ -244,8 +236,8 @@ class RasterSession:
         pairs += [(p, m, None) for p, m in _area_light_parts(scene)]
         self.timings["tessellate"] = time.perf_counter() - t0
         self.n_triangles = sum(p.n_triangles for p, _, _ in pairs)
-        pts = np.vstack([p.positions for p, _, _ in pairs])
-        self.bounds = (pts.min(0), pts.max(0))
+        #: (K, 2, 3) world box of every part: the automatic clip planes (.scene.clip_planes)
+        self.part_boxes = np.array([[p.positions.min(0), p.positions.max(0)] for p, _, _ in pairs])
         self.lights = scene.point_lights()
         self._light_values = light_uniforms(self.lights)
         self._needs = scene.needs()  # its texture entry does not change with update()
@@ -366,8 +358,9 @@ class RasterSession:
             defines = material_defines(self.scene, d.material, self.mode, n_lights=len(self.lights),
                                        has_uv=d.has_uv, blinn=self.blinn, depth_bits=self.depth_bits,
                                        allow_bump=self.mode == "phong", live_material=live_mat,
-                                       live_lights=self.live_lights, needs=self._needs)
-            prog = self.programs.get("raster", defines)
+                                       live_lights=self.live_lights, needs=self._needs,
+                                       user_model=self.shading is not None)
+            prog = self.programs.get("raster", defines, user=self.shading)
             vao = d.vaos.get(id(prog))
             if vao is None:
                 vbo, fmt, names, index = d.buffers
@@ -540,8 +533,7 @@ class RasterSession:
 
     # ------------------------------------------------------------------ drawing
     def near_far(self, camera: Camera) -> tuple[float, float]:
-        lo, hi = self.bounds
-        return auto_near_far(camera, np.array([lo, hi]))
+        return auto_near_far(camera, self.part_boxes)
 
     def framebuffer(self, width: int, height: int):
         """A cached float32 RGBA colour + depth FBO of this size (depth format per
@@ -691,27 +683,41 @@ _SESSIONS: OrderedDict = OrderedDict()
 _MAX_SESSIONS = 6
 
 
-def session_for(scene: Scene, mode: str, tessellation: int, blinn: bool, depth_bits: int) -> tuple[RasterSession, bool]:
-    """A cached :class:`RasterSession` for the scene's content (camera excluded); returns
+def session_for(scene: Scene, mode: str, tessellation: int, blinn: bool, depth_bits: int,
+                shading=None) -> tuple[RasterSession, bool]:
+    """A cached :class:`RasterSession` for the scene's content (camera excluded) and shading
+    model (``shading``: a user's, by its source text and parameter values); returns
     ``(session, created)``."""
     ctx = gl.context()
     key = (id(ctx), id(scene.objects), id(scene.materials), id(scene.lights), id(scene.environment),
-           scene.ambient, mode, tessellation, blinn, depth_bits)
+           scene.ambient, mode, tessellation, blinn, depth_bits, None if shading is None else shading.key)
     hit = _SESSIONS.get(key)
     if hit is not None and hit[1] is scene.objects:
         _SESSIONS.move_to_end(key)
         return hit[0], False
-    session = RasterSession(scene, mode, tessellation=tessellation, blinn=blinn, depth_bits=depth_bits, ctx=ctx)
+    session = RasterSession(scene, mode, tessellation=tessellation, blinn=blinn, depth_bits=depth_bits, ctx=ctx,
+                            shading=shading)
     _SESSIONS[key] = (session, scene.objects)
     if len(_SESSIONS) > _MAX_SESSIONS:
         _SESSIONS.popitem(last=False)[1][0].release()
     return session, True
 
 
+_BYTES_PER_TRIANGLE = 1024
+"""A triangle's tessellated part (float64), its vertex and index buffers (unshared vertices
+for flat shading) and the draws' copies (about 280 B measured at tessellation 48)."""
+_BYTES_PER_PIXEL = 160
+"""Colour and depth attachments, read-backs and the float32 image and depth."""
+_FIXED_BYTES = 64 * 2 ** 20
+"""GL context, programs, textures."""
+
+
 class _RasterRenderer:
-    """Shared implementation of the three registered raster methods."""
+    """Shared implementation of the three registered raster methods (and of the users' shading
+    models, :mod:`.user_shading`: Phong with ``shading``)."""
 
     name = ""
+    mode = ""
     knob = Knob("tessellation", (1, 2, 3, 4, 6, 8, 12, 16, 24, 32), DEFAULT_LEVEL,
                 "tessellation level of analytic primitives (sphere: 4L x 8L, see tessellate)")
     options = {
@@ -724,15 +730,26 @@ class _RasterRenderer:
         "far": Option(float, 0.0, "far clip plane (0: the camera's, or from the scene bounds)"),
     }
 
+    memory_options = ("tessellation",)
+
+    def estimate_bytes(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
+                       **_) -> int:
+        """Triangles (:func:`.estimates.triangle_bound` at ``tessellation``) and pixels."""
+        if not 1 <= tessellation <= MAX_LEVEL:
+            raise WorkbenchError(f"method {self.name!r}: tessellation must be within 1..{MAX_LEVEL}, "
+                                 f"got {tessellation}")
+        return raster_bytes(scene, width, height, tessellation, _BYTES_PER_TRIANGLE, _BYTES_PER_PIXEL,
+                            _FIXED_BYTES)
+
     def render(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
                blinn: bool = False, depth_bits: int = 24, view: str = "color", near: float = 0.0,
-               far: float = 0.0) -> RenderResult:
+               far: float = 0.0, shading=None) -> RenderResult:
         if not 1 <= tessellation <= MAX_LEVEL:
             raise WorkbenchError(f"method {self.name!r}: tessellation must be within 1..{MAX_LEVEL}, "
                                  f"got {tessellation}")
         if near < 0 or far < 0 or (near and far and far <= near):
             raise WorkbenchError(f"method {self.name!r}: need 0 < near < far, got near={near}, far={far}")
-        session, created = session_for(scene, self.name, tessellation, blinn, depth_bits)
+        session, created = session_for(scene, self.mode or self.name, tessellation, blinn, depth_bits, shading)
         t0 = time.perf_counter()
         image, depth, (n, f) = session.draw(scene.camera.with_resolution(width, height),
                                             near=near or None, far=far or None, with_depth=True)

@@ -182,7 +182,7 @@ def light_uniforms(lights) -> dict[str, np.ndarray]:
 def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: int,
                      has_uv: bool, blinn: bool, depth_bits: int, allow_bump: bool,
                      live_material: bool = False, live_lights: bool = False,
-                     needs: frozenset[str] | None = None) -> dict[str, object]:
+                     needs: frozenset[str] | None = None, user_model: bool = False) -> dict[str, object]:
     """The ``#define``s of one draw: what the scene needs and this material uses, nothing else.
 
     ``MODE_*`` (flat, gouraud, phong); the scene's ambient and the material's constants as
@@ -203,7 +203,9 @@ def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: i
     compiles what any value of them needs (the lights, ``SPECULAR``, ``ENV_MAP`` for an
     environment-mapped material, whatever kd, ks and kr are); ``live_lights`` reads the lights'
     positions and colours from uniform arrays (``LIVE_LIGHTS``, :func:`light_uniforms`).
-    ``needs``: ``scene.needs()`` when the caller has it.
+    ``needs``: ``scene.needs()`` when the caller has it.  ``user_model``: a user's shading
+    model replaces the local model (``USER_MODEL``, ``shaders/include/user_model.glsl``; the
+    lights are compiled in whatever kd and ks are, since the user's model may use neither).
     """
     needs = scene.needs() if needs is None else needs
     d = base_defines()
@@ -218,7 +220,9 @@ def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: i
         for k in ("ka", "kd", "ks", "kr", "shininess"):
             d[f"MAT_{k.upper()}"] = _float(getattr(material, k))
     d["N_LIGHTS"] = n_lights
-    if (live_material or material.kd > 0 or material.ks > 0) and n_lights > 0:
+    if user_model:
+        d["USER_MODEL"] = ""
+    if (live_material or user_model or material.kd > 0 or material.ks > 0) and n_lights > 0:
         d["FOR_EACH_LIGHT(X)"] = light_list(scene.point_lights()[:n_lights], live=live_lights)
         if live_lights:
             d["LIVE_LIGHTS"] = ""
@@ -254,16 +258,26 @@ class ProgramCache:
         self.compile_seconds = 0.0
         self.compiles = 0  # programs compiled so far (tests: no compile per slider frame)
 
-    def get(self, name: str, defines: dict[str, object]):
+    def get(self, name: str, defines: dict[str, object], user=None):
+        """The program of shader ``name`` with ``defines``.  ``user``: a user's code appended
+        to the fragment stage (``user.source(number)``, with ``number`` its source-string
+        number in ``#line`` directives; ``user.key`` tells programs apart;
+        ``user.compile_error(log, names, ctx)`` turns the driver's log into the one-line message
+        raised; see :mod:`.user_shading`)."""
         import time
-        key = (name, tuple(sorted((k, str(v)) for k, v in defines.items())))
+        key = (name, tuple(sorted((k, str(v)) for k, v in defines.items())),
+               None if user is None else user.key)
         prog = self.programs.get(key)
         if prog is None:
             t0 = time.perf_counter()
             vs, fs = build_source(f"{name}.vert", defines), build_source(f"{name}.frag", defines)
+            if user is not None:
+                fs += user.source(len(source_names(name + ".frag")))
             try:
                 prog = self.ctx.program(vertex_shader=vs, fragment_shader=fs)
             except Exception as e:  # moderngl raises its own Error with the driver log
+                if user is not None:
+                    raise user.compile_error(str(e), source_names(name + ".frag"), self.ctx) from None
                 raise WorkbenchError(f"shader {name} failed to compile with {dict(key[1])}: {e}\n"
                                      f"(source strings: {source_names(name + '.frag')})") from None
             self.programs[key] = prog

@@ -53,8 +53,10 @@ import numpy as np
 from ..core.errors import WorkbenchError
 from ..core.tol import tol
 from ..scene import features as ft
+from ..scene.clip_planes import auto_near_far
 from ..scene.model import AreaLight, DirectionalLight, Scene
 from ..scene.tessellate import DEFAULT_LEVEL, MAX_LEVEL, tessellate_scene
+from .estimates import raster_bytes
 from . import gl
 from . import texturing as tx
 from .base import Knob, Option, RenderResult
@@ -136,8 +138,6 @@ def build_scene(scene: Scene, level: int):
 
 
 BAKE_SIZE = 1024
-#: Automatic near plane never closer than this fraction of the far plane (as the raster methods).
-NEAR_FAR_RATIO = 1e-3
 
 
 def _baked_texture(tex, part):
@@ -176,13 +176,8 @@ def _pose_looking(position: np.ndarray, direction: np.ndarray) -> np.ndarray:
 
 
 def _near_far(scene: Scene, ps) -> tuple[float, float]:
-    cam = scene.camera
-    lo, hi = ps.bounds
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-    d = cam.project(corners)[1]
-    far = cam.far or float(max(d.max(), tol.zero) * 1.01)
-    near = cam.near or float(max(d.min() * 0.99, far * NEAR_FAR_RATIO))
-    return near, far
+    """Clip planes from each mesh's world box (the raster methods' rule, .scene.clip_planes)."""
+    return auto_near_far(scene.camera, np.array([mesh.bounds for mesh in ps.meshes]))
 
 
 def _render_here(scene: Scene, width: int, height: int, level: int, frames: int = 1) -> dict:
@@ -327,6 +322,16 @@ def frame_time_in_child(scene_name: str, width: int, height: int, frames: int = 
             "fps": round(1.0 / float(np.median(ft_)), 1) if ft_ else None, "gl_renderer": res["gl_renderer"]}
 
 
+_BYTES_PER_TRIANGLE = 2048
+"""A triangle in trimesh, pyrender's primitive and its GL buffers."""
+_BYTES_PER_PIXEL = 256
+"""pyrender's colour and depth renderbuffers, read-backs, float conversions."""
+_FIXED_BYTES = 128 * 2 ** 20
+"""EGL context, pyrender's shaders and scene objects."""
+_BYTES_PER_BAKED_TEXEL = 256
+"""Texture baking's float64 temporaries, one bake at a time (164 MB measured for 1024^2)."""
+
+
 class PyrenderRenderer:
     """The registered ``pyrender`` method (see the module docstring for the mapping)."""
 
@@ -337,6 +342,19 @@ class PyrenderRenderer:
         "tessellation": Option(int, DEFAULT_LEVEL, "tessellation level >= 1"),
         "isolate": Option(bool, False, "render in a child process (needed beside a GLX UI)"),
     }
+
+    memory_options = ("tessellation",)
+
+    def estimate_bytes(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
+                       isolate: bool = False) -> int:
+        """Triangles (:func:`.estimates.triangle_bound`: pyrender's meshes and GL buffers) and
+        pixels (its multisampled framebuffer and read-backs), in this process or the child."""
+        if not 1 <= tessellation <= MAX_LEVEL:
+            raise WorkbenchError(f"method 'pyrender': tessellation must be within 1..{MAX_LEVEL}, got {tessellation}")
+        baked = any(mt.texture is not None and mt.texture.projection != "solid"
+                    for mt in scene.materials.values())
+        return (raster_bytes(scene, width, height, tessellation, _BYTES_PER_TRIANGLE, _BYTES_PER_PIXEL,
+                             _FIXED_BYTES) + baked * _BYTES_PER_BAKED_TEXEL * BAKE_SIZE ** 2)
 
     def render(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
                isolate: bool = False) -> RenderResult:

@@ -19,6 +19,7 @@ BUILTIN: dict[str, str] = {
     "raytrace": "workbench.renderers.raytrace.whitted:RaytraceRenderer",
     "radiosity": "workbench.renderers.radiosity.method:RadiosityRenderer",
     "hybrid": "workbench.renderers.radiosity.hybrid:HybridRenderer",
+    "pathtrace": "workbench.renderers.pathtrace.method:PathTraceRenderer",
     "mitsuba": "workbench.renderers.mitsuba_method:MitsubaRenderer",
 }
 

@@ -16,10 +16,13 @@ with ``d = P - center``, ``Sp`` the pole and ``Se`` the equator made orthogonal 
 * ``spherical`` (the course's globe mapping with its errata fixed, DESIGN.md #4):
   ``v = phi / pi`` with ``phi = atan2(|d x Sp|, -d.Sp)`` (the course's ``arccos(-N.Sp)``: 0 at
   the ``-Sp`` pole, 1 at ``+Sp``), and
-  ``u = atan2(d.W, -d.Se) / 2pi`` wrapped to ``[0, 1)`` (the course's
-  ``arccos(-Se.N / sin phi) / 2pi``, with ``u = theta`` when ``(Sp x Se).N > 0`` and
-  ``1 - theta`` otherwise; the atan2 form is exact at the seam and defined at the poles, where
-  ``u = 0``).
+  ``u = atan2(-d.W, -d.Se) / 2pi`` wrapped to ``[0, 1)``: the longitude, 0 at ``-Se``, 0.5 at
+  ``+Se`` (the prime meridian, the middle of a lat-long image), increasing eastward
+  (counter-clockwise seen from the ``+Sp`` pole, as POV-Ray's ``map_type 1`` and every
+  lat-long image: seen from outside, east is to the right).  The course's
+  ``arccos(-Se.N / sin phi) / 2pi`` with ``u = theta`` when ``(Sp x Se).N > 0`` and ``1 - theta``
+  otherwise runs clockwise in a right-handed frame (DESIGN errata 8: lat-long images come out
+  mirrored); the atan2 form is also exact at the seam and defined at the poles (``u = 0``).
 * ``uv``: the mesh's coordinates; objects without uvs (``uv=None``) fall back to the spherical
   mapping about ``center``, which is also how the tessellator parametrises spheres.
 * ``solid``: the pattern is a function of the 3D point ``scale * d`` itself (Peachey 1985,
@@ -80,8 +83,9 @@ def _wrap01(u: np.ndarray) -> np.ndarray:
 
 
 def longitude(d: np.ndarray, sp, se, w) -> np.ndarray:
-    """``u = atan2(d.W, -d.Se) / 2pi`` wrapped to [0, 1); 0 on the axis (no NaN).  (N,)"""
-    x, y = -(d @ se), d @ w
+    """``u = atan2(-d.W, -d.Se) / 2pi`` wrapped to [0, 1), increasing eastward (counter-clockwise
+    seen from the pole, DESIGN errata 8); 0 on the axis (no NaN).  (N,)"""
+    x, y = -(d @ se), -(d @ w)
     on_axis = x * x + y * y <= tol.zero * tol.zero * np.maximum(1.0, np.sum(d * d, -1))
     u = np.arctan2(np.where(on_axis, 0.0, y), np.where(on_axis, 1.0, x)) / TWO_PI
     return _wrap01(u)

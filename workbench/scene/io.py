@@ -124,6 +124,68 @@ def _path(ctx, t, where, key, required=True):
     return str(p)
 
 
+FLOAT32_MAX = float(np.finfo(np.float32).max)
+LARGEST_EXACT_INTEGER = 2 ** 53      # every number becomes a float64 (and float32 on the GPU)
+
+
+def _where(path: list) -> str:
+    """``["objects", 2, "center", 0]`` -> ``[[objects]] #3.center[0]`` (the messages' style)."""
+    if not path:
+        return "top level"
+    head, rest = path[0], path[1:]
+    if head in ("objects", "lights") and rest and isinstance(rest[0], int):
+        out, rest = f"[[{head}]] #{rest[0] + 1}", rest[1:]
+    elif head == "materials" and rest:
+        out, rest = f"[materials.{rest[0]}]", rest[1:]
+    else:
+        out = f"[{head}]"
+    for k in rest:
+        out += f"[{k}]" if isinstance(k, int) else f".{k}"
+    return out
+
+
+def _numbers_fit(ctx, x, path: list) -> None:
+    """Every number anywhere in the scene fits what reads it, before any section is parsed:
+    floats finite and within float32 range (GL buffers, uniforms and shader literals, and the
+    float32 images, are float32: 1e39 is finite in float64 and infinite on the GPU); integers
+    within +-2^53 (exact as the float64 every number becomes; beyond, ``np.isfinite`` and
+    int64 conversions fail)."""
+    if isinstance(x, dict):
+        for k, v in x.items():
+            _numbers_fit(ctx, v, path + [k])
+    elif isinstance(x, list):
+        for i, v in enumerate(x):
+            _numbers_fit(ctx, v, path + [i])
+    elif isinstance(x, bool):
+        return
+    elif isinstance(x, int):
+        if abs(x) > LARGEST_EXACT_INTEGER:
+            ctx.fail(_where(path), f"integer {x} is too large (|n| <= 2^53 = {LARGEST_EXACT_INTEGER})")
+    elif isinstance(x, float):
+        if not np.isfinite(x):
+            ctx.fail(_where(path), f"expected a finite number, got {x!r}")
+        if abs(x) > FLOAT32_MAX:
+            ctx.fail(_where(path), f"{x!r} is outside the float32 range |x| <= {FLOAT32_MAX:.8g} "
+                                   f"(the GPU and the images are float32)")
+
+
+def _image_file(ctx, t, where, key, required):
+    """``_path`` of an image map, opened and decoded now (Pillow, as the renderers read it), so
+    a file that is not a readable image fails at load, not mid-render."""
+    p = _path(ctx, t, where, key, required)
+    if p is not None:
+        from PIL import Image
+        try:
+            with Image.open(p) as im:
+                im.load()
+                size = im.size
+        except Exception as e:  # noqa: BLE001 -- Pillow raises many kinds for a bad file
+            ctx.fail(f"{where}.{key}", f"not a readable image: {p} ({type(e).__name__}: {e})")
+        if min(size) < 1:
+            ctx.fail(f"{where}.{key}", f"image {p} is empty ({size[0]}x{size[1]})")
+    return p
+
+
 # --------------------------------------------------------------------------- sections
 def _camera(ctx, t) -> m.Camera:
     w = "[camera]"
@@ -214,7 +276,7 @@ def _texture(ctx, t, w):
     if not (isinstance(colors, list) and len(colors) == 2):
         ctx.fail(f"{w}.colors", "expected two colours [[r, g, b], [r, g, b]]")
     cols = tuple(_rgb(ctx, {"c": c}, f"{w}.colors", "c", None) for c in colors)
-    return m.Texture(kind, colors=cols, path=_path(ctx, t, w, "path", kind == "image"),
+    return m.Texture(kind, colors=cols, path=_image_file(ctx, t, w, "path", kind == "image"),
                      mortar=_num(ctx, t, w, "mortar", 0.08, lo=0.0, hi=0.5),
                      **_mapping(ctx, t, w, "uv"))
 
@@ -224,7 +286,7 @@ def _bump(ctx, t, w):
     kind = _str(ctx, t, w, "type", choices=("bricks", "noise", "waves", "image"))
     _image_projection(ctx, t, w, kind)
     return m.Bump(kind, strength=_num(ctx, t, w, "strength", 1.0),
-                  path=_path(ctx, t, w, "path", kind == "image"),
+                  path=_image_file(ctx, t, w, "path", kind == "image"),
                   mortar=_num(ctx, t, w, "mortar", 0.08, lo=0.0, hi=0.5),
                   **_mapping(ctx, t, w, "planar"))
 
@@ -234,7 +296,7 @@ def _opacity(ctx, t, w):
     kind = _str(ctx, t, w, "type", choices=("constant", "grid", "checker", "image"))
     _image_projection(ctx, t, w, kind)
     return m.Opacity(kind, value=_num(ctx, t, w, "value", 1.0, lo=0.0, hi=1.0),
-                     path=_path(ctx, t, w, "path", kind == "image"),
+                     path=_image_file(ctx, t, w, "path", kind == "image"),
                      width=_num(ctx, t, w, "width", 0.2, lo=0.0, hi=1.0),
                      **_mapping(ctx, t, w, "uv"))
 
@@ -245,11 +307,16 @@ def _material(ctx, name, t):
             "texture", "bump", "opacity", "environment"}
     _check_keys(ctx, t, w, keys)
     unit = dict(lo=0.0, hi=1.0)
+    kr, kt = _num(ctx, t, w, "kr", 0.0, **unit), _num(ctx, t, w, "kt", 0.0, **unit)
+    if kr + kt > 1.0:
+        ctx.fail(f"{w}.kt", f"kr + kt = {kr:g} + {kt:g} = {kr + kt:g} > 1: on total internal "
+                            "reflection the transmitted share goes to reflection, so the surface "
+                            "would create energy (DESIGN erratum 9); lower kr or kt")
     return m.Material(
         name, _rgb(ctx, t, w, "color", (0.8, 0.8, 0.8)), _num(ctx, t, w, "ka", 0.1, **unit),
         _num(ctx, t, w, "kd", 0.8, **unit), _num(ctx, t, w, "ks", 0.0, **unit),
-        _num(ctx, t, w, "shininess", 32.0, lo=0.0), _num(ctx, t, w, "kr", 0.0, **unit),
-        _num(ctx, t, w, "kt", 0.0, **unit), _num(ctx, t, w, "ior", 1.0, lo=0.0, lo_open=True),
+        _num(ctx, t, w, "shininess", 32.0, lo=0.0), kr,
+        kt, _num(ctx, t, w, "ior", 1.0, lo=0.0, lo_open=True),
         _rgb(ctx, t, w, "absorption", (0.0, 0.0, 0.0)), _rgb(ctx, t, w, "emission", (0.0, 0.0, 0.0)),
         _texture(ctx, t["texture"], f"{w}.texture") if "texture" in t else None,
         _bump(ctx, t["bump"], f"{w}.bump") if "bump" in t else None,
@@ -373,7 +440,7 @@ def _object(ctx, t, w, materials, *, in_csg=False, inherited=None) -> m.SceneObj
         _check_keys(ctx, t, w, _COMMON | {"vertices"}, {"vertices"})
         return m.Polygon(**common, vertices=m._ro(_polygon_vertices(ctx, t, w)))
     if kind == "mesh":
-        _check_keys(ctx, t, w, _COMMON | {"path", "generate", "vertices", "faces"})
+        _check_keys(ctx, t, w, _COMMON | {"path", "generate", "vertices", "faces", "crease_angle"})
         return _mesh(ctx, t, w, common)
     _check_keys(ctx, t, w, _COMMON | {"op", "left", "right"}, {"op", "left", "right"})
     op = _str(ctx, t, w, "op", choices=("union", "intersection", "difference"))
@@ -403,7 +470,7 @@ def _mesh(ctx, t, w, common):
         kind = _str(ctx, g, f"{w}.generate", "kind", choices=("icosphere", "blob", "torus"))
         from .generate import generate_mesh
         tm = generate_mesh(kind, subdivisions=_num(ctx, g, f"{w}.generate", "subdivisions", 4, lo=0, hi=8, integer=True),
-                           seed=_num(ctx, g, f"{w}.generate", "seed", 0, lo=0, integer=True),
+                           seed=_num(ctx, g, f"{w}.generate", "seed", 0, lo=0, hi=2 ** 32 - 1, integer=True),
                            amplitude=_num(ctx, g, f"{w}.generate", "amplitude", 0.15, lo=0.0),
                            radius=_num(ctx, g, f"{w}.generate", "radius", 1.0, lo=0.0, lo_open=True))
         source = f"generated:{kind}"
@@ -426,12 +493,18 @@ def _mesh(ctx, t, w, common):
         ctx.fail(f"{w}", f"mesh from {source} has no triangles")
     if not np.isfinite(tm.vertices).all():
         ctx.fail(f"{w}", f"mesh from {source} has non-finite vertices")
+    if np.abs(tm.vertices).max() > FLOAT32_MAX:
+        ctx.fail(f"{w}", f"mesh from {source} has vertices outside the float32 range "
+                         f"|x| <= {FLOAT32_MAX:.8g} (the GPU is float32)")
     uvs = None
     vis = getattr(tm, "visual", None)
     if vis is not None and getattr(vis, "uv", None) is not None and len(vis.uv) == len(tm.vertices):
         uvs = m._ro(vis.uv)
-    return m.Mesh(**common, vertices=m._ro(tm.vertices), faces=np.asarray(tm.faces, dtype=np.int64),
-                  normals=m._ro(tm.vertex_normals), uvs=uvs, source=source)
+    from .mesh_normals import DEFAULT_CREASE_ANGLE, crease_normals
+    crease = _num(ctx, t, w, "crease_angle", DEFAULT_CREASE_ANGLE, lo=0.0, hi=180.0)
+    V, F, N, uvs = crease_normals(tm.vertices, tm.faces, crease, uvs)
+    return m.Mesh(**common, vertices=m._ro(V), faces=np.asarray(F, dtype=np.int64),
+                  normals=m._ro(N), uvs=None if uvs is None else m._ro(uvs), source=source)
 
 
 def _environment(ctx, t):
@@ -439,7 +512,7 @@ def _environment(ctx, t):
     _check_keys(ctx, t, w, {"type", "path", "zenith", "horizon", "ground"}, {"type"})
     kind = _str(ctx, t, w, "type", choices=("sky", "image"))
     d = m.Environment()
-    return m.Environment(kind, _path(ctx, t, w, "path", kind == "image"),
+    return m.Environment(kind, _image_file(ctx, t, w, "path", kind == "image"),
                          _rgb(ctx, t, w, "zenith", d.zenith), _rgb(ctx, t, w, "horizon", d.horizon),
                          _rgb(ctx, t, w, "ground", d.ground))
 
@@ -448,6 +521,7 @@ def _environment(ctx, t):
 def scene_from_dict(data: dict, source: str = "<dict>", base_dir: Path | str = ".") -> m.Scene:
     """Build a validated :class:`Scene` from a parsed TOML dictionary."""
     ctx = _Ctx(source, Path(base_dir))
+    _numbers_fit(ctx, data, [])
     _check_keys(ctx, data, "top level", {"scene", "camera", "lights", "materials", "objects", "environment"},
                 {"camera", "objects"})
     st = data.get("scene", {})
@@ -489,4 +563,6 @@ def load_scene(path: str | Path) -> m.Scene:
         raise SceneError(f"{p}: not valid TOML: {e}") from None
     except UnicodeDecodeError as e:
         raise SceneError(f"{p}: not a UTF-8 text file ({e.reason})") from None
+    except OSError as e:
+        raise SceneError(f"{p}: cannot read the scene file ({e.strerror or e})") from None
     return scene_from_dict(data, str(p), p.parent)

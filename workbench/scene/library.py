@@ -28,6 +28,9 @@ def header(path: Path) -> str:
 def resolve(name: str | Path) -> Path:
     """A scene file path from a path or a bundled scene's name (``"cornell"``)."""
     from .io import SceneError
+    if not isinstance(name, (str, Path)):
+        raise SceneError(f"a scene is given by a file path or a bundled scene's name (str), got "
+                         f"{type(name).__name__} {name!r}")
     p = Path(name)
     if p.is_file():
         return p.resolve()

@@ -365,8 +365,10 @@ class Polygon(SceneObject):
 class Mesh(SceneObject):
     """Triangle mesh: vertices (V, 3), faces (F, 3) int, optional per-vertex normals (V, 3) and
     uvs (V, 2).  ``source`` says where it came from (a file path or a generator).
-    ``vertex_emission`` (V, 3), when set, is emitted radiance interpolated over each triangle
-    (the hybrid method hands the radiosity solution to the ray tracer this way)."""
+    ``vertex_emission`` (V, 3), when set, is emitted radiance interpolated over each triangle,
+    from its front side only (where its counter-clockwise winding faces, as a one-sided
+    radiosity patch: its back received nothing); the hybrid method hands the radiosity
+    solution to the ray tracer this way."""
 
     vertices: np.ndarray = field(default_factory=lambda: _ro(np.zeros((0, 3))))
     faces: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), dtype=np.int64))

@@ -16,7 +16,8 @@ Quality knob ``level`` (an object's own ``tessellation`` overrides it):
 sphere      UV sphere, ``4 level`` rings x ``8 level`` segments, analytic normals
 plane       the rectangle cut in ``2 level x 2 level`` cells
 box         each face cut in ``level x level`` cells, face normals
-polygon     fan of triangles, each cut in ``level^2`` (barycentric grid)
+polygon     fan of triangles of each convex piece (a concave polygon's ear-clipped
+            triangles, :mod:`.polygon_pieces`), each cut in ``level^2`` (barycentric grid)
 quadric     surface ``P^T Q P = 0`` inside the object's bounds, not capped (open, as the
             ray tracer sees a cut quadric).  Named shapes (ellipsoid, cylinder, cone,
             hyperboloids, paraboloid): parametric surfaces of revolution, ``4 level`` rows x
@@ -49,6 +50,7 @@ from ..core import transform as tf
 from ..core.errors import WorkbenchError
 from ..core.tol import tol
 from . import model as m
+from .polygon_pieces import convex_pieces
 
 DEFAULT_LEVEL = 6
 
@@ -388,7 +390,9 @@ def tessellate_object(obj: m.SceneObject, level: int = DEFAULT_LEVEL,
     if isinstance(obj, m.Box):
         return [_part(obj, M, *_polygons(_box_faces(obj), L))]
     if isinstance(obj, m.Polygon):
-        return [_part(obj, M, *_polygons([np.asarray(obj.vertices)], L))]
+        P, N, F, fn, fc = _polygons(convex_pieces(obj.vertices), L)
+        fc[:] = np.asarray(obj.vertices).mean(0)  # one flat-shading point for the whole polygon
+        return [_part(obj, M, P, N, F, fn, fc)]
     if isinstance(obj, m.Quadric):
         return [_part(obj, M, *_quadric(obj, L))]
     if isinstance(obj, m.Mesh):

@@ -22,7 +22,7 @@ from ...scene import features as ft
 from ...scene import model as m
 from ..base import Knob, Option, RenderResult
 from ..base import render as render_method
-from .method import common_options, solve_scene
+from .method import common_options, estimate_solve_bytes, solve_scene
 
 RAYTRACE_OPTIONS = ("max_depth", "threshold", "spp", "fresnel")
 
@@ -73,6 +73,16 @@ class HybridRenderer:
                "spp": Option(int, 1, "ray tracer: samples per pixel"),
                "fresnel": Option(str, "none", "ray tracer: reflection/transmission split",
                                  ("none", "schlick", "exact"))}
+    memory_options = ("patch_size", "hemicube_resolution", "solver", "row_cache_mb",
+                      "max_depth", "threshold", "spp")
+
+    def estimate_bytes(self, scene: m.Scene, width: int, height: int, **opts) -> int:
+        """The radiosity pass (:func:`.method.estimate_solve_bytes`), whose patches stay alive,
+        plus the ray tracer on the derived scene (two triangles per patch,
+        :func:`..raytrace.whitted.estimate_trace_bytes`)."""
+        from ..raytrace.whitted import estimate_trace_bytes
+        solve, P = estimate_solve_bytes(scene, opts)
+        return solve + estimate_trace_bytes(scene, width, height, opts, True, extra_triangles=2 * P)
 
     def render(self, scene: m.Scene, width: int, height: int, **opts) -> RenderResult:
         sol = solve_scene(scene, opts, self.name)

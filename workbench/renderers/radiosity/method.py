@@ -66,6 +66,44 @@ def common_options() -> dict[str, Option]:
     }
 
 
+_BYTES_PER_PATCH = 4096
+"""A patch's corners, vertices, triangles, geometry record and outline (about 1.8 kB, measured)."""
+_MATRIX_COPIES = {"direct": 6, "jacobi": 6, "gauss_seidel": 10, "progressive": 6}
+"""P x P float64 arrays alive at once: F and the reciprocity report's three (all solvers), plus
+I - rho F and its LU copy (direct) or the triangular factors of three channels (Gauss-Seidel);
+4.4-5.1 and 8.1-8.7 measured on the Cornell box."""
+_HEMICUBE_BYTES_PER_PIXEL = 20 * 16 + 48
+"""Per top-face pixel (res^2) of the hemicube: up to 16 patches' five faces (3 res^2 each) of
+item buffer, depth and read-back, plus the delta form factors."""
+_DISPLAY_BYTES_PER_PIXEL = 64
+_FIXED_BYTES = 96 * 2 ** 20
+"""GL context, shaders, numba kernels' JIT or cache load."""
+
+
+def estimate_solve_bytes(scene: Scene, opts: dict) -> tuple[int, int]:
+    """Upper bound of the peak bytes of :func:`solve_scene` and the patch count, from the
+    patch count (:func:`.patches.count_patches`, computed from the surfaces' sizes without
+    cutting them): per-patch arrays, the P x P form-factor matrix and the solver's copies of it
+    (none for matrix-free progressive refinement: its row cache and a batch of rows), the
+    hemicube's item buffers, ray-cast rows' samples."""
+    from .patches import count_patches
+    if not opts["patch_size"] > 0:
+        raise WorkbenchError(f"patch_size must be a positive fraction of the scene's diagonal, got {opts['patch_size']}")
+    P = count_patches(scene, opts["patch_size"] * scene_extent(scene))
+    res = int(opts["hemicube_resolution"])
+    total = _FIXED_BYTES + P * _BYTES_PER_PATCH
+    matrix_free = opts["solver"] == "progressive" and opts["form_factors"] == "hemicube"
+    if matrix_free:
+        total += int(max(opts["row_cache_mb"], 0.0) * 2 ** 20) + 4 * 16 * P * 8
+    else:
+        total += _MATRIX_COPIES[opts["solver"]] * 8 * P * P
+    if opts["form_factors"] == "raycast":
+        total += max(int(opts["rays"]), 1) * P * 8
+    elif not (matrix_free and opts["shot_rows"] == "raycast"):
+        total += _HEMICUBE_BYTES_PER_PIXEL * res * res
+    return int(total), P
+
+
 @dataclass
 class Solution:
     """Radiosity of a scene's patches and the report of how it was obtained."""
@@ -191,6 +229,11 @@ class RadiosityRenderer:
     knob = Knob("patch_size", (0.2, 0.1, 0.05, 0.035, 0.025), 0.05,
                 "largest patch edge / scene diagonal")
     options = common_options()
+    memory_options = ("patch_size", "hemicube_resolution", "solver", "row_cache_mb")
+
+    def estimate_bytes(self, scene: Scene, width: int, height: int, **opts) -> int:
+        """:func:`estimate_solve_bytes` plus the Gouraud display's image and buffers."""
+        return estimate_solve_bytes(scene, opts)[0] + _DISPLAY_BYTES_PER_PIXEL * width * height
 
     def render(self, scene: Scene, width: int, height: int, **opts) -> RenderResult:
         from .display import draw

@@ -18,7 +18,7 @@ a surface whose material has ``emission`` emits it.  Reflectance is ``Material.r
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -26,6 +26,7 @@ from ...core import transform as tf
 from ...core.errors import WorkbenchError
 from ...core.tol import tol
 from ...scene import model as m
+from ...scene.polygon_pieces import convex_pieces
 
 MAX_CURVED_LEVEL = 24   # finest tessellation level asked of workbench.scene.tessellate
 
@@ -274,7 +275,7 @@ def _surfaces(scene: m.Scene, h: float) -> tuple[list, list[str]]:
         emis = np.asarray(mat.emission, dtype=np.float64)
         polys: list[np.ndarray] = []
         if isinstance(obj, m.Polygon):
-            polys = [obj.vertices]
+            polys = convex_pieces(obj.vertices)
         elif isinstance(obj, m.Plane):
             polys = [obj.corners()]
         elif isinstance(obj, m.Box):
@@ -359,6 +360,37 @@ def patches_from_scene(scene: m.Scene, patch_size: float) -> tuple[PatchSet, lis
     surfaces = [(k, g, np.zeros(3) if mat is None else mat.reflectance, e, o, n)
                 for k, g, mat, e, o, n in surfaces]
     return _assemble(surfaces, patch_size), left_out
+
+
+def count_patches(scene: m.Scene, patch_size: float) -> int:
+    """The number of patches :func:`patches_from_scene` would cut (same grids and subdivisions,
+    counted from the surfaces' edge lengths without building a patch), for the memory estimate
+    before anything is allocated.  ``patch_size`` in scene units, positive."""
+    if not (patch_size > 0 and np.isfinite(patch_size)):
+        raise WorkbenchError(f"patch_size must be a positive length in scene units, got {patch_size!r}")
+    total, fans = 0, []
+    meshes = [o for o in scene.objects if isinstance(o, m.Mesh)]
+    for obj in meshes:  # as _surfaces, vectorised: one patch per triangle, or n^2 if too long
+        Pw = tf.transform_points(obj.world_from_object, np.asarray(obj.vertices))
+        fans.append(Pw[np.asarray(obj.faces, dtype=np.int64)])
+        if _edge_max(Pw, np.asarray(obj.faces, dtype=np.int64)) <= patch_size:
+            total += len(fans.pop())
+    rest = replace(scene, objects=tuple(o for o in scene.objects if not isinstance(o, m.Mesh)))
+    for kind, geo, *_ in _surfaces(rest, patch_size)[0]:
+        if kind == "mesh":
+            total += len(geo[1])
+        elif len(geo) == 4:
+            nu, nv = _grid_shape(geo, patch_size)
+            total += nu * nv
+        else:  # a fan of triangles, each cut regularly into n^2 (as _split_triangle)
+            g = np.asarray(geo, dtype=np.float64)
+            fans.append(np.stack([np.broadcast_to(g[0], (len(g) - 2, 3)), g[1:-1], g[2:]], 1))
+    if fans:
+        tri = np.concatenate(fans)
+        edge = np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=-1).max(1)
+        n = np.maximum(1.0, np.ceil(edge / patch_size))
+        total += int((n * n).sum())
+    return int(total)
 
 
 def patch_size_for_count(scene: m.Scene, count: int) -> float:

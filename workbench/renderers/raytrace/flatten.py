@@ -31,6 +31,7 @@ import numpy as np
 from ...core.errors import NotApplicable, WorkbenchError
 from ...core.tol import tol
 from ...scene import model as m
+from ...scene.polygon_pieces import convex_pieces
 
 if TYPE_CHECKING:
     from .bvh import Bvh4
@@ -156,7 +157,11 @@ class _Builder:
             self._bound(W, [np.where(np.array(s, bool), hi, lo) for s in np.ndindex(2, 2, 2)])
             return self.add(BOX, obj_index, mat, W, par, top=top)
         if isinstance(o, m.Polygon):
-            return self.polygon(np.asarray(o.vertices), obj_index, mat, W, top=top)
+            pieces = convex_pieces(o.vertices)
+            if len(pieces) > 1 and not top:
+                raise NotApplicable(f"object {o.name or obj_index}: a concave polygon inside a CSG "
+                                    "tree is not supported by the ray tracer")
+            return [self.polygon(p, obj_index, mat, W, top=top) for p in pieces][-1]
         if isinstance(o, m.Quadric):
             Q = np.asarray(o.Q)
             par[:10] = (Q[0, 0], Q[0, 1], Q[0, 2], Q[0, 3], Q[1, 1], Q[1, 2], Q[1, 3], Q[2, 2], Q[2, 3], Q[3, 3])

@@ -26,6 +26,7 @@ import numba as nb
 import numpy as np
 from numba import prange
 
+from ...core.tol import tol
 from .bvh import MAX_DEPTH
 from .flatten import (BOX, CSG_DEPTH, CSG_DIFFERENCE, CSG_INTERSECTION, CSG_UNION, CSGNODE, POLYGON,
                       QUADRIC, RECT, SHADOW_CROSSINGS, SPHERE)
@@ -44,6 +45,8 @@ NO_REFCOUNT = dict(cache=True, error_model="numpy", _nrt=False, fastmath=FAST_MA
 BVH_STACK = 3 * MAX_DEPTH + 4
 """Rows of the 4-wide traversal's stack: at most three pending children per level (``.bvh.MAX_DEPTH``)."""
 CSG_EVENTS = 32
+TOL_CUT = tol.cut
+"""Relative slack of a cut quadric's bounds test (``tol.cut``; a compile-time constant of the kernels)."""
 # Slab exits are enlarged by 1 + 2 gamma_3 (gamma_n = n u / (1 - n u), u = 2^-53) so that
 # rounding never culls a box the ray touches (Ize, "Robust BVH ray traversal", JCGT 2013).
 BOX_GAMMA = 1.0 + 2.0 * 3.0 * 2.0 ** -53 / (1.0 - 3.0 * 2.0 ** -53)
@@ -61,11 +64,10 @@ def _to_object(xf, k, ox, oy, oz, dx, dy, dz):
 @nb.njit(**NO_REFCOUNT)
 def solve_quadratic(A, B, C, zero):
     """Real roots of ``A t^2 + B t + C`` sorted (DESIGN errata 7: ``q = -(B + sign(B) sqrt(disc))/2``,
-    roots ``q/A`` and ``C/q``); ``A = 0`` (relative to ``zero``) gives the linear root ``-C/B``.
+    roots ``q/A`` and ``C/q``); a negligible ``A`` (:func:`linear`) gives the linear root ``-C/B``.
     Returns ``(n, t0, t1)``; a tangent (double) root counts as no root (the course ignores it)."""
-    scale = abs(A) + abs(B) + abs(C)
-    if abs(A) <= zero * scale:
-        if abs(B) <= zero * scale:
+    if linear(A, B, C, zero):
+        if B == 0.0:
             return 0, 0.0, 0.0
         t = -C / B
         return 1, t, t
@@ -79,6 +81,16 @@ def solve_quadratic(A, B, C, zero):
     if t0 > t1:
         t0, t1 = t1, t0
     return 2, t0, t1
+
+
+@nb.njit(error_model="numpy", inline="always")
+def linear(A, B, C, zero):
+    """True when ``A t^2 + B t + C`` is linear for the ray: ``|A C| <= zero B^2``, i.e. the
+    second root ``-B/A`` lies beyond ``1/zero`` times the first ``-C/B`` (or ``A = B = 0``).
+    Homogeneous in the coefficients and in the unit of ``t``, so a quadric at scale 1e6 (``A``
+    of order 1e-12 for a unit direction) is not taken for a plane (as ``|A| <= zero (|A| + |B|
+    + |C|)`` took it)."""
+    return abs(A * C) <= zero * (B * B)
 
 
 @nb.njit(error_model="numpy", inline="always")
@@ -209,8 +221,13 @@ def _quadric_hit(k, par, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
     n, t0, t1 = solve_quadratic(A, B, C, zero)
     for r in range(n):
         t = t0 if r == 0 else t1
-        if tmin < t < tmax and _in_bounds(par, k, ox + t * dx, oy + t * dy, oz + t * dz, 0.0):
-            return t, 0
+        if tmin < t < tmax:
+            px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
+            # the computed point is off by rounding relative to |O| + |t D|: a ray through a
+            # point of the bounds' faces (an ellipsoid's pole) must not fall out of them
+            slack = TOL_CUT * (max(abs(ox), abs(oy), abs(oz)) + abs(t) * max(abs(dx), abs(dy), abs(dz)))
+            if _in_bounds(par, k, px, py, pz, slack):
+                return t, 0
     return np.inf, 0
 
 
@@ -286,8 +303,7 @@ def leaf_events(k, ptype, par, ox, oy, oz, dx, dy, dz, zero, et, ep, ef):
         # the inside {t : A t^2 + B t + C < 0} as up to two intervals (a, b)
         cnt = 0
         ia0, ib0, ia1, ib1 = 0.0, 0.0, 0.0, 0.0
-        scale = abs(A) + abs(B) + abs(C)
-        if abs(A) <= zero * scale:
+        if linear(A, B, C, zero):
             if n == 1:
                 if B > 0.0:
                     ia0, ib0, cnt = -np.inf, r0, 1
@@ -947,7 +963,9 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
     else:
         cr, cg, cb = mat_tab[mi, 0], mat_tab[mi, 1], mat_tab[mi, 2]
     ka, kd, ks, shin = mat_tab[mi, 3], mat_tab[mi, 4], mat_tab[mi, 5], mat_tab[mi, 6]
-    er, eg, eb = ev[i, 0], ev[i, 1], ev[i, 2]
+    # vertex emission (radiosity patches of the hybrid method) leaves the front side only: the
+    # back of a one-sided patch received no light (Mesh.vertex_emission)
+    er, eg, eb = (ev[i, 0], ev[i, 1], ev[i, 2]) if front else (0.0, 0.0, 0.0)
     if mat_tab[mi, 16] < 0.5 or front:
         er, eg, eb = er + mat_tab[mi, 13], eg + mat_tab[mi, 14], eb + mat_tab[mi, 15]
     lr = ka * cr * ambient[0] + er

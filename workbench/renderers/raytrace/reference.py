@@ -296,6 +296,7 @@ def shade(ctx, hit: Hit, D, recurs, weight, media, node):
                             None if hit.uv is None else hit.uv[None])[0]
     if mat.name.startswith("__area_light") and not front:
         mat = replace(mat, emission=(0.0, 0.0, 0.0))
+    emitted = hit.emission if front else 0.0  # vertex emission: front side only (Mesh.vertex_emission)
     vis = np.ones((len(ctx.lights), 1))
     if opts["shadows"]:
         Nv = Ns if Ns @ S >= 0 else -Ns
@@ -306,7 +307,7 @@ def shade(ctx, hit: Hit, D, recurs, weight, media, node):
             vis[li, 0] = shadow_feeler(ctx, hit.P, hit.Ng, L[0], dist[0])
             node["shadow_feelers"].append(dict(light=li, visibility=float(vis[li, 0])))
     color = local_model.shade(hit.P[None], Ns[None], S[None], C, mat, ctx.lights, ctx.scene.ambient,
-                              vis, opts["blinn"])[0] + hit.emission
+                              vis, opts["blinn"])[0] + emitted
     kr, kt = mat.kr, mat.kt
     if kr <= 0 and kt <= 0:
         node["stop"] = "no reflection or transmission"

@@ -12,18 +12,25 @@ import numpy as np
 
 from ...core.tol import tol
 from ...scene import model as m
+from ...scene.polygon_pieces import convex_pieces
+
+
+def is_linear(A: float, B: float, C: float) -> bool:
+    """``|A C| <= tol.zero B^2``: the second root ``-B/A`` lies beyond ``1/tol.zero`` times the
+    first ``-C/B`` (or ``A = B = 0``).  Homogeneous in the coefficients and in the unit of
+    ``t``: a quadric at scale 1e6 is not taken for a plane."""
+    return abs(A * C) <= tol.zero * (B * B)
 
 
 def solve_quadratic(A: float, B: float, C: float) -> list[float]:
     """Real roots of ``A t^2 + B t + C = 0``, sorted.
 
     Stable form (DESIGN errata 7): ``q = -(B + sign(B) sqrt(B^2 - 4AC)) / 2``, roots ``q / A``
-    and ``C / q``.  ``A = 0`` (relative to the coefficients) is linear: ``t = -C / B``.  A
+    and ``C / q``.  A negligible ``A`` (:func:`is_linear`) is linear: ``t = -C / B``.  A
     double root (tangent ray) is no intersection, as the course says ("le cas tangent sera
     ignoré")."""
-    scale = abs(A) + abs(B) + abs(C)
-    if abs(A) <= tol.zero * scale:
-        return [] if abs(B) <= tol.zero * scale else [-C / B]
+    if is_linear(A, B, C):
+        return [] if B == 0.0 else [-C / B]
     disc = B * B - 4.0 * A * C
     if not disc > 0.0:
         return []
@@ -77,7 +84,13 @@ def quadric_surface(q: m.Quadric, O, D) -> list[tuple[float, int]]:
     """Roots of a quadric whose point lies in the object-space bounds (an open, cut surface)."""
     A, B, C = quadric_coefficients(q.Q, O, D)
     lo, hi = np.asarray(q.bounds_min), np.asarray(q.bounds_max)
-    return [(t, 0) for t in solve_quadratic(A, B, C) if np.all((lo <= O + t * D) & (O + t * D <= hi))]
+    out = []
+    for t in solve_quadratic(A, B, C):
+        P = O + t * D
+        slack = tol.cut * (np.abs(O).max() + abs(t) * np.abs(D).max())  # rounding of O + t D
+        if np.all((lo - slack <= P) & (P <= hi + slack)):
+            out.append((t, 0))
+    return out
 
 
 def quadric_solid(q: m.Quadric, O, D) -> list[tuple[float, int]]:
@@ -88,7 +101,7 @@ def quadric_solid(q: m.Quadric, O, D) -> list[tuple[float, int]]:
     A, B, C = quadric_coefficients(q.Q, O, D)
     roots = solve_quadratic(A, B, C)
     inf = np.inf
-    if abs(A) <= tol.zero * (abs(A) + abs(B) + abs(C)):
+    if is_linear(A, B, C):
         inside = ([(-inf, roots[0])] if B > 0 else [(roots[0], inf)]) if roots else ([(-inf, inf)] if C < 0 else [])
     elif A > 0:
         inside = [(roots[0], roots[1])] if roots else []
@@ -116,9 +129,15 @@ def rectangle(p: m.Plane, O, D) -> list[tuple[float, int]]:
 
 
 def polygon(vertices, O, D) -> list[tuple[float, int]]:
-    """Convex planar polygon: plane hit, then the point is left of every edge (seen from the
-    front, vertices counter-clockwise)."""
-    v = np.asarray(vertices)
+    """Planar polygon: the closest hit of its convex pieces (the polygon itself, or the
+    triangles of a concave one, :func:`~workbench.scene.polygon_pieces.convex_pieces`)."""
+    hits = [h for piece in convex_pieces(vertices) for h in _convex_polygon(piece, O, D)]
+    return [min(hits)] if hits else []
+
+
+def _convex_polygon(v, O, D) -> list[tuple[float, int]]:
+    """Convex planar polygon (k, 3): plane hit, then the point is left of every edge (seen
+    from the front, vertices counter-clockwise)."""
     n = np.cross(v[1:-1] - v[0], v[2:] - v[0]).sum(0)
     n = n / np.linalg.norm(n)
     den = D @ n

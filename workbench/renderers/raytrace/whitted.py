@@ -54,10 +54,100 @@ def _callback(v):
     raise ValueError("expected a callable on_tile(y0, y1, x0, x1, tile) or None")
 
 
-_BYTES_PER_PRIMARY_RAY = 96
-"""Origin, direction, jitter and pixel index of one primary ray (all are built up front)."""
-_PRIMARY_RAYS_GIB = 4.0
-"""Largest primary-ray set accepted (the machine has 24 GiB; bands bound everything else)."""
+_BYTES_PER_PRIMARY_RAY = 160
+"""Origin, direction, jitter, pixel index and temporaries of one primary ray (all are built
+up front by :func:`camera_rays`)."""
+_BYTES_PER_WAVEFRONT_RAY = 1536
+"""Arrays of one ray in a wavefront iteration: its state, hit record, shading outputs, two
+child slots, compaction output and texturing temporaries (about 1 kB, measured)."""
+_BYTES_PER_FEELER = 160
+"""A shadow feeler of the wavefront's opacity visibility pass (per ray and light)."""
+_BYTES_PER_STACK_ROW = 136
+"""A pending ray of the fused kernel's stack (:func:`.kernels.ray_stack`)."""
+_BYTES_PER_TRIANGLE = 768
+"""A mesh triangle in the flattened scene and its BVH (458 MB for 1.31 M triangles, bench
+bvh_1m, with margin)."""
+_BYTES_PER_PIXEL = 64
+"""Image, depth and the band's float64 results."""
+_FIXED_BYTES = 96 * 2 ** 20
+"""Kernels' JIT (or cache load), scene tables, per-task scratch."""
+
+
+def generation_bound(scene: Scene, max_depth: int, threshold: float, recursive: bool) -> int:
+    """The ``max_depth`` the kernels get: at most ``max_depth``, and one more than the deepest
+    generation a ray can reach with a weight above ``threshold`` (so that it changes no image
+    and no count).
+
+    A ray of generation g (primary = 1) carries a weight of at most k^(g-1), with k the largest
+    ``kr + kt`` of the scene's materials (a child's factor is kr, kt, kr + kt on total internal
+    reflection, or kr + kt F, kt (1 - F) with Fresnel), and a child is traced only if its
+    weight exceeds ``threshold``.  With k < 1 and a threshold above the smallest normal double
+    (below it, products stall in the subnormals), g <= 1 + ceil(ln threshold / ln k'), k' = k
+    rounded up by 2^-50 for the products' rounding.  Otherwise the bound is ``max_depth``.
+    """
+    if not recursive:
+        return 1
+    k = max((m.kr + m.kt for m in scene.materials.values()), default=0.0)
+    if k <= 0.0:
+        return 1
+    if k < 1.0 and threshold >= np.finfo(np.float64).tiny:
+        kk = k * (1.0 + 2.0 ** -50)
+        reach = 1 + int(np.ceil(np.log(threshold) / np.log(kk)))
+        return int(min(max_depth, reach + 1))
+    return int(max_depth)
+
+
+def _growth(scene: Scene, G: int, threshold: float, branches: int) -> float:
+    """Upper bound of (rays of one wavefront iteration) / (primary rays of the band): each
+    iteration at most multiplies the rays by ``branches``, and, where every material has
+    kr + kt <= 1, the rays of generation g above ``threshold`` number at most
+    k^(g-1) / threshold per primary ray (their weights sum to at most k^(g-1))."""
+    if branches <= 1 or G <= 1:
+        return 1.0
+    g = np.arange(1, min(G, 4096) + 1, dtype=np.float64)
+    by_branching = np.exp(np.minimum((g - 1) * np.log(branches), 700.0))
+    k = max((m.kr + m.kt for m in scene.materials.values()), default=0.0)
+    if k <= 1.0 and threshold > 0.0:
+        by_weight = np.exp(np.minimum((g - 1) * np.log(max(k, 1e-300)) - np.log(threshold), 700.0))
+        by_branching = np.minimum(by_branching, np.maximum(by_weight, 1.0))
+    elif G > 4096:
+        return float(np.exp(700.0))
+    return float(by_branching.max())
+
+
+def estimate_trace_bytes(scene: Scene, width: int, height: int, opts: dict, recursive: bool,
+                         extra_triangles: int = 0) -> int:
+    """Upper bound of the peak bytes of a ray-traced render (see :meth:`_WhittedBase.estimate_bytes`);
+    ``extra_triangles``: triangles the scene will gain before tracing (hybrid's patch meshes)."""
+    from ...scene import model as m
+    spp = int(opts["spp"])
+    tris = extra_triangles + sum(len(o.faces) for o in scene.objects if isinstance(o, m.Mesh))
+    total = _FIXED_BYTES + tris * _BYTES_PER_TRIANGLE + width * height * _BYTES_PER_PIXEL
+    total += width * height * spp * _BYTES_PER_PRIMARY_RAY
+    G = generation_bound(scene, int(opts.get("max_depth", 1)), float(opts.get("threshold", 0.0)), recursive)
+    if fusable(scene, scene.materials.values()):  # MAX_TASKS stacks of 2 G + 2 pending rays
+        return int(total + 64 * (2 * G + 2) * _BYTES_PER_STACK_ROW)
+    # the wavefront: the largest iteration of a band (capped by _Tracer.ray_cap)
+    cap = wavefront_cap(scene, width, height, spp, G, float(opts.get("threshold", 0.0)), recursive)
+    total += _BYTES_PER_WAVEFRONT_RAY * cap
+    if F.OPACITY in scene.needs():
+        total += _BYTES_PER_FEELER * len(scene.lights) * cap
+    return int(total)
+
+
+def wavefront_cap(scene: Scene, width: int, height: int, spp: int, G: int, threshold: float,
+                  recursive: bool) -> int:
+    """Most rays one wavefront iteration may hold: the band's primary rays times
+    :func:`_growth` (reflection, refraction and, with opacity maps, the ray continuing
+    through a partly transparent surface).  :class:`_Tracer` refuses to go beyond it."""
+    n0 = min(height, max(1, _RAYS_PER_BAND // (width * spp))) * width * spp
+    mats = scene.materials.values()
+    branches = (int(recursive and any(m.kr > 0 for m in mats)) + int(recursive and any(m.kt > 0 for m in mats))
+                + int(F.OPACITY in scene.needs()))
+    grow = _growth(scene, G, threshold, max(branches, 1))
+    if F.OPACITY in scene.needs():
+        grow *= 2.0  # continuations are not threshold-tested: at most one per ray and iteration
+    return int(min(n0 * grow, 2.0 ** 62))
 
 
 def camera_frame(camera, width: int, height: int) -> np.ndarray:
@@ -214,22 +304,27 @@ TEX_COLS = 17
 """Columns of the fused kernel's texture table (see :func:`.kernels.checker_color`)."""
 
 
+def fusable(scene: Scene, materials) -> bool:
+    """Whether the fused kernel can shade ``materials``: no environment, bump or opacity map,
+    and surface colours plain or ``checker`` with the ``planar`` or ``solid`` projection."""
+    return scene.environment is None and all(
+        m.bump is None and m.opacity is None
+        and (m.texture is None or (m.texture.kind == "checker" and m.texture.projection in ("planar", "solid")))
+        for m in materials)
+
+
 def fused_textures(scene: Scene, sd: SceneData):
     """The (M, TEX_COLS) texture table of :func:`.kernels.render_pixels` when every material's
     surface colour is one the fused kernel evaluates itself (plain, or a ``checker`` with the
     ``planar`` or ``solid`` projection) and nothing else needs numpy (bump, opacity, an
     environment); else None (the wavefront path)."""
-    if scene.environment is not None:
+    if not fusable(scene, sd.materials):
         return None
     tab = np.zeros((len(sd.materials), TEX_COLS))
     for i, m in enumerate(sd.materials):
-        if m.bump is not None or m.opacity is not None:
-            return None
         tx = m.texture
         if tx is None:
             continue
-        if tx.kind != "checker" or tx.projection not in ("planar", "solid"):
-            return None
         from ..texturing import frame
         _, se, w = frame(tx.pole, tx.equator)
         tab[i, 0] = _kernels().CHECKER_PLANAR if tx.projection == "planar" else _kernels().CHECKER_SOLID
@@ -272,7 +367,10 @@ class _Tracer:
         self.do_refl, self.do_refr = refl, refr
         fres = {"none": 0, "schlick": 1, "exact": 2}[opts["fresnel"]]
         self.env = scene.environment is not None and self.col.tex is not None
-        self.kopts = np.array([opts["max_depth"] if recursive else 1, opts.get("threshold", 0.0), fres,
+        self.G = generation_bound(scene, opts["max_depth"], opts.get("threshold", 0.0), recursive)
+        self.ray_cap = wavefront_cap(scene, scene.camera.width, scene.camera.height, opts["spp"], self.G,
+                                     opts.get("threshold", 0.0), recursive)
+        self.kopts = np.array([self.G, opts.get("threshold", 0.0), fres,
                                float(opts["transmissive_shadows"]), float(opts["blinn"]),
                                float(self.do_shadow), float(refl), float(refr), tol.ray_offset,
                                tol.t_min, tol.zero, sd.extent, float(not self.env)])
@@ -362,6 +460,9 @@ class _Tracer:
                 O, D, w, stk, nstk, tmin, pix, gen = (np.concatenate([x, y]) for x, y in
                                                       zip((O, D, w, stk, nstk, tmin, pix, gen), cont))
             n = len(O)
+            if n > self.ray_cap:  # the bound estimate_bytes counted on
+                raise WorkbenchError(f"raytrace: a ray generation grew beyond {self.ray_cap} rays (the "
+                                     "memory estimate's bound): lower max_depth or raise threshold")
         return acc / spp, depth_map
 
     def _visibility(self, O, D, h, ns):
@@ -439,10 +540,6 @@ class _WhittedBase:
     def render(self, scene: Scene, width: int, height: int, **o) -> RenderResult:
         if not 1 <= o["spp"] <= 4096:
             raise WorkbenchError(f"method {self.name!r}: option 'spp' must be within 1..4096, got {o['spp']}")
-        gib = width * height * o["spp"] * _BYTES_PER_PRIMARY_RAY / 2 ** 30
-        if gib > _PRIMARY_RAYS_GIB:
-            raise WorkbenchError(f"method {self.name!r}: {width}x{height} at spp {o['spp']} needs about "
-                                 f"{gib:.1f} GiB of primary rays (limit {_PRIMARY_RAYS_GIB} GiB): lower spp or the size")
         timings = {}
         t0 = time.perf_counter()
         sd = flatten(scene)
@@ -497,6 +594,15 @@ class _WhittedBase:
         return RenderResult(self.name, image.reshape(height, width, 3), timings, st, used, left,
                             depth=depth.reshape(height, width))
 
+    def estimate_bytes(self, scene: Scene, width: int, height: int, **o) -> int:
+        """Upper bound of the render's peak bytes: primary rays (w h spp), image, mesh
+        triangles and BVH, the fused kernel's ray stacks (2 G + 2 rows per task, G from
+        :func:`generation_bound`) and the wavefront's largest iteration
+        (:func:`wavefront_cap`, enforced while tracing)."""
+        if not 1 <= o["spp"] <= 4096:
+            raise WorkbenchError(f"method {self.name!r}: option 'spp' must be within 1..4096, got {o['spp']}")
+        return estimate_trace_bytes(scene, width, height, o, self.recursive)
+
     def _features(self, scene, tr):
         needs = scene.needs()
         left = list(tr.col.missing)
@@ -535,6 +641,7 @@ class RaycastRenderer(_WhittedBase):
     recursive = False
     knob = Knob("spp", (1, 2, 4, 8, 16), 1, "samples per pixel")
     options = dict(_COMMON)
+    memory_options = ("spp",)
 
 
 class RaytraceRenderer(_WhittedBase):
@@ -546,6 +653,12 @@ class RaytraceRenderer(_WhittedBase):
     options = {**_COMMON,
                "max_depth": Option(int, 5, "maximum ray generations per path (primary = 1), >= 1"),
                "threshold": Option(float, 1e-3, "perceptual threshold: a child ray whose accumulated weight (max RGB) is at most this is not traced")}
+    memory_options = ("max_depth", "threshold", "spp")
+
+    def estimate_bytes(self, scene, width, height, **o):
+        if o["max_depth"] < 1:
+            raise WorkbenchError(f"method 'raytrace': option 'max_depth' must be >= 1, got {o['max_depth']}")
+        return super().estimate_bytes(scene, width, height, **o)
 
     def render(self, scene, width, height, **o):
         if o["max_depth"] < 1:

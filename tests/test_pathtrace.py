@@ -1,0 +1,287 @@
+"""The path tracer (``pathtrace``): energy (furnaces), direct light against the Whitted ray
+tracer, the kernel against its readable reference, its own noise estimate, determinism and
+progressive accumulation, finite images on every bundled scene."""
+from __future__ import annotations
+
+import tracemalloc
+
+import numpy as np
+import pytest
+
+import workbench
+from workbench.core.errors import NotApplicable
+from workbench.renderers.pathtrace import reference
+from workbench.renderers.pathtrace.session import PathTraceSession
+from workbench.scene.library import bundled
+
+FURNACE = 0.25 / (1.0 - 0.8)   # E / (1 - rho) of scenes/furnace.toml
+
+
+def _scene(tmp_path, text, name="t"):
+    p = tmp_path / f"{name}.toml"
+    p.write_text(text)
+    return workbench.load_scene(str(p))
+
+
+def _furnace_with(tmp_path, material, obj):
+    """The bundled furnace with one more material and object inside."""
+    from pathlib import Path
+    src = Path(workbench.__file__).resolve().parents[1] / "scenes" / "furnace.toml"
+    return _scene(tmp_path, src.read_text() + material + obj, "furnace_plus")
+
+
+def test_furnace_radiance_everywhere(tmp_path):
+    r = workbench.render(workbench.load_scene("furnace"), "pathtrace", width=16, height=16, spp=64)
+    se = r.std_error
+    assert se is not None and se.shape == r.image.shape and (se > 0).all()
+    assert np.all(np.abs(r.image - FURNACE) <= 5.0 * se)
+    # the image mean: pixels (not channels: grey) are independent, standard error noise_rmse / sqrt(pixels)
+    n = r.image.shape[0] * r.image.shape[1]
+    assert abs(r.image.mean() - FURNACE) <= 5.0 * r.stats["noise_rmse"] / np.sqrt(n)
+    assert r.stats["nonfinite_samples"] == 0
+
+
+@pytest.mark.parametrize("kind,fresnel", [("kt = 1.0\nior = 1.5", "exact"), ("kt = 1.0\nior = 1.5", "none"),
+                                          ("kr = 1.0", "none"), ("kr = 0.3\nkt = 0.7\nior = 1.33", "schlick")])
+def test_white_furnace_with_specular_sphere(tmp_path, kind, fresnel):
+    """A lossless specular sphere in the furnace changes nothing: every pixel stays E / (1 - rho)
+    (BSDF sampling of the delta lobes conserves energy, refraction into and out of the medium)."""
+    sc = _furnace_with(tmp_path, f"\n[materials.glass]\ncolor = [1.0, 1.0, 1.0]\nka = 0.0\nkd = 0.0\n{kind}\n",
+                       '\n[[objects]]\ntype = "sphere"\nmaterial = "glass"\ncenter = [0.5, 0.5, 0.6]\nradius = 0.25\n')
+    r = workbench.render(sc, "pathtrace", width=12, height=12, spp=64, fresnel=fresnel)
+    assert np.all(np.abs(r.image - FURNACE) <= 5.0 * r.std_error)
+    assert abs(r.image.mean() - FURNACE) <= 5.0 * r.stats["noise_rmse"] / np.sqrt(r.image.shape[0] * r.image.shape[1])
+
+
+_PLANE = """
+[scene]
+name = "plane"
+background = [0.0, 0.0, 0.0]
+ambient = [0.0, 0.0, 0.0]
+[camera]
+position = [0.0, 3.0, 4.0]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 40.0
+resolution = [16, 12]
+[materials.matte]
+color = [1.0, 0.5, 0.25]
+kd = 0.7
+ka = 0.0
+[[objects]]
+type = "plane"
+material = "matte"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 1.0, 0.0]
+size = [40.0, 40.0]
+"""
+
+
+def test_directional_light_on_a_plane_is_exact(tmp_path):
+    """One diffuse plane under a directional light: every path ends after one bounce, so the
+    estimate has no variance: kd C I cos, the course's diffuse term, as the Whitted tracer."""
+    sc = _scene(tmp_path, _PLANE + '[[lights]]\ntype = "directional"\ndirection = [0.3, -1.0, 0.2]\nintensity = 0.8\n')
+    pt = workbench.render(sc, "pathtrace", spp=4)
+    wh = workbench.render(sc, "raytrace", spp=1)
+    d = np.array([0.3, -1.0, 0.2]) / np.linalg.norm([0.3, -1.0, 0.2])
+    expect = 0.7 * np.array([1.0, 0.5, 0.25]) * 0.8 * -d[1]
+    assert np.allclose(pt.image, expect, rtol=1e-5)
+    assert np.allclose(wh.image, expect, rtol=1e-5)
+
+
+def test_point_light_on_a_plane_matches_whitted(tmp_path):
+    """Inverse-square point light over a diffuse plane: the path tracer's direct light (irradiance
+    pi I cos / r^2, reflected rho / pi) against the Whitted ray tracer's kd C I cos / r^2, both
+    box-filtered pixels (the ray tracer's stratified jitter at 256 samples is far more accurate
+    than the path tracer's uniform jitter, whose own standard error bounds the difference)."""
+    sc = _scene(tmp_path, _PLANE + '[[lights]]\ntype = "point"\nposition = [0.5, 1.5, 0.3]\n'
+                'intensity = 2.0\nfalloff = "inverse_square"\n')
+    pt = workbench.render(sc, "pathtrace", spp=256)
+    wh = workbench.render(sc, "raytrace", spp=256)
+    assert pt.stats["noise_rmse"] > 0.0
+    assert np.all(np.abs(pt.image - wh.image) <= 5.0 * pt.std_error + 1e-3 * wh.image + 1e-6)
+
+
+def test_noise_estimate_is_honest():
+    """Two seeds differ by sqrt(se1^2 + se2^2) in RMS, as each image's own estimate says."""
+    sc = workbench.load_scene("cornell")
+    a = workbench.render(sc, "pathtrace", width=24, height=24, spp=32, seed=1)
+    b = workbench.render(sc, "pathtrace", width=24, height=24, spp=32, seed=2)
+    measured = np.sqrt(np.mean((a.image.astype(np.float64) - b.image) ** 2))
+    predicted = np.hypot(a.stats["noise_rmse"], b.stats["noise_rmse"])
+    assert 0.75 <= measured / predicted <= 1.33
+
+
+def test_seeded_progressive_and_thread_independent():
+    sc = workbench.load_scene("cornell_spheres")
+    once = PathTraceSession(sc, 10, 8, seed=3)
+    once.add_samples(8)
+    steps = PathTraceSession(sc, 10, 8, seed=3)
+    steps.add_samples(3)
+    steps.add_samples(5)
+    assert np.array_equal(once.image, steps.image)
+    assert np.array_equal(once.std_error, steps.std_error)
+    other = PathTraceSession(sc, 10, 8, seed=4)
+    other.add_samples(8)
+    assert not np.array_equal(once.image, other.image)
+    import numba
+    saved = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = PathTraceSession(sc, 10, 8, seed=3)
+        one.add_samples(8)
+    finally:
+        numba.set_num_threads(saved)
+    assert np.array_equal(once.image, one.image)
+
+
+_GLOSSY = """
+[scene]
+name = "glossy"
+background = [0.05, 0.05, 0.1]
+ambient = [0.3, 0.3, 0.3]
+[camera]
+position = [0.0, 1.0, 3.0]
+look_at = [0.0, 0.4, 0.0]
+fov_y = 50.0
+resolution = [8, 6]
+[[lights]]
+type = "point"
+position = [1.0, 2.0, 1.0]
+intensity = 0.6
+[[lights]]
+type = "area"
+vertices = [[-1.0, 2.0, -1.0], [-1.0, 2.0, 0.0], [0.0, 2.0, 0.0], [0.0, 2.0, -1.0]]
+color = [2.0, 2.0, 1.5]
+[materials.floor]
+color = [0.6, 0.7, 0.8]
+kd = 0.6
+ks = 0.5
+shininess = 20.0
+[materials.ball]
+color = [0.9, 0.3, 0.2]
+kd = 0.5
+ks = 0.3
+shininess = 60.0
+kr = 0.2
+[materials.glass]
+color = [1.0, 1.0, 1.0]
+kd = 0.0
+kr = 0.1
+kt = 0.9
+ior = 1.5
+absorption = [0.2, 0.5, 1.0]
+[[objects]]
+type = "plane"
+material = "floor"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 1.0, 0.0]
+size = [6.0, 6.0]
+[[objects]]
+type = "sphere"
+material = "ball"
+center = [-0.5, 0.4, 0.0]
+radius = 0.4
+[[objects]]
+type = "sphere"
+material = "glass"
+center = [0.5, 0.35, 0.3]
+radius = 0.35
+"""
+
+
+@pytest.mark.parametrize("name", ["cornell_spheres", "glossy"])
+def test_kernel_agrees_with_readable_reference(tmp_path, name):
+    """At a few pixels the numba kernel and the readable twin (the ray tracer's readable
+    intersection, numpy random numbers) agree within 5 combined standard errors."""
+    if name == "glossy":
+        sc, w, h, opts = _scene(tmp_path, _GLOSSY), 8, 6, dict(fresnel="exact")
+        pixels = [(1, 1), (3, 2), (3, 5), (4, 6), (5, 3)]
+    else:
+        sc, w, h, opts = workbench.load_scene(name), 8, 8, dict(fresnel="schlick")
+        pixels = [(1, 4), (5, 2), (5, 5), (3, 0), (7, 4)]
+    ses = PathTraceSession(sc, w, h, seed=7, **opts)
+    ses.add_samples(2048)
+    km = ses.image.reshape(-1, 3)[[i * w + j for i, j in pixels]]
+    ks = ses.std_error.reshape(-1, 3)[[i * w + j for i, j in pixels]]
+    rm, rs = reference.render_pixels(sc, w, h, pixels, 160, seed=11, **opts)
+    assert (rs > 0).any(axis=1).all()  # every pixel is lit (a real check, not zeros)
+    assert np.all(np.abs(km - rm) <= 5.0 * np.hypot(ks, rs) + 1e-9)
+
+
+@pytest.mark.parametrize("name", [p.stem for p in bundled()])
+def test_every_bundled_scene_finite(name):
+    r = workbench.render(workbench.load_scene(name), "pathtrace", width=8, height=6, spp=2)
+    assert np.isfinite(r.image).all() and np.isfinite(r.std_error).all()
+    assert r.stats["nonfinite_pixels"] == 0 and r.stats["nonfinite_samples"] == 0
+    assert r.image.max() > 0.0
+
+
+def test_no_light_is_not_applicable(tmp_path):
+    sc = _scene(tmp_path, _PLANE)
+    with pytest.raises(NotApplicable, match="nothing emits light"):
+        workbench.render(sc, "pathtrace", spp=1)
+
+
+def test_memory_estimate_bounds_the_allocations():
+    from workbench.renderers.base import get_renderer
+    sc = workbench.load_scene("cornell")
+    PathTraceSession(sc, 4, 4).add_samples(1)  # compiled outside the measure
+    tracemalloc.start()
+    try:
+        workbench.render(sc, "pathtrace", width=96, height=64, spp=2)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert 0 < peak <= get_renderer("pathtrace").estimate_bytes(sc, 96, 64)
+
+
+def test_run_to_noise_stops_at_the_target_or_the_cap():
+    from workbench.renderers.pathtrace.session import run_to_noise
+    sc = workbench.load_scene("furnace")
+    ses = run_to_noise(PathTraceSession(sc, 6, 6), 0.02, max_spp=4096)
+    assert ses.noise_rmse <= 0.02 and ses.samples < 4096
+    capped = run_to_noise(PathTraceSession(sc, 6, 6), 1e-6, max_spp=24)
+    assert capped.samples == 24 and capped.noise_rmse > 1e-6
+
+
+def test_normalised_phong_lobe_under_a_directional_light(tmp_path):
+    """A purely glossy plane (kd = 0, ks, n) seen through a tiny field of view at 10 degrees from
+    the light's mirror direction: one bounce, no variance, the normalised lobe
+    ks (n + 2) / (2 pi) cos^n(alpha) times the irradiance pi I cos(theta); and the course's
+    ks cos^n(alpha) I in the Whitted tracer: their ratio is (n + 2) cos(theta) / 2 (DESIGN.md)."""
+    a = np.radians(10.0)
+    r = np.array([0.6, 0.8, 0.0])                                   # mirror of the light direction
+    v = np.array([r[0] * np.cos(a) - r[1] * np.sin(a), r[0] * np.sin(a) + r[1] * np.cos(a), 0.0])
+    cam = 10.0 * v
+    sc = _scene(tmp_path, f"""
+[scene]
+name = "gloss"
+background = [0.0, 0.0, 0.0]
+ambient = [0.0, 0.0, 0.0]
+[camera]
+position = [{cam[0]}, {cam[1]}, {cam[2]}]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 0.01
+resolution = [4, 4]
+[[lights]]
+type = "directional"
+direction = [0.6, -0.8, 0.0]
+intensity = 0.9
+[materials.gloss]
+color = [1.0, 1.0, 1.0]
+ka = 0.0
+kd = 0.0
+ks = 0.8
+shininess = 20.0
+[[objects]]
+type = "plane"
+material = "gloss"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 1.0, 0.0]
+size = [1000.0, 1000.0]
+""")
+    pt = workbench.render(sc, "pathtrace", spp=8)
+    wh = workbench.render(sc, "raytrace", spp=1)
+    course = 0.8 * np.cos(a) ** 20 * 0.9
+    assert np.allclose(wh.image, course, rtol=1e-3)
+    assert np.allclose(pt.image, course * (20 + 2) / 2 * 0.8, rtol=1e-3)

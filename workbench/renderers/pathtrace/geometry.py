@@ -1,0 +1,44 @@
+"""The scene as the path tracer traces it: flat opaque polygons and rectangles become
+triangle meshes, so that they are intersected through the ray tracer's 4-wide BVH
+(:func:`..raytrace.kernels.bvh_hit`, watertight triangle tests four at a time) instead of one
+by one in :func:`..raytrace.kernels.closest`'s linear loop over analytic primitives: the
+Cornell box's 15 quadrilaterals cost a BVH descent instead of 15 polygon tests per ray.
+
+Only what a triangle mesh describes identically is converted: convex polygons and rectangles
+(fan triangles in vertex order: the same front face) whose material has no texture, bump or
+opacity map (those read the polygon's own object-space mapping) and no transmission (a mesh is
+a solid, a polygon a thin sheet).  Area lights stay polygons (front-face emitters).
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ...scene import model as m
+from .emitters import fan_triangles
+
+
+def _as_mesh(o, vertices):
+    tris = fan_triangles(np.asarray(vertices, dtype=np.float64))
+    if tris is None:
+        return o
+    V = tris.reshape(-1, 3)
+    F = np.arange(len(V), dtype=np.int64).reshape(-1, 3)
+    return m.Mesh(o.material, world_from_object=o.world_from_object, name=o.name,
+                  tessellation=o.tessellation, vertices=V, faces=F, source=f"pathtrace: {o.kind} as triangles")
+
+
+def triangulated(scene: m.Scene) -> m.Scene:
+    """``scene`` with its plain opaque convex polygons and rectangles as triangle meshes."""
+    out = []
+    for o in scene.objects:
+        mat = scene.materials.get(o.material) if not isinstance(o, m.CSG) else None
+        plain = (mat is not None and mat.kt <= 0.0 and mat.texture is None and mat.bump is None
+                 and mat.opacity is None)
+        if plain and isinstance(o, m.Polygon):
+            o = _as_mesh(o, o.vertices)
+        elif plain and isinstance(o, m.Plane):
+            o = _as_mesh(o, o.corners())
+        out.append(o)
+    return replace(scene, objects=tuple(out))

@@ -1,0 +1,476 @@
+"""Numba kernels of the path tracer: unbiased Monte Carlo estimation of the rendering equation
+(Kajiya, "The rendering equation", SIGGRAPH 1986) on the ray tracer's arrays, BVH and
+intersection kernels (:func:`..raytrace.kernels.closest`, :func:`..raytrace.kernels.surface`).
+
+One path per sample, from the camera (uniform jitter in the pixel: the box-filtered pixel):
+
+* at each hit, emission ``L_e`` (front face only for area lights) is added with the path
+  throughput ``beta``, weighted by multiple importance sampling against the light strategy
+  (power heuristic, Veach & Guibas 1995; Veach 1997 ch. 9) unless the previous bounce was a
+  delta lobe or the camera;
+* the surface is a mixture of lobes with weights ``a_d = kd C`` (Lambert, ``a_d / pi``),
+  ``a_s = ks`` (normalised modified Phong, ``ks (n + 2) / (2 pi) cos^n alpha``; Lafortune &
+  Willems 1994), ``a_r`` (mirror) and ``a_t`` (transmission: refraction through solids, straight
+  through thin sheets), from ``kr, kt`` with the ray tracer's Fresnel option; all scaled by
+  ``1 / max(1, kd max(C) + ks + kr + kt)`` so that no surface reflects more than it receives;
+* next-event estimation at non-delta vertices: one emitter triangle point
+  (:mod:`.emitters`, MIS with the BSDF strategy) and every point / directional light (delta
+  lights: no MIS; a light of value ``I`` gives the irradiance ``pi I S cos`` with ``S`` its
+  falloff and spot factor, so that a Lambertian surface reflects ``kd C I S cos``: the course's
+  diffuse term, and the convention of the area lights' point stand-ins);
+* the next direction: a lobe chosen with probability proportional to its weight, then for the
+  non-delta pair the one-sample mixture of the cosine and Phong densities;
+* Russian roulette from the ``rr_start``-th bounce on: survive with
+  ``q = min(0.95, max(beta))``, ``beta /= q``; a path stops for good at ``max_bounces``
+  (``0.95^k``: unreachable in practice, a guard against endless loops).
+
+Random numbers: a counter-based hash (SplitMix64's finaliser) of (seed, pixel, sample index,
+dimension), so an image depends on the seed only, not on how the threads share the work, and
+more samples continue a sequence (:class:`..pathtrace.session.PathTraceSession`).
+
+The readable twin of this estimator is :mod:`.reference`; the two are tested against each other.
+"""
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+from numba import prange
+
+from ..raytrace.kernels import (MAX_TASKS, NO_REFCOUNT, _feeler, _light_dir, checker_color, closest,
+                                scratch, surface)
+
+BLOCK = 32
+"""Pixels per work item of :func:`render_samples`."""
+NCOUNTS = 7
+"""Columns of the counts: camera rays, extension rays, shadow rays, paths ended by Russian
+roulette, paths that escaped, non-finite samples (recorded as 0), paths stopped at
+``max_bounces``."""
+INV_PI = 1.0 / math.pi
+INV_2PI = 0.5 / math.pi
+_G = np.uint64(0x9E3779B97F4A7C15)
+_M1 = np.uint64(0xBF58476D1CE4E5B9)
+_M2 = np.uint64(0x94D049BB133111EB)
+_S30, _S27, _S31, _S11 = np.uint64(30), np.uint64(27), np.uint64(31), np.uint64(11)
+
+
+@nb.njit(error_model="numpy", inline="always")
+def _mix(z):
+    """SplitMix64's finaliser (Steele, Lea & Flood, OOPSLA 2014): a bijective 64-bit hash."""
+    z = (z ^ (z >> _S30)) * _M1
+    z = (z ^ (z >> _S27)) * _M2
+    return z ^ (z >> _S31)
+
+
+@nb.njit(error_model="numpy", inline="always")
+def path_key(seed, pixel, sample):
+    """The random stream of one path: a hash of (seed, pixel, sample index)."""
+    return _mix(_mix(_mix(np.uint64(seed) + _G) + np.uint64(pixel)) + np.uint64(sample))
+
+
+@nb.njit(error_model="numpy", inline="always")
+def rand(key, dim):
+    """Uniform in [0, 1): dimension ``dim`` of the stream ``key`` (53 bits)."""
+    return float(_mix(key + np.uint64(dim) * _G) >> _S11) * (1.0 / 9007199254740992.0)
+
+
+@nb.njit(error_model="numpy", inline="always")
+def _unit(x, y, z):
+    n = math.sqrt(x * x + y * y + z * z)
+    if n > 0.0:
+        return x / n, y / n, z / n
+    return 0.0, 0.0, 0.0
+
+
+@nb.njit(error_model="numpy", inline="always")
+def _frame(nx, ny, nz):
+    """Two unit tangents completing ``n`` (Duff et al., "Building an orthonormal basis,
+    revisited", JCGT 2017)."""
+    s = 1.0 if nz >= 0.0 else -1.0
+    a = -1.0 / (s + nz)
+    b = nx * ny * a
+    return 1.0 + s * nx * nx * a, s * b, -s * nx, b, s + ny * ny * a, -ny
+
+
+@nb.njit(error_model="numpy", inline="always")
+def _around(nx, ny, nz, cos_t, phi):
+    """Unit direction at polar angle ``acos(cos_t)`` and azimuth ``phi`` about ``n``."""
+    tx, ty, tz, bx, by, bz = _frame(nx, ny, nz)
+    sin_t = math.sqrt(max(0.0, 1.0 - cos_t * cos_t))
+    c, s = math.cos(phi) * sin_t, math.sin(phi) * sin_t
+    return c * tx + s * bx + cos_t * nx, c * ty + s * by + cos_t * ny, c * tz + s * bz + cos_t * nz
+
+
+@nb.njit(error_model="numpy", inline="always")
+def camera_ray_at(cam, i, j, u, v):
+    """Unit direction of the ray through point ``(j + u, i + v)`` of the image plane (pixel
+    ``(i, j)``, ``u, v`` in [0, 1); ``u = v = 1/2`` is :func:`..raytrace.kernels.camera_ray`'s
+    centre ray) of the camera ``cam`` (``raytrace.whitted.camera_frame``)."""
+    x = ((j + u) / cam[14] * 2.0 - 1.0) * cam[12] * cam[13]
+    y = (1.0 - (i + v) / cam[15] * 2.0) * cam[12]
+    return _unit(x * cam[3] + y * cam[4] - cam[5], x * cam[6] + y * cam[7] - cam[8],
+                 x * cam[9] + y * cam[10] - cam[11])
+
+
+@nb.njit(error_model="numpy", inline="always")
+def mis_weight(pa, pb, beta):
+    """Power heuristic ``pa^beta / (pa^beta + pb^beta)`` (``beta = 1``: balance heuristic)."""
+    if beta == 2.0:
+        a, b = pa * pa, pb * pb
+    else:
+        a, b = pa, pb
+    return a / (a + b) if a > 0.0 else 0.0
+
+
+@nb.njit(error_model="numpy", inline="always")
+def phong_lobe(ks, shin, rx, ry, rz, wx, wy, wz):
+    """``(ks cos^n alpha (n + 2) / (2 pi), cos^n alpha (n + 1) / (2 pi))``: the normalised Phong
+    lobe's value and its sampling density, ``alpha`` the angle between ``w`` and the mirror
+    direction ``r`` (Lafortune & Willems 1994); 0 beyond 90 degrees, and where ``ks = 0``."""
+    ca = rx * wx + ry * wy + rz * wz
+    if ca <= 0.0 or ks <= 0.0:
+        return 0.0, 0.0
+    c = ca ** shin if shin > 0.0 else 1.0
+    return ks * (shin + 2.0) * INV_2PI * c, (shin + 1.0) * INV_2PI * c
+
+
+@nb.njit(**NO_REFCOUNT)
+def pick_emitter(cdf, u):
+    """Index of the first ``cdf`` entry above ``u`` (binary search)."""
+    lo, hi = 0, cdf.shape[0] - 1
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if cdf[mid] > u:
+            hi = mid
+        else:
+            lo = mid + 1
+    return lo
+
+
+@nb.njit(cache=True, error_model="numpy")
+def hit_rows():
+    """One row per hit record of :func:`..raytrace.kernels.surface`: geometric normal, shading
+    normal, uv, object-space point, vertex emission; then the media stack (4)."""
+    return (np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 2)), np.empty((1, 3)), np.empty((1, 3)),
+            np.zeros(4, np.int64))
+
+
+@nb.njit(cache=True, error_model="numpy", parallel=True)
+def render_samples(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq, counts):
+    """Add samples ``s0 .. s0 + nsamp - 1`` of every pixel to its running sums.
+
+    Parameters
+    ----------
+    geo : the ray tracer's geometry tuple (``SceneData.kernel_args()``).
+    shading : ``(mat_of (P,), mat_tab (M, 24), tex_tab (M, 17), lights (L, 14))``: the
+        flattened materials, the fused checker table (``raytrace.whitted.fused_textures``) and the
+        point / directional lights (``flatten.light_rows``, area lights excluded).
+    emitters : :meth:`.emitters.Emitters.arrays`.
+    cam : (16,) ``raytrace.whitted.camera_frame``.
+    opts : (20,) float64: fresnel (0 none, 1 Schlick, 2 exact), tol.ray_offset, tol.t_min,
+        tol.zero, extent, tol.normal_cancel, rr_start, max_bounces, textures on, MIS exponent,
+        background RGB (3), media around the camera (count, then 4 material rows).
+    seed, s0, nsamp : int.
+    sums, sumsq : (H*W, 3) float64, updated: sum and sum of squares of the sample radiances.
+    counts : (NCOUNTS,) int64, updated (see ``NCOUNTS``).
+    """
+    npix = sums.shape[0]
+    nblocks = (npix + BLOCK - 1) // BLOCK
+    nit = max(1, min(nblocks, MAX_TASKS))
+    part = np.zeros((nit, 8), np.int64)
+    for c in prange(nit):
+        scr, rows = scratch(), hit_rows()
+        for b in range(c, nblocks, nit):
+            pixel_block(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq, part[c],
+                        b * BLOCK, min(npix, (b + 1) * BLOCK), scr, rows)
+    for c in range(nit):
+        for q in range(NCOUNTS):
+            counts[q] += part[c, q]
+
+
+@nb.njit(**NO_REFCOUNT)
+def pixel_block(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq, counts, p0, p1,
+                scr, rows):
+    """Pixels ``p0 .. p1 - 1`` of :func:`render_samples`, each sample's path in turn."""
+    width = int(cam[14])
+    for p in range(p0, p1):
+        i, j = p // width, p % width
+        for s in range(s0, s0 + nsamp):
+            key = path_key(seed, p, s)
+            dx, dy, dz = camera_ray_at(cam, i, j, rand(key, 0), rand(key, 1))
+            r, g, b = trace_path(geo, shading, emitters, opts, key, cam[0], cam[1], cam[2], dx, dy, dz,
+                                 counts, scr, rows)
+            if not (math.isfinite(r) and math.isfinite(g) and math.isfinite(b)):
+                counts[5] += 1
+                r, g, b = 0.0, 0.0, 0.0
+            sums[p, 0] += r
+            sums[p, 1] += g
+            sums[p, 2] += b
+            sumsq[p, 0] += r * r
+            sumsq[p, 1] += g * g
+            sumsq[p, 2] += b * b
+
+
+@nb.njit(**NO_REFCOUNT)
+def cast(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr):
+    """:func:`..raytrace.kernels.closest` over every primitive (area lights included), compiled
+    once here and called by every ray of a path (camera, extension and shadow rays)."""
+    stack, st, sp_, sf, sn = scr
+    return closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, False, any_hit, zero, eps, stack, st,
+                   sp_, sf, sn)
+
+
+@nb.njit(**NO_REFCOUNT)
+def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts, scr, rows):
+    """Radiance (RGB) carried along one path from ``o`` in direction ``d`` (unit): see the
+    module docstring.  Random dimensions: 0, 1 pixel jitter; then 8 per bounce."""
+    mat_of, mat_tab, tex_tab, lights = shading
+    em_tri, em_n, em_prim, em_mtri, em_cdf, lpdf_prim, lpdf_tri = emitters
+    solid = geo[5]
+    tri_e = geo[12]
+    h_ng, h_ns, h_uv, h_po, h_ev, stk = rows
+    fres = int(opts[0])
+    ray_off, t_min, zero, extent, ncancel = opts[1], opts[2], opts[3], opts[4], opts[5]
+    rr_start, max_bounces = int(opts[6]), int(opts[7])
+    use_tex, beta_mis = opts[8] > 0.5, opts[9]
+    nstk = int(opts[13])
+    for q in range(4):
+        stk[q] = int(opts[14 + q])
+    n_em = em_cdf.shape[0]
+    nl = lights.shape[0]
+    br, bg_, bb = 1.0, 1.0, 1.0           # path throughput beta
+    Lr, Lg, Lb = 0.0, 0.0, 0.0
+    delta_before = True                    # camera or a delta lobe before this hit: no MIS
+    pdf_prev = 0.0                         # solid-angle density of the BSDF sample that led here
+    tmin = 0.0
+    counts[0] += 1
+    for bounce in range(max_bounces):
+        dim = 2 + 8 * bounce
+        eps = ray_off * max(max(abs(ox), abs(oy), abs(oz)), extent)
+        t, k, f, tri, b1, b2 = cast(geo, ox, oy, oz, dx, dy, dz, tmin, np.inf, np.bool_(False), zero, eps, scr)
+        if k < 0:
+            counts[4] += 1
+            Lr += br * opts[10]
+            Lg += bg_ * opts[11]
+            Lb += bb * opts[12]
+            return Lr, Lg, Lb
+        if nstk > 0:  # Beer-Lambert absorption of the medium the segment crossed
+            ma = stk[nstk - 1]
+            br *= math.exp(-mat_tab[ma, 10] * t)
+            bg_ *= math.exp(-mat_tab[ma, 11] * t)
+            bb *= math.exp(-mat_tab[ma, 12] * t)
+        px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
+        surface(geo, k, f, tri, b1, b2, px, py, pz, ncancel, h_ng, h_ns, h_uv, h_po, h_ev, 0)
+        mi = mat_of[k]
+        gx, gy, gz = h_ng[0, 0], h_ng[0, 1], h_ng[0, 2]
+        cos_g = -(gx * dx + gy * dy + gz * dz)
+        front = cos_g > 0.0
+        fx, fy, fz = (gx, gy, gz) if front else (-gx, -gy, -gz)   # geometric normal, incident side
+        nx, ny, nz = h_ns[0, 0], h_ns[0, 1], h_ns[0, 2]
+        if nx * dx + ny * dy + nz * dz > 0.0:
+            nx, ny, nz = -nx, -ny, -nz                              # shading normal, incident side
+        # ---- emission
+        er, eg, eb = h_ev[0, 0], h_ev[0, 1], h_ev[0, 2]
+        if mat_tab[mi, 16] < 0.5 or front:
+            er += mat_tab[mi, 13]
+            eg += mat_tab[mi, 14]
+            eb += mat_tab[mi, 15]
+        if er > 0.0 or eg > 0.0 or eb > 0.0:
+            w = 1.0
+            if not delta_before:
+                dens = lpdf_tri[tri] if tri >= 0 else lpdf_prim[k]
+                if dens > 0.0 and cos_g != 0.0:
+                    w = mis_weight(pdf_prev, dens * t * t / abs(cos_g), beta_mis)
+            Lr += br * er * w
+            Lg += bg_ * eg * w
+            Lb += bb * eb * w
+        # ---- lobes
+        cr, cg, cb = mat_tab[mi, 0], mat_tab[mi, 1], mat_tab[mi, 2]
+        if use_tex and mat_tab[mi, 17] > 0.5:
+            tr_, tg_, tb_ = checker_color(tex_tab, mi, h_po[0, 0], h_po[0, 1], h_po[0, 2])
+            cr, cg, cb = cr * tr_, cg * tg_, cb * tb_
+        kd, ks, shin, kr, kt = mat_tab[mi, 4], mat_tab[mi, 5], mat_tab[mi, 6], mat_tab[mi, 7], mat_tab[mi, 8]
+        total = kd * max(cr, cg, cb) + ks + kr + kt
+        scale = 1.0 / total if total > 1.0 else 1.0
+        adr, adg, adb = kd * cr * scale, kd * cg * scale, kd * cb * scale
+        a_s = ks * scale
+        a_r, a_t = kr * scale, kt * scale
+        m_d = max(adr, adg, adb)
+        m_nd = m_d + a_s
+        # mirror direction of the incident ray about the shading normal (Phong lobe axis)
+        cosi = -(dx * nx + dy * ny + dz * nz)
+        rx, ry, rz = dx + 2.0 * cosi * nx, dy + 2.0 * cosi * ny, dz + 2.0 * cosi * nz
+        if rx * fx + ry * fy + rz * fz <= 0.0:  # below the surface: about the geometric normal
+            cg_ = -(dx * fx + dy * fy + dz * fz)
+            rx, ry, rz = dx + 2.0 * cg_ * fx, dy + 2.0 * cg_ * fy, dz + 2.0 * cg_ * fz
+        rx, ry, rz = _unit(rx, ry, rz)
+        # refraction geometry and the Fresnel split of kr, kt (as the ray tracer's shade_hit)
+        new_n = nstk
+        tx, ty, tz = dx, dy, dz
+        push = False
+        if a_t > 0.0 and solid[k]:
+            cf = -(dx * fx + dy * fy + dz * fz)
+            if front:
+                n1 = mat_tab[stk[nstk - 1], 9] if nstk > 0 else 1.0
+                n2 = mat_tab[mi, 9]
+                push = True
+            else:
+                n1 = mat_tab[mi, 9]
+                jj = nstk - 1
+                while jj >= 0 and stk[jj] != mi:
+                    jj -= 1
+                n2 = 1.0
+                if jj >= 0:
+                    new_n = nstk - 1
+                    top_ = -1
+                    for q in range(nstk - 1, -1, -1):
+                        if q != jj:
+                            top_ = stk[q]
+                            break
+                    n2 = mat_tab[top_, 9] if top_ >= 0 else 1.0
+                elif nstk > 0:
+                    n2 = mat_tab[stk[nstk - 1], 9]
+            eta = n1 / n2
+            kk = 1.0 - eta * eta * (1.0 - cf * cf)
+            if kk <= 0.0:  # total internal reflection: the transmitted share is reflected
+                a_r, a_t = a_r + a_t, 0.0
+            else:
+                cost = math.sqrt(kk)
+                tx, ty, tz = _unit(eta * dx + (eta * cf - cost) * fx, eta * dy + (eta * cf - cost) * fy,
+                                   eta * dz + (eta * cf - cost) * fz)
+                if fres > 0:
+                    if fres == 1:
+                        r0 = (n1 - n2) / (n1 + n2)
+                        r0 *= r0
+                        cc = cf if n1 <= n2 else cost
+                        F = r0 + (1.0 - r0) * (1.0 - cc) ** 5
+                    else:
+                        rs = (n1 * cf - n2 * cost) / (n1 * cf + n2 * cost)
+                        rp = (n2 * cf - n1 * cost) / (n2 * cf + n1 * cost)
+                        F = 0.5 * (rs * rs + rp * rp)
+                    a_r, a_t = a_r + a_t * F, a_t * (1.0 - F)
+        lobes = m_nd + a_r + a_t
+        if lobes <= 0.0:
+            return Lr, Lg, Lb
+        P_nd = m_nd / lobes
+        pm = max(abs(px), abs(py), abs(pz))
+        off = ray_off * max(pm, extent)
+        tmin_here = t_min * max(pm, extent)
+        # ---- next-event estimation at a non-delta surface
+        if m_nd > 0.0:
+            if n_em > 0:
+                e = pick_emitter(em_cdf, rand(key, dim))
+                su = math.sqrt(rand(key, dim + 1))
+                u2 = rand(key, dim + 2)
+                c0, c1, c2 = 1.0 - su, su * (1.0 - u2), su * u2
+                qx = c0 * em_tri[e, 0] + c1 * em_tri[e, 3] + c2 * em_tri[e, 6]
+                qy = c0 * em_tri[e, 1] + c1 * em_tri[e, 4] + c2 * em_tri[e, 7]
+                qz = c0 * em_tri[e, 2] + c1 * em_tri[e, 5] + c2 * em_tri[e, 8]
+                vx, vy, vz = qx - px, qy - py, qz - pz
+                dist = math.sqrt(vx * vx + vy * vy + vz * vz)
+                if dist > 0.0:
+                    lx, ly, lz = vx / dist, vy / dist, vz / dist
+                    cos_l = -(lx * em_n[e, 0] + ly * em_n[e, 1] + lz * em_n[e, 2])
+                    emi = mat_of[em_prim[e]]
+                    ler, leg, leb = 0.0, 0.0, 0.0
+                    if cos_l > 0.0 or mat_tab[emi, 16] < 0.5:
+                        ler, leg, leb = mat_tab[emi, 13], mat_tab[emi, 14], mat_tab[emi, 15]
+                    mt = em_mtri[e]
+                    if mt >= 0:
+                        for q in range(3):
+                            v = c0 * tri_e[mt, q] + c1 * tri_e[mt, 3 + q] + c2 * tri_e[mt, 6 + q]
+                            if q == 0:
+                                ler += v
+                            elif q == 1:
+                                leg += v
+                            else:
+                                leb += v
+                    cos_s = nx * lx + ny * ly + nz * lz
+                    if ((ler > 0.0 or leg > 0.0 or leb > 0.0) and cos_s > 0.0 and cos_l != 0.0
+                            and fx * lx + fy * ly + fz * lz > 0.0):
+                        fs, ps = phong_lobe(a_s, shin, rx, ry, rz, lx, ly, lz)
+                        p_b = P_nd * (m_d * cos_s * INV_PI + a_s * ps) / m_nd
+                        p_l = (lpdf_tri[mt] if mt >= 0 else lpdf_prim[em_prim[e]]) * dist * dist / abs(cos_l)
+                        if p_l > 0.0:
+                            sx_, sy_, sz_, tmx = _feeler(px, py, pz, gx, gy, gz, lx, ly, lz, dist, off)
+                            counts[2] += 1
+                            _, kb, _, _, _, _ = cast(geo, sx_, sy_, sz_, lx, ly, lz, tmin_here, tmx,
+                                                     np.bool_(True), zero, off, scr)
+                            if kb < 0:
+                                wl = mis_weight(p_l, p_b, beta_mis) * cos_s / p_l
+                                Lr += br * (adr * INV_PI + fs) * ler * wl
+                                Lg += bg_ * (adg * INV_PI + fs) * leg * wl
+                                Lb += bb * (adb * INV_PI + fs) * leb * wl
+            for li in range(nl):
+                lx, ly, lz, dist, sc = _light_dir(lights, li, px, py, pz)
+                cos_s = nx * lx + ny * ly + nz * lz
+                if cos_s <= 0.0 or sc == 0.0 or fx * lx + fy * ly + fz * lz <= 0.0:
+                    continue
+                sx_, sy_, sz_, tmx = _feeler(px, py, pz, gx, gy, gz, lx, ly, lz, dist, off)
+                counts[2] += 1
+                _, kb, _, _, _, _ = cast(geo, sx_, sy_, sz_, lx, ly, lz, tmin_here, tmx, np.bool_(True), zero, off, scr)
+                if kb >= 0:
+                    continue
+                fs, _ = phong_lobe(a_s, shin, rx, ry, rz, lx, ly, lz)
+                e_ = math.pi * sc * cos_s  # irradiance per unit light value
+                Lr += br * (adr * INV_PI + fs) * lights[li, 4] * e_
+                Lg += bg_ * (adg * INV_PI + fs) * lights[li, 5] * e_
+                Lb += bb * (adb * INV_PI + fs) * lights[li, 6] * e_
+        # ---- Russian roulette
+        if bounce + 1 >= rr_start:
+            q_rr = min(0.95, max(br, bg_, bb))
+            if rand(key, dim + 3) >= q_rr:
+                counts[3] += 1
+                return Lr, Lg, Lb
+            br, bg_, bb = br / q_rr, bg_ / q_rr, bb / q_rr
+        # ---- next direction
+        u = rand(key, dim + 4) * lobes
+        if u < m_nd:
+            if rand(key, dim + 5) * m_nd < m_d:   # cosine-weighted hemisphere about n
+                ct = math.sqrt(rand(key, dim + 6))
+                wx, wy, wz = _around(nx, ny, nz, ct, 2.0 * math.pi * rand(key, dim + 7))
+            else:                                  # cos^n alpha about the mirror direction
+                ct = rand(key, dim + 6) ** (1.0 / (shin + 1.0))
+                wx, wy, wz = _around(rx, ry, rz, ct, 2.0 * math.pi * rand(key, dim + 7))
+            cos_s = nx * wx + ny * wy + nz * wz
+            if cos_s <= 0.0 or fx * wx + fy * wy + fz * wz <= 0.0:
+                return Lr, Lg, Lb
+            fs, ps = phong_lobe(a_s, shin, rx, ry, rz, wx, wy, wz)
+            pdf = P_nd * (m_d * cos_s * INV_PI + a_s * ps) / m_nd
+            if not pdf > 0.0:
+                return Lr, Lg, Lb
+            br *= (adr * INV_PI + fs) * cos_s / pdf
+            bg_ *= (adg * INV_PI + fs) * cos_s / pdf
+            bb *= (adb * INV_PI + fs) * cos_s / pdf
+            delta_before, pdf_prev = False, pdf
+            ox, oy, oz = px + off * fx, py + off * fy, pz + off * fz
+            dx, dy, dz = wx, wy, wz
+        elif u < m_nd + a_r:                        # mirror: R = I - 2 (I.N) N
+            gain = lobes
+            br, bg_, bb = br * gain, bg_ * gain, bb * gain
+            delta_before = True
+            ox, oy, oz = px + off * fx, py + off * fy, pz + off * fz
+            dx, dy, dz = rx, ry, rz
+        else:                                       # transmission
+            gain = lobes
+            br, bg_, bb = br * gain, bg_ * gain, bb * gain
+            delta_before = True
+            ox, oy, oz = px - off * fx, py - off * fy, pz - off * fz
+            dx, dy, dz = tx, ty, tz
+            if solid[k]:
+                if push:
+                    if nstk < 4:
+                        stk[nstk] = mi
+                        nstk += 1
+                elif new_n < nstk:  # leave: drop the topmost entry of this material
+                    jj = nstk - 1
+                    while stk[jj] != mi:
+                        jj -= 1
+                    for q in range(jj, nstk - 1):
+                        stk[q] = stk[q + 1]
+                    nstk -= 1
+        tmin = tmin_here
+        counts[1] += 1
+    counts[6] += 1
+    return Lr, Lg, Lb
