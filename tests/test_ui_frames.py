@@ -264,3 +264,31 @@ def test_a_job_is_not_taken_for_a_later_scene_and_removed_panels_are_cancelled()
     board.keep_only(["flat"])
     assert "raycast" not in board.current and job.cancelled.is_set() and not board.busy()
     board.join_all(60)
+
+
+def test_path_tracer_panel_refines_pass_by_pass(monkeypatch):
+    """The pathtrace panel's job is progressive: one sample per pixel per pass here, each
+    pass's running image and noise shown (``notify`` each time), ending at the ``spp`` option
+    with exactly the image of a session given all samples at once (same seed); a cancel stops
+    it between passes."""
+    from workbench.app.ui import jobs
+    from workbench.renderers.pathtrace.session import PathTraceSession
+    scene = workbench.load_scene("cornell")
+    c = scene.camera.with_resolution(16, 16)
+    monkeypatch.setattr(jobs, "PASS_SAMPLES", 16 * 16)
+    seen = []
+    board = jobs.JobBoard()
+    job = board.request(scene, c, "pathtrace", {"spp": 8}, tiled=False)
+    board.notify = None
+    job.notify = lambda: seen.append((job.spp, job.noise))
+    job.thread.join(120)
+    assert job.error is None and job.progressive and job.spp == 8
+    assert [s for s, _ in seen if s][-1] == 8 and len({s for s, _ in seen}) >= 6  # passes shown
+    noises = [n for _, n in seen if n is not None]
+    assert noises and noises[-1] == job.noise
+    whole = PathTraceSession(replace(scene, camera=c), 16, 16).add_samples(8)
+    assert np.array_equal(job.image, whole)
+    stopped = board.request(scene, cam.orbit(c, 0.2, 0.0), "pathtrace", {"spp": 10**6}, tiled=False)
+    stopped.cancelled.set()
+    stopped.thread.join(120)
+    assert stopped.image is None and stopped.spp < 10**6

@@ -35,8 +35,12 @@ from .state import CHILD, RASTER, AppState, shown_image
 LIVE_REST_SECONDS = 0.5
 """How long edited material or light values must stay unchanged before a GL panel compiles
 them back into its programs (until then it draws them from uniforms)."""
-TILED = ("raycast", "raytrace")
-"""CPU methods that accept ``on_tile`` (partial images)."""
+
+
+def tiled(method: str) -> bool:
+    """The method accepts ``on_tile`` (it reports partial images band by band)."""
+    from ...renderers.base import get_renderer
+    return "on_tile" in get_renderer(method).options
 
 
 class DisplayPasses:
@@ -369,17 +373,22 @@ def read_pixel(fbo, i: int, j: int, shape: tuple[int, int]) -> np.ndarray | None
 def refresh_cpu(state: AppState, method: str) -> None:
     """Ask for ``method``'s background job; take its image when it has new tiles."""
     job = state.jobs.request(state.scene, state.camera, method, state.options[method],
-                             tiled=method in TILED)
+                             tiled=tiled(method))
     if job.cancelled.is_set():
         state.status[method] = "restarting (stale image)"
     elif job.error:
         state.status[method] = job.error
     elif job.done:
         state.timings[method] = job.seconds
-        state.status[method] = "done"
+        state.status[method] = (f"done: {job.spp} spp, noise {job.noise:.3g}"
+                                if job.progressive and job.noise is not None else "done")
+    elif job.progressive:
+        target = state.options[method]["spp"]
+        state.status[method] = (f"refining: {job.spp}/{target} spp" +
+                                ("" if job.noise is None else f", noise {job.noise:.3g}"))
     else:
         state.status[method] = (f"rendering: {job.rows_done}/{state.camera.height} rows"
-                                if method in TILED else "rendering...")
+                                if tiled(method) else "rendering...")
     if stale(state, f"{method} job", (id(job), job.version)) or method not in state.images:
         state.images[method] = job.snapshot()
 

@@ -31,6 +31,14 @@ from dataclasses import replace
 
 import numpy as np
 
+PROGRESSIVE = {"pathtrace": "workbench.renderers.pathtrace.session:PathTraceSession"}
+"""Methods whose job refines one image pass after pass (a session with ``add_samples(n)``,
+``image``, ``samples`` and ``noise_rmse``, as :class:`~workbench.renderers.pathtrace.session.
+PathTraceSession`): the panel shows the running image, its samples per pixel and noise, and
+the job ends at the method's ``spp`` option."""
+PASS_SAMPLES = 1 << 16
+"""Samples (over the whole image) per pass of a progressive job: a 256 x 192 panel gets one
+sample per pixel per pass, so its image and noise refresh several times a second at first."""
 RESTART_SETTLE_SECONDS = 0.15
 """How long a new request must stay unchanged before the UI's board starts its job (0 for the
 error plot's reference board, which waits for a still camera itself)."""
@@ -59,6 +67,8 @@ class Job:
     seconds : wall time of the finished render, or None.
     error : message of a failed render, or None.
     version : number of changes of ``partial``/``image``/``error`` so far.
+    spp, noise : a progressive job's samples per pixel so far and its noise (RMS standard
+    error of the pixel means; None before two samples).
     """
 
     def __init__(self, scene, camera, method: str, options: dict, tiled: bool, notify=None):
@@ -72,6 +82,8 @@ class Job:
         self.error = None
         self.rows_done = 0
         self.version = 0
+        self.progressive = method in PROGRESSIVE
+        self.spp, self.noise = 0, None
         self.cancelled = threading.Event()
         self.lock = threading.Lock()
         self.notify = notify
@@ -106,7 +118,11 @@ class Job:
             os.setpriority(os.PRIO_PROCESS, tid, min(19, os.getpriority(os.PRIO_PROCESS, tid) + JOB_NICE))
         t0 = time.perf_counter()
         try:
-            res = render(scene, method, width=scene.camera.width, height=scene.camera.height, **opts)
+            if self.progressive:
+                image = self._refine(scene, method, opts)
+            else:
+                image = render(scene, method, width=scene.camera.width,
+                               height=scene.camera.height, **opts).image
         except Cancelled:
             return
         except Exception as e:  # shown in the panel, never kills the UI
@@ -116,10 +132,32 @@ class Job:
             self._notify()
             return
         with self.lock:
-            self.image = np.asarray(res.image, np.float32)
+            self.image = np.asarray(image, np.float32)
             self.seconds = time.perf_counter() - t0
             self.version += 1
         self._notify()
+
+    def _refine(self, scene, method: str, opts: dict) -> np.ndarray:
+        """A progressive render: passes of :data:`PASS_SAMPLES` samples until ``opts["spp"]``
+        samples per pixel, each pass's running image in ``partial`` (cancelled between
+        passes); returns the final image."""
+        import importlib
+        mod, attr = PROGRESSIVE[method].split(":")
+        opts = dict(opts)
+        target = int(opts.pop("spp"))
+        w, h = scene.camera.width, scene.camera.height
+        session = getattr(importlib.import_module(mod), attr)(scene, w, h, **opts)
+        per_pass = max(1, PASS_SAMPLES // (w * h))
+        while session.samples < target:
+            if self.cancelled.is_set():
+                raise Cancelled
+            image = session.add_samples(min(per_pass, target - session.samples))
+            noise = session.noise_rmse
+            with self.lock:
+                self.partial, self.spp, self.noise = image, session.samples, noise
+                self.version += 1
+            self._notify()
+        return session.image
 
     def snapshot(self) -> np.ndarray:
         """The finished image, else a copy of the partial one."""

@@ -99,7 +99,7 @@ def _final_image(state: AppState, method: str) -> tuple[np.ndarray, float] | Non
 def _reference(state: AppState, plot: ErrorPlot) -> np.ndarray | None:
     """The reference image of the current key once rendered (requests it meanwhile)."""
     from ...compare.reference import candidates, finest_options
-    from .frames import TILED
+    from .frames import tiled
     from .jobs import JobBoard
     if plot.ref_image is not None:
         return plot.ref_image
@@ -112,7 +112,7 @@ def _reference(state: AppState, plot: ErrorPlot) -> np.ndarray | None:
     while plot.candidates:
         m = plot.candidates[0]
         plot.reference, plot.ref_options = m, finest_options(m)
-        job = plot.board.request(state.scene, state.camera, m, plot.ref_options, tiled=m in TILED)
+        job = plot.board.request(state.scene, state.camera, m, plot.ref_options, tiled=tiled(m))
         if job.cancelled.is_set():  # the previous key's job, still ending: wait for it
             plot.message = "rendering the reference..."
             return None

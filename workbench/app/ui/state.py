@@ -94,10 +94,12 @@ def choosable_methods() -> list[str]:
 
 
 def default_options(method: str) -> dict:
-    """The method's quality knob at its default value."""
+    """The method's quality knob at its default value; a progressive method's
+    (:data:`~.jobs.PROGRESSIVE`) at its most accurate, which it refines towards pass by pass."""
     from ...renderers.base import get_renderer
+    from .jobs import PROGRESSIVE
     knob = get_renderer(method).knob
-    return {knob.name: knob.default}
+    return {knob.name: knob.values[-1] if method in PROGRESSIVE else knob.default}
 
 
 def first_view(scene: Scene, allowed) -> list[str]:
