@@ -57,3 +57,23 @@ def test_long_session_keeps_jobs_and_gl_objects_bounded(xvfb, tmp_path):
         assert (a["scene"], a["methods"]) == (b["scene"], b["methods"])
         for kind in ("gl_textures", "gl_framebuffers", "gl_buffers", "gl_programs"):
             assert b[kind] <= a[kind], (kind, a, b)
+
+
+@pytest.mark.parametrize("window", ["1280x720", "1024x600"])
+def test_nothing_is_cut_off_and_panels_fit(xvfb, tmp_path, window):
+    """Before at 1280 x 720: the Difference window's B selector and kind, the knob labels and
+    the method names ran past their windows' right edges (FLIP could not be chosen)."""
+    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", "cornell_spheres",
+                        "--window", window, "--test-script", "layout", "--out", str(tmp_path)],
+                       cwd=ROOT, env={**os.environ, "DISPLAY": xvfb}, capture_output=True,
+                       text=True, timeout=300)
+    assert p.returncode == 0, p.stderr[-2000:]
+    log = json.loads((tmp_path / "summary.json").read_text())["script"]
+    assert log["cut"] == []
+    w, h = (int(x) for x in window.split("x"))
+    panels = {m: r for m, r in log["blits"] if m != "difference"}
+    assert len(panels) >= 3  # the first view of an emitter scene
+    cw, ch = log["camera"]
+    for m, (x0, y0, x1, y1) in panels.items():
+        assert 0 <= x0 and x1 <= w and 0 <= y0 and y1 <= h, m  # on screen, not below the fold
+        assert abs((x1 - x0) / (y1 - y0) - cw / ch) < 0.03, m

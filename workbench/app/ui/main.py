@@ -171,7 +171,9 @@ def main(argv: list[str] | None = None) -> int:
     script = None
     if args.test_script:
         args.out = args.out or Path("out/ui")
+    if args.out is not None:  # also without a script: the last frame and the summary
         args.out.mkdir(parents=True, exist_ok=True)
+    if args.test_script:
         script = SCRIPTS[args.test_script](args.out)
     t0 = time.perf_counter()
     run(state, args.frames, script, args.window)

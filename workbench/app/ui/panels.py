@@ -39,6 +39,34 @@ def colour_scale(values: np.ndarray, vmax: float) -> np.ndarray:
     return table[idx.astype(np.intp)]
 
 
+def check_fits(state: AppState, name: str) -> None:
+    """Note in ``state.cut`` whether the last item (its frame and label) ends past the right
+    edge of its window's content: nothing should (scripts and tests read it)."""
+    right = imgui.get_window_pos().x + imgui.get_window_width() - imgui.get_style().window_padding.x
+    if imgui.get_item_rect_max().x > right + 1.0:
+        state.cut.add(name)
+    else:
+        state.cut.discard(name)
+
+
+def same_line_if_fits(width: float) -> None:
+    """Continue the line if an item ``width`` pixels wide still fits in the window, else
+    start a new line (buttons that wrap instead of running past the edge)."""
+    spacing = imgui.get_style().item_spacing.x
+    right = imgui.get_window_pos().x + imgui.get_window_width() - imgui.get_style().window_padding.x
+    if imgui.get_item_rect_max().x + spacing + width <= right:
+        imgui.same_line()
+
+
+def button_width(label: str) -> float:
+    return imgui.calc_text_size(label).x + 2 * imgui.get_style().frame_padding.x
+
+
+def label_room(*labels: str) -> float:
+    """Pixels a widget's label beside it needs (the longest of ``labels``)."""
+    return max(imgui.calc_text_size(x).x for x in labels) + imgui.get_style().item_inner_spacing.x
+
+
 def scene_picker(state: AppState) -> None:
     """Combo over the bundled scenes (a scene opened from a file is listed first)."""
     from ...scene.library import bundled
@@ -46,16 +74,20 @@ def scene_picker(state: AppState) -> None:
     if state.scene_path not in paths:
         paths = [state.scene_path, *paths]
     names = [p.stem if p.parent == paths[-1].parent else p.name for p in paths]
+    imgui.set_next_item_width(-label_room("scene"))
     changed, idx = imgui.combo("scene", paths.index(state.scene_path), names)
+    check_fits(state, "scene")
     if changed and paths[idx] != state.scene_path:
         set_scene(state, str(paths[idx]))
     if imgui.button("reset camera"):
         state.camera = cam.reset(state.scene, state.camera)
-    imgui.same_line()
+    same_line_if_fits(button_width("reset zoom"))
     if imgui.button("reset zoom"):
         state.view = (1.0, 0.5, 0.5)
-    imgui.same_line()
-    if imgui.button("export"):
+    same_line_if_fits(button_width("export"))
+    clicked = imgui.button("export")
+    check_fits(state, "export")
+    if clicked:
         folder = (state.export_dir / f"{state.scene_path.stem}_{state.frame:06d}").resolve()
         state.status["export"] = f"saved {len(export(state, folder))} files to {folder}"
     if "export" in state.status:
@@ -65,11 +97,18 @@ def scene_picker(state: AppState) -> None:
 
 
 def method_list(state: AppState) -> None:
-    """Checkboxes over the methods (1 to 6 selected), two per row; a refused change says why."""
-    for k, m in enumerate(choosable_methods()):
-        if k % 2:
-            imgui.same_line(imgui.get_window_width() / 2)
+    """Checkboxes over the methods (1 to 6 selected), in as many columns as their labels
+    fit (two at most); a refused change says why."""
+    methods = choosable_methods()
+    style = imgui.get_style()
+    column = imgui.get_frame_height() + label_room(*methods) + style.item_spacing.x
+    cols = 2 if 2 * column <= imgui.get_content_region_avail().x else 1
+    x0 = imgui.get_cursor_pos_x()
+    for k, m in enumerate(methods):
+        if k % cols:
+            imgui.same_line(x0 + column)
         changed, on = imgui.checkbox(m, m in state.methods)
+        check_fits(state, f"method {m}")
         if changed:
             toggle_method(state, m, on)
     if "methods" in state.status:
@@ -83,15 +122,19 @@ def parameters(state: AppState) -> None:
     from ...renderers.base import get_renderer
     imgui.separator_text("material")
     names = list(state.scene.materials)
+    imgui.push_item_width(-label_room("material", *MATERIAL_FIELDS))  # labels fit beside
     changed, idx = imgui.combo("material", names.index(state.material), names)
+    check_fits(state, "material")
     if changed:
         state.material = names[idx]
     mat = state.scene.materials[state.material]
     for f in MATERIAL_FIELDS:
         lo, hi = MATERIAL_RANGES[f]
         changed, v = imgui.slider_float(f, float(getattr(mat, f)), lo, hi)
+        check_fits(state, f)
         if changed:
             set_material_value(state, state.material, f, v)
+    imgui.pop_item_width()
     imgui.separator_text("quality")
     for m in state.methods:
         knob = get_renderer(m).knob
@@ -102,6 +145,7 @@ def parameters(state: AppState) -> None:
         imgui.set_next_item_width(-1)
         changed, idx = imgui.slider_int(f"##knob {m}", idx, 0, len(values) - 1,
                                         format=str(values[idx]))
+        check_fits(state, f"knob {m}")
         if changed:
             set_option(state, m, knob.name, values[idx])
 
@@ -171,6 +215,7 @@ def image_panels(state: AppState) -> None:
             imgui.same_line(0, PANEL_GAP)
         imgui.begin_group()
         t = state.timings.get(m)
+        imgui.align_text_to_frame_padding()  # every panel's title on the same baseline
         text_in_width(f"{m}  {'' if t is None else f'{t * 1e3:.1f} ms'}", w)
         if m in state.images:
             tex = panel_texture(state, m)
@@ -194,6 +239,7 @@ def image_panels(state: AppState) -> None:
         modes = list(DISPLAY_MODES) if mode in DISPLAY_MODES else [mode, *DISPLAY_MODES]
         imgui.set_next_item_width(w)
         changed, k_mode = imgui.combo(f"##display {m}", modes.index(mode), modes)
+        check_fits(state, f"display {m}")
         if changed:
             set_display(state, m, modes[k_mode])
         imgui.end_group()
@@ -213,11 +259,14 @@ def difference_panel(state: AppState) -> None:
     half = max(40.0, (imgui.get_content_region_avail().x - style.item_spacing.x) / 2 - label)
     imgui.set_next_item_width(half)
     _, ia = imgui.combo("A", ms.index(a), ms)
+    check_fits(state, "difference A")
     imgui.same_line()
     imgui.set_next_item_width(half)
     _, ib = imgui.combo("B", ms.index(b), ms)
+    check_fits(state, "difference B")
     imgui.set_next_item_width(max(40.0, min(120.0, half)))
     _, ik = imgui.combo("kind", kinds.index(state.diff_kind), kinds)
+    check_fits(state, "difference kind")
     state.diff_pair, state.diff_kind = (ms[ia], ms[ib]), kinds[ik]
     a, b = state.diff_pair
     if a not in state.images or b not in state.images:

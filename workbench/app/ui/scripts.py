@@ -158,6 +158,25 @@ class Features:
                 for m, pts in state.errors.points.items()}
 
 
+class Layout:
+    """Frames 4 to 8 drawn with every widget in place (the docked windows have their sizes from
+    frame 2 on; the script sees the previous frame's widgets): logs
+    the widgets that ran past their window's edge (``state.cut``), the window report and the
+    panels' blit rectangles, then quits."""
+
+    def __init__(self, out: Path):
+        self.out, self.log = out, {"cut": []}
+
+    def __call__(self, state: AppState) -> None:
+        if 4 <= state.frame <= 8:
+            self.log["cut"] = sorted(set(self.log["cut"]) | state.cut)
+        if state.frame == 8:
+            self.log["windows"] = window_report()
+            self.log["blits"] = [[m, list(r)] for m, r in state.gpu.blits.last]
+            self.log["camera"] = [state.camera.width, state.camera.height]
+            state.quit = True
+
+
 def _gpu_counts(state: AppState) -> tuple[int, int]:
     """(GL panel draws, pixel read-backs from the GPU) so far."""
     draws = sum(p.draws for p in state.gpu.raster.values()) if state.gpu is not None else 0
@@ -534,5 +553,5 @@ SCRIPTS = {"check": Check, "features": Features, "radiosity": Radiosity, "pyrend
            "gpu_panels": GpuPanels, "slider_frames": SliderFrames,
            "fps_material_drag": lambda out: SliderFps(out, "material"),
            "fps_slider_drag": lambda out: SliderFps(out, "material+light"),
-           "idle": Idle, "idle_quick": lambda out: Idle(out, seconds=3.0),
+           "layout": Layout, "idle": Idle, "idle_quick": lambda out: Idle(out, seconds=3.0),
            "soak": Soak, "soak_quick": lambda out: Soak(out, rounds=10)}

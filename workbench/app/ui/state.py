@@ -84,6 +84,8 @@ class AppState:
     errors: object = None
     patch_pick: object = None
     pyrender: object = None
+    cut: set = field(default_factory=set)
+    """Widgets that ran past their window's right edge in the last frame (``panels.check_fits``)."""
     quit: bool = False
 
 
