@@ -147,7 +147,7 @@ def test_help_still_prints_and_exits_0(capsys):
 def test_study_refuses_bad_sweep_values_before_rendering(tmp_path, capsys, monkeypatch):
     import workbench.compare.study as study
     monkeypatch.setattr(study, "timed_run", lambda *a, **k: pytest.fail("rendered"))
-    monkeypatch.setattr(study, "choose_reference", lambda *a, **k: pytest.fail("rendered"))
+    monkeypatch.setattr(study, "References", lambda *a, **k: pytest.fail("rendered"))
     line = _one_error_line(*_cli(["study", "whitted", "--out", tmp_path / "s", "--methods", "raycast",
                                   "--sweep", "raycast:spp=a,b"], capsys)[::2])
     assert "--sweep raycast:spp" in line and "'a'" in line

@@ -143,5 +143,5 @@ def test_estimate_covers_the_images_read_back():
     r = get_renderer("povray")
     scene = workbench.load_scene("mesh")  # 81,920 triangles written as text
     small, big = r.estimate_bytes(scene, 10, 10), r.estimate_bytes(scene, 1000, 1000)
-    assert big - small == (1000 * 1000 - 100) * 3 * (2 + 8 + 4)
+    assert big - small == (1000 * 1000 - 100) * 3 * (2 + 8 + 4 + 16)  # + POV-Ray's float buffer
     assert small > 81920 * 50  # the mesh's SDL text (at least 50 bytes a triangle)
