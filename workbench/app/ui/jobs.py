@@ -142,10 +142,13 @@ class Job:
         samples per pixel, each pass's running image in ``partial`` (cancelled between
         passes); returns the final image."""
         import importlib
+
+        from ...renderers.base import check_memory, get_renderer
         mod, attr = PROGRESSIVE[method].split(":")
+        w, h = scene.camera.width, scene.camera.height
+        check_memory(get_renderer(method), scene, w, h, opts)  # as render() does first
         opts = dict(opts)
         target = int(opts.pop("spp"))
-        w, h = scene.camera.width, scene.camera.height
         session = getattr(importlib.import_module(mod), attr)(scene, w, h, **opts)
         per_pass = max(1, PASS_SAMPLES // (w * h))
         while session.samples < target:
