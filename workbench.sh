@@ -38,8 +38,12 @@ if [ "$what" = test ]; then
   exec .venv/bin/python -m pytest -q
 fi
 
-echo "== main job: quick error-vs-time study and side-by-side comparison of every method on the default scene (whitted)"
-echo "   (the first run also compiles the ray tracer's numba kernels, about 40-70 s; later runs load them from .numba_cache)"
+echo "== main job: quick error-vs-time study and side-by-side comparison of every method, on the default scene"
+echo "   (whitted: point lights, judged against the Whitted ray tracer) and on cornell_spheres (an area light:"
+echo "   every method applies, judged against the converged path tracer; its reference is cached after the first run)"
+echo "   (the first run also compiles the numba kernels, a minute or two; later runs load them from .numba_cache)"
 .venv/bin/workbench study whitted --quick --out out/report
 .venv/bin/workbench compare whitted --out out/report
-echo "== report: $PWD/out/report/report.html"
+.venv/bin/workbench study cornell_spheres --quick --out out/report_cornell_spheres
+.venv/bin/workbench compare cornell_spheres --size 256x256 --out out/report_cornell_spheres
+echo "== reports: $PWD/out/report/report.html and $PWD/out/report_cornell_spheres/report.html"

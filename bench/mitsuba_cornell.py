@@ -29,11 +29,16 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 OUT = ROOT / "bench" / "results" / "mitsuba_cornell.json"
 
+from workbench.compare.agreement import light_pixels  # noqa: E402  (re-exported for callers)
+
 
 def noise_image(result) -> np.ndarray | None:
-    """The per-pixel standard error a method put in its stats: the first (H, W[, 3]) array whose
-    key names ``stderr`` or ``noise`` (``mitsuba`` uses ``stderr``), broadcast to (H, W, 3)."""
+    """The per-pixel standard error of a result: ``result.std_error`` (``pathtrace``), else the
+    first (H, W[, 3]) array in its stats whose key names ``stderr`` or ``noise`` (``mitsuba``
+    uses ``stderr``), broadcast to (H, W, 3)."""
     H, W = result.image.shape[:2]
+    if getattr(result, "std_error", None) is not None:
+        return np.asarray(result.std_error, dtype=np.float64)
     for k, v in result.stats.items():
         if isinstance(v, np.ndarray) and v.shape[:2] == (H, W) and ("stderr" in k or "noise" in k):
             v = np.asarray(v, dtype=np.float64)
@@ -59,21 +64,6 @@ def run_once(scene, method: str, size: int, spp: int, seed: int = 0) -> tuple[di
         if k in r.stats:
             entry[k] = r.stats[k]
     return entry, r
-
-
-def light_pixels(scene, width: int, height: int) -> np.ndarray:
-    """(H, W) bool: pixels the projected bounding boxes of the area lights touch (grown by one
-    pixel): where a light's edge crosses a pixel the estimates' variance is largest and their
-    one-degree-of-freedom noise estimates least reliable."""
-    from workbench.scene.model import AreaLight
-    cam = scene.camera.with_resolution(width, height)
-    mask = np.zeros((height, width), bool)
-    for light in scene.lights:
-        if isinstance(light, AreaLight):
-            xy, _ = cam.project(np.asarray(light.vertices))
-            lo, hi = np.floor(xy.min(0)).astype(int) - 1, np.ceil(xy.max(0)).astype(int) + 1
-            mask[max(lo[1], 0):max(hi[1], 0), max(lo[0], 0):max(hi[0], 0)] = True
-    return mask
 
 
 def validate_pathtrace(pt, mi, exclude: np.ndarray | None = None) -> dict:

@@ -27,7 +27,6 @@ def test_ear_clipping_covers_the_polygon_exactly(verts):
     assert len(tris) == len(verts) - 2
     total = sum(_area(np.asarray(verts, dtype=np.float64)[t]) for t in tris)
     assert abs(total - _area(verts)) <= 1e-12 * _area(verts)
-    n = np.cross(np.subtract(verts[1], verts[0]), np.subtract(verts[2], verts[0]))
     for t in tris:  # every triangle wound like the polygon (its normal +z)
         a, b, c = np.asarray(verts, dtype=np.float64)[t]
         assert np.cross(b - a, c - a)[2] > 0.0
@@ -63,13 +62,7 @@ def _ellipsoid_scene(R, *, scaled):
     return scene_from_dict(scene_dict([obj], camera=cam, lights=[{"type": "point", "position": [2 * R, 3 * R, 6 * R]}]))
 
 
-IO_SINGULAR = pytest.mark.xfail(strict=True, reason="scene/io.py rejects a scale-1e-6 transform as "
-                                "singular (|det| <= tol.zero, absolute): left to the validation work")
-
-
-@pytest.mark.parametrize("R,scaled", [(R, s) for R in (1.0, 100.0, 1e4, 1e6, 1e-6) for s in (False, True)
-                                      if (R, s) != (1e-6, True)]
-                         + [pytest.param(1e-6, True, marks=IO_SINGULAR)])
+@pytest.mark.parametrize("R,scaled", [(R, s) for R in (1.0, 100.0, 1e4, 1e6, 1e-6) for s in (False, True)])
 def test_ray_through_the_pole_of_an_ellipsoid_hits_it_at_every_scale(R, scaled):
     """Before: a miss at the pole from R = 100 (the hit point rounded out of the bounds) and
     everywhere at R = 1e6 (|A| <= zero (|A| + |B| + |C|) took the quadric for a plane)."""
@@ -87,7 +80,7 @@ def test_ray_through_the_pole_of_an_ellipsoid_hits_it_at_every_scale(R, scaled):
 def test_quadric_seen_whole_by_the_ray_caster_at_every_scale(R):
     import workbench
     seen = [np.isfinite(workbench.render(_ellipsoid_scene(R, scaled=s), "raycast", width=33, height=33).depth)
-            for s in ((False, True) if R >= 1.0 else (False,))]  # 1e-6 transforms: see IO_SINGULAR
+            for s in (False, True)]
     ref = np.isfinite(workbench.render(_ellipsoid_scene(1.0, scaled=False), "raycast", width=33, height=33).depth)
     assert ref.sum() > 700
     for s in seen:

@@ -95,16 +95,10 @@ def test_random_scene_objects_seen_alike(seed, gl_ctx):
     assert iou(ray, ras) >= 0.97, (seed, s, list(kinds), iou(ray, ras))
 
 
-IO_ABSOLUTE = pytest.mark.xfail(strict=True, reason="scene/io.py refuses it at scale 1e-6 (absolute "
-                                "tolerances: polygon 'zero area', generated torus 'no triangles'): "
-                                "left to the validation work")
-
-
 def _scale_cases():
     for kind in KINDS:
         for s in (1e-6, 1e6):
-            marks = [IO_ABSOLUTE] if s == 1e-6 and kind in ("polygon", "concave_polygon", "mesh") else []
-            yield pytest.param(kind, s, marks=marks, id=f"{kind}-{s:g}")
+            yield pytest.param(kind, s, id=f"{kind}-{s:g}")
 
 
 @pytest.mark.gl

@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 import workbench
-from workbench.core.transform import normalize
 from workbench.renderers import local_model as lm
 from workbench.scene.io import scene_from_dict
 

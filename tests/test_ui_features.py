@@ -74,7 +74,7 @@ def test_bad_scene_file_keeps_the_scene_and_says_why(tmp_path):
 
 def test_light_edits_make_a_new_scene_and_refuse_bad_values():
     from workbench.core.errors import WorkbenchError
-    from workbench.app.ui.state import light_fields, light_value, reset_lights, set_light_value
+    from workbench.app.ui.state import light_fields, reset_lights, set_light_value
     state = new_state("whitted")
     base = state.scene
     assert light_fields(base.lights[0]) == ("position", "color", "intensity")

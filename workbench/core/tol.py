@@ -29,7 +29,9 @@ class Tolerances:
         scene declares a planar polygon (fraction of the polygon's diameter).  The published
         Cornell box's red wall is 0.2 % off its plane, hence 0.5 %.
     symmetric : float
-        Relative asymmetry tolerated in a quadric's 4x4 matrix: ``|Q - Q^T| <= symmetric * |Q|``.
+        Relative asymmetry tolerated in a quadric's 4x4 matrix, entry by entry:
+        ``|Q_ij - Q_ji| <= symmetric * max(|Q_ij|, |Q_ji|)`` (both scale alike when the
+        quadric is scaled, so the test does not depend on its size).
     normal_cancel : float
         An interpolated normal shorter than this (before normalisation) is treated as
         cancelled; the geometric normal is used instead.
@@ -51,6 +53,21 @@ class Tolerances:
     bump_step : float
         Finite-difference step of a bump map's height gradient, as a fraction of one pattern
         period (the step in object units is ``bump_step / scale``).
+    degenerate : float
+        Relative size at or below which a scene's geometry counts as degenerate (refused at
+        load, or replaced by a fallback), always measured against the object's own size so
+        that a scene scaled by 1e-6 or 1e6 is judged like the unscaled one:
+
+        * a polygon whose Newell vector ``|sum (v_i - v_0) x (v_{i+1} - v_0)|`` (twice its
+          area) is at most ``degenerate * d * max(d, |v|_inf)``, ``d`` its diameter (the
+          ``|v|_inf`` term bounds the rounding of the vertex differences of a polygon far
+          from the origin);
+        * a transform whose smallest singular value is at most ``degenerate`` times its
+          largest (a scale component at most ``degenerate`` times the largest);
+        * a camera whose ``|look_at - position|`` is at most ``degenerate`` times the larger
+          of ``|look_at|, |position|``;
+        * two directions whose angle has a sine at most ``degenerate`` (camera up and view
+          direction, texture pole and equator, a plane's ``u_axis`` and its normal).
     """
 
     zero: float = 1e-12
@@ -63,6 +80,7 @@ class Tolerances:
     hemicube_flat: float = 1e-3
     cut: float = 1e-9
     bump_step: float = 1e-3
+    degenerate: float = 1e-9
 
 
 tol = Tolerances()

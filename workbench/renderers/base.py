@@ -178,7 +178,7 @@ def convert_options(r: Renderer, options: dict) -> dict:
                 val = v.lower() in ("1", "true", "yes", "on")
             else:
                 val = o.kind(v)
-        except (TypeError, ValueError) as e:
+        except (TypeError, ValueError):
             raise WorkbenchError(f"method {r.name!r}: option {k!r} expects {getattr(o.kind, '__name__', 'a valid value')}"
                                  f" ({o.help}), got {v!r}") from None
         if isinstance(val, float) and not np.isfinite(val):

@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.transform import normalize
-from ..scene.model import DirectionalLight, Material, PointLight
+from ..scene.model import DirectionalLight, Material
 
 
 def light_incidence(light, P: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

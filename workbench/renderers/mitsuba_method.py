@@ -43,7 +43,6 @@ import numpy as np
 
 from ..core.errors import WorkbenchError
 from ..core.tol import tol
-from ..scene import features as F
 from ..scene.model import Scene
 from ..scene.tessellate import MAX_LEVEL
 from .base import Knob, Option, RenderResult

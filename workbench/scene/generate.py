@@ -16,7 +16,10 @@ def generate_mesh(kind: str, *, subdivisions: int = 4, seed: int = 0, amplitude:
     import trimesh
     if kind == "torus":
         n = 8 * 2 ** subdivisions
-        return trimesh.creation.torus(radius, radius / 3.0, major_sections=n, minor_sections=n)
+        # built at unit size, then scaled: trimesh merges vertices closer than an absolute
+        # 1e-8, which collapses a small torus to no triangles
+        unit = trimesh.creation.torus(1.0, 1.0 / 3.0, major_sections=n, minor_sections=n)
+        return trimesh.Trimesh(np.asarray(unit.vertices) * radius, unit.faces, process=False)
     mesh = trimesh.creation.icosphere(subdivisions=subdivisions, radius=1.0)
     v = np.asarray(mesh.vertices)
     if kind == "blob":

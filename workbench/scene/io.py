@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import tomllib
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -71,7 +71,7 @@ def _vec(ctx, t, where, key, default=None, *, n=3, nonzero=False, lo=None):
         isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) for x in v)
     if not ok:
         ctx.fail(f"{where}.{key}", f"expected a list of {n} finite numbers, got {v!r}")
-    if nonzero and np.linalg.norm(v) <= tol.zero:
+    if nonzero and not tf.normalize(v).any():   # a direction: any length has one, 0 has none
         ctx.fail(f"{where}.{key}", f"expected a non-zero vector, got {v!r}")
     if lo is not None and min(v) < lo:
         ctx.fail(f"{where}.{key}", f"expected components >= {lo}, got {v!r}")
@@ -186,16 +186,22 @@ def _image_file(ctx, t, where, key, required):
     return p
 
 
+def _parallel(a, b) -> bool:
+    """Directions ``a`` and ``b`` (3,), non-zero, at an angle whose sine is at most
+    ``tol.degenerate`` (whatever their lengths)."""
+    return float(np.linalg.norm(np.cross(tf.normalize(a), tf.normalize(b)))) <= tol.degenerate
+
+
 # --------------------------------------------------------------------------- sections
 def _camera(ctx, t) -> m.Camera:
     w = "[camera]"
     _check_keys(ctx, t, w, {"position", "look_at", "up", "fov_y", "resolution", "near", "far"},
                 {"position", "look_at"})
     pos, at = _vec(ctx, t, w, "position"), _vec(ctx, t, w, "look_at")
-    if np.linalg.norm(np.subtract(at, pos)) <= tol.zero:
+    if np.linalg.norm(np.subtract(at, pos)) <= tol.degenerate * max(np.linalg.norm(at), np.linalg.norm(pos)):
         ctx.fail(f"{w}.look_at", "must differ from position (zero-length view direction)")
     up = _vec(ctx, t, w, "up", (0.0, 1.0, 0.0), nonzero=True)
-    if np.linalg.norm(np.cross(np.subtract(at, pos), up)) <= 1e-9 * np.linalg.norm(np.subtract(at, pos)) * np.linalg.norm(up):
+    if _parallel(np.subtract(at, pos), up):
         ctx.fail(f"{w}.up", "is parallel to the view direction")
     res = t.get("resolution", [320, 240])
     if not (isinstance(res, list) and len(res) == 2 and all(isinstance(x, int) and not isinstance(x, bool) and 1 <= x <= 16384 for x in res)):
@@ -238,8 +244,8 @@ def _polygon_vertices(ctx, t, w):
         ctx.fail(f"{w}.vertices", "expected a list of at least 3 points [x, y, z]")
     v = np.array(v, dtype=np.float64)
     cross = np.cross(v[1:-1] - v[0], v[2:] - v[0]).sum(0)
-    diam = np.ptp(v, axis=0).max()
-    if np.linalg.norm(cross) <= (tol.zero + 1e-12 * diam) * max(diam, 1.0) ** 2:
+    diam = float(np.ptp(v, axis=0).max())
+    if np.linalg.norm(cross) <= tol.degenerate * diam * max(diam, float(np.abs(v).max())):
         ctx.fail(f"{w}.vertices", "polygon has zero area (collinear or repeated points)")
     n = cross / np.linalg.norm(cross)
     dev = np.abs((v - v[0]) @ n).max()
@@ -256,7 +262,7 @@ def _mapping(ctx, t, w, default_projection):
                 choices=("uv", "planar", "cylindrical", "spherical", "solid"))
     pole = tuple(tf.normalize(_vec(ctx, t, w, "pole", (0.0, 1.0, 0.0), nonzero=True)))
     equator = tuple(tf.normalize(_vec(ctx, t, w, "equator", (1.0, 0.0, 0.0), nonzero=True)))
-    if proj in ("spherical", "cylindrical") and abs(np.dot(pole, equator)) > 1 - 1e-6:
+    if proj in ("spherical", "cylindrical") and _parallel(pole, equator):
         ctx.fail(f"{w}.equator", "must not be parallel to the pole")
     return dict(projection=proj, scale=_num(ctx, t, w, "scale", 1.0, lo=0.0, lo_open=True),
                 center=_vec(ctx, t, w, "center", (0.0, 0.0, 0.0)), pole=pole, equator=equator)
@@ -339,12 +345,15 @@ def _transform(ctx, t, w) -> np.ndarray:
         s = tt.get("scale", 1.0)
         sv = _vec(ctx, {"s": [s] * 3 if isinstance(s, (int, float)) and not isinstance(s, bool) else s},
                   w, "s", None)
-        if min(abs(x) for x in sv) <= tol.zero:
-            ctx.fail(f"{w}.scale", f"scale must be non-zero, got {s!r}")
+        if min(abs(x) for x in sv) <= tol.degenerate * max(abs(x) for x in sv):
+            ctx.fail(f"{w}.scale", f"scale must be non-zero on every axis (each at least "
+                                   f"{tol.degenerate:g} times the largest), got {s!r}")
         M = (tf.translate(_vec(ctx, tt, w, "translate", (0.0, 0.0, 0.0)))
              @ tf.rotate_xyz(_vec(ctx, tt, w, "rotate", (0.0, 0.0, 0.0))) @ tf.scale(sv))
-    if abs(np.linalg.det(M[:3, :3])) <= tol.zero:
-        ctx.fail(f"{w}", "transform is singular")
+    sing = np.linalg.svd(M[:3, :3], compute_uv=False)   # descending
+    if not sing[-1] > tol.degenerate * sing[0]:
+        ctx.fail(f"{w}", f"transform is singular (singular values {sing[0]:.3g} .. {sing[-1]:.3g}: "
+                         f"the smallest must exceed {tol.degenerate:g} times the largest)")
     return M
 
 
@@ -413,10 +422,12 @@ def _object(ctx, t, w, materials, *, in_csg=False, inherited=None) -> m.SceneObj
         natural = None
         if "Q" in t:
             Q = _matrix(ctx, t, w, "Q")
-            if np.abs(Q - Q.T).max() > tol.symmetric * max(np.abs(Q).max(), 1.0):
-                i, j = np.unravel_index(np.argmax(np.abs(Q - Q.T)), Q.shape)
+            # entry by entry: Q_ij and Q_ji scale alike under a transform of the quadric
+            asym = np.abs(Q - Q.T) - tol.symmetric * np.maximum(np.abs(Q), np.abs(Q.T))
+            if (asym > 0).any():
+                i, j = np.unravel_index(np.argmax(asym), Q.shape)
                 ctx.fail(f"{w}.Q", f"matrix is not symmetric (Q[{i}][{j}] = {Q[i, j]} but Q[{j}][{i}] = {Q[j, i]})")
-            if np.abs(Q[:3, :3]).max() <= tol.zero and np.abs(Q[:3, 3]).max() <= tol.zero:
+            if not Q[:3].any():   # exactly: a tiny term is a huge quadric, not none
                 ctx.fail(f"{w}.Q", "degenerate quadric (no x, y or z terms)")
             shape = "general"
         else:

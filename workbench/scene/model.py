@@ -16,6 +16,7 @@ from typing import Literal, Union
 import numpy as np
 
 from ..core import transform as tf
+from ..core.tol import tol
 
 Vec3 = tuple[float, float, float]
 RGB = tuple[float, float, float]
@@ -311,9 +312,9 @@ class Plane(SceneObject):
     def frame(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Orthonormal (u, v, n) of the rectangle, right-handed with ``n`` the normal."""
         n = tf.normalize(np.asarray(self.normal))
-        u = np.asarray(self.u_axis, dtype=np.float64)
-        u = u - (u @ n) * n
-        if np.linalg.norm(u) < 1e-6:
+        u_axis = np.asarray(self.u_axis, dtype=np.float64)
+        u = u_axis - (u_axis @ n) * n
+        if np.linalg.norm(u) <= tol.degenerate * np.linalg.norm(u_axis):   # u_axis along n
             u = np.cross(n, [1.0, 0.0, 0.0] if abs(n[0]) < 0.9 else [0.0, 0.0, 1.0])
         u = tf.normalize(u)
         return u, np.cross(n, u), n

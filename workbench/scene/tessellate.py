@@ -211,20 +211,41 @@ def _quadric_gradient(Q: np.ndarray, P: np.ndarray) -> np.ndarray:
     return 2.0 * (H @ Q.T)[:, :3]
 
 
-def _quadric_solid(q: m.Quadric, level: int):
+def _unit_quadric(q: m.Quadric) -> tuple[np.ndarray, np.ndarray]:
+    """The quadric in the unit frame of its bounds: ``(Qu, S)``.
+
+    S (4, 4) maps the frame's coordinates onto the world's (the bounds' centre at the origin,
+    half their diagonal as unit length), and ``Qu = S^T Q S / max |S^T Q S|``: the same surface,
+    ``P^T Qu P`` of order 1 over the bounds, and the same Qu for the quadric scaled, moved or
+    multiplied by any constant.  Work done in this frame (level set, gradient floors) does not
+    depend on the scene's scale."""
+    Q = np.asarray(q.Q, dtype=np.float64)
+    lo, hi = np.asarray(q.bounds_min, dtype=np.float64), np.asarray(q.bounds_max, dtype=np.float64)
+    S = np.eye(4)
+    S[:3, :3] *= 0.5 * float(np.linalg.norm(hi - lo))
+    S[:3, 3] = 0.5 * (lo + hi)
+    Qu = S.T @ Q @ S
+    return Qu / np.abs(Qu).max(), S
+
+
+def _quadric_solid(q: m.Quadric, level: int) -> tuple[np.ndarray, np.ndarray]:
     """Closed mesh of ``{P^T Q P <= 0} ∩ bounds`` by marching tetrahedra (manifold3d level
-    set, about ``8 level`` cells along the bounds' diagonal); returns the Manifold.
+    set, about ``8 level`` cells along the bounds' diagonal): points (V, 3), faces (F, 3).
 
     The signed function handed to manifold3d is ``min(-q(P) / |grad q(P)|, distance inside
     the box)`` (first-order distance to the quadric), evaluated with plain floats because
-    manifold3d calls it once per grid point."""
+    manifold3d calls it once per grid point.  The level set is built in
+    :func:`_unit_quadric`'s frame (so that manifold3d's own tolerances, and the floor
+    ``tol.normal_cancel`` of ``|grad q|``, which vanishes at an ellipsoid's centre, meet the
+    same numbers at every scale); its points are then scaled and moved onto the bounds."""
     import manifold3d
-    Q = [[float(x) for x in row] for row in np.asarray(q.Q, dtype=np.float64)]
-    lo = [float(x) for x in q.bounds_min]
-    hi = [float(x) for x in q.bounds_max]
-    diag = float(np.linalg.norm(np.subtract(hi, lo)))
-    floor = diag * tol.normal_cancel
-    h = diag / (8.0 * level)
+    Qu, S = _unit_quadric(q)
+    Q = [[float(x) for x in row] for row in Qu]
+    k, c = float(S[0, 0]), S[:3, 3]
+    lo = [float(x) for x in (np.asarray(q.bounds_min) - c) / k]
+    hi = [float(x) for x in (np.asarray(q.bounds_max) - c) / k]
+    h = 2.0 / (8.0 * level)          # the frame's diagonal is 2
+    floor = tol.normal_cancel
 
     def sdf(x, y, z):
         p = (x, y, z, 1.0)
@@ -234,9 +255,11 @@ def _quadric_solid(q: m.Quadric, level: int):
         inside_box = min(x - lo[0], y - lo[1], z - lo[2], hi[0] - x, hi[1] - y, hi[2] - z)
         return min(-value / max(grad, floor), inside_box)
 
-    pad = 2.0 * h
+    pad = 2.5 * h    # the lower box faces half a cell off the grid: no sdf sign left to rounding there
     bounds = [lo[0] - pad, lo[1] - pad, lo[2] - pad, hi[0] + pad, hi[1] + pad, hi[2] + pad]
-    return manifold3d.Manifold.level_set(sdf, bounds, h)
+    mesh = manifold3d.Manifold.level_set(sdf, bounds, h).to_mesh()
+    U = np.asarray(mesh.vert_properties, dtype=np.float64)[:, :3]
+    return c + k * U, np.asarray(mesh.tri_verts, dtype=np.int64)
 
 
 def _named_radii(q: m.Quadric) -> tuple[float, float, float]:
@@ -310,9 +333,7 @@ def _cut_to_bounds(P: np.ndarray, F: np.ndarray, lo: np.ndarray, hi: np.ndarray)
 def _general_quadric(q: m.Quadric, level: int) -> tuple[np.ndarray, np.ndarray]:
     """Surface of a general quadric inside its bounds: the level-set solid with its box caps
     removed."""
-    mesh = _quadric_solid(q, level).to_mesh()
-    P = np.asarray(mesh.vert_properties, dtype=np.float64)[:, :3]
-    F = np.asarray(mesh.tri_verts, dtype=np.int64)
+    P, F = _quadric_solid(q, level)
     lo, hi = np.asarray(q.bounds_min), np.asarray(q.bounds_max)
     on_cap = np.zeros(len(F), dtype=bool)
     for axis in range(3):
@@ -320,11 +341,14 @@ def _general_quadric(q: m.Quadric, level: int) -> tuple[np.ndarray, np.ndarray]:
             on_cap |= (np.abs(P[F][:, :, axis] - plane) <= tol.planar * (hi[axis] - lo[axis])).all(1)
     # vertices of the crease between surface and caps are interpolated across it: pull every
     # vertex onto the surface (Newton steps along the gradient), staying inside the bounds
-    Q = np.asarray(q.Q, dtype=np.float64)
+    Qu, S = _unit_quadric(q)
+    k, c = S[0, 0], S[:3, 3]
+    U, ulo, uhi = (P - c) / k, (lo - c) / k, (hi - c) / k   # in the unit frame
     for _ in range(3):
-        g = _quadric_gradient(Q, P)
-        g2 = np.maximum(np.sum(g * g, -1), tol.zero)
-        P = np.clip(P - (_quadric_value(Q, P) / g2)[:, None] * g, lo, hi)
+        g = _quadric_gradient(Qu, U)
+        g2 = np.maximum(np.sum(g * g, -1), tol.normal_cancel ** 2)
+        U = np.clip(U - (_quadric_value(Qu, U) / g2)[:, None] * g, ulo, uhi)
+    P = np.clip(c + k * U, lo, hi)
     return P, F[~on_cap]
 
 

@@ -33,11 +33,7 @@ def _leaf_manifold(leaf: m.SceneObject, M: np.ndarray, level: int, leaf_id: int)
         F = np.array(F, dtype=np.int64)
     elif isinstance(leaf, m.Quadric):
         closed = _closed_named_quadric(leaf, level)
-        if closed is None:
-            mesh = _quadric_solid(leaf, level).to_mesh()
-            closed = (np.asarray(mesh.vert_properties, dtype=np.float64)[:, :3],
-                      np.asarray(mesh.tri_verts, dtype=np.int64))
-        P, F = closed
+        P, F = closed if closed is not None else _quadric_solid(leaf, level)
     elif isinstance(leaf, m.Mesh):
         import trimesh
         tm = trimesh.Trimesh(np.asarray(leaf.vertices), np.asarray(leaf.faces), process=True)

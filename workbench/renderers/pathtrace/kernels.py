@@ -24,6 +24,31 @@ One path per sample, from the camera (uniform jitter in the pixel: the box-filte
   ``q = min(0.95, max(beta))``, ``beta /= q``; a path stops for good at ``max_bounces``
   (``0.95^k``: unreachable in practice, a guard against endless loops).
 
+Transport (``opts[18]``), for the matched references of other methods (DESIGN.md, "Ground
+truth and the error split"):
+
+* ``full`` (0): all of the above;
+* ``diffuse`` (1): exactly what radiosity computes (``radiosity.patches``, ``.hemicube``): every
+  surface is Lambertian with reflectance ``kd C`` (``ks, kr, kt`` ignored: opaque, no Phong
+  lobe, no mirror, no glass; plain colours, no textures), scaled only where ``kd max(C) > 1``;
+  only surfaces emit (area lights, ``emission``; point and directional lights, vertex emission
+  and the background light nothing: a camera ray that escapes still sees the background, as
+  radiosity's display clears to it); every surface is one-sided, as the form factors see it:
+  its back neither emits nor reflects (a black occluder), except where the camera sees a back
+  face, which radiosity's display draws with its front's value: the Lambertian front radiance,
+  the same in every direction, is estimated there (the path leaves from the front side);
+* ``eye_specular`` (2): the hybrid method's physics (``radiosity.hybrid``): along the eye path
+  (the camera, then only delta bounces) a surface with ``kr > 0`` or ``kt > 0`` keeps its mirror
+  and transmission lobes (Fresnel split, media, absorption as ``full``) and its Lambertian
+  ``kd C``, weights scaled by ``1 / max(1, kd max(C) + kr + kt)``; ``ks`` is ignored (the hybrid's
+  highlights come from the ray tracer's point-light stand-ins, not from the diffuse solution:
+  that difference is missing physics); from the first non-delta bounce on, ``diffuse`` transport
+  (no caustics: a mirror or glass surface is Lambertian ``kd C`` there).
+
+Pixel filter (``opts[19]``): 0 box (uniform jitter over the pixel's square: the workbench's ideal
+image), 1 centre (every sample through the pixel's centre: the point-sampled image of the
+raster and radiosity methods; the estimate converges to the radiance seen at the centre).
+
 Random numbers: a counter-based hash (SplitMix64's finaliser) of (seed, pixel, sample index,
 dimension), so an image depends on the seed only, not on how the threads share the work, and
 more samples continue a sequence (:class:`..pathtrace.session.PathTraceSession`).
@@ -170,7 +195,9 @@ def render_samples(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sum
     cam : (16,) ``raytrace.whitted.camera_frame``.
     opts : (20,) float64: fresnel (0 none, 1 Schlick, 2 exact), tol.ray_offset, tol.t_min,
         tol.zero, extent, tol.normal_cancel, rr_start, max_bounces, textures on, MIS exponent,
-        background RGB (3), media around the camera (count, then 4 material rows).
+        background RGB (3), media around the camera (count, then 4 material rows), transport
+        (0 full, 1 diffuse, 2 eye_specular: see the module docstring), pixel filter (0 box:
+        uniform jitter in the pixel, 1 centre: every sample through the pixel's centre).
     seed, s0, nsamp : int.
     sums, sumsq : (H*W, 3) float64, updated: sum and sum of squares of the sample radiances.
     counts : (NCOUNTS,) int64, updated (see ``NCOUNTS``).
@@ -194,11 +221,15 @@ def pixel_block(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq,
                 scr, rows):
     """Pixels ``p0 .. p1 - 1`` of :func:`render_samples`, each sample's path in turn."""
     width = int(cam[14])
+    centre = opts[19] > 0.5
     for p in range(p0, p1):
         i, j = p // width, p % width
         for s in range(s0, s0 + nsamp):
             key = path_key(seed, p, s)
-            dx, dy, dz = camera_ray_at(cam, i, j, rand(key, 0), rand(key, 1))
+            if centre:
+                dx, dy, dz = camera_ray_at(cam, i, j, 0.5, 0.5)
+            else:
+                dx, dy, dz = camera_ray_at(cam, i, j, rand(key, 0), rand(key, 1))
             r, g, b = trace_path(geo, shading, emitters, opts, key, cam[0], cam[1], cam[2], dx, dy, dz,
                                  counts, scr, rows)
             if not (math.isfinite(r) and math.isfinite(g) and math.isfinite(b)):
@@ -235,6 +266,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
     rr_start, max_bounces = int(opts[6]), int(opts[7])
     use_tex, beta_mis = opts[8] > 0.5, opts[9]
     nstk = int(opts[13])
+    transport = int(opts[18])
     for q in range(4):
         stk[q] = int(opts[14 + q])
     n_em = em_cdf.shape[0]
@@ -242,6 +274,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
     br, bg_, bb = 1.0, 1.0, 1.0           # path throughput beta
     Lr, Lg, Lb = 0.0, 0.0, 0.0
     delta_before = True                    # camera or a delta lobe before this hit: no MIS
+    eye = True                             # only the camera and delta lobes before this hit
     pdf_prev = 0.0                         # solid-angle density of the BSDF sample that led here
     tmin = 0.0
     counts[0] += 1
@@ -251,9 +284,10 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
         t, k, f, tri, b1, b2 = cast(geo, ox, oy, oz, dx, dy, dz, tmin, np.inf, np.bool_(False), zero, eps, scr)
         if k < 0:
             counts[4] += 1
-            Lr += br * opts[10]
-            Lg += bg_ * opts[11]
-            Lb += bb * opts[12]
+            if transport == 0 or eye:  # diffuse transport: the background is seen, it lights nothing
+                Lr += br * opts[10]
+                Lg += bg_ * opts[11]
+                Lb += bb * opts[12]
             return Lr, Lg, Lb
         if nstk > 0:  # Beer-Lambert absorption of the medium the segment crossed
             ma = stk[nstk - 1]
@@ -270,9 +304,25 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
         nx, ny, nz = h_ns[0, 0], h_ns[0, 1], h_ns[0, 2]
         if nx * dx + ny * dy + nz * dz > 0.0:
             nx, ny, nz = -nx, -ny, -nz                              # shading normal, incident side
+        kd, ks, shin, kr, kt = mat_tab[mi, 4], mat_tab[mi, 5], mat_tab[mi, 6], mat_tab[mi, 7], mat_tab[mi, 8]
+        if transport > 0:
+            if transport == 2 and eye and (kr > 0.0 or kt > 0.0):
+                ks = 0.0                   # eye-path mirror / glass: its delta lobes and kd C
+            else:
+                ks, kr, kt = 0.0, 0.0, 0.0  # Lambertian kd C, one-sided
+                if not front:
+                    if not eye:
+                        return Lr, Lg, Lb  # a back face is black to the form factors
+                    # the eye sees a back face with its front's (view-independent) radiance
+                    front = True
+                    fx, fy, fz = gx, gy, gz
+                    if nx * gx + ny * gy + nz * gz < 0.0:
+                        nx, ny, nz = -nx, -ny, -nz
         # ---- emission
-        er, eg, eb = h_ev[0, 0], h_ev[0, 1], h_ev[0, 2]
-        if mat_tab[mi, 16] < 0.5 or front:
+        er, eg, eb = 0.0, 0.0, 0.0
+        if transport == 0:
+            er, eg, eb = h_ev[0, 0], h_ev[0, 1], h_ev[0, 2]
+        if front or (transport == 0 and mat_tab[mi, 16] < 0.5):
             er += mat_tab[mi, 13]
             eg += mat_tab[mi, 14]
             eb += mat_tab[mi, 15]
@@ -290,7 +340,6 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
         if use_tex and mat_tab[mi, 17] > 0.5:
             tr_, tg_, tb_ = checker_color(tex_tab, mi, h_po[0, 0], h_po[0, 1], h_po[0, 2])
             cr, cg, cb = cr * tr_, cg * tg_, cb * tb_
-        kd, ks, shin, kr, kt = mat_tab[mi, 4], mat_tab[mi, 5], mat_tab[mi, 6], mat_tab[mi, 7], mat_tab[mi, 8]
         total = kd * max(cr, cg, cb) + ks + kr + kt
         scale = 1.0 / total if total > 1.0 else 1.0
         adr, adg, adb = kd * cr * scale, kd * cg * scale, kd * cb * scale
@@ -374,10 +423,10 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                     cos_l = -(lx * em_n[e, 0] + ly * em_n[e, 1] + lz * em_n[e, 2])
                     emi = mat_of[em_prim[e]]
                     ler, leg, leb = 0.0, 0.0, 0.0
-                    if cos_l > 0.0 or mat_tab[emi, 16] < 0.5:
+                    if cos_l > 0.0 or (transport == 0 and mat_tab[emi, 16] < 0.5):
                         ler, leg, leb = mat_tab[emi, 13], mat_tab[emi, 14], mat_tab[emi, 15]
                     mt = em_mtri[e]
-                    if mt >= 0:
+                    if mt >= 0 and transport == 0:
                         for q in range(3):
                             v = c0 * tri_e[mt, q] + c1 * tri_e[mt, 3 + q] + c2 * tri_e[mt, 6 + q]
                             if q == 0:
@@ -443,7 +492,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
             br *= (adr * INV_PI + fs) * cos_s / pdf
             bg_ *= (adg * INV_PI + fs) * cos_s / pdf
             bb *= (adb * INV_PI + fs) * cos_s / pdf
-            delta_before, pdf_prev = False, pdf
+            delta_before, pdf_prev, eye = False, pdf, False
             ox, oy, oz = px + off * fx, py + off * fy, pz + off * fz
             dx, dy, dz = wx, wy, wz
         elif u < m_nd + a_r:                        # mirror: R = I - 2 (I.N) N

@@ -8,6 +8,10 @@ tracer's Fresnel option, ``emission`` as radiance; the ambient term ``ka`` is of
 for the indirect light the path tracer computes); the lobes are scaled down together when
 ``kd max(C) + ks + kr + kt > 1``.  Checker textures are evaluated in the kernel (as the ray
 tracer's fused path); other textures, bump, opacity maps and the environment map are left out.
+
+Options ``transport`` (``full``, ``diffuse``: radiosity's physics, ``eye_specular``: the hybrid's)
+and ``pixel_filter`` (``box``, ``center``) make it the *matched* reference of other methods
+(:mod:`.kernels` docstring).
 """
 from __future__ import annotations
 
@@ -17,7 +21,7 @@ from ...core.errors import WorkbenchError
 from ...scene import features as F
 from ...scene.model import Scene
 from ..base import Knob, Option, RenderResult
-from .session import FRESNEL, MIS, PathTraceSession, estimate_bytes
+from .session import FRESNEL, MIS, PIXEL_FILTER, TRANSPORT, PathTraceSession, estimate_bytes
 
 _SAMPLES_PER_PASS = 1 << 20
 """Samples (pixels x spp) per kernel call: passes short enough for a progress bar and a UI."""
@@ -40,6 +44,13 @@ class PathTraceRenderer:
         "seed": Option(int, 0, "seed of the random numbers (>= 0; same seed, same image)"),
         "fresnel": Option(str, "none", "reflection/transmission split: none (constant kr, kt), schlick or exact dielectric", tuple(FRESNEL)),
         "mis": Option(str, "power", "multiple importance sampling heuristic", tuple(MIS)),
+        "transport": Option(str, "full", "light transport: full; diffuse (radiosity's physics: every surface "
+                            "Lambertian kd*color and one-sided, ks/kr/kt ignored, only area lights and emissive "
+                            "materials emit); eye_specular (the hybrid's: mirror and glass followed along the eye "
+                            "path, ks ignored, then diffuse transport, no caustics)", tuple(TRANSPORT)),
+        "pixel_filter": Option(str, "box", "box: uniform jitter over the pixel (the ideal image); center: every "
+                               "sample through the pixel centre (the point-sampled image of raster and radiosity)",
+                               tuple(PIXEL_FILTER)),
         "rr_start": Option(int, 3, "bounce from which Russian roulette plays (survival min(0.95, max throughput))"),
         "max_bounces": Option(int, 1000, "hard stop of a path (a guard: roulette ends paths long before)"),
         "progress": Option(bool, False, "show a tqdm progress bar (CLI)"),
@@ -57,7 +68,8 @@ class PathTraceRenderer:
             raise WorkbenchError(f"method 'pathtrace': option 'spp' must be within 1..{MAX_SPP}, got {o['spp']}")
         t0 = time.perf_counter()
         ses = PathTraceSession(scene, width, height, seed=o["seed"], fresnel=o["fresnel"],
-                               rr_start=o["rr_start"], max_bounces=o["max_bounces"], mis=o["mis"])
+                               rr_start=o["rr_start"], max_bounces=o["max_bounces"], mis=o["mis"],
+                               transport=o["transport"], pixel_filter=o["pixel_filter"])
         per_pass = max(1, _SAMPLES_PER_PASS // (width * height))
         bar = None
         if o["progress"]:
@@ -75,17 +87,31 @@ class PathTraceRenderer:
         timings = dict(ses.timings)
         timings["setup"] = time.perf_counter() - t0 - timings["trace"]
         stats = ses.stats()
-        return RenderResult(self.name, ses.image, timings, stats, *self._features(scene, ses),
-                            std_error=ses.std_error)
+        se = ses.std_error
+        if se is not None:  # kept with the stats' arrays by the reference cache
+            stats["stderr"], stats["stderr_rms"] = se, stats["noise_rmse"]
+        return RenderResult(self.name, ses.image, timings, stats, *self._features(scene, ses), std_error=se)
 
     def _features(self, scene: Scene, ses: PathTraceSession):
         needs = scene.needs()
         left = ["ambient: off (the path tracer computes the indirect light it stands in for)"]
+        if ses.transport != "full":
+            why = f"transport={ses.transport}: "
+            for f, what in ((F.POINT_LIGHTS, "only emitting surfaces light the scene"),
+                            (F.DIRECTIONAL_LIGHTS, "only emitting surfaces light the scene"),
+                            (F.SPECULAR, "no Phong lobe (ks ignored)")):
+                if f in needs:
+                    left.append(f"{f}: {why}{what}")
+            for f in (F.REFLECTION, F.REFRACTION, F.ABSORPTION):
+                if f in needs:
+                    left.append(f"{f}: {why}" + ("Lambertian kd*color, opaque" if ses.transport == "diffuse"
+                                                 else "followed along the eye path only (no caustics)"))
         if not ses.textured:
+            why = ("not evaluated by the path tracer's kernel" if ses.transport == "full"
+                   else f"transport={ses.transport}: as radiosity")
             for f in (F.TEXTURES, F.BUMP, F.OPACITY, F.ENVIRONMENT):
                 if f in needs:
-                    left.append(f"{f}: not evaluated by the path tracer's kernel (plain colour, "
-                                "unbumped, opaque, background colour)")
+                    left.append(f"{f}: {why} (plain colour, unbumped, opaque, background colour)")
         left += [f"emitter sampling: {u}" for u in ses.emitters.unsampled]
         missing = {x.split(":")[0] for x in left}
         used = sorted(f for f in needs if f not in missing)

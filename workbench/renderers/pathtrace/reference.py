@@ -6,7 +6,9 @@ the kernel's docstring), on the ray tracer's readable intersection
 numbers: the two agree in expectation, which the tests check against both noise estimates.
 
 Covered: plain colours (no textures), emissive analytic surfaces and area lights (emissive
-meshes are refused), point and directional lights, mirrors and dielectrics with nested media.
+meshes are refused), point and directional lights, mirrors and dielectrics with nested media;
+the ``transport`` modes (``full``, ``diffuse``, ``eye_specular``) and ``pixel_filter`` (``box``,
+``center``) of the kernel's docstring.
 """
 from __future__ import annotations
 
@@ -22,7 +24,7 @@ from ..raytrace import reference as rt
 from ..raytrace.flatten import MESH, flatten
 from ..raytrace.whitted import camera_frame
 from .emitters import build_emitters
-from .session import FRESNEL, MIS
+from .session import FRESNEL, MIS, PIXEL_FILTER, TRANSPORT
 
 
 @dataclass
@@ -32,6 +34,8 @@ class Options:
     rr_start: int = 3
     max_bounces: int = 1000
     mis: str = "power"
+    transport: str = "full"
+    pixel_filter: str = "box"
 
 
 class Tracer:
@@ -43,6 +47,10 @@ class Tracer:
         self.o = options
         if options.fresnel not in FRESNEL or options.mis not in MIS:
             raise WorkbenchError(f"pathtrace reference: bad fresnel {options.fresnel!r} or mis {options.mis!r}")
+        if options.transport not in TRANSPORT or options.pixel_filter not in PIXEL_FILTER:
+            raise WorkbenchError(f"pathtrace reference: bad transport {options.transport!r} or pixel_filter "
+                                 f"{options.pixel_filter!r}")
+        self.full = options.transport == "full"
         self.ctx = rt.Context(self.scene, fresnel=options.fresnel)
         sd = flatten(self.scene)
         if (sd.tri_e > 0).any() or any(sd.mat_tab[sd.mat[k], 13:16].max() > 0 for k in np.flatnonzero(sd.ptype == MESH)):
@@ -52,10 +60,13 @@ class Tracer:
         self.density = {}  # object index -> light-strategy density per unit area
         for k in np.flatnonzero(sd.top):
             self.density[int(sd.obj[k])] = float(self.em.lpdf_prim[k])
-        self.lights = [lt for lt in scene.lights if not isinstance(lt, m.AreaLight)]
+        # diffuse transport: surfaces are the only emitters (radiosity's physics)
+        self.lights = [lt for lt in scene.lights if not isinstance(lt, m.AreaLight)] if self.full else []
         self.cam = camera_frame(self.scene.camera, width, height)
         self.beta = MIS[options.mis]
         self.media0 = rt.enclosing_media(self.scene, self.scene.camera.position)
+        if options.transport == "diffuse":
+            self.media0 = []
 
     def camera_ray(self, i, j, u, v):
         """Direction through image-plane point ``(j + u, i + v)`` (as ``kernels.camera_ray_at``)."""
@@ -70,12 +81,19 @@ class Tracer:
         a, b = pa ** self.beta, pb ** self.beta
         return a / (a + b) if a > 0 else 0.0
 
-    def lobes(self, mat: m.Material):
-        """Weights ``(a_d (3,), a_s, a_r, a_t)`` scaled by ``1 / max(1, kd max(C) + ks + kr + kt)``."""
+    def specular_here(self, mat: m.Material, eye: bool) -> bool:
+        """Does this hit keep its delta lobes (``full``; ``eye_specular`` along the eye path)?"""
+        return self.full or (self.o.transport == "eye_specular" and eye and (mat.kr > 0 or mat.kt > 0))
+
+    def lobes(self, mat: m.Material, eye: bool = True):
+        """Weights ``(a_d (3,), a_s, a_r, a_t)`` scaled by ``1 / max(1, kd max(C) + ks + kr + kt)``
+        (``ks`` is 0 unless ``full``; ``ks, kr, kt`` are 0 where :meth:`specular_here` is not)."""
         C = np.asarray(mat.color, dtype=np.float64)
-        total = mat.kd * C.max() + mat.ks + mat.kr + mat.kt
+        ks = mat.ks if self.full else 0.0
+        kr, kt = (mat.kr, mat.kt) if self.specular_here(mat, eye) else (0.0, 0.0)
+        total = mat.kd * C.max() + ks + kr + kt
         s = 1.0 / total if total > 1.0 else 1.0
-        return mat.kd * C * s, mat.ks * s, mat.kr * s, mat.kt * s
+        return mat.kd * C * s, ks * s, kr * s, kt * s
 
     def phong(self, n, R, w):
         """Normalised Phong lobe value per unit ks and its sampling density (Lafortune & Willems 1994)."""
@@ -90,11 +108,14 @@ class Tracer:
         beta = np.ones(3)
         L = np.zeros(3)
         delta_before, pdf_prev, tmin = True, 0.0, 0.0
+        eye = True  # only the camera and delta bounces so far
         media = list(self.media0)
         for bounce in range(self.o.max_bounces):
             hit = rt.closest(self.ctx, O, D, tmin)
             if hit is None:
-                return L + beta * np.asarray(self.scene.background, dtype=np.float64)
+                if self.full or eye:  # diffuse transport: the background lights nothing
+                    L = L + beta * np.asarray(self.scene.background, dtype=np.float64)
+                return L
             if media:
                 beta = beta * np.exp(-np.asarray(media[-1].absorption) * hit.t)
             mat, P = hit.material, hit.P
@@ -102,8 +123,13 @@ class Tracer:
             front = cos_g > 0
             Nf = hit.Ng if front else -hit.Ng
             Ns = hit.Ns if hit.Ns @ D <= 0 else -hit.Ns
-            Le = np.asarray(hit.emission, dtype=np.float64) * np.ones(3)
-            if front or not mat.name.startswith("__area_light"):
+            if not self.specular_here(mat, eye) and not self.full and not front:
+                if not eye:
+                    return L  # one-sided: a back face is black (radiosity's form factors)
+                front, Nf = True, hit.Ng  # the eye sees the front's radiance on a back face
+                Ns = hit.Ns if hit.Ns @ hit.Ng >= 0 else -hit.Ns
+            Le = np.asarray(hit.emission, dtype=np.float64) * np.ones(3) if self.full else np.zeros(3)
+            if front or (self.full and not mat.name.startswith("__area_light")):
                 Le = Le + np.asarray(mat.emission)
             if Le.max() > 0:
                 w = 1.0
@@ -111,7 +137,7 @@ class Tracer:
                 if not delta_before and dens > 0 and cos_g != 0:
                     w = self.mis(pdf_prev, dens * hit.t ** 2 / abs(cos_g))
                 L = L + beta * Le * w
-            a_d, a_s, a_r, a_t = self.lobes(mat)
+            a_d, a_s, a_r, a_t = self.lobes(mat, eye)
             m_d = a_d.max()
             m_nd = m_d + a_s
             R = D + 2 * (-(D @ Ns)) * Ns
@@ -158,7 +184,7 @@ class Tracer:
                     return L
                 f, pdf = f_and_pdf(w)
                 beta = beta * f * (Ns @ w) / pdf
-                delta_before, pdf_prev = False, pdf
+                delta_before, pdf_prev, eye = False, pdf, False
                 O, D = P + off * Nf, w
             elif u < m_nd + a_r:
                 beta = beta * lobes
@@ -188,7 +214,8 @@ class Tracer:
             l = v / dist
             cos_l = -(l @ em.normal[e])
             mat = self.em_material[e]
-            Le = np.asarray(mat.emission) if (cos_l > 0 or not mat.name.startswith("__area_light")) else np.zeros(3)
+            two_sided = self.full and not mat.name.startswith("__area_light")
+            Le = np.asarray(mat.emission) if (cos_l > 0 or two_sided) else np.zeros(3)
             cos_s = Ns @ l
             if Le.max() > 0 and cos_s > 0 and cos_l != 0 and Nf @ l > 0:
                 f, p_b = f_and_pdf(l)
@@ -243,7 +270,8 @@ def render_pixels(scene: m.Scene, width: int, height: int, pixels, spp: int, **o
     pos = np.asarray(scene.camera.position, dtype=np.float64)
     mean, se = np.zeros((len(pixels), 3)), np.zeros((len(pixels), 3))
     for q, (i, j) in enumerate(pixels):
-        S = np.array([tr.radiance(pos, tr.camera_ray(i, j, rng.random(), rng.random()), rng)
+        centre = tr.o.pixel_filter == "center"
+        S = np.array([tr.radiance(pos, tr.camera_ray(i, j, *((0.5, 0.5) if centre else rng.random(2))), rng)
                       for _ in range(spp)])
         mean[q] = S.mean(0)
         se[q] = S.std(0, ddof=1) / np.sqrt(spp)

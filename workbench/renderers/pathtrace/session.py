@@ -3,7 +3,8 @@ of squares, so a caller (the renderer, the UI, a reference cache) asks for more 
 gets the running image and its noise estimate.
 
 Image definition: a pixel is the box-filtered average of the radiance over its square (uniform
-jitter in the pixel), linear RGB, nothing clipped.  Noise: the per-pixel standard error of the
+jitter in the pixel; ``pixel_filter="center"``: the radiance through its centre), linear RGB,
+nothing clipped.  Noise: the per-pixel standard error of the
 mean ``sqrt(s^2 / N)`` with ``s^2`` the unbiased sample variance of the pixel's ``N`` sample
 radiances (per channel); ``noise_rmse`` is its root mean square over pixels and channels.
 The same ``seed`` gives the same image whatever the thread count; ``add_samples(a)`` then
@@ -25,6 +26,12 @@ from .geometry import triangulated
 
 FRESNEL = {"none": 0, "schlick": 1, "exact": 2}
 MIS = {"balance": 1.0, "power": 2.0}
+TRANSPORT = {"full": 0, "diffuse": 1, "eye_specular": 2}
+"""Light transport the estimator follows (:mod:`.kernels` docstring): all of it; radiosity's
+(Lambertian ``kd C``, one-sided surfaces, surface emitters only); the hybrid's (mirror and glass
+along the eye path, then radiosity's)."""
+PIXEL_FILTER = {"box": 0, "center": 1}
+"""``box``: uniform jitter over the pixel's square; ``center``: every sample through its centre."""
 _BYTES_PER_PIXEL = 2 * 24 + 4 * 24
 """Running sums and sums of squares (float64), then at most four (H*W, 3) float64 temporaries
 while the image and its standard error are made."""
@@ -57,16 +64,20 @@ class PathTraceSession:
     max_bounces : hard stop of a path (>= 1).  mis : ``power`` (exponent 2) or ``balance``.
     triangulate : trace plain opaque polygons and rectangles as triangles through the BVH
     (:mod:`.geometry`; the same surfaces, faster), else as the ray tracer's polygons.
+    transport : ``full`` | ``diffuse`` | ``eye_specular`` (:data:`TRANSPORT`; the latter two
+    ignore point and directional lights, textures and vertex emission).
+    pixel_filter : ``box`` | ``center`` (:data:`PIXEL_FILTER`).
 
     Raises
     ------
     NotApplicable
         Nothing emits light: no emissive surface, no area / point / directional light and a
-        black background.
+        black background (``diffuse``, ``eye_specular``: no emissive surface and no area light).
     """
 
     def __init__(self, scene: m.Scene, width: int, height: int, *, seed: int = 0, fresnel: str = "none",
-                 rr_start: int = 3, max_bounces: int = 1000, mis: str = "power", triangulate: bool = True):
+                 rr_start: int = 3, max_bounces: int = 1000, mis: str = "power", triangulate: bool = True,
+                 transport: str = "full", pixel_filter: str = "box"):
         if seed < 0:
             raise WorkbenchError(f"pathtrace: seed must be >= 0, got {seed}")
         if rr_start < 1 or max_bounces < 1:
@@ -74,29 +85,41 @@ class PathTraceSession:
         if fresnel not in FRESNEL or mis not in MIS:
             raise WorkbenchError(f"pathtrace: fresnel must be one of {', '.join(FRESNEL)} and mis one of "
                                  f"{', '.join(MIS)}, got {fresnel!r}, {mis!r}")
+        if transport not in TRANSPORT or pixel_filter not in PIXEL_FILTER:
+            raise WorkbenchError(f"pathtrace: transport must be one of {', '.join(TRANSPORT)} and pixel_filter "
+                                 f"one of {', '.join(PIXEL_FILTER)}, got {transport!r}, {pixel_filter!r}")
+        self.transport, self.pixel_filter = transport, pixel_filter
         t0 = time.perf_counter()
         self.scene = scene.with_camera(scene.camera.with_resolution(width, height))
         self.width, self.height, self.seed = int(width), int(height), int(seed)
         sd = flatten(triangulated(self.scene) if triangulate else self.scene)
         self.sd = sd
         self.emitters = build_emitters(sd)
-        point = [lt for lt in scene.lights if not isinstance(lt, m.AreaLight)]
+        full = transport == "full"
+        point = [lt for lt in scene.lights if not isinstance(lt, m.AreaLight)] if full else []
         lights = np.ascontiguousarray(light_rows(point).reshape(-1, 14))
-        emissive = bool((sd.mat_tab[sd.mat, 13:16] > 0).any() or (sd.tri_e > 0).any())
+        surfaces_emit = bool((sd.mat_tab[sd.mat, 13:16] > 0).any())
+        emissive = surfaces_emit or bool((sd.tri_e > 0).any())
         background = np.asarray(scene.background, dtype=np.float64)
-        if not (emissive or len(point) or (background > 0).any()):
+        if full and not (emissive or len(point) or (background > 0).any()):
             raise NotApplicable("pathtrace: nothing emits light (no emissive surface, no light and a "
                                 "black background): the image would be black")
-        tex = fused_textures(self.scene, sd)
+        if not full and not surfaces_emit:
+            raise NotApplicable(f"pathtrace (transport={transport}): no emitting surface (area light or "
+                                "emissive material): diffuse transport has nothing to distribute")
+        tex = fused_textures(self.scene, sd) if full else None
         self.textured = tex is not None
         if tex is None:
             tex = np.zeros((len(sd.mat_tab), TEX_COLS))
         from ..raytrace.reference import enclosing_media
         names = [mt.name for mt in sd.materials]
         media = [names.index(mt.name) for mt in enclosing_media(self.scene, self.scene.camera.position)][-4:]
+        if transport == "diffuse":  # every surface opaque: no medium
+            media = []
         self.opts = np.array([FRESNEL[fresnel], tol.ray_offset, tol.t_min, tol.zero, sd.extent,
                               tol.normal_cancel, rr_start, max_bounces, float(self.textured), MIS[mis],
-                              *background, len(media), *(media + [0] * (4 - len(media))), 0.0, 0.0])
+                              *background, len(media), *(media + [0] * (4 - len(media))),
+                              TRANSPORT[transport], PIXEL_FILTER[pixel_filter]])
         self.shading = (sd.mat, sd.mat_tab, np.ascontiguousarray(tex), lights)
         self.geo = sd.kernel_args()
         self.cam = camera_frame(self.scene.camera, self.width, self.height)

@@ -1,0 +1,179 @@
+"""The path tracer against Mitsuba 3 (``scalar_rgb``) on the Cornell box, same run, same host.
+
+* ``throughput``: ``cornell`` at 256x256, 64 spp, the methods alternating ``--repeat`` times
+  (numba on 2 threads; Mitsuba's own thread pool, one thread per core: 2 here); per render the
+  wall time of the sampling phase (pathtrace ``timings["trace"]``, Mitsuba ``timings["render"]``,
+  the ``mi.render`` calls), the CPU seconds of that phase, the whole call's wall time, and the
+  1-minute load average before and after.  Samples per second (best of the repeats) and their
+  ratio pathtrace / Mitsuba, per wall second and per CPU second.
+* ``equal_rmse``: both methods at 16, 64 and 256 spp, three seeds each, at ``--rmse-size``
+  (default 64) against one shared Mitsuba reference of ``--ref-spp`` (default 4096) spp, kept in
+  the reference cache (``workbench.compare.reference_cache``: a second run does not re-render
+  it).  Per render the RMSE and the *excess* MSE ``RMSE^2 - noise_ref^2`` (the reference's own
+  noise, from its per-pixel standard error, removed: what is left is the method's error); per
+  method the constant ``c^2 = mean(excess MSE x spp)`` (unbiased Monte Carlo: MSE = c^2 / spp;
+  pooled over the runs, since one image's error is dominated by a few light-edge pixels and
+  varies from seed to seed), and from ``c`` and the measured sampling time per spp the time
+  each method needs to reach the excess RMSE ``c_pathtrace / 8`` (pathtrace at 64 spp), and
+  their ratio; the same off the light's own pixels.
+* Each part runs ``pathtrace`` (default: Russian roulette from the 3rd bounce), ``mitsuba``
+  (``scalar_rgb``, Russian roulette from depth 5) and ``pathtrace_rr5`` (``rr_start = 5``).
+* ``reference``: the pathtrace image of ``cornell`` at 256x256 run to the noise level
+  ``--target`` (RMS of the per-pixel standard error), timed (wall and CPU), load average.
+
+Usage: ``PYTHONPATH=. .venv/bin/python bench/pathtrace_vs_mitsuba.py [--repeat 2] [--quick]``
+writes ``bench/results/pathtrace_vs_mitsuba.json`` and prints it.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+OUT = ROOT / "bench" / "results" / "pathtrace_vs_mitsuba.json"
+THREADS = 2
+#: What is compared: label -> (method, options).  ``pathtrace_rr5`` starts Russian roulette at
+#: the 5th bounce, as Mitsuba's path integrator does (the method's default is the 3rd).
+VARIANTS = {"pathtrace": ("pathtrace", {}), "mitsuba": ("mitsuba", {"variant": "scalar_rgb"}),
+            "pathtrace_rr5": ("pathtrace", {"rr_start": 5})}
+
+
+def load() -> float:
+    return round(os.getloadavg()[0], 2)
+
+
+def sample_time(r) -> tuple[float, float]:
+    """(wall, CPU) seconds of a result's sampling phase."""
+    if r.method == "pathtrace":
+        return r.timings["trace"], r.timings["trace_cpu"]
+    return r.timings["render"], r.stats["render_cpu_seconds"]
+
+
+def render(scene, label: str, size: int, spp: int, seed: int):
+    import workbench
+    method, opts = VARIANTS[label]
+    l0 = load()
+    r = workbench.render(scene, method, width=size, height=size, spp=spp, seed=seed, **opts)
+    wall, cpu = sample_time(r)
+    n = spp * size * size
+    return r, {"method": label, "spp": spp, "size": size, "sample_wall_s": round(wall, 3),
+               "sample_cpu_s": round(cpu, 3), "call_wall_s": round(r.timings["total"], 3),
+               "samples_per_s": round(n / wall), "samples_per_cpu_s": round(n / cpu),
+               "load_before": l0, "load_after": load()}
+
+
+def throughput(scene, size: int, spp: int, repeat: int) -> dict:
+    runs = []
+    for k in range(repeat):
+        for m in VARIANTS:
+            runs.append(render(scene, m, size, spp, seed=k)[1])
+    best = {m: max((e for e in runs if e["method"] == m), key=lambda e: e["samples_per_s"]) for m in VARIANTS}
+    return {"scene": scene.name, "size": size, "spp": spp, "threads": THREADS, "runs": runs, "best": best,
+            "ratio_samples_per_s": best["pathtrace"]["samples_per_s"] / best["mitsuba"]["samples_per_s"],
+            "ratio_samples_per_cpu_s": best["pathtrace"]["samples_per_cpu_s"] / best["mitsuba"]["samples_per_cpu_s"],
+            "ratio_samples_per_s_rr5": best["pathtrace_rr5"]["samples_per_s"] / best["mitsuba"]["samples_per_s"]}
+
+
+def equal_rmse(scene, size: int, ref_spp: int, spps=(16, 64, 256), seeds=(7, 8, 9)) -> dict:
+    from workbench.compare.agreement import light_pixels
+    from workbench.compare.reference_cache import cached_render
+    l0 = load()
+    ref = cached_render(scene, "mitsuba", size, size, spp=ref_spp, seed=1000, variant="scalar_rgb")
+    se2 = ref.stats["stderr"].astype(np.float64) ** 2
+    off = ~light_pixels(scene, size, size)
+    ref_noise2, ref_noise2_off = float(np.mean(se2)), float(np.mean(se2[off]))
+    out = {"size": size, "seeds": list(seeds),
+           "reference": {"method": "mitsuba", "spp": ref_spp, "cache": ref.stats.get("cache"),
+                         "noise_rms": ref_noise2 ** 0.5, "noise_rms_off_light": ref_noise2_off ** 0.5,
+                         "load_before": l0, "load_after": load()},
+           "runs": []}
+    per: dict = {}
+    for spp in spps:
+        for seed in seeds:
+            for m in VARIANTS:
+                r, e = render(scene, m, size, spp, seed=seed)
+                err2 = (r.image.astype(np.float64) - ref.image) ** 2
+                mse, mse_off = float(np.mean(err2)), float(np.mean(err2[off]))
+                e.update(seed=seed, rmse=mse ** 0.5, excess_mse=mse - ref_noise2, rmse_off_light=mse_off ** 0.5,
+                         excess_mse_off_light=mse_off - ref_noise2_off)
+                out["runs"].append(e)
+                per.setdefault(m, []).append(e)
+    fit = {}
+    for m, rows in per.items():
+        # unbiased Monte Carlo: excess MSE = c^2 / spp; c^2 pooled over every run
+        c2 = float(np.mean([e["excess_mse"] * e["spp"] for e in rows]))
+        c2_off = float(np.mean([e["excess_mse_off_light"] * e["spp"] for e in rows]))
+        wall_per_spp = sum(e["sample_wall_s"] for e in rows) / sum(e["spp"] for e in rows)
+        cpu_per_spp = sum(e["sample_cpu_s"] for e in rows) / sum(e["spp"] for e in rows)
+        fit[m] = {"c": max(c2, 0.0) ** 0.5, "c_off_light": max(c2_off, 0.0) ** 0.5,
+                  "wall_s_per_spp": wall_per_spp, "cpu_s_per_spp": cpu_per_spp}
+    target = fit["pathtrace"]["c"] / 64 ** 0.5  # the excess RMSE pathtrace reaches at 64 spp
+    for m, f in fit.items():
+        spp_needed = (f["c"] / target) ** 2
+        f.update(spp_to_target=spp_needed, wall_s_to_target=spp_needed * f["wall_s_per_spp"],
+                 cpu_s_to_target=spp_needed * f["cpu_s_per_spp"],
+                 efficiency_per_cpu_s=1.0 / (f["c"] ** 2 * f["cpu_s_per_spp"]))
+    M = fit["mitsuba"]
+    ratios = {}
+    for m in ("pathtrace", "pathtrace_rr5"):
+        P = fit[m]
+        ratios[m] = {"wall_time_to_equal_rmse_over_mitsuba": P["wall_s_to_target"] / M["wall_s_to_target"],
+                     "cpu_time_to_equal_rmse_over_mitsuba": P["cpu_s_to_target"] / M["cpu_s_to_target"],
+                     "cpu_time_to_equal_rmse_off_light_over_mitsuba":
+                         (P["c_off_light"] ** 2 * P["cpu_s_per_spp"]) / (M["c_off_light"] ** 2 * M["cpu_s_per_spp"])}
+    out.update(target_excess_rmse=target, fit=fit, ratios=ratios)
+    return out
+
+
+def reference(scene, size: int, target: float) -> dict:
+    from workbench.renderers.pathtrace.session import PathTraceSession, run_to_noise
+    l0 = load()
+    t0 = time.perf_counter()
+    ses = run_to_noise(PathTraceSession(scene, size, size, seed=11), target, max_spp=1 << 14)
+    wall = time.perf_counter() - t0
+    return {"size": size, "target_noise_rms": target, "reached_noise_rms": ses.noise_rmse, "spp": ses.samples,
+            "wall_s": round(wall, 2), "trace_wall_s": round(ses.timings["trace"], 2),
+            "trace_cpu_s": round(ses.timings["trace_cpu"], 2), "load_before": l0, "load_after": load(),
+            "mean_radiance": ses.image.mean(axis=(0, 1)).tolist()}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=2)
+    ap.add_argument("--size", type=int, default=256)
+    ap.add_argument("--spp", type=int, default=64)
+    ap.add_argument("--rmse-size", type=int, default=64)
+    ap.add_argument("--ref-spp", type=int, default=4096)
+    ap.add_argument("--target", type=float, default=0.01, help="noise level of the 256x256 pathtrace reference")
+    ap.add_argument("--quick", action="store_true", help="small sizes (a smoke test)")
+    a = ap.parse_args()
+    if a.quick:
+        a.size, a.spp, a.rmse_size, a.ref_spp, a.repeat, a.target = 32, 8, 16, 256, 1, 0.05
+    import numba
+
+    import workbench
+    numba.set_num_threads(THREADS)
+    scene = workbench.load_scene("cornell")
+    workbench.render(scene, "pathtrace", width=8, height=8, spp=2)  # JIT compile or cache load, apart
+    res = {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "machine": f"{os.cpu_count()} CPUs, shared",
+           "image_definition": "box-filtered pixel average, linear RGB, not clipped (both methods)",
+           "load_before": load()}
+    res["throughput"] = throughput(scene, a.size, a.spp, a.repeat)
+    res["equal_rmse"] = equal_rmse(scene, a.rmse_size, a.ref_spp)
+    res["reference"] = reference(scene, a.size, a.target)
+    res["load_after"] = load()
+    if not a.quick:
+        OUT.parent.mkdir(parents=True, exist_ok=True)
+        OUT.write_text(json.dumps(res, indent=1))
+    print(json.dumps(res, indent=1))
+
+
+if __name__ == "__main__":
+    main()
