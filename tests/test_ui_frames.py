@@ -292,3 +292,15 @@ def test_path_tracer_panel_refines_pass_by_pass(monkeypatch):
     stopped.cancelled.set()
     stopped.thread.join(120)
     assert stopped.image is None and stopped.spp < 10**6
+
+
+def test_panel_images_tell_their_size_without_reading():
+    """A scene switch changes the panels' aspect while a CPU or child panel still holds the
+    previous scene's image: the difference view asks each image's size first (it crashed the
+    window on two sizes)."""
+    images = PanelImages()
+    images["raytrace"] = np.zeros((96, 96, 3), np.float32)
+    images.set_pending("phong", lambda: np.zeros((72, 96, 3), np.float32), shape=(72, 96))
+    assert not images.has_shape("raytrace", (72, 96)) and images.has_shape("raytrace", (96, 96))
+    assert images.has_shape("phong", (72, 96)) and not images.has_shape("phong", (96, 96))
+    assert images.reads == 0  # a GL panel drawn before a switch, then hidden: still pending

@@ -186,6 +186,8 @@ class ScreenBlits:
         import math
 
         from imgui_bundle import imgui
+
+        from ...renderers import gl
         GL_READ_FRAMEBUFFER, GL_DRAW_FRAMEBUFFER = 0x8CA8, 0x8CA9
         GL_COLOR_BUFFER_BIT, GL_NEAREST = 0x4000, 0x2600
         io = imgui.get_io()
@@ -210,6 +212,12 @@ class ScreenBlits:
             self.blit(ia0, ib0, ia1, ib1, round(dx0 * sx), round(fb_h - dy0 * sy),
                       round(dx1 * sx), round(fb_h - dy1 * sy), GL_COLOR_BUFFER_BIT, GL_NEAREST)
             self.last.append((name, (x0, y0, x1, y1)))
+        # a display texture re-made at another size (a scene of another aspect) gets a new
+        # name: the read framebuffers of textures not shown this frame are released (they
+        # piled up, one per re-made texture)
+        shown = {tex.glo for _, tex, *_ in self.queue}
+        for glo in [g for g in self.read_fbos if g not in shown]:
+            gl.release_framebuffer(self.read_fbos.pop(glo))
         self.queue = []
         self.ctx.scissor = None
         if self.bind is not None:
@@ -354,7 +362,8 @@ def refresh_raster(state: AppState, method: str) -> bool:
     state.ctx.screen.use()  # back to the window's framebuffer for imgui
     state.timings[method] = time.perf_counter() - t0
     state.images.set_pending(method, lambda: RasterSession.read_image(fbo),
-                             pixel=lambda i, j, shape: read_pixel(fbo, i, j, shape))
+                             pixel=lambda i, j, shape: read_pixel(fbo, i, j, shape),
+                             shape=(cam.height, cam.width))
     g.linear[method] = (fbo.color_attachments[0], True, state.images.version(method))
     panel.drawn, panel.draws = cam, panel.draws + 1
     return True
@@ -389,8 +398,12 @@ def refresh_cpu(state: AppState, method: str) -> None:
     else:
         state.status[method] = (f"rendering: {job.rows_done}/{state.camera.height} rows"
                                 if tiled(method) else "rendering...")
-    if stale(state, f"{method} job", (id(job), job.version)) or method not in state.images:
-        state.images[method] = job.snapshot()
+    shape = (state.camera.height, state.camera.width, 3)
+    if stale(state, f"{method} job", (id(job), job.version, shape)) or method not in state.images:
+        image = job.snapshot()
+        # the previous job's image is kept while its successor waits, unless it has another
+        # size (a scene switch changed the panels' aspect): then black until the new one comes
+        state.images[method] = image if image.shape == shape else np.zeros(shape, np.float32)
 
 
 def update_images(state: AppState) -> None:

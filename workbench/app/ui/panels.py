@@ -271,6 +271,10 @@ def difference_panel(state: AppState) -> None:
     a, b = state.diff_pair
     if a not in state.images or b not in state.images:
         return
+    shape = (state.camera.height, state.camera.width)
+    if not all(state.images.has_shape(m, shape) for m in (a, b)):
+        imgui.text_disabled("waiting for both images at the panels' size")
+        return  # one is still the previous scene's (another size): nothing to compare yet
     # recomputed only when either image or the kind changed (a static frame reads no pixels)
     key = (a, b, state.diff_kind, state.images.version(a), state.images.version(b))
     if stale(state, "difference", key) or "difference" not in state.textures:
