@@ -23,6 +23,14 @@ frames) and the results go to ``bench/results/ui_fps.json``:
   position slider moving every frame too; ``programs_compiled`` counts the GL programs the
   panels' sessions compiled during the count.
 
+* ``idle``: the three GL panels and the ray-trace panel, untouched: once nothing is in progress
+  (the ray trace, the error plot's reference and evaluations), the frames drawn and the process
+  CPU time (every thread) over 10 s (``scripts.Idle``; hello_imgui idles at ``main.IDLE_FPS``),
+  then a knob change from the script whose job must still deliver its image;
+* ``soak``: 24 rounds of a scene switch (whitted, csg, cornell, quadrics), a method toggle, knob
+  changes and a short camera drag, each round waiting for the jobs (``scripts.Soak``, 256 px
+  panels): the process RSS, the jobs kept and the GL objects alive after each round.
+
 ``--cases a,b`` runs only those cases and keeps the other entries of the results file.
 
 ``gui_ms_mean`` is the time in the frame's Python callbacks (panel updates + widgets); the rest
@@ -59,6 +67,7 @@ def free_display() -> int:
 
 
 def measure(scene: str, size: int, window: str, cpu: bool, script: str) -> dict:
+    """Run ``script`` in the window (three GL panels, plus the ray tracer with ``cpu``)."""
     n = free_display()
     w, h = (int(x) for x in window.split("x"))
     xvfb = subprocess.Popen(["Xvfb", f":{n}", "-screen", "0", f"{w + 64}x{h + 64}x24",
@@ -101,6 +110,14 @@ print(json.dumps({{"seconds": time.perf_counter() - t0, "numba_threads": numba.g
             **json.loads(out.strip().splitlines()[-1])}
 
 
+def soak(result: dict) -> dict:
+    """The soak session's rounds summed up: RSS at rounds 4 (every scene seen once) and last."""
+    rounds = result["rounds"]
+    result["rss_mb_round4_last"] = [rounds[4]["rss_mb"], rounds[-1]["rss_mb"]]
+    result["jobs_kept_max"] = max(r["jobs_kept"] for r in rounds)
+    return result
+
+
 def main() -> None:
     p = argparse.ArgumentParser()
     p.add_argument("--scene", default="whitted")
@@ -114,7 +131,9 @@ def main() -> None:
              "drag_gl_only": lambda: measure(a.scene, a.size, a.window, False, "fps"),
              "material_drag": lambda: measure(a.scene, a.size, a.window, False, "fps_material_drag"),
              "slider_drag": lambda: measure(a.scene, a.size, a.window, False, "fps_slider_drag"),
-             "raytrace_without_window": lambda: raytrace_without_window(a.scene, a.size)}
+             "raytrace_without_window": lambda: raytrace_without_window(a.scene, a.size),
+             "idle": lambda: measure(a.scene, a.size, a.window, True, "idle"),
+             "soak": lambda: soak(measure(a.scene, 256, a.window, True, "soak"))}
     chosen = [c for c in a.cases.split(",") if c] or list(cases)
     bad = [c for c in chosen if c not in cases]
     if bad:

@@ -197,7 +197,7 @@ def test_patch_pick_item_buffer_and_row(gl_ctx):
     across the top face's edges (a surface seen at the edge of the top face goes on in the
     folded-out side); the row is the hemicube's and is drawn on the patches."""
     from workbench.app.ui import patch_view as pv
-    state = new_state("cornell", ["phong", "radiosity"], (96, 96))
+    state = new_state("cornell", ["phong", "radiosity"], 96)
     patches = pv.scene_patches(state)
     for ij, surface in (((20, 48), "ceiling"), ((92, 30), "floor"), ((50, 10), "left_wall")):
         pick = pv.select_patch(state, *ij)
@@ -289,7 +289,7 @@ def test_pyrender_panel_from_a_child_process(pyrender_session):
 def test_pyrender_child_that_dies_is_reported_not_raised():
     """A killed child: the panel says so, later requests send nothing, closing still joins."""
     from workbench.app.ui.pyrender_proc import DIED, PyrenderProcess
-    state = new_state("whitted", ["phong"], (32, 32))
+    state = new_state("whitted", ["phong"], 32)
     proc = PyrenderProcess()
     proc.process.kill()
     proc.process.join(10)

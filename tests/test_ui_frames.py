@@ -18,6 +18,7 @@ import pytest
 import workbench
 from workbench.app.ui import camera as cam
 from workbench.app.ui.images import PanelImages
+from workbench.app.ui.state import panel_camera
 from workbench.core.imageio import to_srgb8
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -54,12 +55,14 @@ def test_static_frames_draw_nothing_and_a_camera_change_redraws_once(gpu_session
 def test_shown_panels_are_the_cli_images(gpu_session):
     out, summary = gpu_session
     scene = workbench.load_scene("whitted")
-    orbited = cam.orbit(scene.camera.with_resolution(SIZE, SIZE), 0.3, 0.1)
+    orbited = cam.orbit(panel_camera(scene.camera, SIZE), 0.3, 0.1)
+    H, W = orbited.height, orbited.width
+    assert (W, H) == (SIZE, SIZE * 3 // 4)  # whitted's 4:3, not a square crop
     assert np.allclose(summary["script"]["position"], orbited.position)
     for m in RASTER:
         shown = np.load(out / f"shown_{m}.npy")
-        assert shown.shape == (SIZE, SIZE, 4) and (shown[..., 3] == 255).all()
-        cli = workbench.render(replace(scene, camera=orbited), m, width=SIZE, height=SIZE).image
+        assert shown.shape == (H, W, 4) and (shown[..., 3] == 255).all()
+        cli = workbench.render(replace(scene, camera=orbited), m, width=W, height=H).image
         expected = to_srgb8(cli)
         assert expected.std() > 10, m  # a real picture, not a flat colour
         assert np.abs(shown[..., :3].astype(int) - expected).max() <= 1, m
@@ -75,9 +78,15 @@ def test_panels_are_copied_into_the_window_where_imgui_laid_them_out(gpu_session
     assert set(RASTER) | {"difference"} <= set(rects)
     for m in [*RASTER, "difference"]:
         x0, y0, x1, y1 = (round(v) for v in rects[m])
-        assert (x1 - x0, y1 - y0) == (SIZE, SIZE)
         shown = np.load(out / f"shown_{m}.npy")[..., :3].astype(int)
-        assert np.array_equal(shot[y0:y1, x0:x1], shown), m
+        h, w = shown.shape[:2]
+        assert abs((x1 - x0) / (y1 - y0) - w / h) < 0.03, m  # the camera's aspect
+        # scaled to the item by a nearest blit: window pixel (y, x) shows texel
+        # (floor((y + 0.5) h / height), floor((x + 0.5) w / width)), up to rounding at edges
+        iy = np.minimum(((np.arange(y1 - y0) + 0.5) * h / (y1 - y0)).astype(int), h - 1)
+        ix = np.minimum(((np.arange(x1 - x0) + 0.5) * w / (x1 - x0)).astype(int), w - 1)
+        expected = shown[iy][:, ix]
+        assert (shot[y0:y1, x0:x1] == expected).all(-1).mean() > 0.97, m
 
 
 def test_difference_view_on_the_gpu_is_the_cpu_error_map(gpu_session):
@@ -135,20 +144,65 @@ def test_job_restarts_wait_for_the_request_to_settle():
     board = JobBoard(settle=0.3)
     c0 = scene.camera.with_resolution(16, 16)
     first = board.request(scene, c0, "raycast", {}, tiled=True)
-    assert len(board.started) == 1 and not first.cancelled.is_set()
+    assert board.count == 1 and not first.cancelled.is_set()
     first.thread.join(60)
     t0 = time.perf_counter()
     for k in range(1, 4):  # three different cameras in a row: the first job is cancelled
         job = board.request(scene, cam.orbit(c0, 0.1 * k, 0.0), "raycast", {}, tiled=True)
         assert job is first and first.cancelled.is_set()
-    assert len(board.started) == 1 and board.busy()  # a restart is pending
+    assert board.count == 1 and board.busy()  # a restart is pending
     last = cam.orbit(c0, 0.3, 0.0)
     while board.request(scene, last, "raycast", {}, tiled=True) is first:
         time.sleep(0.01)
-    assert time.perf_counter() - t0 >= 0.3 and len(board.started) == 2
+    assert time.perf_counter() - t0 >= 0.3 and board.count == 2
     assert board.current["raycast"].key[1] == last
     board.join_all(60)
     assert not any(j.thread.is_alive() for j in board.started)
+
+
+def test_job_board_forgets_ended_jobs_and_notifies():
+    """A long session starts hundreds of jobs: the board keeps only the current ones and those
+    still running (each holds its scene and images), and ``notify`` is called from the job's
+    thread when tiles and the image arrive (the window wakes its idle loop with it)."""
+    import threading
+
+    from workbench.app.ui.jobs import JobBoard
+    scene = workbench.load_scene("whitted")
+    calls = []
+    board = JobBoard(notify=lambda: calls.append(threading.current_thread().name))
+    c0 = scene.camera.with_resolution(8, 8)
+    for k in range(12):
+        job = board.request(scene, cam.orbit(c0, 0.05 * k, 0.0), "raycast", {}, tiled=True)
+        job.thread.join(60)
+        assert job.image is not None
+        board.request(scene, cam.orbit(c0, 0.05 * k, 0.0), "raycast", {}, tiled=True)
+    assert board.count == 12 and len(board.started) == 1
+    assert board.started[0] is board.current["raycast"]
+    assert len(calls) >= 12 and set(calls) == {"ui-job-raycast"}
+    board.join_all(60)
+
+
+def test_a_request_back_at_a_cancelled_job_starts_it_again():
+    """The error plot's reference stayed on "rendering the reference..." after a drag and a
+    camera reset: the reset camera's request matched the job cancelled by the drag, and the
+    board kept answering with that stopped job.  Now a cancelled job that had not ended is
+    started again; one that had ended gives its image (and is no longer counted busy)."""
+    from workbench.app.ui.jobs import JobBoard
+    scene = workbench.load_scene("whitted")
+    board = JobBoard()
+    c0 = scene.camera.with_resolution(64, 64)
+    first = board.request(scene, c0, "raytrace", {}, tiled=True)
+    first.cancelled.set()  # the camera moved away (the plot's track cancels)
+    first.thread.join(60)
+    assert first.image is None
+    again = board.request(scene, c0, "raytrace", {}, tiled=True)  # camera reset
+    assert again is not first and not again.cancelled.is_set()
+    again.thread.join(60)
+    assert again.image is not None
+    again.cancelled.set()  # cancelled after it ended
+    assert board.request(scene, c0, "raytrace", {}, tiled=True) is again
+    assert not board.busy()
+    board.join_all(60)
 
 
 def test_probe_reads_one_pixel_not_the_panel(gpu_session):
@@ -210,3 +264,43 @@ def test_a_job_is_not_taken_for_a_later_scene_and_removed_panels_are_cancelled()
     board.keep_only(["flat"])
     assert "raycast" not in board.current and job.cancelled.is_set() and not board.busy()
     board.join_all(60)
+
+
+def test_path_tracer_panel_refines_pass_by_pass(monkeypatch):
+    """The pathtrace panel's job is progressive: one sample per pixel per pass here, each
+    pass's running image and noise shown (``notify`` each time), ending at the ``spp`` option
+    with exactly the image of a session given all samples at once (same seed); a cancel stops
+    it between passes."""
+    from workbench.app.ui import jobs
+    from workbench.renderers.pathtrace.session import PathTraceSession
+    scene = workbench.load_scene("cornell")
+    c = scene.camera.with_resolution(16, 16)
+    monkeypatch.setattr(jobs, "PASS_SAMPLES", 16 * 16)
+    seen = []
+    board = jobs.JobBoard()
+    job = board.request(scene, c, "pathtrace", {"spp": 8}, tiled=False)
+    board.notify = None
+    job.notify = lambda: seen.append((job.spp, job.noise))
+    job.thread.join(120)
+    assert job.error is None and job.progressive and job.spp == 8
+    assert [s for s, _ in seen if s][-1] == 8 and len({s for s, _ in seen}) >= 6  # passes shown
+    noises = [n for _, n in seen if n is not None]
+    assert noises and noises[-1] == job.noise
+    whole = PathTraceSession(replace(scene, camera=c), 16, 16).add_samples(8)
+    assert np.array_equal(job.image, whole)
+    stopped = board.request(scene, cam.orbit(c, 0.2, 0.0), "pathtrace", {"spp": 10**6}, tiled=False)
+    stopped.cancelled.set()
+    stopped.thread.join(120)
+    assert stopped.image is None and stopped.spp < 10**6
+
+
+def test_panel_images_tell_their_size_without_reading():
+    """A scene switch changes the panels' aspect while a CPU or child panel still holds the
+    previous scene's image: the difference view asks each image's size first (it crashed the
+    window on two sizes)."""
+    images = PanelImages()
+    images["raytrace"] = np.zeros((96, 96, 3), np.float32)
+    images.set_pending("phong", lambda: np.zeros((72, 96, 3), np.float32), shape=(72, 96))
+    assert not images.has_shape("raytrace", (72, 96)) and images.has_shape("raytrace", (96, 96))
+    assert images.has_shape("phong", (72, 96)) and not images.has_shape("phong", (96, 96))
+    assert images.reads == 0  # a GL panel drawn before a switch, then hidden: still pending

@@ -44,7 +44,7 @@ def slider_session(xvfb, tmp_path_factory):
 
 def _scene_after(k: int):
     """The scene the UI shows after edit ``k`` (the script's slider_step on a fresh state)."""
-    state = new_state("whitted", list(RASTER), (SIZE, SIZE))
+    state = new_state("whitted", list(RASTER), SIZE)
     slider_step(state, k, "material+light")
     return replace(state.scene, camera=state.camera)
 
@@ -70,7 +70,7 @@ def test_each_slider_frame_shows_its_values(slider_session):
             prev[m] = img
     scene = _scene_after(EDITS[-1])
     for m in RASTER:
-        cli = workbench.render(scene, m, width=SIZE, height=SIZE).image
+        cli = workbench.render(scene, m, width=scene.camera.width, height=scene.camera.height).image
         assert np.abs(np.load(out / f"edit{EDITS[-1]}_{m}.npy") - cli).max() <= 1e-4, m
 
 
@@ -82,6 +82,6 @@ def test_rested_values_are_compiled_back_in(slider_session):
     scene = _scene_after(EDITS[-1])
     for m in RASTER:
         img = np.load(out / f"settled_{m}.npy")
-        cli = workbench.render(scene, m, width=SIZE, height=SIZE).image
+        cli = workbench.render(scene, m, width=scene.camera.width, height=scene.camera.height).image
         assert np.abs(img - cli).max() <= 1e-6, m
         assert np.abs(img - np.load(out / f"edit{EDITS[-1]}_{m}.npy")).max() <= 1e-4, m

@@ -35,8 +35,12 @@ from .state import CHILD, RASTER, AppState, shown_image
 LIVE_REST_SECONDS = 0.5
 """How long edited material or light values must stay unchanged before a GL panel compiles
 them back into its programs (until then it draws them from uniforms)."""
-TILED = ("raycast", "raytrace")
-"""CPU methods that accept ``on_tile`` (partial images)."""
+
+
+def tiled(method: str) -> bool:
+    """The method accepts ``on_tile`` (it reports partial images band by band)."""
+    from ...renderers.base import get_renderer
+    return "on_tile" in get_renderer(method).options
 
 
 class DisplayPasses:
@@ -182,6 +186,8 @@ class ScreenBlits:
         import math
 
         from imgui_bundle import imgui
+
+        from ...renderers import gl
         GL_READ_FRAMEBUFFER, GL_DRAW_FRAMEBUFFER = 0x8CA8, 0x8CA9
         GL_COLOR_BUFFER_BIT, GL_NEAREST = 0x4000, 0x2600
         io = imgui.get_io()
@@ -206,6 +212,12 @@ class ScreenBlits:
             self.blit(ia0, ib0, ia1, ib1, round(dx0 * sx), round(fb_h - dy0 * sy),
                       round(dx1 * sx), round(fb_h - dy1 * sy), GL_COLOR_BUFFER_BIT, GL_NEAREST)
             self.last.append((name, (x0, y0, x1, y1)))
+        # a display texture re-made at another size (a scene of another aspect) gets a new
+        # name: the read framebuffers of textures not shown this frame are released (they
+        # piled up, one per re-made texture)
+        shown = {tex.glo for _, tex, *_ in self.queue}
+        for glo in [g for g in self.read_fbos if g not in shown]:
+            gl.release_framebuffer(self.read_fbos.pop(glo))
         self.queue = []
         self.ctx.scissor = None
         if self.bind is not None:
@@ -350,7 +362,8 @@ def refresh_raster(state: AppState, method: str) -> bool:
     state.ctx.screen.use()  # back to the window's framebuffer for imgui
     state.timings[method] = time.perf_counter() - t0
     state.images.set_pending(method, lambda: RasterSession.read_image(fbo),
-                             pixel=lambda i, j, shape: read_pixel(fbo, i, j, shape))
+                             pixel=lambda i, j, shape: read_pixel(fbo, i, j, shape),
+                             shape=(cam.height, cam.width))
     g.linear[method] = (fbo.color_attachments[0], True, state.images.version(method))
     panel.drawn, panel.draws = cam, panel.draws + 1
     return True
@@ -369,19 +382,28 @@ def read_pixel(fbo, i: int, j: int, shape: tuple[int, int]) -> np.ndarray | None
 def refresh_cpu(state: AppState, method: str) -> None:
     """Ask for ``method``'s background job; take its image when it has new tiles."""
     job = state.jobs.request(state.scene, state.camera, method, state.options[method],
-                             tiled=method in TILED)
+                             tiled=tiled(method))
     if job.cancelled.is_set():
         state.status[method] = "restarting (stale image)"
     elif job.error:
         state.status[method] = job.error
     elif job.done:
         state.timings[method] = job.seconds
-        state.status[method] = "done"
+        state.status[method] = (f"done: {job.spp} spp, noise {job.noise:.3g}"
+                                if job.progressive and job.noise is not None else "done")
+    elif job.progressive:
+        target = state.options[method]["spp"]
+        state.status[method] = (f"refining: {job.spp}/{target} spp" +
+                                ("" if job.noise is None else f", noise {job.noise:.3g}"))
     else:
         state.status[method] = (f"rendering: {job.rows_done}/{state.camera.height} rows"
-                                if method in TILED else "rendering...")
-    if stale(state, f"{method} job", (id(job), job.version)) or method not in state.images:
-        state.images[method] = job.snapshot()
+                                if tiled(method) else "rendering...")
+    shape = (state.camera.height, state.camera.width, 3)
+    if stale(state, f"{method} job", (id(job), job.version, shape)) or method not in state.images:
+        image = job.snapshot()
+        # the previous job's image is kept while its successor waits, unless it has another
+        # size (a scene switch changed the panels' aspect): then black until the new one comes
+        state.images[method] = image if image.shape == shape else np.zeros(shape, np.float32)
 
 
 def update_images(state: AppState) -> None:
@@ -395,6 +417,16 @@ def update_images(state: AppState) -> None:
             refresh_pyrender(state)
         else:
             refresh_cpu(state, m)
+
+
+def in_progress(state: AppState) -> bool:
+    """Something on screen changes by itself this frame: a background job or the pyrender child
+    is working, the error plot waits for its reference or evaluations, or a GL panel has edited
+    values still to compile back in.  The loop then runs at full rate (capped while a job runs,
+    :func:`.main.frame_rest`); otherwise it idles."""
+    proc = state.pyrender
+    return (state.jobs.busy() or (proc is not None and proc.busy) or state.errors.busy(state.frame)
+            or (state.gpu is not None and any(p.session.live for p in state.gpu.raster.values())))
 
 
 def panel_texture(state: AppState, method: str):

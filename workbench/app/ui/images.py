@@ -31,6 +31,7 @@ class PanelImages(MutableMapping):
         self._values: dict[str, np.ndarray] = {}
         self._pending: dict[str, Callable[[], np.ndarray]] = {}
         self._pixel: dict[str, Callable] = {}
+        self._shapes: dict[str, tuple | None] = {}
         self._versions: dict[str, int] = {}
         self.reads = 0
         self.pixel_reads = 0
@@ -50,11 +51,13 @@ class PanelImages(MutableMapping):
         self._bump(key)
 
     def set_pending(self, key: str, read: Callable[[], np.ndarray],
-                    pixel: Callable | None = None) -> None:
+                    pixel: Callable | None = None, shape: tuple[int, int] | None = None) -> None:
         """Replace ``key`` by an image that ``read()`` produces on first access;
-        ``pixel(i, j, shape)``, if given, reads one of its pixels (see :meth:`pixel`) meanwhile."""
+        ``pixel(i, j, shape)``, if given, reads one of its pixels (see :meth:`pixel`) meanwhile;
+        ``shape`` is the image's (H, W) (:meth:`has_shape`)."""
         self._values.pop(key, None)
         self._pending[key] = read
+        self._shapes[key] = None if shape is None else tuple(shape)
         self._pixel.pop(key, None)
         if pixel is not None:
             self._pixel[key] = pixel
@@ -69,6 +72,13 @@ class PanelImages(MutableMapping):
             return read(i, j, shape)
         image = self[key]
         return image[i, j] if image.shape[:2] == tuple(shape) else None
+
+    def has_shape(self, key: str, shape: tuple[int, int]) -> bool:
+        """``key``'s image is (H, W) = ``shape``, without reading a pending entry (its size is
+        the one given to :meth:`set_pending`)."""
+        if key in self._pending:
+            return self._shapes.get(key) == tuple(shape)
+        return self._values[key].shape[:2] == tuple(shape)
 
     def __delitem__(self, key: str) -> None:
         if key not in self:

@@ -13,14 +13,14 @@ from .state import AppState
 
 
 def pixel_under_mouse(state: AppState) -> tuple[int, int] | None:
-    """(row, column) of the image pixel under the mouse in the last drawn panel (through the
-    linked 2D view), or None."""
+    """(row, column) of the image pixel under the mouse in the last drawn panel (shown at any
+    size, through the linked 2D view), or None."""
     if not imgui.is_item_hovered():
         return None
     from .camera import view_window
-    lo, mouse = imgui.get_item_rect_min(), imgui.get_mouse_pos()
+    lo, mouse, size = imgui.get_item_rect_min(), imgui.get_mouse_pos(), imgui.get_item_rect_size()
     (u0, v0), (u1, v1) = view_window(state.view)
-    fx, fy = (mouse.x - lo.x) / state.camera.width, (mouse.y - lo.y) / state.camera.height
+    fx, fy = (mouse.x - lo.x) / size.x, (mouse.y - lo.y) / size.y
     i = int((v0 + fy * (v1 - v0)) * state.camera.height)
     j = int((u0 + fx * (u1 - u0)) * state.camera.width)
     if 0 <= i < state.camera.height and 0 <= j < state.camera.width:

@@ -31,6 +31,14 @@ from dataclasses import replace
 
 import numpy as np
 
+PROGRESSIVE = {"pathtrace": "workbench.renderers.pathtrace.session:PathTraceSession"}
+"""Methods whose job refines one image pass after pass (a session with ``add_samples(n)``,
+``image``, ``samples`` and ``noise_rmse``, as :class:`~workbench.renderers.pathtrace.session.
+PathTraceSession`): the panel shows the running image, its samples per pixel and noise, and
+the job ends at the method's ``spp`` option."""
+PASS_SAMPLES = 1 << 16
+"""Samples (over the whole image) per pass of a progressive job: a 256 x 192 panel gets one
+sample per pixel per pass, so its image and noise refresh several times a second at first."""
 RESTART_SETTLE_SECONDS = 0.15
 """How long a new request must stay unchanged before the UI's board starts its job (0 for the
 error plot's reference board, which waits for a still camera itself)."""
@@ -59,9 +67,11 @@ class Job:
     seconds : wall time of the finished render, or None.
     error : message of a failed render, or None.
     version : number of changes of ``partial``/``image``/``error`` so far.
+    spp, noise : a progressive job's samples per pixel so far and its noise (RMS standard
+    error of the pixel means; None before two samples).
     """
 
-    def __init__(self, scene, camera, method: str, options: dict, tiled: bool):
+    def __init__(self, scene, camera, method: str, options: dict, tiled: bool, notify=None):
         # the job keeps its scene: while the job is current no later scene can reuse the id
         # in its key (every material or light edit builds a new Scene)
         self.scene = scene
@@ -72,8 +82,11 @@ class Job:
         self.error = None
         self.rows_done = 0
         self.version = 0
+        self.progressive = method in PROGRESSIVE
+        self.spp, self.noise = 0, None
         self.cancelled = threading.Event()
         self.lock = threading.Lock()
+        self.notify = notify
         opts = dict(options)
         if tiled:
             opts["on_tile"] = self._on_tile
@@ -89,6 +102,11 @@ class Job:
             self.partial[y0:y1, x0:x1] = tile
             self.rows_done = max(self.rows_done, y1)
             self.version += 1
+        self._notify()
+
+    def _notify(self) -> None:
+        if self.notify is not None:
+            self.notify()
 
     def _run(self, scene, method, opts):
         import numba
@@ -100,18 +118,49 @@ class Job:
             os.setpriority(os.PRIO_PROCESS, tid, min(19, os.getpriority(os.PRIO_PROCESS, tid) + JOB_NICE))
         t0 = time.perf_counter()
         try:
-            res = render(scene, method, width=scene.camera.width, height=scene.camera.height, **opts)
+            if self.progressive:
+                image = self._refine(scene, method, opts)
+            else:
+                image = render(scene, method, width=scene.camera.width,
+                               height=scene.camera.height, **opts).image
         except Cancelled:
             return
         except Exception as e:  # shown in the panel, never kills the UI
             with self.lock:
                 self.error = f"{type(e).__name__}: {e}"
                 self.version += 1
+            self._notify()
             return
         with self.lock:
-            self.image = np.asarray(res.image, np.float32)
+            self.image = np.asarray(image, np.float32)
             self.seconds = time.perf_counter() - t0
             self.version += 1
+        self._notify()
+
+    def _refine(self, scene, method: str, opts: dict) -> np.ndarray:
+        """A progressive render: passes of :data:`PASS_SAMPLES` samples until ``opts["spp"]``
+        samples per pixel, each pass's running image in ``partial`` (cancelled between
+        passes); returns the final image."""
+        import importlib
+
+        from ...renderers.base import check_memory, get_renderer
+        mod, attr = PROGRESSIVE[method].split(":")
+        w, h = scene.camera.width, scene.camera.height
+        check_memory(get_renderer(method), scene, w, h, opts)  # as render() does first
+        opts = dict(opts)
+        target = int(opts.pop("spp"))
+        session = getattr(importlib.import_module(mod), attr)(scene, w, h, **opts)
+        per_pass = max(1, PASS_SAMPLES // (w * h))
+        while session.samples < target:
+            if self.cancelled.is_set():
+                raise Cancelled
+            image = session.add_samples(min(per_pass, target - session.samples))
+            noise = session.noise_rmse
+            with self.lock:
+                self.partial, self.spp, self.noise = image, session.samples, noise
+                self.version += 1
+            self._notify()
+        return session.image
 
     def snapshot(self) -> np.ndarray:
         """The finished image, else a copy of the partial one."""
@@ -124,19 +173,27 @@ class Job:
 
 
 class JobBoard:
-    """The current job of each CPU method plus every thread ever started (joined at exit).
+    """The current job of each CPU method plus the threads started and not yet ended (joined
+    at exit).  An ended job that is no longer current is forgotten at the next start: each job
+    holds its scene and two images, so a long session kept them all (hundreds of MB).
 
     ``settle``: seconds a changed request must stay the same before its job starts (the old
-    job is cancelled at once); ``waiting[method]`` is (request key, when it was first seen)."""
+    job is cancelled at once); ``waiting[method]`` is (request key, when it was first seen);
+    ``notify``: called with no argument from a job's thread when it has new tiles, its image
+    or an error (the window wakes its loop with it), or None; ``count``: jobs started so far."""
 
-    def __init__(self, settle: float = 0.0):
+    def __init__(self, settle: float = 0.0, notify=None):
         self.settle = settle
+        self.notify = notify
         self.current: dict[str, Job] = {}
         self.started: list[Job] = []
         self.waiting: dict[str, tuple] = {}
+        self.count = 0
 
     def request(self, scene, camera, method: str, options: dict, tiled: bool) -> Job:
-        """The job for this request: the current one if its key matches; else the old one is
+        """The job for this request: the current one if its key matches (and it was not
+        cancelled before it ended: back at a cancelled request, e.g. after a camera reset, the
+        render starts again); else the old one is
         cancelled and a new one starts once the old thread has ended and the request has not
         changed for ``settle`` seconds (at most one thread per method, so a mouse drag does not
         pile up renders: meanwhile the old image shows).  The first request of a method
@@ -144,8 +201,11 @@ class JobBoard:
         key = job_key(scene, camera, method, options)
         job = self.current.get(method)
         if job is not None and job.key == key:
-            self.waiting.pop(method, None)
-            return job
+            if job.cancelled.is_set() and job.done and not job.thread.is_alive():
+                job.cancelled.clear()  # it ended before the cancel: its image is the answer
+            if not job.cancelled.is_set():  # a cancelled one stopped short: started again
+                self.waiting.pop(method, None)
+                return job
         now = time.perf_counter()
         seen = self.waiting.get(method)
         if seen is None or seen[0] != key:
@@ -155,9 +215,12 @@ class JobBoard:
             if job.thread.is_alive() or now - seen[1] < self.settle:
                 return job
         del self.waiting[method]
-        job = Job(scene, camera, method, options, tiled)
+        job = Job(scene, camera, method, options, tiled, self.notify)
         self.current[method] = job
+        current = set(map(id, self.current.values()))
+        self.started = [j for j in self.started if j.thread.is_alive() or id(j) in current]
         self.started.append(job)
+        self.count += 1
         return job
 
     def keep_only(self, methods) -> None:

@@ -18,6 +18,10 @@ from ..args import size
 from .state import AppState, new_state
 
 WINDOW_SIZE = (1280, 760)
+IDLE_FPS = 2.0
+"""Frames per second while nothing changes and no input comes (hello_imgui's idling: it sleeps
+between frames; an input event, :func:`hello_imgui.request_refresh` from a background job that
+delivers, or :func:`.frames.in_progress` wakes it at once)."""
 
 
 def frame_rest(last: float | None, now: float, cap: float, job_running: bool) -> float:
@@ -27,6 +31,30 @@ def frame_rest(last: float | None, now: float, cap: float, job_running: bool) ->
     if last is None or cap <= 0.0 or not job_running:
         return 0.0
     return max(0.0, last + 1.0 / cap - now)
+
+
+def window_title(state: AppState) -> str:
+    """The window's title: the scene shown."""
+    return f"workbench ui: {state.scene_path.stem}"
+
+
+def _glfw():
+    """The window's GLFW library (imgui-bundle's), with the title functions typed."""
+    import ctypes
+
+    import imgui_bundle
+    glfw = ctypes.CDLL(str(Path(imgui_bundle.__file__).parent / "libglfw.so.3"))
+    glfw.glfwGetCurrentContext.restype = ctypes.c_void_p
+    glfw.glfwSetWindowTitle.argtypes = [ctypes.c_void_p, ctypes.c_char_p]
+    glfw.glfwGetWindowTitle.argtypes = [ctypes.c_void_p]
+    glfw.glfwGetWindowTitle.restype = ctypes.c_char_p
+    return glfw
+
+
+def shown_title() -> str:
+    """The title the window has now (GLFW's), for scripts and tests."""
+    glfw = _glfw()
+    return (glfw.glfwGetWindowTitle(glfw.glfwGetCurrentContext()) or b"").decode()
 
 
 def run(state: AppState, max_frames: int | None = None, script=None,
@@ -39,16 +67,17 @@ def run(state: AppState, max_frames: int | None = None, script=None,
 
     from ...renderers import gl
     from . import window_style
-    from .frames import blit_panels, release_gl, update_images
+    from .frames import blit_panels, in_progress, release_gl, update_images
     from .layout import docking_params
     from .panels import status_bar
     from .plot import track
-    clock = {"t": None}
+    clock = {"t": None, "title": window_title(state)}
 
     def post_init():
         state.ctx = moderngl.create_context()  # the window's current GLFW context
         gl.use_context(state.ctx)
         state.gl_renderer = gl.renderer_name(state.ctx)
+        state.jobs.notify = hello_imgui.request_refresh  # a job's new tiles wake the loop
 
     def show_gui():
         now = time.perf_counter()
@@ -61,8 +90,14 @@ def run(state: AppState, max_frames: int | None = None, script=None,
         clock["t"] = now
         update_images(state)
         track(state)
+        if window_title(state) != clock["title"]:  # the scene changed: so does the title
+            clock["title"] = window_title(state)
+            glfw = _glfw()
+            glfw.glfwSetWindowTitle(glfw.glfwGetCurrentContext(), clock["title"].encode())
         if script is not None:
             script(state)
+        if in_progress(state) or getattr(script, "keeps_awake", script is not None):
+            hello_imgui.request_refresh()
 
     def end_frame():  # after every dockable window's gui, before ImGui renders
         state.gui_seconds = time.perf_counter() - clock["t"]
@@ -75,13 +110,17 @@ def run(state: AppState, max_frames: int | None = None, script=None,
         release_gl(state)
 
     params = hello_imgui.RunnerParams()
-    params.app_window_params.window_title = f"workbench ui: {state.scene_path.stem}"
+    params.app_window_params.window_title = window_title(state)
     params.app_window_params.window_geometry.size = window
-    params.fps_idling.enable_idling = False
+    params.fps_idling.enable_idling = True
+    params.fps_idling.fps_idle = IDLE_FPS
     # hello_imgui asks for an 8x multisampled window by default: on llvmpipe that makes every
     # frame ~4x dearer (imgui anti-aliases its own shapes and text without it)
     params.renderer_backend_options.open_gl_options.anti_aliasing_samples = 0
     params.imgui_window_params.show_status_bar = True
+    # hello_imgui's own FPS and idling toggle sat under the status text in a narrow window
+    # (1024 x 600); the status text gives the frame time, and idling is always on
+    params.imgui_window_params.show_status_fps = False
     params.imgui_window_params.default_imgui_window_type = \
         hello_imgui.DefaultImGuiWindowType.provide_full_screen_dock_space
     params.docking_params = docking_params(state, window[1])
@@ -115,20 +154,26 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m workbench.app.ui.main")
     p.add_argument("scene", nargs="?", default="whitted")
     p.add_argument("--methods", default="", help="comma-separated, 1 to 6")
-    p.add_argument("--size", type=int, default=256, help="panel width and height in pixels")
+    p.add_argument("--size", type=int, default=256,
+                   help="panel resolution: pixels along the longer side (the other side keeps "
+                        "the scene camera's aspect)")
     p.add_argument("--frames", type=int, default=None, help="stop after this many frames")
     p.add_argument("--window", type=size, default=WINDOW_SIZE, metavar="WxH",
                    help="window size in pixels (default %(default)s)")
     p.add_argument("--test-script", default=None, help="check or fps (see scripts.py)")
     p.add_argument("--out", type=Path, default=None, help="folder for the script's outputs")
     args = p.parse_args(argv)
+    if not 8 <= args.size <= 4096:
+        p.error(f"--size {args.size}: the panels' resolution must be 8 to 4096 pixels")
     from .scripts import SCRIPTS
     state = new_state(args.scene, [m for m in args.methods.split(",") if m] or None,
-                      (args.size, args.size))
+                      args.size)
     script = None
     if args.test_script:
         args.out = args.out or Path("out/ui")
+    if args.out is not None:  # also without a script: the last frame and the summary
         args.out.mkdir(parents=True, exist_ok=True)
+    if args.test_script:
         script = SCRIPTS[args.test_script](args.out)
     t0 = time.perf_counter()
     run(state, args.frames, script, args.window)
@@ -140,7 +185,7 @@ def main(argv: list[str] | None = None) -> int:
             Image.fromarray(shot[..., :3]).save(args.out / "ui.png")
         summary = {"frames": state.frame, "seconds": time.perf_counter() - t0,
                    "gl_renderer": state.gl_renderer, "methods": state.methods,
-                   "scene": state.scene_path.stem, "panel_size": list(state.panel_size),
+                   "scene": state.scene_path.stem, "panel_size": [state.camera.width, state.camera.height],
                    "timings": state.timings,
                    "threads": [t.name for t in threading.enumerate()],
                    "child_processes": [c.name for c in multiprocessing.active_children()],

@@ -10,8 +10,8 @@ from .frames import (difference_on_gpu, image_stats, panel_texture, show_image, 
 from .inspect import export, pixel_under_mouse, probe_tooltip, select_ray_tree
 from .layout import focus
 from .patch_view import select_patch
-from .state import (DISPLAY_MODES, HARMONIES, MATERIAL_FIELDS, MAX_PANELS, AppState,
-                    choosable_methods, set_display, set_material_value, set_option, set_scene)
+from .state import (DISPLAY_MODES, HARMONIES, MATERIAL_FIELDS, AppState, choosable_methods,
+                    set_display, set_material_value, set_option, set_scene, toggle_method)
 
 ORBIT_SPEED = 0.01
 """Radians of orbit per pixel of mouse drag."""
@@ -39,6 +39,34 @@ def colour_scale(values: np.ndarray, vmax: float) -> np.ndarray:
     return table[idx.astype(np.intp)]
 
 
+def check_fits(state: AppState, name: str) -> None:
+    """Note in ``state.cut`` whether the last item (its frame and label) ends past the right
+    edge of its window's content: nothing should (scripts and tests read it)."""
+    right = imgui.get_window_pos().x + imgui.get_window_width() - imgui.get_style().window_padding.x
+    if imgui.get_item_rect_max().x > right + 1.0:
+        state.cut.add(name)
+    else:
+        state.cut.discard(name)
+
+
+def same_line_if_fits(width: float) -> None:
+    """Continue the line if an item ``width`` pixels wide still fits in the window, else
+    start a new line (buttons that wrap instead of running past the edge)."""
+    spacing = imgui.get_style().item_spacing.x
+    right = imgui.get_window_pos().x + imgui.get_window_width() - imgui.get_style().window_padding.x
+    if imgui.get_item_rect_max().x + spacing + width <= right:
+        imgui.same_line()
+
+
+def button_width(label: str) -> float:
+    return imgui.calc_text_size(label).x + 2 * imgui.get_style().frame_padding.x
+
+
+def label_room(*labels: str) -> float:
+    """Pixels a widget's label beside it needs (the longest of ``labels``)."""
+    return max(imgui.calc_text_size(x).x for x in labels) + imgui.get_style().item_inner_spacing.x
+
+
 def scene_picker(state: AppState) -> None:
     """Combo over the bundled scenes (a scene opened from a file is listed first)."""
     from ...scene.library import bundled
@@ -46,34 +74,47 @@ def scene_picker(state: AppState) -> None:
     if state.scene_path not in paths:
         paths = [state.scene_path, *paths]
     names = [p.stem if p.parent == paths[-1].parent else p.name for p in paths]
+    imgui.set_next_item_width(-label_room("scene"))
     changed, idx = imgui.combo("scene", paths.index(state.scene_path), names)
+    check_fits(state, "scene")
     if changed and paths[idx] != state.scene_path:
         set_scene(state, str(paths[idx]))
     if imgui.button("reset camera"):
         state.camera = cam.reset(state.scene, state.camera)
-    imgui.same_line()
+    same_line_if_fits(button_width("reset zoom"))
     if imgui.button("reset zoom"):
         state.view = (1.0, 0.5, 0.5)
-    imgui.same_line()
-    if imgui.button("export"):
-        folder = state.export_dir / f"{state.scene_path.stem}_{state.frame:06d}"
+    same_line_if_fits(button_width("export"))
+    clicked = imgui.button("export")
+    check_fits(state, "export")
+    if clicked:
+        folder = (state.export_dir / f"{state.scene_path.stem}_{state.frame:06d}").resolve()
         state.status["export"] = f"saved {len(export(state, folder))} files to {folder}"
     if "export" in state.status:
+        imgui.push_text_wrap_pos(0.0)
         imgui.text_disabled(state.status["export"])
+        imgui.pop_text_wrap_pos()
 
 
 def method_list(state: AppState) -> None:
-    """Checkboxes over the methods (1 to 6 selected), two per row."""
-    for k, m in enumerate(choosable_methods()):
-        if k % 2:
-            imgui.same_line(imgui.get_window_width() / 2)
-        on = m in state.methods
-        changed, on = imgui.checkbox(m, on)
+    """Checkboxes over the methods (1 to 6 selected), in as many columns as their labels
+    fit (two at most); a refused change says why."""
+    methods = choosable_methods()
+    style = imgui.get_style()
+    column = imgui.get_frame_height() + label_room(*methods) + style.item_spacing.x
+    cols = 2 if 2 * column <= imgui.get_content_region_avail().x else 1
+    x0 = imgui.get_cursor_pos_x()
+    for k, m in enumerate(methods):
+        if k % cols:
+            imgui.same_line(x0 + column)
+        changed, on = imgui.checkbox(m, m in state.methods)
+        check_fits(state, f"method {m}")
         if changed:
-            if on and len(state.methods) < MAX_PANELS:
-                state.methods.append(m)
-            elif not on and len(state.methods) > 1:
-                state.methods.remove(m)
+            toggle_method(state, m, on)
+    if "methods" in state.status:
+        imgui.push_text_wrap_pos(0.0)
+        imgui.text_colored(imgui.ImVec4(1.0, 0.6, 0.3, 1.0), state.status["methods"])
+        imgui.pop_text_wrap_pos()
 
 
 def parameters(state: AppState) -> None:
@@ -81,23 +122,30 @@ def parameters(state: AppState) -> None:
     from ...renderers.base import get_renderer
     imgui.separator_text("material")
     names = list(state.scene.materials)
+    imgui.push_item_width(-label_room("material", *MATERIAL_FIELDS))  # labels fit beside
     changed, idx = imgui.combo("material", names.index(state.material), names)
+    check_fits(state, "material")
     if changed:
         state.material = names[idx]
     mat = state.scene.materials[state.material]
     for f in MATERIAL_FIELDS:
         lo, hi = MATERIAL_RANGES[f]
         changed, v = imgui.slider_float(f, float(getattr(mat, f)), lo, hi)
+        check_fits(state, f)
         if changed:
             set_material_value(state, state.material, f, v)
+    imgui.pop_item_width()
     imgui.separator_text("quality")
     for m in state.methods:
         knob = get_renderer(m).knob
         values = list(knob.values)
         cur = state.options[m][knob.name]
         idx = values.index(cur) if cur in values else 0
-        changed, idx = imgui.slider_int(f"{m} {knob.name}", idx, 0, len(values) - 1,
+        imgui.text(f"{m}: {knob.name}")  # its own line: a label beside the slider was cut
+        imgui.set_next_item_width(-1)
+        changed, idx = imgui.slider_int(f"##knob {m}", idx, 0, len(values) - 1,
                                         format=str(values[idx]))
+        check_fits(state, f"knob {m}")
         if changed:
             set_option(state, m, knob.name, values[idx])
 
@@ -110,39 +158,65 @@ def handle_mouse(state: AppState) -> None:
         return
     io = imgui.get_io()
     dx, dy = io.mouse_delta.x, io.mouse_delta.y
+    size = imgui.get_item_rect_size()  # the image as shown (scaled from the camera's pixels)
     if io.key_ctrl:  # Ctrl+click selects a pixel, no camera move
         return
     if io.key_shift:  # Shift: linked 2D zoom (wheel) and pan (left drag) of all panels
         lo, mouse = imgui.get_item_rect_min(), imgui.get_mouse_pos()
         (u0, v0), (u1, v1) = cam.view_window(state.view)
-        fx, fy = (mouse.x - lo.x) / state.camera.width, (mouse.y - lo.y) / state.camera.height
+        fx, fy = (mouse.x - lo.x) / size.x, (mouse.y - lo.y) / size.y
         if io.mouse_wheel:
             at = (u0 + fx * (u1 - u0), v0 + fy * (v1 - v0))
             state.view = cam.zoom_view(state.view, 1.25 ** io.mouse_wheel, at)
         if imgui.is_mouse_dragging(imgui.MouseButton_.left) and (dx or dy):
-            state.view = cam.pan_view(state.view, dx / state.camera.width,
-                                      dy / state.camera.height)
+            state.view = cam.pan_view(state.view, dx / size.x, dy / size.y)
         return
     if imgui.is_mouse_dragging(imgui.MouseButton_.left) and (dx or dy):
         state.camera = cam.orbit(state.camera, -dx * ORBIT_SPEED, dy * ORBIT_SPEED)
     elif imgui.is_mouse_dragging(imgui.MouseButton_.right) and (dx or dy):
-        h = state.camera.height
-        state.camera = cam.pan(state.camera, -dx / h, dy / h)
+        state.camera = cam.pan(state.camera, -dx / size.y, dy / size.y)
     if io.mouse_wheel:
         state.camera = cam.zoom(state.camera, ZOOM_STEP ** io.mouse_wheel)
 
 
+def fit_text(text: str, width: float) -> str:
+    """``text`` cut to ``width`` pixels of the current font (an ellipsis marks the cut)."""
+    if imgui.calc_text_size(text).x <= width:
+        return text
+    lo, hi = 0, len(text)
+    while lo < hi:  # the longest prefix that fits with its ellipsis
+        mid = (lo + hi + 1) // 2
+        if imgui.calc_text_size(text[:mid] + "...").x <= width:
+            lo = mid
+        else:
+            hi = mid - 1
+    return text[:lo] + "..."
+
+
+def text_in_width(text: str, width: float, disabled: bool = False) -> None:
+    """One line of ``text`` cut to ``width`` pixels; the whole text as a tooltip when cut."""
+    shown = fit_text(text, width)
+    (imgui.text_disabled if disabled else imgui.text)(shown)
+    if shown != text and imgui.is_item_hovered():
+        imgui.set_tooltip(text)
+
+
 def image_panels(state: AppState) -> None:
-    """One image per selected method, side by side, wrapping to the available width."""
-    w, h = state.camera.width, state.camera.height
-    avail = imgui.get_content_region_avail().x
-    per_row = max(1, int(avail // (w + 8)))
+    """One image per selected method at the scene camera's aspect, as large as the window
+    allows, in as many rows as fit best (:func:`~.layout.panel_grid`); each image is shown
+    scaled from the panels' render resolution."""
+    from .layout import PANEL_GAP, PANEL_LINES, panel_grid
+    avail = imgui.get_content_region_avail()
+    chrome = PANEL_LINES * imgui.get_frame_height_with_spacing()
+    cols, w, h = panel_grid(len(state.methods), avail.x, avail.y,
+                            state.camera.width / state.camera.height, chrome)
     for k, m in enumerate(state.methods):
-        if k % per_row:
-            imgui.same_line()
+        if k % cols:
+            imgui.same_line(0, PANEL_GAP)
         imgui.begin_group()
         t = state.timings.get(m)
-        imgui.text(f"{m}  {'' if t is None else f'{t * 1e3:.1f} ms'}")
+        imgui.align_text_to_frame_padding()  # every panel's title on the same baseline
+        text_in_width(f"{m}  {'' if t is None else f'{t * 1e3:.1f} ms'}", w)
         if m in state.images:
             tex = panel_texture(state, m)
             show_image(state, m, tex, imgui.ImVec2(w, h), *cam.view_window(state.view))
@@ -158,11 +232,14 @@ def image_panels(state: AppState) -> None:
                         and imgui.is_mouse_clicked(imgui.MouseButton_.left)):
                     select_patch(state, *ij)
                     focus("Patch view")
-        imgui.text_disabled(state.status.get(m, "")[:40])
+        else:
+            imgui.dummy(imgui.ImVec2(w, h))
+        text_in_width(state.status.get(m, ""), w, disabled=True)
         mode = state.display.get(m, "direct24")
         modes = list(DISPLAY_MODES) if mode in DISPLAY_MODES else [mode, *DISPLAY_MODES]
         imgui.set_next_item_width(w)
         changed, k_mode = imgui.combo(f"##display {m}", modes.index(mode), modes)
+        check_fits(state, f"display {m}")
         if changed:
             set_display(state, m, modes[k_mode])
         imgui.end_group()
@@ -175,18 +252,29 @@ def difference_panel(state: AppState) -> None:
     ms = state.methods
     a, b = (x if x in ms else ms[0] for x in state.diff_pair)
     kinds = ["abs", "flip"]
-    imgui.set_next_item_width(120)
+    # the two selectors share the window's width, the kind on its own line: nothing is cut
+    # off in a narrow window (at 1280 wide, B and the kind were past the right edge)
+    style = imgui.get_style()
+    label = imgui.calc_text_size("A").x + style.item_inner_spacing.x
+    half = max(40.0, (imgui.get_content_region_avail().x - style.item_spacing.x) / 2 - label)
+    imgui.set_next_item_width(half)
     _, ia = imgui.combo("A", ms.index(a), ms)
+    check_fits(state, "difference A")
     imgui.same_line()
-    imgui.set_next_item_width(120)
+    imgui.set_next_item_width(half)
     _, ib = imgui.combo("B", ms.index(b), ms)
-    imgui.same_line()
-    imgui.set_next_item_width(80)
+    check_fits(state, "difference B")
+    imgui.set_next_item_width(max(40.0, min(120.0, half)))
     _, ik = imgui.combo("kind", kinds.index(state.diff_kind), kinds)
+    check_fits(state, "difference kind")
     state.diff_pair, state.diff_kind = (ms[ia], ms[ib]), kinds[ik]
     a, b = state.diff_pair
     if a not in state.images or b not in state.images:
         return
+    shape = (state.camera.height, state.camera.width)
+    if not all(state.images.has_shape(m, shape) for m in (a, b)):
+        imgui.text_disabled("waiting for both images at the panels' size")
+        return  # one is still the previous scene's (another size): nothing to compare yet
     # recomputed only when either image or the kind changed (a static frame reads no pixels)
     key = (a, b, state.diff_kind, state.images.version(a), state.images.version(b))
     if stale(state, "difference", key) or "difference" not in state.textures:
@@ -198,7 +286,12 @@ def difference_panel(state: AppState) -> None:
     tex = state.textures["difference"]
     vmax, mean = image_stats(state, "difference")
     vmax = max(vmax, 1e-6)
-    size = imgui.ImVec2(state.camera.width, state.camera.height)
+    # the window's width at the camera's aspect, leaving room for the scale's two lines
+    avail = imgui.get_content_region_avail()
+    room_h = avail.y - 2 * imgui.get_frame_height_with_spacing()
+    aspect = state.camera.width / state.camera.height
+    w = max(32.0, min(avail.x, room_h * aspect))
+    size = imgui.ImVec2(w, w / aspect)
     show_image(state, "difference", tex, size, *cam.view_window(state.view))
     if "colour_scale" not in state.textures:
         upload(state, "colour_scale",
@@ -206,7 +299,7 @@ def difference_panel(state: AppState) -> None:
     tb = state.textures["colour_scale"]
     imgui.text("0")
     imgui.same_line()
-    imgui.image(imgui.ImTextureRef(tb.glo), imgui.ImVec2(size.x - 60, 10))
+    imgui.image(imgui.ImTextureRef(tb.glo), imgui.ImVec2(max(10.0, size.x - 60), 10))
     imgui.same_line()
     imgui.text(f"{vmax:.3g}")
     imgui.text(f"mean {mean:.4f}")
@@ -237,5 +330,6 @@ def status_text(state: AppState) -> str:
 
 
 def status_bar(state: AppState) -> None:
-    """The status bar line (:func:`status_text`)."""
-    imgui.text(status_text(state))
+    """The status bar line (:func:`status_text`), cut to the window's width (whole in a
+    tooltip)."""
+    text_in_width(status_text(state), imgui.get_content_region_avail().x)

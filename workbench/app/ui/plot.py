@@ -57,8 +57,16 @@ class ErrorPlot:
     failed: dict = field(default_factory=dict)
     metric: str = "rmse"
     shown: int = -2
+    gave_up: bool = False
     board: object = None
     pool: ProcessPoolExecutor | None = None
+
+    def busy(self, frame: int) -> bool:
+        """Something will arrive without any input: evaluations in the worker, or, while the
+        plot is shown (drawn in frame ``frame`` or the one before), its reference."""
+        if self.pending:
+            return True
+        return self.shown >= frame - 1 and self.ref_image is None and not self.gave_up
 
     def shutdown(self) -> None:
         """Cancel the reference render and end the worker process (joined)."""
@@ -91,7 +99,7 @@ def _final_image(state: AppState, method: str) -> tuple[np.ndarray, float] | Non
 def _reference(state: AppState, plot: ErrorPlot) -> np.ndarray | None:
     """The reference image of the current key once rendered (requests it meanwhile)."""
     from ...compare.reference import candidates, finest_options
-    from .frames import TILED
+    from .frames import tiled
     from .jobs import JobBoard
     if plot.ref_image is not None:
         return plot.ref_image
@@ -104,7 +112,7 @@ def _reference(state: AppState, plot: ErrorPlot) -> np.ndarray | None:
     while plot.candidates:
         m = plot.candidates[0]
         plot.reference, plot.ref_options = m, finest_options(m)
-        job = plot.board.request(state.scene, state.camera, m, plot.ref_options, tiled=m in TILED)
+        job = plot.board.request(state.scene, state.camera, m, plot.ref_options, tiled=tiled(m))
         if job.cancelled.is_set():  # the previous key's job, still ending: wait for it
             plot.message = "rendering the reference..."
             return None
@@ -112,14 +120,45 @@ def _reference(state: AppState, plot: ErrorPlot) -> np.ndarray | None:
             break
         plot.candidates.pop(0)  # does not apply to this scene: the next in the rule's order
     else:
-        plot.message = "no reference: no method renders this scene"
+        plot.message, plot.gave_up = "no reference: no method renders this scene", True
         return None
     if job.image is None:
-        plot.message = f"rendering the reference ({plot.reference} {plot.ref_options})..."
+        plot.message = f"rendering the reference: {plot.reference} ({options_text(plot.ref_options)})..."
         return None
     plot.ref_image = job.image
-    plot.message = f"reference: {plot.reference} {plot.ref_options} ({job.seconds:.2f} s)"
+    plot.message = (f"reference: {plot.reference} ({options_text(plot.ref_options)}), "
+                    f"{job.seconds:.2f} s")
     return plot.ref_image
+
+
+def options_text(options: dict) -> str:
+    """``{"max_depth": 12}`` -> ``"max_depth=12"`` (the plot's header and labels)."""
+    return ", ".join(f"{k}={v}" for k, v in options.items())
+
+
+MARKERS = ("circle", "square", "diamond", "up", "down", "left", "right", "cross", "plus",
+           "asterisk")
+"""implot marker of each method, by its place in the registry (the same shape every frame)."""
+
+
+def marker_of(method: str) -> str:
+    """The name of ``method``'s marker in :data:`MARKERS` (stable: by registry order)."""
+    from .state import choosable_methods
+    allowed = choosable_methods()
+    k = allowed.index(method) if method in allowed else len(allowed)
+    return MARKERS[k % len(MARKERS)]
+
+
+def plotted_lines(plot: ErrorPlot, methods, metric: str) -> dict:
+    """{method: (run times in ms, errors)} of the methods on screen (a removed panel's line
+    leaves the legend), each sorted by run time, errors at least :data:`FLOOR`."""
+    lines = {}
+    for m in methods:
+        rows = sorted(plot.points.get(m, {}).values(), key=lambda p: p["seconds"])
+        if rows:
+            lines[m] = (np.array([p["seconds"] * 1e3 for p in rows]),
+                        np.maximum(np.array([p[metric] for p in rows]), FLOOR))
+    return lines
 
 
 def _evaluate(image: np.ndarray, reference: np.ndarray) -> dict:
@@ -137,6 +176,7 @@ def track(state: AppState) -> None:
             for job in plot.board.current.values():
                 job.cancelled.set()
         plot.key, plot.since, plot.ref_image, plot.candidates = key, time.perf_counter(), None, []
+        plot.gave_up = False
         plot.points, plot.pending, plot.failed = {}, {}, {}
     for (m, opts), fut in list(plot.pending.items()):
         if fut.done():
@@ -194,12 +234,10 @@ def error_plot(state: AppState) -> None:
     if changed:
         plot.metric = METRICS[k]
     imgui.same_line()
+    imgui.push_text_wrap_pos(0.0)
     imgui.text_disabled(plot.message)
-    lines = {}
-    for m, pts in plot.points.items():
-        rows = sorted(pts.values(), key=lambda p: p["seconds"])
-        lines[m] = (np.array([p["seconds"] * 1e3 for p in rows]),
-                    np.maximum(np.array([p[plot.metric] for p in rows]), FLOOR))
+    imgui.pop_text_wrap_pos()
+    lines = plotted_lines(plot, state.methods, plot.metric)
     for name in CLEAR_FILLS:
         implot.push_style_color(getattr(implot.Col_, name), imgui.ImVec4(0.0, 0.0, 0.0, 0.0))
     if implot.begin_plot("##error against run time", imgui.ImVec2(-1, -1)):
@@ -213,7 +251,7 @@ def error_plot(state: AppState) -> None:
         else:  # 1 ms to 1 s, errors 1e-3 to 1
             implot.setup_axes_limits(1.0, 1e3, 1e-3, 1.0, implot.Cond_.always)
         for m, (xs, ys) in lines.items():
-            implot.plot_line(m, xs, ys)
-            implot.plot_scatter(m, xs, ys)
+            spec = implot.Spec(marker=getattr(implot.Marker_, marker_of(m)), marker_size=5)
+            implot.plot_line(m, xs, ys, spec)
         implot.end_plot()
     implot.pop_style_color(len(CLEAR_FILLS))

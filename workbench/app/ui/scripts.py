@@ -158,6 +158,25 @@ class Features:
                 for m, pts in state.errors.points.items()}
 
 
+class Layout:
+    """Frames 4 to 8 drawn with every widget in place (the docked windows have their sizes from
+    frame 2 on; the script sees the previous frame's widgets): logs
+    the widgets that ran past their window's edge (``state.cut``), the window report and the
+    panels' blit rectangles, then quits."""
+
+    def __init__(self, out: Path):
+        self.out, self.log = out, {"cut": []}
+
+    def __call__(self, state: AppState) -> None:
+        if 4 <= state.frame <= 8:
+            self.log["cut"] = sorted(set(self.log["cut"]) | state.cut)
+        if state.frame == 8:
+            self.log["windows"] = window_report()
+            self.log["blits"] = [[m, list(r)] for m, r in state.gpu.blits.last]
+            self.log["camera"] = [state.camera.width, state.camera.height]
+            state.quit = True
+
+
 def _gpu_counts(state: AppState) -> tuple[int, int]:
     """(GL panel draws, pixel read-backs from the GPU) so far."""
     draws = sum(p.draws for p in state.gpu.raster.values()) if state.gpu is not None else 0
@@ -244,7 +263,7 @@ class Fps:
             state.camera = cam.orbit(state.camera, self.step, 0.0)
         if state.frame == self.warmup:
             self.t0, self.busy_frames, self.gui, self.frame_ms = time.perf_counter(), 0, 0.0, []
-            self.counts, self.starts = _gpu_counts(state), len(state.jobs.started)
+            self.counts, self.starts = _gpu_counts(state), state.jobs.count
         elif self.t0 is not None and "fps" not in self.log:
             busy = state.jobs.busy()
             self.busy_frames += busy
@@ -259,7 +278,7 @@ class Fps:
                                 frame_ms_p10_50_90_99=q,
                                 frames_with_cpu_job_running=self.busy_frames,
                                 gl_panel_draws=d1 - d0, read_backs=r1 - r0,
-                                cpu_jobs_started=len(state.jobs.started) - self.starts,
+                                cpu_jobs_started=state.jobs.count - self.starts,
                                 panels_window=window_report()["Panels"].get("size"),
                                 raster_ms={m: state.timings.get(m, 0) * 1e3
                                            for m in state.methods if m in RASTER})
@@ -390,9 +409,149 @@ class GpuPanels:
             state.quit = True
 
 
+def process_cpu_seconds() -> float:
+    """CPU seconds used so far by this process, every thread included (user + system)."""
+    import os
+    t = os.times()
+    return t.user + t.system
+
+
+def rss_bytes() -> int:
+    """Resident set size of this process (``VmRSS`` of /proc/self/status), bytes."""
+    for line in Path("/proc/self/status").read_text().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1]) * 1024
+    return 0
+
+
+class Idle:
+    """Nothing touched: once nothing is in progress (:func:`.frames.in_progress`: jobs, the
+    error plot's reference and evaluations) and ``settle`` seconds have passed (longer than
+    hello_imgui's time active after the last event), count the frames drawn and the
+    process CPU time over ``seconds``; then change the ray tracer's knob from the script (no
+    input event) and wait for the restarted job's image, which must reach its panel although
+    the window was idling; then switch to csg and read the window's title.  Scripts keep the loop awake unless, like this one, they say not."""
+
+    keeps_awake = False
+
+    def __init__(self, out: Path, seconds: float = 10.0, settle: float = 4.0):
+        self.out, self.seconds, self.settle, self.log = out, seconds, settle, {}
+        self.t_begin = self.t_start = time.perf_counter()
+        self.t0, self.step = None, 0
+
+    def __call__(self, state: AppState) -> None:
+        from .frames import in_progress
+        now = time.perf_counter()
+        if self.step == 0 and in_progress(state) and now - self.t_begin < CPU_WAIT_SECONDS:
+            self.t_start = now
+        if self.step == 0 and now - self.t_start > self.settle:
+            self.t0, self.cpu0, self.frame0, self.rss0 = now, process_cpu_seconds(), state.frame, rss_bytes()
+            self.step = 1
+        elif self.step == 1 and now - self.t0 >= self.seconds:
+            dt = now - self.t0
+            cpu = process_cpu_seconds() - self.cpu0
+            self.log["idle"] = {"seconds": dt, "frames": state.frame - self.frame0,
+                                "fps": (state.frame - self.frame0) / dt, "cpu_seconds": cpu,
+                                "cpu_percent_of_a_core": 100.0 * cpu / dt,
+                                "rss_mb_before_after": [self.rss0 / 2**20, rss_bytes() / 2**20]}
+            if "raytrace" in state.methods:
+                knob = state.options["raytrace"]["max_depth"]
+                set_option(state, "raytrace", "max_depth", 2 if knob != 2 else 3)
+                self.t0, self.frame0, self.step = now, state.frame, 2
+            else:
+                state.quit = True
+        elif self.step == 2:
+            job = state.jobs.current.get("raytrace")
+            if (job is not None and job.image is not None and job.key[3] == (("max_depth",
+                state.options["raytrace"]["max_depth"]),)) or now - self.t0 > CPU_WAIT_SECONDS:
+                shown = state.images["raytrace"]
+                self.log["job_after_idle"] = {
+                    "done": job is not None and job.image is not None,
+                    "shown_is_job_image": bool(job is not None and job.image is not None
+                                               and np.array_equal(shown, job.image)),
+                    "frames": state.frame - self.frame0, "seconds": now - self.t0}
+                from .main import shown_title
+                from .state import set_scene
+                self.log["title_before"] = shown_title()
+                set_scene(state, "csg")
+                self.step = 3
+        elif self.step == 3:
+            from .main import shown_title
+            self.log["title_after"] = shown_title()
+            state.quit = True
+
+
+class Soak:
+    """A long session in a loop: ``rounds`` rounds of a scene switch (through ``scenes``),
+    a method added or removed, a knob change, camera orbits and a difference pair change,
+    waiting between rounds until the background jobs have ended.  Logs, every round, the
+    process RSS, the jobs the board keeps, and the GL textures, framebuffers, buffers and
+    programs alive in the window's context (:func:`gl_object_counts`)."""
+
+    def __init__(self, out: Path, rounds: int = 24,
+                 scenes=("whitted", "csg", "cornell", "quadrics")):
+        self.out, self.rounds, self.scenes, self.log = out, rounds, scenes, {"rounds": []}
+        self.round, self.t_wait, self.phase = 0, time.perf_counter(), 0
+
+    def __call__(self, state: AppState) -> None:
+        from .state import set_scene
+        if state.frame < 2:
+            return
+        if self.phase < 6:  # a few frames of orbiting (every panel redraws, jobs restart)
+            state.camera = cam.orbit(state.camera, 0.05, 0.01)
+            self.phase += 1
+            return
+        if state.jobs.busy() and time.perf_counter() - self.t_wait < CPU_WAIT_SECONDS:
+            return
+        counts = gl_object_counts(state)
+        self.log["rounds"].append({"round": self.round, "rss_mb": rss_bytes() / 2**20,
+                                   "jobs_kept": len(state.jobs.started),
+                                   "scene": state.scene_path.stem, "methods": list(state.methods),
+                                   **counts})
+        if self.round >= self.rounds:
+            state.quit = True
+            return
+        k = self.round
+        set_scene(state, self.scenes[k % len(self.scenes)])
+        extra = ("raycast", "gouraud")[k % 2]
+        if extra in state.methods and len(state.methods) > 1:
+            state.methods.remove(extra)
+        elif len(state.methods) < 6:
+            state.methods.append(extra)
+        set_option(state, "phong", "tessellation", (2, 3, 4)[k % 3])
+        set_option(state, "raytrace", "max_depth", (2, 3)[k % 2])
+        state.diff_pair = (state.methods[0], state.methods[-1])
+        self.round, self.phase, self.t_wait = k + 1, 0, time.perf_counter()
+
+
+def gl_object_counts(state: AppState, names: int = 4096) -> dict:
+    """GL objects alive in the window's context: how many of the names 1..``names`` are
+    textures, framebuffers, buffers and programs (``glIsTexture`` and friends, through the
+    window's GLFW); empty without GLFW."""
+    import ctypes
+
+    import imgui_bundle
+    try:
+        glfw = ctypes.CDLL(str(Path(imgui_bundle.__file__).parent / "libglfw.so.3"))
+    except OSError:
+        return {}
+    glfw.glfwGetProcAddress.restype = ctypes.c_void_p
+    glfw.glfwGetProcAddress.argtypes = [ctypes.c_char_p]
+    out = {}
+    for kind in ("Texture", "Framebuffer", "Buffer", "Program"):
+        addr = glfw.glfwGetProcAddress(f"glIs{kind}".encode())
+        if not addr:
+            continue
+        is_ = ctypes.CFUNCTYPE(ctypes.c_ubyte, ctypes.c_uint)(addr)
+        out[f"gl_{kind.lower()}s"] = sum(1 for n in range(1, names + 1) if is_(n))
+    return out
+
+
 SCRIPTS = {"check": Check, "features": Features, "radiosity": Radiosity, "pyrender": Pyrender,
            "fps": Fps,
            "fps_static": lambda out: Fps(out, step=0.0, raytrace_spp=16, wait_cpu=True),
            "gpu_panels": GpuPanels, "slider_frames": SliderFrames,
            "fps_material_drag": lambda out: SliderFps(out, "material"),
-           "fps_slider_drag": lambda out: SliderFps(out, "material+light")}
+           "fps_slider_drag": lambda out: SliderFps(out, "material+light"),
+           "layout": Layout, "idle": Idle, "idle_quick": lambda out: Idle(out, seconds=3.0),
+           "soak": Soak, "soak_quick": lambda out: Soak(out, rounds=10)}

@@ -17,6 +17,12 @@ CHILD = ("pyrender",)
 """Methods rendered in a child process (PyOpenGL's EGL platform cannot share the window's
 process): :mod:`.pyrender_proc`."""
 MAX_PANELS = 6
+FIRST_VIEW = ("phong", "raytrace")
+"""The methods of the first view of any scene: a raster method beside the ray tracer (their
+difference in the difference view); :data:`EMITTER_VIEW` is added for a scene with emitters."""
+EMITTER_VIEW = ("radiosity", "pathtrace")
+"""Added to the first view of a scene with emitters (where registered): the diffuse
+interreflection and the path-traced ground truth."""
 FPS_CAP_WHILE_JOB = 40.0
 """While a background job runs, frames come at most this often (the rest of a frame's time is
 slept, so the job gets the CPU); 0 for no cap.  Above the 30 fps the window must keep."""
@@ -36,7 +42,8 @@ class AppState:
     ``scene`` is the loaded scene with the material and light overrides applied;
     ``scene_version`` grows with every change of it (cache keys of GL sessions and background
     jobs).  ``camera`` is the
-    shared camera of all panels at the panel resolution; ``view`` (zoom, centre u, centre v)
+    shared camera of all panels at the panel resolution (:func:`panel_camera`: ``panel_size``
+    pixels along the longer side, the scene camera's aspect); ``view`` (zoom, centre u, centre v)
     the linked 2D zoom of every image panel.  ``images`` holds each panel's last
     linear (H, W, 3) float32 image (raster ones read back from the GPU on first access),
     ``timings`` its last render time in seconds.  ``gpu`` is :class:`.frames.PanelGPU` (raster
@@ -53,7 +60,7 @@ class AppState:
     overrides: dict[str, dict[str, float]] = field(default_factory=dict)
     light_overrides: dict[int, dict[str, object]] = field(default_factory=dict)
     scene_version: int = 0
-    panel_size: tuple[int, int] = (256, 256)
+    panel_size: int = 256
     images: PanelImages = field(default_factory=PanelImages)
     textures: dict[str, object] = field(default_factory=dict)
     timings: dict[str, float] = field(default_factory=dict)
@@ -77,6 +84,8 @@ class AppState:
     errors: object = None
     patch_pick: object = None
     pyrender: object = None
+    cut: set = field(default_factory=set)
+    """Widgets that ran past their window's right edge in the last frame (``panels.check_fits``)."""
     quit: bool = False
 
 
@@ -87,15 +96,35 @@ def choosable_methods() -> list[str]:
 
 
 def default_options(method: str) -> dict:
-    """The method's quality knob at its default value."""
+    """The method's quality knob at its default value; a progressive method's
+    (:data:`~.jobs.PROGRESSIVE`) at its most accurate, which it refines towards pass by pass."""
     from ...renderers.base import get_renderer
+    from .jobs import PROGRESSIVE
     knob = get_renderer(method).knob
-    return {knob.name: knob.default}
+    return {knob.name: knob.values[-1] if method in PROGRESSIVE else knob.default}
+
+
+def first_view(scene: Scene, allowed) -> list[str]:
+    """The methods shown when none are named: :data:`FIRST_VIEW`, plus :data:`EMITTER_VIEW`
+    when the scene has emitters (``Scene.needs()``), each where registered."""
+    from ...scene.features import EMITTERS
+    wanted = [*FIRST_VIEW, *(EMITTER_VIEW if EMITTERS in scene.needs() else ())]
+    return [m for m in wanted if m in allowed]
+
+
+def panel_camera(camera: Camera, size: int) -> Camera:
+    """``camera`` at the panels' resolution: ``size`` pixels along its longer side, the other
+    side keeping its aspect ratio (at least 1 pixel)."""
+    w, h = camera.width, camera.height
+    if w >= h:
+        return camera.with_resolution(size, max(1, round(size * h / w)))
+    return camera.with_resolution(max(1, round(size * w / h)), size)
 
 
 def new_state(scene_name: str, methods: list[str] | None = None,
-              panel_size: tuple[int, int] = (256, 256)) -> AppState:
-    """Load ``scene_name`` (bundled name or path) and build the initial state."""
+              panel_size: int = 256) -> AppState:
+    """Load ``scene_name`` (bundled name or path) and build the initial state; the panels
+    render ``panel_size`` pixels along the camera's longer side (:func:`panel_camera`)."""
     from ...core.errors import WorkbenchError
     from ...scene.io import load_scene
     from ...scene.library import resolve
@@ -105,31 +134,44 @@ def new_state(scene_name: str, methods: list[str] | None = None,
     path = resolve(scene_name)
     scene = load_scene(path)
     allowed = choosable_methods()
-    methods = list(methods) if methods else [m for m in RASTER if m in allowed]
+    methods = list(methods) if methods else first_view(scene, allowed)
     bad = [m for m in methods if m not in allowed]
     if bad or not 1 <= len(methods) <= MAX_PANELS:
         raise WorkbenchError(f"methods must be 1 to {MAX_PANELS} of {', '.join(allowed)} "
                              f"(got {', '.join(methods)})")
     return AppState(scene=scene, scene_path=path, base_scene=scene,
-                    camera=scene.camera.with_resolution(*panel_size), methods=methods,
+                    camera=panel_camera(scene.camera, panel_size), methods=methods,
                     options={m: default_options(m) for m in allowed},
                     material=next(iter(scene.materials)), panel_size=panel_size,
-                    diff_pair=(methods[0], methods[-1]), jobs=JobBoard(RESTART_SETTLE_SECONDS),
+                    diff_pair=(methods[0], methods[min(1, len(methods) - 1)]), jobs=JobBoard(RESTART_SETTLE_SECONDS),
                     browser=Browser(path.parent), errors=ErrorPlot())
 
 
 def set_scene(state: AppState, scene_name: str) -> None:
-    """Switch to another scene: camera reset, overrides dropped.  A scene that does not load
-    raises its :class:`~workbench.core.errors.WorkbenchError` and changes nothing."""
+    """Switch to another scene: camera reset, overrides dropped; the methods of the old scene's
+    first view (:func:`first_view`, not edited) become the new scene's.  A scene that does not
+    load raises its :class:`~workbench.core.errors.WorkbenchError` and changes nothing."""
     from ...scene.io import load_scene
     from ...scene.library import resolve
     path = resolve(scene_name)
     scene = load_scene(path)
+    allowed = choosable_methods()
+    if state.methods == first_view(state.base_scene, allowed):
+        state.methods[:] = first_view(scene, allowed)
+        state.diff_pair = (state.methods[0], state.methods[min(1, len(state.methods) - 1)])
     state.scene_path, state.base_scene, state.scene = path, scene, scene
-    state.camera = state.scene.camera.with_resolution(*state.panel_size)
+    state.camera = panel_camera(state.scene.camera, state.panel_size)
     state.overrides, state.light_overrides = {}, {}
     state.material = next(iter(state.scene.materials))
     state.scene_version += 1
+    # what showed the old scene goes: the ray tree, the picked patch, the run times (a CPU
+    # panel's time is its new job's), the file browser's last outcome
+    state.ray_tree = state.patch_pick = None
+    state.timings.clear()
+    for k in ("patch pick", "lights", "export"):
+        state.status.pop(k, None)
+    if state.browser is not None:
+        state.browser.message, state.browser.failed = "", False
 
 
 def _apply_overrides(state: AppState) -> None:
@@ -205,6 +247,27 @@ def reset_lights(state: AppState) -> None:
     """Back to the scene file's lights."""
     state.light_overrides = {}
     _apply_overrides(state)
+
+
+def toggle_method(state: AppState, method: str, on: bool) -> bool:
+    """Show (``on``) or hide ``method``'s panel; returns whether the list changed.  A seventh
+    panel or hiding the last one is refused with the reason in ``state.status["methods"]``
+    (shown in the Methods window)."""
+    state.status.pop("methods", None)
+    if on and method not in state.methods:
+        if len(state.methods) >= MAX_PANELS:
+            state.status["methods"] = (f"{method} not added: at most {MAX_PANELS} panels "
+                                       "(untick one first)")
+            return False
+        state.methods.append(method)
+        return True
+    if not on and method in state.methods:
+        if len(state.methods) == 1:
+            state.status["methods"] = f"{method} kept: at least one panel is shown"
+            return False
+        state.methods.remove(method)
+        return True
+    return False
 
 
 def set_option(state: AppState, method: str, name: str, value) -> None:
