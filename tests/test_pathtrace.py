@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import workbench
+from pathtrace_scenes import PLANE, scene
 from workbench.core.errors import NotApplicable
 from workbench.renderers.pathtrace import reference
 from workbench.renderers.pathtrace.session import PathTraceSession
@@ -17,17 +18,11 @@ from workbench.scene.library import bundled
 FURNACE = 0.25 / (1.0 - 0.8)   # E / (1 - rho) of scenes/furnace.toml
 
 
-def _scene(tmp_path, text, name="t"):
-    p = tmp_path / f"{name}.toml"
-    p.write_text(text)
-    return workbench.load_scene(str(p))
-
-
 def _furnace_with(tmp_path, material, obj):
     """The bundled furnace with one more material and object inside."""
     from pathlib import Path
     src = Path(workbench.__file__).resolve().parents[1] / "scenes" / "furnace.toml"
-    return _scene(tmp_path, src.read_text() + material + obj, "furnace_plus")
+    return scene(tmp_path, src.read_text() + material + obj, "furnace_plus")
 
 
 def test_furnace_radiance_everywhere(tmp_path):
@@ -53,33 +48,10 @@ def test_white_furnace_with_specular_sphere(tmp_path, kind, fresnel):
     assert abs(r.image.mean() - FURNACE) <= 5.0 * r.stats["noise_rmse"] / np.sqrt(r.image.shape[0] * r.image.shape[1])
 
 
-_PLANE = """
-[scene]
-name = "plane"
-background = [0.0, 0.0, 0.0]
-ambient = [0.0, 0.0, 0.0]
-[camera]
-position = [0.0, 3.0, 4.0]
-look_at = [0.0, 0.0, 0.0]
-fov_y = 40.0
-resolution = [16, 12]
-[materials.matte]
-color = [1.0, 0.5, 0.25]
-kd = 0.7
-ka = 0.0
-[[objects]]
-type = "plane"
-material = "matte"
-point = [0.0, 0.0, 0.0]
-normal = [0.0, 1.0, 0.0]
-size = [40.0, 40.0]
-"""
-
-
 def test_directional_light_on_a_plane_is_exact(tmp_path):
     """One diffuse plane under a directional light: every path ends after one bounce, so the
     estimate has no variance: kd C I cos, the course's diffuse term, as the Whitted tracer."""
-    sc = _scene(tmp_path, _PLANE + '[[lights]]\ntype = "directional"\ndirection = [0.3, -1.0, 0.2]\nintensity = 0.8\n')
+    sc = scene(tmp_path, PLANE + '[[lights]]\ntype = "directional"\ndirection = [0.3, -1.0, 0.2]\nintensity = 0.8\n')
     pt = workbench.render(sc, "pathtrace", spp=4)
     wh = workbench.render(sc, "raytrace", spp=1)
     d = np.array([0.3, -1.0, 0.2]) / np.linalg.norm([0.3, -1.0, 0.2])
@@ -93,7 +65,7 @@ def test_point_light_on_a_plane_matches_whitted(tmp_path):
     pi I cos / r^2, reflected rho / pi) against the Whitted ray tracer's kd C I cos / r^2, both
     box-filtered pixels (the ray tracer's stratified jitter at 256 samples is far more accurate
     than the path tracer's uniform jitter, whose own standard error bounds the difference)."""
-    sc = _scene(tmp_path, _PLANE + '[[lights]]\ntype = "point"\nposition = [0.5, 1.5, 0.3]\n'
+    sc = scene(tmp_path, PLANE + '[[lights]]\ntype = "point"\nposition = [0.5, 1.5, 0.3]\n'
                 'intensity = 2.0\nfalloff = "inverse_square"\n')
     pt = workbench.render(sc, "pathtrace", spp=256)
     wh = workbench.render(sc, "raytrace", spp=256)
@@ -194,7 +166,7 @@ def test_kernel_agrees_with_readable_reference(tmp_path, name):
     """At a few pixels the numba kernel and the readable twin (the ray tracer's readable
     intersection, numpy random numbers) agree within 5 combined standard errors."""
     if name == "glossy":
-        sc, w, h, opts = _scene(tmp_path, _GLOSSY), 8, 6, dict(fresnel="exact")
+        sc, w, h, opts = scene(tmp_path, _GLOSSY), 8, 6, dict(fresnel="exact")
         pixels = [(1, 1), (3, 2), (3, 5), (4, 6), (5, 3)]
     else:
         sc, w, h, opts = workbench.load_scene(name), 8, 8, dict(fresnel="schlick")
@@ -217,7 +189,7 @@ def test_every_bundled_scene_finite(name):
 
 
 def test_no_light_is_not_applicable(tmp_path):
-    sc = _scene(tmp_path, _PLANE)
+    sc = scene(tmp_path, PLANE)
     with pytest.raises(NotApplicable, match="nothing emits light"):
         workbench.render(sc, "pathtrace", spp=1)
 
@@ -253,7 +225,7 @@ def test_normalised_phong_lobe_under_a_directional_light(tmp_path):
     r = np.array([0.6, 0.8, 0.0])                                   # mirror of the light direction
     v = np.array([r[0] * np.cos(a) - r[1] * np.sin(a), r[0] * np.sin(a) + r[1] * np.cos(a), 0.0])
     cam = 10.0 * v
-    sc = _scene(tmp_path, f"""
+    sc = scene(tmp_path, f"""
 [scene]
 name = "gloss"
 background = [0.0, 0.0, 0.0]

@@ -10,18 +10,13 @@ import numpy as np
 import pytest
 
 import workbench
+from pathtrace_scenes import PLANE, scene
 from workbench.core.errors import NotApplicable
 from workbench.renderers.pathtrace import reference
 from workbench.renderers.pathtrace.session import PathTraceSession
 from workbench.scene.model import AreaLight
 
 SCENES = Path(workbench.__file__).resolve().parents[1] / "scenes"
-
-
-def _scene(tmp_path, text, name="t"):
-    p = tmp_path / f"{name}.toml"
-    p.write_text(text)
-    return workbench.load_scene(str(p))
 
 
 def _light_pixels(scene, width, height):
@@ -98,8 +93,8 @@ def test_diffuse_mode_is_the_scene_with_lambertian_materials(tmp_path):
     sphere Lambertian kd * colour and no point light, path-traced with full transport (the glass
     sphere, kd = 0, is black and opaque in both): the same image within the combined noise."""
     assert _MIRROR in _BOX_WITH_SPHERES
-    shiny = _scene(tmp_path, _BOX_WITH_SPHERES.replace(_MIRROR, _SHINY) + _POINT, "shiny")
-    matte = _scene(tmp_path, _BOX_WITH_SPHERES.replace(_MIRROR, _MATTE).replace("kt = 0.9", "kt = 0.0")
+    shiny = scene(tmp_path, _BOX_WITH_SPHERES.replace(_MIRROR, _SHINY) + _POINT, "shiny")
+    matte = scene(tmp_path, _BOX_WITH_SPHERES.replace(_MIRROR, _MATTE).replace("kt = 0.9", "kt = 0.0")
                    .replace("kr = 0.08", "kr = 0.0"), "matte")
     kw = dict(width=20, height=20, spp=512)
     diffuse = workbench.render(shiny, "pathtrace", transport="diffuse", seed=1, **kw)
@@ -112,40 +107,17 @@ def test_diffuse_mode_is_the_scene_with_lambertian_materials(tmp_path):
     assert any(e.startswith("point_lights: transport=diffuse") for e in diffuse.left_out)
 
 
-_PLANE = """
-[scene]
-name = "plane"
-background = [0.0, 0.0, 0.0]
-ambient = [0.0, 0.0, 0.0]
-[camera]
-position = [0.0, 3.0, 4.0]
-look_at = [0.0, 0.0, 0.0]
-fov_y = 40.0
-resolution = [16, 12]
-[materials.matte]
-color = [1.0, 0.5, 0.25]
-kd = 0.7
-ka = 0.0
-[[objects]]
-type = "plane"
-material = "matte"
-point = [0.0, 0.0, 0.0]
-normal = [0.0, 1.0, 0.0]
-size = [40.0, 40.0]
-"""
-
-
 def test_pixel_filter_center_on_a_flat_lit_wall_and_at_the_pixel_centre(tmp_path):
     """A plane under a directional light (uniform radiance, no variance): ``center`` equals
     ``box``.  Under a point light (radiance varies across a pixel), ``center`` is the
     radiance at the pixel centre: the ray caster's one centre sample, while the box-filtered
     pixel differs from it."""
-    flat = _scene(tmp_path, _PLANE + '[[lights]]\ntype = "directional"\ndirection = [0.3, -1.0, 0.2]\nintensity = 0.8\n')
+    flat = scene(tmp_path, PLANE + '[[lights]]\ntype = "directional"\ndirection = [0.3, -1.0, 0.2]\nintensity = 0.8\n')
     c = workbench.render(flat, "pathtrace", spp=4, pixel_filter="center")
     b = workbench.render(flat, "pathtrace", spp=4, pixel_filter="box")
     assert c.image.max() > 0.0
     assert np.allclose(c.image, b.image, rtol=1e-5, atol=0.0)
-    lit = _scene(tmp_path, _PLANE + '[[lights]]\ntype = "point"\nposition = [0.5, 1.5, 0.3]\n'
+    lit = scene(tmp_path, PLANE + '[[lights]]\ntype = "point"\nposition = [0.5, 1.5, 0.3]\n'
                  'intensity = 2.0\nfalloff = "inverse_square"\n')
     c = workbench.render(lit, "pathtrace", spp=2, pixel_filter="center")
     b = workbench.render(lit, "pathtrace", spp=2, pixel_filter="box")
@@ -158,7 +130,7 @@ def test_pixel_filter_center_on_a_flat_lit_wall_and_at_the_pixel_centre(tmp_path
 def test_diffuse_modes_need_an_emitting_surface(tmp_path):
     """A scene lit by a point light only: the full transport renders it, the diffuse ones
     say there is nothing to distribute (as radiosity)."""
-    sc = _scene(tmp_path, _PLANE + '[[lights]]\ntype = "point"\nposition = [0.5, 1.5, 0.3]\nintensity = 2.0\n')
+    sc = scene(tmp_path, PLANE + '[[lights]]\ntype = "point"\nposition = [0.5, 1.5, 0.3]\nintensity = 2.0\n')
     assert workbench.render(sc, "pathtrace", spp=2).image.max() > 0.0
     for transport in ("diffuse", "eye_specular"):
         with pytest.raises(NotApplicable, match="no emitting surface"):
@@ -245,7 +217,7 @@ emissive panel whose (two-sided in ``full``) emission is one-sided in the diffus
 def test_kernel_agrees_with_readable_reference_in_every_mode(tmp_path, transport, pixel_filter):
     """At a few pixels (background, the wall's back, each ball, the floor, the lamp's back) the numba kernel and the
     readable twin agree within 5 combined standard errors; the chosen pixels are lit."""
-    sc = _scene(tmp_path, _ROOM, "room")
+    sc = scene(tmp_path, _ROOM, "room")
     w, h = 8, 6
     pixels = [(0, 0), (1, 3), (3, 2), (3, 5), (5, 3), (3, 6)]
     opts = dict(fresnel="exact", transport=transport, pixel_filter=pixel_filter)
@@ -263,7 +235,7 @@ def test_eye_sees_the_front_radiance_on_a_back_face(tmp_path):
     """The room's wall seen from its back (pixel centre ray, ``diffuse``) shows the radiance of its
     lit front at that point (radiosity's display draws a patch's value on both sides): the same
     as a narrow camera in front of the wall looking at that point, within the noise."""
-    sc = _scene(tmp_path, _ROOM, "room")
+    sc = scene(tmp_path, _ROOM, "room")
     back = workbench.render(sc, "pathtrace", width=8, height=6, spp=4096, seed=3, transport="diffuse",
                             pixel_filter="center")
     i, j = 1, 3
