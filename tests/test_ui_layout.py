@@ -107,10 +107,6 @@ def test_plot_header_legend_and_markers():
     lines = plotted_lines(plot, ["phong", "raytrace"], "rmse")
     assert list(lines) == ["phong"]  # flat was removed from the panels: not in the legend
     assert lines["phong"][0].tolist() == [500.0]
-    # the error split: a point with its error against the matched reference adds a second line
-    plot.points["phong"][(("tessellation", 6),)] = {**pt, "rmse_matched": 0.01, "flip_matched": 0.02}
-    lines = plotted_lines(plot, ["phong"], "rmse")
-    assert list(lines) == ["phong", "phong vs matched"] and lines["phong vs matched"][1].tolist() == [0.01]
     shapes = [marker_of(m) for m in choosable_methods()]
     assert shapes == [marker_of(m) for m in choosable_methods()]  # the same every call
     assert len(set(shapes[:len(MARKERS)])) == min(len(shapes), len(MARKERS))

@@ -8,9 +8,7 @@ only while the plot's window is shown (a reference can take long: radiosity or h
 finest patches, which cannot be cancelled midway, so closing the window waits for it).  Each
 panel whose image is final (a raster draw, a finished CPU job) gives one point per knob
 setting: its run time and :func:`workbench.compare.metrics.metrics` against the reference
-(RMSE, PSNR, FLIP) and against the method's matched reference (the error split of
-:mod:`workbench.compare.reference`: a second, "vs matched" line per method, its discretisation
-error; that reference is rendered in a background job too), computed in a worker process: ``flip_evaluator`` holds the GIL (a 256 x 256
+(RMSE, PSNR, FLIP), computed in a worker process: ``flip_evaluator`` holds the GIL (a 256 x 256
 evaluation, ~0.2 s, stalled the UI thread for as long when it ran in a thread).  The UI thread
 only copies images and reads finished results; a change of scene or camera starts a new set of
 points.
@@ -44,11 +42,7 @@ background instead of painting its frame, plot area and legend, which on llvmpip
 class ErrorPlot:
     """Points of error against run time for one (scene version, camera).
 
-    ``points[method][option values]`` is ``{"seconds", "rmse", "psnr", "flip", "label"}``, plus
-    ``rmse_matched``, ``flip_matched`` (error against the method's matched reference, its
-    discretisation error: :func:`workbench.compare.reference.matched_spec`) where it has one.
-    ``matched[method]`` is that reference's image, or False (none); ``matched_boards`` render
-    them, one board per (reference method, options): a board runs one job per method.
+    ``points[method][option values]`` is ``{"seconds", "rmse", "psnr", "flip", "label"}``.
     """
 
     key: tuple | None = None
@@ -66,23 +60,18 @@ class ErrorPlot:
     gave_up: bool = False
     board: object = None
     pool: ProcessPoolExecutor | None = None
-    matched: dict = field(default_factory=dict)
-    matched_boards: dict = field(default_factory=dict)
-    matched_waiting: bool = False
 
     def busy(self, frame: int) -> bool:
         """Something will arrive without any input: evaluations in the worker, or, while the
         plot is shown (drawn in frame ``frame`` or the one before), its reference."""
         if self.pending:
             return True
-        return self.shown >= frame - 1 and ((self.ref_image is None and not self.gave_up)
-                                            or self.matched_waiting)
+        return self.shown >= frame - 1 and self.ref_image is None and not self.gave_up
 
     def shutdown(self) -> None:
         """Cancel the reference render and end the worker process (joined)."""
-        for board in [self.board, *self.matched_boards.values()]:
-            if board is not None:
-                board.join_all()
+        if self.board is not None:
+            self.board.join_all()
         if self.pool is not None:
             self.pool.shutdown(wait=True, cancel_futures=True)
             self.pool = None
@@ -142,34 +131,6 @@ def _reference(state: AppState, plot: ErrorPlot) -> np.ndarray | None:
     return plot.ref_image
 
 
-def _matched(state: AppState, plot: ErrorPlot, method: str):
-    """``method``'s matched reference image for the current key: the image, None while it
-    renders, or False when the method has none (outside renderers) or it does not apply."""
-    if method in plot.matched:
-        return plot.matched[method]
-    from ...compare.reference import finest_options, matched_spec
-    from .frames import tiled
-    from .jobs import JobBoard
-    spec = matched_spec(method)
-    if spec is None:
-        plot.matched[method] = False
-        return False
-    ref_m, opts, _ = spec
-    if ref_m == "pathtrace" and "spp" not in opts:  # 'converged': its finest knob here
-        opts = {**opts, **finest_options(ref_m)}
-    board = plot.matched_boards.setdefault((ref_m, tuple(sorted(opts.items()))), JobBoard())
-    job = board.request(state.scene, state.camera, ref_m, opts, tiled=tiled(ref_m))
-    if job.cancelled.is_set():  # the previous key's job, still ending
-        return None
-    if job.error is not None:
-        plot.matched[method] = False
-        return False
-    if job.image is None:
-        return None
-    plot.matched[method] = job.image
-    return job.image
-
-
 def options_text(options: dict) -> str:
     """``{"max_depth": 12}`` -> ``"max_depth=12"`` (the plot's header and labels)."""
     return ", ".join(f"{k}={v}" for k, v in options.items())
@@ -197,10 +158,6 @@ def plotted_lines(plot: ErrorPlot, methods, metric: str) -> dict:
         if rows:
             lines[m] = (np.array([p["seconds"] * 1e3 for p in rows]),
                         np.maximum(np.array([p[metric] for p in rows]), FLOOR))
-        rows = [p for p in rows if f"{metric}_matched" in p]
-        if rows:  # the discretisation error: against the method's matched reference
-            lines[f"{m} vs matched"] = (np.array([p["seconds"] * 1e3 for p in rows]),
-                                        np.maximum(np.array([p[f"{metric}_matched"] for p in rows]), FLOOR))
     return lines
 
 
@@ -215,11 +172,9 @@ def track(state: AppState) -> None:
     plot = state.errors
     key = (state.scene_version, state.camera)
     if key != plot.key:
-        for board in [plot.board, *plot.matched_boards.values()]:
-            if board is not None:
-                for job in board.current.values():
-                    job.cancelled.set()
-        plot.matched = {}
+        if plot.board is not None:
+            for job in plot.board.current.values():
+                job.cancelled.set()
         plot.key, plot.since, plot.ref_image, plot.candidates = key, time.perf_counter(), None, []
         plot.gave_up = False
         plot.points, plot.pending, plot.failed = {}, {}, {}
@@ -236,7 +191,6 @@ def track(state: AppState) -> None:
     ref = _reference(state, plot)
     if ref is None:
         return
-    plot.matched_waiting = False
     for m in state.methods:
         opts = tuple(sorted(state.options[m].items()))
         if opts in plot.points.get(m, {}) or (m, opts) in plot.pending or (m, opts) in plot.failed:
@@ -244,32 +198,20 @@ def track(state: AppState) -> None:
         final = _final_image(state, m)
         if final is None or final[0].shape != ref.shape:
             continue
-        matched = _matched(state, plot, m)
-        if matched is None:
-            plot.matched_waiting = True
-            continue
-        if matched is not False and matched.shape != ref.shape:
-            matched = False
         image, seconds = final
         if plot.pool is None:
             plot.pool = ProcessPoolExecutor(1, mp_context=mp.get_context("spawn"))
         label = ", ".join(f"{k} {v}" for k, v in opts)
         try:
-            plot.pending[(m, opts)] = plot.pool.submit(_point, image, ref, seconds, label,
-                                                       None if matched is False else matched)
+            plot.pending[(m, opts)] = plot.pool.submit(_point, image, ref, seconds, label)
         except BrokenProcessPool:  # the worker died (e.g. out of memory): a new one next time
             plot.pool.shutdown(wait=False, cancel_futures=True)
             plot.pool = None
             plot.failed[(m, opts)] = plot.message = f"{m}: the error-evaluation process died"
 
 
-def _point(image: np.ndarray, reference: np.ndarray, seconds: float, label: str,
-           matched: np.ndarray | None = None) -> dict:
-    point = {**_evaluate(image, reference), "seconds": float(seconds), "label": label}
-    if matched is not None:
-        m = _evaluate(image, matched)
-        point.update(rmse_matched=m["rmse"], flip_matched=m["flip"])
-    return point
+def _point(image: np.ndarray, reference: np.ndarray, seconds: float, label: str) -> dict:
+    return {**_evaluate(image, reference), "seconds": float(seconds), "label": label}
 
 
 def log_limits(values: np.ndarray) -> tuple[float, float]:
@@ -309,8 +251,7 @@ def error_plot(state: AppState) -> None:
         else:  # 1 ms to 1 s, errors 1e-3 to 1
             implot.setup_axes_limits(1.0, 1e3, 1e-3, 1.0, implot.Cond_.always)
         for m, (xs, ys) in lines.items():
-            spec = implot.Spec(marker=getattr(implot.Marker_, marker_of(m.split(" vs ")[0])),
-                               marker_size=3 if " vs " in m else 5)
+            spec = implot.Spec(marker=getattr(implot.Marker_, marker_of(m)), marker_size=5)
             implot.plot_line(m, xs, ys, spec)
         implot.end_plot()
     implot.pop_style_color(len(CLEAR_FILLS))
