@@ -63,8 +63,8 @@ import numba as nb
 import numpy as np
 from numba import prange
 
-from ..raytrace.kernels import (MAX_TASKS, NO_REFCOUNT, _feeler, _light_dir, checker_color, closest,
-                                fresnel_reflectance,
+from ..raytrace.kernels import (MAX_TASKS, NO_REFCOUNT, _feeler, _light_dir, _normalize, checker_color,
+                                closest, fresnel_reflectance,
                                 scratch, surface)
 
 BLOCK = 32
@@ -102,14 +102,6 @@ def rand(key, dim):
 
 
 @nb.njit(error_model="numpy", inline="always")
-def _unit(x, y, z):
-    n = math.sqrt(x * x + y * y + z * z)
-    if n > 0.0:
-        return x / n, y / n, z / n
-    return 0.0, 0.0, 0.0
-
-
-@nb.njit(error_model="numpy", inline="always")
 def _frame(nx, ny, nz):
     """Two unit tangents completing ``n`` (Duff et al., "Building an orthonormal basis,
     revisited", JCGT 2017)."""
@@ -135,7 +127,7 @@ def camera_ray_at(cam, i, j, u, v):
     centre ray) of the camera ``cam`` (``raytrace.whitted.camera_frame``)."""
     x = ((j + u) / cam[14] * 2.0 - 1.0) * cam[12] * cam[13]
     y = (1.0 - (i + v) / cam[15] * 2.0) * cam[12]
-    return _unit(x * cam[3] + y * cam[4] - cam[5], x * cam[6] + y * cam[7] - cam[8],
+    return _normalize(x * cam[3] + y * cam[4] - cam[5], x * cam[6] + y * cam[7] - cam[8],
                  x * cam[9] + y * cam[10] - cam[11])
 
 
@@ -354,7 +346,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
         if rx * fx + ry * fy + rz * fz <= 0.0:  # below the surface: about the geometric normal
             cg_ = -(dx * fx + dy * fy + dz * fz)
             rx, ry, rz = dx + 2.0 * cg_ * fx, dy + 2.0 * cg_ * fy, dz + 2.0 * cg_ * fz
-        rx, ry, rz = _unit(rx, ry, rz)
+        rx, ry, rz = _normalize(rx, ry, rz)
         # refraction geometry and the Fresnel split of kr, kt (as the ray tracer's shade_hit)
         new_n = nstk
         tx, ty, tz = dx, dy, dz
@@ -387,7 +379,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                 a_r, a_t = a_r + a_t, 0.0
             else:
                 cost = math.sqrt(kk)
-                tx, ty, tz = _unit(eta * dx + (eta * cf - cost) * fx, eta * dy + (eta * cf - cost) * fy,
+                tx, ty, tz = _normalize(eta * dx + (eta * cf - cost) * fx, eta * dy + (eta * cf - cost) * fy,
                                    eta * dz + (eta * cf - cost) * fz)
                 if fres > 0:
                     F = fresnel_reflectance(fres, n1, n2, cf, cost)
