@@ -20,7 +20,7 @@ length, threshold, max_gradient, lo (3), hi (3), stack depth]``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numba as nb
 import numpy as np

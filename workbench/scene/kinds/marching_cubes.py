@@ -64,8 +64,9 @@ def marching_cubes(values: np.ndarray, xs: np.ndarray, ys: np.ndarray, zs: np.nd
     Returns
     -------
     P : (V, 3) float64 vertices (on cube edges, linearly interpolated).
-    F : (T, 3) int64 faces, counter-clockwise seen from the outside; zero-area triangles
-        (from flat layers or vertices on grid points) are left out.
+    F : (T, 3) int64 faces, counter-clockwise seen from the outside.  Vertices at the same
+        position are merged (a sample exactly at the level, a flat layer) and the triangles
+        that collapse to a segment or a point are left out.
     """
     v = np.where(np.isnan(values), 1.0, values).astype(np.float64)
     X, Y, Z = v.shape
@@ -127,9 +128,11 @@ def marching_cubes(values: np.ndarray, xs: np.ndarray, ys: np.ndarray, zs: np.nd
                - (cpos * ins[..., None]).sum(1) / ins.sum(1)[:, None])
     flip = (n * out_dir).sum(1) < 0.0
     F[flip] = F[flip][:, ::-1]
-    n = np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]])
-    area2 = np.linalg.norm(n, axis=1)
-    good = area2 > 0.0
+    # a sample exactly at the level puts the vertices of all its edges on it: merge vertices
+    # at one position and drop the triangles that collapse (keeps every edge used twice)
+    P, same = np.unique(P, axis=0, return_inverse=True)
+    F = same.reshape(-1)[F]
+    good = (F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 2] != F[:, 0])
     return P, F[good]
 
 
