@@ -117,6 +117,7 @@ class _Parser:
         self.text = text
         self.toks = _tokens(text, self.fail)
         self.i = 0
+        self.nest = 0
         self.code: list[tuple[int, float]] = []
 
     def fail(self, pos: int, msg: str):
@@ -150,14 +151,18 @@ class _Parser:
             self.code.append((_BINARY_OPS[op], 0.0))
 
     def unary(self):
-        kind, value, _ = self.peek()
+        kind, value, pos = self.peek()
+        self.nest += 1      # every nesting (parentheses, arguments, signs, powers) passes here
+        if self.nest > MAX_STACK:
+            self.fail(pos, f"nested too deeply (more than {MAX_STACK} levels)")
         if kind == "op" and value in "+-":
             self.take()
             self.unary()
             if value == "-":
                 self.code.append((NEG, 0.0))
-            return
-        self.power()
+        else:
+            self.power()
+        self.nest -= 1
 
     def power(self):
         self.atom()

@@ -184,5 +184,6 @@ def shade_normals(P: np.ndarray, F: np.ndarray, gradient, lo, hi):
     back = (cn * cap_normal[is_cap]).sum(1) < 0.0
     Fc = (len(P) + np.arange(3 * len(cf))).reshape(-1, 3)
     Fc[back] = Fc[back][:, ::-1]
-    return (np.concatenate([P, Pc]), np.concatenate([N, Nc]),
-            np.concatenate([F[~is_cap], Fc]).astype(np.int64))
+    P, N, F = np.concatenate([P, Pc]), np.concatenate([N, Nc]), np.concatenate([F[~is_cap], Fc])
+    used, F = np.unique(F, return_inverse=True)      # drop the vertices only caps used
+    return P[used], N[used], F.reshape(-1, 3).astype(np.int64)
