@@ -76,8 +76,8 @@ def parse(t: dict, where: str, common: dict) -> Lathe:
     if ((seg == 0).all(1)).any():
         i = int(np.argmax((seg == 0).all(1)))
         val.fail(f"{where}.points[{i + 1}]", "repeats the previous point (a zero-length segment)")
-    if len(P) == 2 and P[0, 1] == P[1, 1] and P[0, 0] == 0.0 == P[1, 0]:
-        val.fail(f"{where}.points", "a profile on the axis has no surface")
+    if (P[:, 0] == 0.0).all():
+        val.fail(f"{where}.points", "every point is on the axis (r = 0): the profile sweeps no surface")
     return Lathe(points=P, **common)
 
 
