@@ -9,8 +9,9 @@ March by sphere tracing (Hart, "Sphere tracing", The Visual Computer 12, 1996): 
 the step ``h = max(|g(t)| / L, h_min)`` cannot jump a crossing unless it is the floor
 ``h_min = MIN_STEP (t1 - t0)``, a fixed fraction of the chord (only features thinner than
 that along the ray, where the surface also comes within ``h_min L`` of the ray in value, may
-be missed).  A change of status between two steps is narrowed by bisection to adjacent
-floating-point numbers: the accuracy of the hit is that of evaluating f.  Normals: the exact
+be missed).  A change of status between two steps is narrowed to adjacent floating-point
+numbers (bisection in the readable twin, the Illinois method in the numba one): the accuracy
+of the hit is that of evaluating f.  Normals: the exact
 gradient of f by forward-mode automatic differentiation of the program; on the box's faces,
 the face's normal.
 
@@ -213,6 +214,35 @@ def _g(par, k, aux, ox, oy, oz, dx, dy, dz, t, stack):
 
 
 @nb.njit(cache=True, error_model="numpy")
+def _narrow(par, k, aux, ox, oy, oz, dx, dy, dz, a, fa, b, fb, stack):
+    """The end past the change of ``g < 0`` in ``[a, b]`` (values ``fa``, ``fb``), narrowed to
+    adjacent floats by the Illinois method (regula falsi halving the value kept at an end that
+    stays twice; Dowell & Jarratt, BIT 11, 1971), bisecting wherever the secant point is not
+    strictly inside the bracket (a NaN value, a flat stretch)."""
+    sa = fa < 0.0
+    side = 0
+    for _ in range(BISECTIONS):
+        m = 0.5 * (a + b)
+        if m <= a or m >= b:
+            break
+        c = (a * fb - b * fa) / (fb - fa)
+        if not (a < c < b):
+            c = m
+        fc = _g(par, k, aux, ox, oy, oz, dx, dy, dz, c, stack)
+        if (fc < 0.0) == sa:
+            a, fa = c, fc
+            if side == -1:
+                fb *= 0.5
+            side = -1
+        else:
+            b, fb = c, fc
+            if side == 1:
+                fa *= 0.5
+            side = 1
+    return b
+
+
+@nb.njit(cache=True, error_model="numpy")
 def iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, cap, stack):
     """Crossings ``tmin < t < tmax`` of the solid's boundary (see :func:`crossings`), written to
     ``out_t``, ``out_f`` (face), at most ``cap``; returns their count.  ``stack``: scratch of
@@ -250,15 +280,7 @@ def iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f,
         tn = min(t + max(h, h_min), t1)
         gn = _g(par, k, aux, ox, oy, oz, dx, dy, dz, tn, stack)
         if (gn < 0.0) != status:
-            a, b = t, tn
-            for _ in range(BISECTIONS):
-                mid = 0.5 * (a + b)
-                if mid <= a or mid >= b:
-                    break
-                if (_g(par, k, aux, ox, oy, oz, dx, dy, dz, mid, stack) < 0.0) == status:
-                    a = mid
-                else:
-                    b = mid
+            b = _narrow(par, k, aux, ox, oy, oz, dx, dy, dz, t, gt, tn, gn, stack)
             if tmin < b < tmax:
                 out_t[m], out_f[m] = b, 0
                 m += 1
