@@ -57,27 +57,27 @@ def _objects():
     star = [[math.cos(a) * (1.0 if i % 2 == 0 else 0.4), math.sin(a) * (1.0 if i % 2 == 0 else 0.4)]
             for i, a in enumerate(np.linspace(0, 2 * np.pi, 11)[:-1])]
     return [
-        ("blob, 3 components", 0, blob, blob.parse({"threshold": 0.3, "components": [
+        ("blob, 3 components", 0, blob, blob.read({"threshold": 0.3, "components": [
             {"center": [0, 0, 0], "radius": 1.0}, {"center": [1.2, 0, 0], "radius": 1.0},
             {"center": [0.6, 0.8, 0], "radius": 0.7, "strength": -0.5}]}, "b", common)),
-        ("blob, 16 components", 0, blob, blob.parse({"threshold": 0.3, "components": many}, "b", common)),
-        ("isosurface sphere", 1, isosurface, isosurface.parse(
+        ("blob, 16 components", 0, blob, blob.read({"threshold": 0.3, "components": many}, "b", common)),
+        ("isosurface sphere", 1, isosurface, isosurface.read(
             {"function": "x^2+y^2+z^2", "threshold": 4.0, "max_gradient": 10.4, **iso}, "i", common)),
-        ("isosurface torus", 1, isosurface, isosurface.parse(
+        ("isosurface torus", 1, isosurface, isosurface.read(
             {"function": "(sqrt(x^2+z^2)-2)^2+y^2", "threshold": 0.25, "max_gradient": 8.0, **iso}, "i", common)),
-        ("isosurface gyroid", 1, isosurface, isosurface.parse(
+        ("isosurface gyroid", 1, isosurface, isosurface.read(
             {"function": "sin(x)*cos(y)+sin(y)*cos(z)+sin(z)*cos(x)", "threshold": 0.0, "max_gradient": 2.5, **iso},
             "i", common)),
-        ("lathe, 6-point cup", 2, lathe, lathe.parse(
+        ("lathe, 6-point cup", 2, lathe, lathe.read(
             {"points": [[0, 0], [1, 0], [1.5, 2], [1.2, 2], [0.8, 0.3], [0, 0.3]]}, "l", common)),
-        ("prism, 10-vertex star", 3, prism, prism.parse({"polygon": star, "heights": [0, 0.5]}, "p", common)),
+        ("prism, 10-vertex star", 3, prism, prism.read({"polygon": star, "heights": [0, 0.5]}, "p", common)),
     ]
 
 
 def _tessellate(mod, obj, res):
     if mod is prism:
-        return mod.tessellate(obj)
-    return mod.tessellate(obj, res)
+        return mod.mesh(obj)
+    return mod.mesh(obj, res)
 
 
 def main(n_rays: int = 50_000) -> dict:

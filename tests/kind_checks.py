@@ -43,3 +43,9 @@ def assert_alternates(crossings, inside_at):
     for i, (a, b) in enumerate(zip(ts[:-1], ts[1:])):
         if b > a:
             assert inside_at(0.5 * (a + b)) == (i % 2 == 0), (i, ts)
+
+
+def index_edge_uses(F: np.ndarray) -> np.ndarray:
+    """How many triangles use each edge of an indexed mesh (closed and welded: all 2)."""
+    e = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+    return np.unique(e, axis=0, return_counts=True)[1]

@@ -99,7 +99,7 @@ def test_first_hit_after_tmin_from_inside():
 def test_marching_cubes_mesh_of_one_component():
     R = 2.0 * math.sqrt(0.5)
     b = _one((1.0, 2.0, 3.0), 2.0, 1.0, 0.25)
-    P, N, F = B.tessellate(b, 24)
+    P, N, F = B.mesh(b, 24)
     assert (welded_edge_uses(P, F) == 2).all()
     vol = mesh_volume(P, F)
     assert 0.97 * 4 / 3 * math.pi * R ** 3 < vol < 4 / 3 * math.pi * R ** 3
@@ -112,7 +112,7 @@ def test_marching_cubes_mesh_of_one_component():
 def test_marching_cubes_error_falls_with_resolution():
     errs = []
     for res in (16, 32, 64):
-        P, _, F = B.tessellate(TWO, res)
+        P, _, F = B.mesh(TWO, res)
         errs.append(np.abs(B.field_value(TWO, P) - TWO.threshold).max())
     assert errs[0] > 2.5 * errs[1] > 2.5 * 2.5 * errs[2]
 
@@ -127,6 +127,6 @@ def test_marching_cubes_error_falls_with_resolution():
 ])
 def test_bad_tables_fail_in_one_line(table_, key):
     with pytest.raises(WorkbenchError) as e:
-        B.parse(table_, "o", {"material": "m"})
+        B.read(table_, "o", {"material": "m"})
     msg = str(e.value)
     assert msg.startswith(key + ":") and "\n" not in msg

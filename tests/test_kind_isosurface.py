@@ -19,7 +19,7 @@ GYROID = "sin(x)*cos(y) + sin(y)*cos(z) + sin(z)*cos(x)"
 
 
 def _iso(function, threshold, L, lo, hi):
-    return I.parse({"function": function, "threshold": threshold, "max_gradient": L,
+    return I.read({"function": function, "threshold": threshold, "max_gradient": L,
                     "bounds": {"min": list(lo), "max": list(hi)}}, "o", {"material": "m"})
 
 
@@ -160,7 +160,7 @@ def test_solid_is_closed_by_its_bounds():
     s = _iso("x^2 + y^2 + z^2", 1.0, 7.0, (-0.5, -2, -2), (2, 2, 2))
     t, n = I.intersect(s, np.array([-3.0, 0.1, 0.2]), np.array([1.0, 0.0, 0.0]))
     assert t == pytest.approx(2.5, rel=REL) and np.allclose(n, [-1, 0, 0])
-    P, N, F = I.tessellate(s, 48)
+    P, N, F = I.mesh(s, 48)
     assert (welded_edge_uses(P, F) == 2).all()
     want = 4 / 3 * math.pi - math.pi * 0.25 * 2.5 / 3      # sphere minus the cap x < -0.5
     assert abs(mesh_volume(P, F) - want) < 0.01 * want
@@ -172,7 +172,7 @@ def test_solid_is_closed_by_its_bounds():
 def test_torus_mesh():
     R, a = 2.0, 0.5
     s = _iso(f"(sqrt(x^2 + z^2) - {R})^2 + y^2", a * a, 8.0, (-3, -1, -3), (3, 1, 3))
-    P, N, F = I.tessellate(s, 48)
+    P, N, F = I.mesh(s, 48)
     assert (welded_edge_uses(P, F) == 2).all()
     want = 2 * math.pi ** 2 * R * a * a
     assert 0.97 * want < mesh_volume(P, F) < want
@@ -190,6 +190,6 @@ def test_torus_mesh():
 ])
 def test_bad_tables_fail_in_one_line(table_, key):
     with pytest.raises(WorkbenchError) as e:
-        I.parse(table_, "o", {"material": "m"})
+        I.read(table_, "o", {"material": "m"})
     msg = str(e.value)
     assert msg.startswith(key + ":") and "\n" not in msg

@@ -17,7 +17,7 @@ CUP = [[0, 0], [1, 0], [1.5, 2], [1.2, 2], [0.8, 0.3], [0, 0.3]]
 
 
 def _lathe(points):
-    return L.parse({"points": points}, "o", {"material": "m"})
+    return L.read({"points": points}, "o", {"material": "m"})
 
 
 def _first(la, O, D, tmin=0.0, tmax=np.inf):
@@ -100,7 +100,7 @@ def test_scale_invariance():
 
 def test_tessellation_volume_is_pappus():
     la = _lathe(CUP)
-    P, N, F = L.tessellate(la, 256)
+    P, N, F = L.mesh(la, 256)
     assert (welded_edge_uses(P, F) == 2).all()
     p = np.array(CUP, dtype=float)
     exact = sum(math.pi * (y1 - y0) * (r0 * r0 + r0 * r1 + r1 * r1) / 3

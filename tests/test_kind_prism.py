@@ -18,7 +18,7 @@ STAR = [[math.cos(a) * (1.0 if i % 2 == 0 else 0.4), math.sin(a) * (1.0 if i % 2
 
 
 def _prism(polygon, heights):
-    return R.parse({"polygon": polygon, "heights": heights}, "o", {"material": "m"})
+    return R.read({"polygon": polygon, "heights": heights}, "o", {"material": "m"})
 
 
 def _slab(lo, hi, O, D):
@@ -102,7 +102,7 @@ def test_scale_invariance():
 
 def test_tessellation_is_closed_with_the_right_volume():
     p = _prism(STAR, [0.0, 0.5])
-    P, N, F = R.tessellate(p)
+    P, N, F = R.mesh(p)
     assert (welded_edge_uses(P, F) == 2).all()
     x, z = np.array(STAR).T
     area = abs(0.5 * np.sum(x * np.roll(z, -1) - np.roll(x, -1) * z))
@@ -119,6 +119,6 @@ def test_tessellation_is_closed_with_the_right_volume():
 ])
 def test_bad_tables_fail_in_one_line(t, key):
     with pytest.raises(WorkbenchError) as e:
-        R.parse(t, "o", {"material": "m"})
+        R.read(t, "o", {"material": "m"})
     msg = str(e.value)
     assert msg.startswith(key + ":") and "\n" not in msg

@@ -37,6 +37,16 @@ from .. import model as m
 from . import values as val
 from .marching_cubes import grid_cells, marching_cubes, shade_normals
 
+TYPE = "blob"
+PTYPE = 7
+"""Its ``ptype`` in the ray tracer's primitive table."""
+SOLID = True
+CONVEX = False
+COMPOSITE = False
+KEYS = frozenset({"threshold", "components"})
+REQUIRED = KEYS
+LEVEL_CELLS = 8
+"""Marching-cubes cells along the longest side of the bounds per tessellation level."""
 MAX_COMPONENTS = 256
 """Most components a blob may have (the kernels' cost per ray is quadratic in their number)."""
 BISECTIONS = 200
@@ -54,10 +64,10 @@ class Blob(m.SceneObject):
 
 
 # --------------------------------------------------------------------------- parse
-def parse(t: dict, where: str, common: dict) -> Blob:
+def read(t: dict, where: str, common: dict) -> Blob:
     """Read ``{threshold = T, components = [{center = [x, y, z], radius = r, strength = s}, ...]}``
     (``common``: the keys every object has, already read: material, transform, ...)."""
-    val.check_keys(t, where, val.COMMON | {"threshold", "components"}, {"threshold", "components"})
+    val.check_keys(t, where, val.COMMON | KEYS, REQUIRED)
     threshold = val.number(t, where, "threshold", lo=0.0, lo_open=True)
     comps = t.get("components")
     if not isinstance(comps, list) or not 1 <= len(comps) <= MAX_COMPONENTS:
@@ -76,6 +86,12 @@ def parse(t: dict, where: str, common: dict) -> Blob:
         val.fail(f"{where}.components", "needs a component of positive strength (else the field never "
                  "exceeds the threshold)")
     return Blob(components=C, threshold=threshold, **common)
+
+
+def bound_points(b: Blob) -> np.ndarray:
+    """(8, 3) corners of :func:`bounds`."""
+    lo, hi = bounds(b)
+    return np.array([np.where(np.array(s, bool), hi, lo) for s in np.ndindex(2, 2, 2)])
 
 
 def bounds(b: Blob) -> tuple[np.ndarray, np.ndarray]:
@@ -170,6 +186,11 @@ def crossings(b: Blob, O, D) -> list[tuple[float, int]]:
     return out
 
 
+def hits(b: Blob, O, D, solid: bool = True) -> list[tuple[float, int]]:
+    """The registry's name for :func:`crossings` (a blob is always a solid)."""
+    return crossings(b, O, D)
+
+
 def normal(b: Blob, face: int, P) -> np.ndarray:
     """Unit outward normal at the surface point P (3,)."""
     g = gradient(b, P)
@@ -185,7 +206,7 @@ def intersect(b: Blob, O, D, tmin: float = 0.0, tmax: float = np.inf):
 
 
 # --------------------------------------------------------------------------- tessellation
-def tessellate(b: Blob, resolution: int):
+def mesh(b: Blob, resolution: int):
     """Marching cubes over the bounds (``resolution`` cells along their longest side, plus a
     cell of margin): ``(P (V, 3), N (V, 3) unit outward normals, F (T, 3) int64)``, object space."""
     lo, hi = bounds(b)
@@ -196,6 +217,18 @@ def tessellate(b: Blob, resolution: int):
     G = np.stack(np.meshgrid(xs, ys, zs, indexing="ij"), -1)
     P, F = marching_cubes(b.threshold - field_value(b, G), xs, ys, zs)
     return shade_normals(P, F, lambda X: gradient(b, X), lo, hi)
+
+
+def solid_mesh(b: Blob, level: int) -> tuple[np.ndarray, np.ndarray]:
+    """Closed object-space mesh ``(P (V, 3), F (T, 3))`` at ``LEVEL_CELLS * level`` cells (for
+    the raster's CSG booleans)."""
+    P, _, F = mesh(b, LEVEL_CELLS * level)
+    return P, F
+
+
+def analytic_normals(b: Blob, P: np.ndarray):
+    """Object-space normals (-grad F) at points P (n, 3), and no cap."""
+    return gradient(b, P), np.zeros(len(P), dtype=bool)
 
 
 # --------------------------------------------------------------------------- kernel rows

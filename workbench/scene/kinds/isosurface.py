@@ -31,6 +31,16 @@ from . import values as val
 from .expression import Program, compile_expression, evaluate, evaluate_gradient, evaluate_numpy, gradient_numpy
 from .marching_cubes import closed_grid, grid_cells, marching_cubes, pad_outside, shade_normals
 
+TYPE = "isosurface"
+PTYPE = 8
+"""Its ``ptype`` in the ray tracer's primitive table."""
+SOLID = True
+CONVEX = False
+COMPOSITE = False
+KEYS = frozenset({"function", "threshold", "max_gradient", "bounds"})
+REQUIRED = frozenset({"function", "max_gradient", "bounds"})
+LEVEL_CELLS = 8
+"""Marching-cubes cells along the longest side of the bounds per tessellation level."""
 MIN_STEP = 2.0 ** -16
 """Smallest marching step, as a fraction of the ray's chord through the bounds (bounds the
 work per ray by 2^16 steps)."""
@@ -59,14 +69,13 @@ class Isosurface(m.SceneObject):
 
 
 # --------------------------------------------------------------------------- parse
-def parse(t: dict, where: str, common: dict) -> Isosurface:
+def read(t: dict, where: str, common: dict) -> Isosurface:
     """Read ``{function = "...", threshold = T, max_gradient = L, bounds = {min, max}}``.
 
     The declared ``max_gradient`` is checked against |grad f| on a ``GRADIENT_CHECK^3`` grid
     over the bounds: a bound below a sampled gradient is refused (the root search would step
     over surfaces), naming the point."""
-    val.check_keys(t, where, val.COMMON | {"function", "threshold", "max_gradient", "bounds"},
-                   {"function", "max_gradient", "bounds"})
+    val.check_keys(t, where, val.COMMON | KEYS, REQUIRED)
     if not isinstance(t.get("function"), str):
         val.fail(f"{where}.function", f"expected an expression of x, y, z as a string, got {t.get('function')!r}")
     try:
@@ -88,6 +97,12 @@ def parse(t: dict, where: str, common: dict) -> Isosurface:
                  f"{[round(c, 6) for c in p]}: the root search could step over the surface")
     return Isosurface(function=t["function"], threshold=threshold, max_gradient=L,
                       bounds_min=lo, bounds_max=hi, program=prog, **common)
+
+
+def bound_points(s: Isosurface) -> np.ndarray:
+    """(8, 3) corners of the bounds."""
+    lo, hi = bounds(s)
+    return np.array([np.where(np.array(q, bool), hi, lo) for q in np.ndindex(2, 2, 2)])
 
 
 def bounds(s: Isosurface) -> tuple[np.ndarray, np.ndarray]:
@@ -167,6 +182,11 @@ def crossings(s: Isosurface, O, D) -> list[tuple[float, int]]:
     return out
 
 
+def hits(s: Isosurface, O, D, solid: bool = True) -> list[tuple[float, int]]:
+    """The registry's name for :func:`crossings` (an isosurface is always a solid)."""
+    return crossings(s, O, D)
+
+
 def normal(s: Isosurface, face: int, P) -> np.ndarray:
     """Unit outward normal at P (3,): grad f on the function's surface, the box face's normal
     on a face of the bounds."""
@@ -187,16 +207,41 @@ def intersect(s: Isosurface, O, D, tmin: float = 0.0, tmax: float = np.inf):
 
 
 # --------------------------------------------------------------------------- tessellation
-def tessellate(s: Isosurface, resolution: int):
+def mesh(s: Isosurface, resolution: int):
     """Marching cubes over the bounds (``resolution`` cells along their longest side), closed
     on the bounds' faces: ``(P (V, 3), N (V, 3) unit outward normals, F (T, 3) int64)``."""
+    P, F = _closed_mesh(s, resolution)
+    return shade_normals(P, F, lambda Q: gradient_numpy(s.program, Q[:, 0], Q[:, 1], Q[:, 2])[1], *bounds(s))
+
+
+def _closed_mesh(s: Isosurface, resolution: int) -> tuple[np.ndarray, np.ndarray]:
+    """Marching cubes of ``f - threshold`` over the bounds, padded outside (closed on them)."""
     lo, hi = bounds(s)
-    n = grid_cells(lo, hi, resolution, f"isosurface {s.name!r}")
-    xs, ys, zs = closed_grid(lo, hi, n)
+    xs, ys, zs = closed_grid(lo, hi, grid_cells(lo, hi, resolution, f"isosurface {s.name!r}"))
     X, Y, Z = np.meshgrid(xs[1:-1], ys[1:-1], zs[1:-1], indexing="ij")
-    v = pad_outside(evaluate_numpy(s.program, X, Y, Z) - s.threshold)
-    P, F = marching_cubes(v, xs, ys, zs)
-    return shade_normals(P, F, lambda Q: gradient_numpy(s.program, Q[:, 0], Q[:, 1], Q[:, 2])[1], lo, hi)
+    return marching_cubes(pad_outside(evaluate_numpy(s.program, X, Y, Z) - s.threshold), xs, ys, zs)
+
+
+def solid_mesh(s: Isosurface, level: int) -> tuple[np.ndarray, np.ndarray]:
+    """Closed object-space mesh ``(P (V, 3), F (T, 3))`` at ``LEVEL_CELLS * level`` cells (for
+    the raster's CSG booleans; caps included, vertices shared)."""
+    return _closed_mesh(s, LEVEL_CELLS * level)
+
+
+def analytic_normals(s: Isosurface, P: np.ndarray):
+    """Object-space normals at points P (n, 3): grad f, or the face's normal on the bounds
+    (``cap`` True there)."""
+    P = np.asarray(P, dtype=np.float64)
+    lo, hi = bounds(s)
+    N = gradient_numpy(s.program, P[:, 0], P[:, 1], P[:, 2])[1]
+    cap = np.zeros(len(P), dtype=bool)
+    for axis in range(3):
+        for side, plane in ((-1.0, lo[axis]), (1.0, hi[axis])):
+            on = P[:, axis] == plane
+            N[on] = 0.0
+            N[on, axis] = side
+            cap |= on
+    return N, cap
 
 
 # --------------------------------------------------------------------------- kernel rows

@@ -34,6 +34,17 @@ from .. import model as m
 from . import values as val
 from .crossing_events import alternate, sort_hits
 
+TYPE = "lathe"
+PTYPE = 9
+"""Its ``ptype`` in the ray tracer's primitive table."""
+SOLID = True
+"""When its profile is closed (:func:`solid`); an open lathe is a sheet."""
+CONVEX = False
+COMPOSITE = False
+KEYS = frozenset({"points"})
+REQUIRED = KEYS
+LEVEL_STEPS = 8
+"""Angular steps per tessellation level (as a sphere's segments)."""
 MAX_POINTS = 256
 TOL_CUT = tol.cut
 TOL_ZERO = tol.zero
@@ -65,9 +76,9 @@ class Lathe(m.SceneObject):
 
 
 # --------------------------------------------------------------------------- parse
-def parse(t: dict, where: str, common: dict) -> Lathe:
+def read(t: dict, where: str, common: dict) -> Lathe:
     """Read ``{points = [[r, y], ...]}`` (at least 2 points, r >= 0, no zero-length segment)."""
-    val.check_keys(t, where, val.COMMON | {"points"}, {"points"})
+    val.check_keys(t, where, val.COMMON | KEYS, REQUIRED)
     P = val.points(t, where, "points", 2, least=2, most=MAX_POINTS)
     if (P[:, 0] < 0).any():
         i = int(np.argmax(P[:, 0] < 0))
@@ -79,6 +90,17 @@ def parse(t: dict, where: str, common: dict) -> Lathe:
     if (P[:, 0] == 0.0).all():
         val.fail(f"{where}.points", "every point is on the axis (r = 0): the profile sweeps no surface")
     return Lathe(points=P, **common)
+
+
+def solid(la: Lathe) -> bool:
+    """Has an inside (its profile is closed)."""
+    return la.closed
+
+
+def bound_points(la: Lathe) -> np.ndarray:
+    """(8, 3) corners of :func:`bounds`."""
+    lo, hi = bounds(la)
+    return np.array([np.where(np.array(s, bool), hi, lo) for s in np.ndindex(2, 2, 2)])
 
 
 def bounds(la: Lathe) -> tuple[np.ndarray, np.ndarray]:
@@ -149,6 +171,11 @@ def crossings(la: Lathe, O, D) -> list[tuple[float, int]]:
     return alternate(hits, lambda t: bool(inside(la, O + t * D)))
 
 
+def hits(la: Lathe, O, D, solid: bool = False) -> list[tuple[float, int]]:
+    """The registry's name for :func:`crossings`."""
+    return crossings(la, O, D)
+
+
 def normal(la: Lathe, face: int, P) -> np.ndarray:
     """Unit normal of segment ``face`` at P (3,) (outward for a closed lathe)."""
     (r0, y0), (r1, y1) = la.points[face], la.points[face + 1]
@@ -171,11 +198,12 @@ def intersect(la: Lathe, O, D, tmin: float = 0.0, tmax: float = np.inf):
 
 
 # --------------------------------------------------------------------------- tessellation
-def tessellate(la: Lathe, steps: int):
+def mesh(la: Lathe, steps: int):
     """Each segment swept in ``steps`` angular steps: ``(P, N, F)`` with the segment's normal on
     its own vertices (smooth around the axis, creased between segments)."""
     ang = np.linspace(0.0, 2.0 * np.pi, steps + 1)
     c, s = np.cos(ang), np.sin(ang)
+    c[-1], s[-1] = 1.0, 0.0          # the seam's two copies at exactly the same place
     Ps, Ns, Fs, base = [], [], [], 0
     for i in range(len(la.points) - 1):
         (r0, y0), (r1, y1) = la.points[i], la.points[i + 1]
@@ -196,6 +224,20 @@ def tessellate(la: Lathe, steps: int):
     back = (fn * N[F].sum(1)).sum(1) < 0.0
     F[back] = F[back][:, ::-1]
     return P, N, F.astype(np.int64)
+
+
+def solid_mesh(la: Lathe, level: int) -> tuple[np.ndarray, np.ndarray]:
+    """Closed, welded object-space mesh ``(P, F)`` of a closed lathe at ``LEVEL_STEPS * level``
+    steps (for the raster's CSG booleans)."""
+    P, _, F = mesh(la, LEVEL_STEPS * level)
+    return weld(P, F)
+
+
+def weld(P: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Merge vertices at the same position; drop the triangles that collapse."""
+    P, same = np.unique(P, axis=0, return_inverse=True)
+    F = same.reshape(-1)[F]
+    return P, F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 2] != F[:, 0])]
 
 
 # --------------------------------------------------------------------------- kernel rows

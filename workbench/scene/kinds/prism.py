@@ -25,7 +25,16 @@ from .. import model as m
 from ..polygon_pieces import ear_triangles
 from . import values as val
 from .crossing_events import alternate, sort_hits
+from .lathe import weld
 
+TYPE = "prism"
+PTYPE = 10
+"""Its ``ptype`` in the ray tracer's primitive table."""
+SOLID = True
+CONVEX = False
+COMPOSITE = False
+KEYS = frozenset({"polygon", "heights"})
+REQUIRED = KEYS
 MAX_VERTICES = 256
 TOL_CUT = tol.cut
 """``tol.cut`` as a compile-time constant of the kernels."""
@@ -61,10 +70,10 @@ def _segments_cross(a, b, c, d) -> bool:
             or (o4 == 0 and on(c, d, b)))
 
 
-def parse(t: dict, where: str, common: dict) -> Prism:
+def read(t: dict, where: str, common: dict) -> Prism:
     """Read ``{polygon = [[x, z], ...], heights = [y0, y1]}``: at least 3 vertices, a simple
     polygon (no two non-adjacent edges meet, no repeated vertex), ``y0 < y1``."""
-    val.check_keys(t, where, val.COMMON | {"polygon", "heights"}, {"polygon", "heights"})
+    val.check_keys(t, where, val.COMMON | KEYS, REQUIRED)
     P = val.points(t, where, "polygon", 2, least=3, most=MAX_VERTICES)
     y0, y1 = val.vector(t, where, "heights", n=2)
     if not y0 < y1:
@@ -85,6 +94,12 @@ def parse(t: dict, where: str, common: dict) -> Prism:
     if abs(area2) <= tol.degenerate * diam * max(diam, float(np.abs(P).max())):
         val.fail(f"{where}.polygon", "has no area")
     return Prism(polygon=P, y0=y0, y1=y1, **common)
+
+
+def bound_points(p: Prism) -> np.ndarray:
+    """(8, 3) corners of :func:`bounds`."""
+    lo, hi = bounds(p)
+    return np.array([np.where(np.array(s, bool), hi, lo) for s in np.ndindex(2, 2, 2)])
 
 
 def bounds(p: Prism) -> tuple[np.ndarray, np.ndarray]:
@@ -109,7 +124,7 @@ def inside(p: Prism, P) -> np.ndarray:
     return (p.y0 < P[..., 1]) & (P[..., 1] < p.y1) & _in_polygon(p.polygon, P[..., 0], P[..., 2])
 
 
-def hits(p: Prism, O, D) -> list[tuple[float, int]]:
+def piece_hits(p: Prism, O, D) -> list[tuple[float, int]]:
     """Every ``(t, face)`` where the line meets a wall or a cap."""
     ox, oy, oz = O
     dx, dy, dz = D
@@ -139,7 +154,12 @@ def crossings(p: Prism, O, D) -> list[tuple[float, int]]:
     """Crossings ``(t, face)`` of the line with the solid's boundary, sorted, alternating
     entering / leaving (:func:`.crossing_events.alternate`)."""
     O, D = np.asarray(O, dtype=np.float64), np.asarray(D, dtype=np.float64)
-    return alternate(hits(p, O, D), lambda t: bool(inside(p, O + t * D)))
+    return alternate(piece_hits(p, O, D), lambda t: bool(inside(p, O + t * D)))
+
+
+def hits(p: Prism, O, D, solid: bool = True) -> list[tuple[float, int]]:
+    """The registry's name for :func:`crossings`."""
+    return crossings(p, O, D)
 
 
 def normal(p: Prism, face: int, P=None) -> np.ndarray:
@@ -154,7 +174,7 @@ def normal(p: Prism, face: int, P=None) -> np.ndarray:
 
 def intersect(p: Prism, O, D, tmin: float = 0.0, tmax: float = np.inf):
     """First hit ``tmin < t < tmax``: ``(t, unit normal)``, or ``(inf, None)``."""
-    h = [(t, f) for t, f in hits(p, np.asarray(O, dtype=np.float64), np.asarray(D, dtype=np.float64)) if tmin < t < tmax]
+    h = [(t, f) for t, f in piece_hits(p, np.asarray(O, dtype=np.float64), np.asarray(D, dtype=np.float64)) if tmin < t < tmax]
     if not h:
         return np.inf, None
     t, f = min(h)
@@ -162,7 +182,7 @@ def intersect(p: Prism, O, D, tmin: float = 0.0, tmax: float = np.inf):
 
 
 # --------------------------------------------------------------------------- tessellation
-def tessellate(p: Prism):
+def mesh(p: Prism):
     """Walls (one quad per edge, flat normals) and caps (ear clipping of the polygon):
     ``(P, N, F)`` counter-clockwise seen from outside."""
     k = len(p.polygon)
@@ -186,6 +206,12 @@ def tessellate(p: Prism):
     back = (fn * N[F[:, 0]]).sum(1) < 0.0
     F[back] = F[back][:, ::-1]
     return P, N, F
+
+
+def solid_mesh(p: Prism, level: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """Closed, welded object-space mesh ``(P, F)`` (exact at any level)."""
+    P, _, F = mesh(p)
+    return weld(P, F)
 
 
 # --------------------------------------------------------------------------- kernel rows
