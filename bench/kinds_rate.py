@@ -30,22 +30,19 @@ NPAR = 20
 @nb.njit(cache=True)
 def _run(code, par, aux, O, D, t_out):
     """First hit of every ray (kind ``code``: 0 blob, 1 isosurface, 2 lathe, 3 prism)."""
-    one = np.zeros(1)
-    onef = np.zeros(1, dtype=np.int64)
-    stack = np.zeros(MAX_STACK)
+    out_t = np.zeros(4)
+    out_f = np.zeros(4, dtype=np.int64)
+    stack = np.zeros((MAX_STACK, 4))
     for i in range(O.shape[0]):
         ox, oy, oz, dx, dy, dz = O[i, 0], O[i, 1], O[i, 2], D[i, 0], D[i, 1], D[i, 2]
-        t = np.inf
         if code == 0:
-            if blob.blob_crossings(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, one, 1) == 1:
-                t = one[0]
+            t, _ = blob.blob_first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
         elif code == 1:
-            if isosurface.iso_crossings(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, one, onef, 1, stack) == 1:
-                t = one[0]
+            t, _ = isosurface.iso_first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
         elif code == 2:
-            t = lathe.lathe_first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf)[0]
+            t, _ = lathe.lathe_first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
         else:
-            t = prism.prism_first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf)[0]
+            t, _ = prism.prism_first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
         t_out[i] = t
 
 

@@ -8,6 +8,11 @@ NPAR = 20
 SCALES = (1e-6, 1e-3, 1.0, 1e3, 1e6)
 
 
+def scratch():
+    """``(out_t, out_f, stack)``: the scratch arrays the kinds' numba entry points take."""
+    return np.zeros(64), np.zeros(64, dtype=np.int64), np.zeros((64, 4))
+
+
 def table(head: np.ndarray, row: int = 0) -> np.ndarray:
     """A (row + 1, NPAR) parameter table whose row ``row`` is ``head`` (the kernels' layout)."""
     par = np.zeros((row + 1, NPAR))

@@ -28,7 +28,7 @@ def _numba(s, O, D, tmin=-np.inf, tmax=np.inf, cap=16):
     par = table(head)
     ot, of = np.zeros(cap), np.zeros(cap, dtype=np.int64)
     n = I.iso_crossings(par, 0, aux, *map(float, O), *map(float, D), tmin, tmax, ot, of, cap,
-                        np.zeros(MAX_STACK))
+                        np.zeros((MAX_STACK, 4)))
     return par, aux, ot[:n], of[:n]
 
 
@@ -50,7 +50,7 @@ def test_expression_errors_name_the_position(text, pos):
 def test_expression_precedence(text, x, want):
     p = compile_expression(text)
     assert evaluate_numpy(p, x, 0.0, 0.0) == pytest.approx(want, rel=1e-15)
-    assert evaluate(p.code, 0, p.length, x, 0.0, 0.0, np.zeros(MAX_STACK)) == pytest.approx(want, rel=1e-15)
+    assert evaluate(p.code, 0, p.length, x, 0.0, 0.0, np.zeros((MAX_STACK, 4))) == pytest.approx(want, rel=1e-15)
 
 
 @pytest.mark.parametrize("text", ["(" * 70 + "x" + "+1)" * 70, "x+(" * 70 + "x" + ")" * 70, "-" * 4000 + "x",
@@ -68,7 +68,7 @@ def test_evaluators_and_gradients_agree(text):
     P = np.random.default_rng(3).uniform(-2, 2, (60, 3))
     a = evaluate_numpy(p, *P.T)
     v, g = gradient_numpy(p, *P.T)
-    st, st4 = np.zeros(MAX_STACK), np.zeros((MAX_STACK, 4))
+    st, st4 = np.zeros((MAX_STACK, 4)), np.zeros((MAX_STACK, 4))
     b = np.array([evaluate(p.code, 0, p.length, *q, st) for q in P])
     c = np.array([evaluate_gradient(p.code, 0, p.length, *q, st4) for q in P])
     assert np.allclose(a, b, rtol=1e-13, atol=1e-13) and np.array_equal(a, v)

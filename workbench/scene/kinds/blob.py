@@ -232,6 +232,7 @@ def analytic_normals(b: Blob, P: np.ndarray):
 
 
 # --------------------------------------------------------------------------- kernel rows
+# (the numba entry points' shared signatures: see .crossing_events)
 def params(b: Blob, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
     """Parameter row head ``[aux offset, n, T]`` (3,) and aux (5 n,)."""
     return (np.array([aux_offset, len(b.components), b.threshold], dtype=np.float64),
@@ -416,7 +417,24 @@ def blob_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out, cap):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def blob_normal(par, k, aux, x, y, z):
+def blob_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
+    """Nearest hit ``tmin < t < tmax``: ``(t, 0)``, ``(inf, 0)`` on a miss."""
+    if blob_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, 1) == 1:
+        return out_t[0], 0
+    return np.inf, 0
+
+
+@nb.njit(cache=True, error_model="numpy")
+def blob_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
+    """Interval list along the whole line (entering / leaving alternate); returns the count."""
+    m = blob_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, -np.inf, np.inf, out_t, cap)
+    for i in range(m):
+        out_f[i] = 0
+    return m
+
+
+@nb.njit(cache=True, error_model="numpy")
+def blob_normal(par, k, aux, face, x, y, z, stack):
     """Outward normal -grad F at the object-space point (not normalised)."""
     off, n = int(par[k, 0]), int(par[k, 1])
     nx, ny, nz = 0.0, 0.0, 0.0
@@ -434,7 +452,7 @@ def blob_normal(par, k, aux, x, y, z):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def blob_inside(par, k, aux, x, y, z):
+def blob_inside(par, k, aux, x, y, z, stack):
     """F(x, y, z) > T."""
     off, n = int(par[k, 0]), int(par[k, 1])
     F = 0.0

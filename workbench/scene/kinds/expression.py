@@ -289,26 +289,27 @@ def evaluate_numpy(program: Program, x, y, z) -> np.ndarray:
 @nb.njit(cache=True, error_model="numpy")
 def evaluate(code, start, n, x, y, z, stack):
     """The numba stack machine: value of the program ``code[start : start + 2 n]`` (pairs) at
-    ``(x, y, z)``; ``stack`` is scratch of at least the program's depth."""
+    ``(x, y, z)``; ``stack`` is (depth, 4) scratch (the one :func:`evaluate_gradient` takes;
+    this uses its first column)."""
     sp = 0
     for i in range(n):
         op = int(code[start + 2 * i])
         if op == CONST:
-            stack[sp] = code[start + 2 * i + 1]
+            stack[sp, 0] = code[start + 2 * i + 1]
             sp += 1
         elif op == VAR_X:
-            stack[sp] = x
+            stack[sp, 0] = x
             sp += 1
         elif op == VAR_Y:
-            stack[sp] = y
+            stack[sp, 0] = y
             sp += 1
         elif op == VAR_Z:
-            stack[sp] = z
+            stack[sp, 0] = z
             sp += 1
         elif op == NEG:
-            stack[sp - 1] = -stack[sp - 1]
+            stack[sp - 1, 0] = -stack[sp - 1, 0]
         elif op >= FIRST_UNARY:
-            v = stack[sp - 1]
+            v = stack[sp - 1, 0]
             u = op - FIRST_UNARY
             if u == 0:
                 r = math.sin(v)
@@ -338,10 +339,10 @@ def evaluate(code, start, n, x, y, z, stack):
                 r = abs(v)
             else:
                 r = float(math.floor(v))
-            stack[sp - 1] = r
+            stack[sp - 1, 0] = r
         else:
-            b = stack[sp - 1]
-            a = stack[sp - 2]
+            b = stack[sp - 1, 0]
+            a = stack[sp - 2, 0]
             sp -= 1
             if op == ADD:
                 r = a + b
@@ -360,8 +361,8 @@ def evaluate(code, start, n, x, y, z, stack):
                     r = min(a, b) if op == MIN else max(a, b)
             else:
                 r = math.atan2(a, b)
-            stack[sp - 1] = r
-    return stack[0]
+            stack[sp - 1, 0] = r
+    return stack[0, 0]
 
 
 def _unary_derivative(u: int, v):

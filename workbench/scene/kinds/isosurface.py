@@ -245,6 +245,7 @@ def analytic_normals(s: Isosurface, P: np.ndarray):
 
 
 # --------------------------------------------------------------------------- kernel rows
+# (the numba entry points' shared signatures: see .crossing_events)
 def params(s: Isosurface, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
     """Parameter row head (11,) and aux (the program's code)."""
     return (np.array([aux_offset, s.program.length, s.threshold, s.max_gradient, *s.bounds_min,
@@ -290,8 +291,8 @@ def _narrow(par, k, aux, ox, oy, oz, dx, dy, dz, a, fa, b, fb, stack):
 @nb.njit(cache=True, error_model="numpy")
 def iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, cap, stack):
     """Crossings ``tmin < t < tmax`` of the solid's boundary (see :func:`crossings`), written to
-    ``out_t``, ``out_f`` (face), at most ``cap``; returns their count.  ``stack``: scratch of
-    the program's depth."""
+    ``out_t``, ``out_f`` (face), at most ``cap``; returns their count.  ``stack``: (depth, 4)
+    scratch of the program's evaluators."""
     t0, t1, f0, f1 = -np.inf, np.inf, 0, 0
     for a in range(3):
         o = ox if a == 0 else (oy if a == 1 else oz)
@@ -339,14 +340,28 @@ def iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f,
 
 
 @nb.njit(cache=True, error_model="numpy")
-def iso_normal(par, k, aux, face, x, y, z, stack4):
-    """Outward normal at the object-space point (not normalised); ``stack4``: (depth, 4)
+def iso_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
+    """Nearest hit ``tmin < t < tmax``: ``(t, face)``, ``(inf, 0)`` on a miss."""
+    if iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, 1, stack) == 1:
+        return out_t[0], out_f[0]
+    return np.inf, 0
+
+
+@nb.njit(cache=True, error_model="numpy")
+def iso_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
+    """Interval list along the whole line (entering / leaving alternate); returns the count."""
+    return iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, -np.inf, np.inf, out_t, out_f, cap, stack)
+
+
+@nb.njit(cache=True, error_model="numpy")
+def iso_normal(par, k, aux, face, x, y, z, stack):
+    """Outward normal at the object-space point (not normalised); ``stack``: (depth, 4)
     scratch of the gradient evaluator."""
     if face >= 1:
         a = (face - 1) // 2
         sgn = 1.0 if (face - 1) % 2 == 1 else -1.0
         return (sgn if a == 0 else 0.0), (sgn if a == 1 else 0.0), (sgn if a == 2 else 0.0)
-    _, gx, gy, gz = evaluate_gradient(aux, int(par[k, 0]), int(par[k, 1]), x, y, z, stack4)
+    _, gx, gy, gz = evaluate_gradient(aux, int(par[k, 0]), int(par[k, 1]), x, y, z, stack)
     return gx, gy, gz
 
 

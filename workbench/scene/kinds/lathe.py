@@ -241,6 +241,7 @@ def weld(P: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 # --------------------------------------------------------------------------- kernel rows
+# (the numba entry points' shared signatures: see .crossing_events)
 def params(la: Lathe, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
     """Parameter row head ``[aux offset, points, closed, orientation]`` and aux (2 k,)."""
     return (np.array([aux_offset, len(la.points), float(la.closed), la.orientation]),
@@ -291,7 +292,7 @@ def _segment_roots(aux, j, ox, oy, oz, dx, dy, dz, zero):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def lathe_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax):
+def lathe_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
     """Nearest hit ``tmin < t < tmax``: ``(t, segment)``, ``(inf, 0)`` on a miss."""
     off, n = int(par[k, 0]), int(par[k, 1])
     best, bf = tmax, -1
@@ -307,7 +308,7 @@ def lathe_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def lathe_inside(par, k, aux, x, y, z):
+def lathe_inside(par, k, aux, x, y, z, stack):
     """Even-odd test of ``(rho, y)`` against the closed profile."""
     if par[k, 2] == 0.0:
         return False
@@ -324,7 +325,7 @@ def lathe_inside(par, k, aux, x, y, z):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def lathe_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap):
+def lathe_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
     """Interval list of a closed lathe along the whole line (entering / leaving alternate),
     written to ``out_t``, ``out_f`` (segment); returns the count (hits past ``cap`` are
     dropped: a line meets at most two per segment)."""
@@ -344,7 +345,7 @@ def lathe_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap):
         if nxt == t:
             continue
         tm = 0.5 * (t + nxt)
-        after = nxt < np.inf and lathe_inside(par, k, aux, ox + tm * dx, oy + tm * dy, oz + tm * dz)
+        after = nxt < np.inf and lathe_inside(par, k, aux, ox + tm * dx, oy + tm * dy, oz + tm * dz, stack)
         if after != status:
             out_t[w], out_f[w] = t, out_f[i]
             w += 1
@@ -353,7 +354,7 @@ def lathe_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def lathe_normal(par, k, aux, face, x, y, z):
+def lathe_normal(par, k, aux, face, x, y, z, stack):
     """Normal of segment ``face`` at the object-space point (unit)."""
     j = int(par[k, 0]) + 2 * face
     o = par[k, 3]

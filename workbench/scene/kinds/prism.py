@@ -215,6 +215,7 @@ def solid_mesh(p: Prism, level: int = 1) -> tuple[np.ndarray, np.ndarray]:
 
 
 # --------------------------------------------------------------------------- kernel rows
+# (the numba entry points' shared signatures: see .crossing_events)
 def params(p: Prism, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
     """Parameter row head ``[aux offset, vertices, y0, y1, orientation]`` and aux (2 k,)."""
     return (np.array([aux_offset, len(p.polygon), p.y0, p.y1, p.orientation]),
@@ -233,7 +234,7 @@ def _in_polygon_nb(aux, off, n, x, z):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def prism_inside(par, k, aux, x, y, z):
+def prism_inside(par, k, aux, x, y, z, stack):
     return par[k, 2] < y < par[k, 3] and _in_polygon_nb(aux, int(par[k, 0]), int(par[k, 1]), x, z)
 
 
@@ -274,7 +275,7 @@ def prism_hits(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, tmin, tma
 
 
 @nb.njit(cache=True, error_model="numpy")
-def prism_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax):
+def prism_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
     """Nearest hit ``tmin < t < tmax``: ``(t, face)``, ``(inf, 0)`` on a miss."""
     off, n, y0, y1 = int(par[k, 0]), int(par[k, 1]), par[k, 2], par[k, 3]
     best, bf = tmax, -1
@@ -293,7 +294,7 @@ def prism_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def prism_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap):
+def prism_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
     """Interval list along the whole line (entering / leaving alternate); returns the count."""
     m = prism_hits(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, -np.inf, np.inf)
     sort_hits(out_t, out_f, m)
@@ -304,7 +305,7 @@ def prism_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap):
         if nxt == t:
             continue
         tm = 0.5 * (t + nxt)
-        after = nxt < np.inf and prism_inside(par, k, aux, ox + tm * dx, oy + tm * dy, oz + tm * dz)
+        after = nxt < np.inf and prism_inside(par, k, aux, ox + tm * dx, oy + tm * dy, oz + tm * dz, stack)
         if after != status:
             out_t[w], out_f[w] = t, out_f[i]
             w += 1
@@ -313,7 +314,7 @@ def prism_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def prism_normal(par, k, aux, face):
+def prism_normal(par, k, aux, face, x, y, z, stack):
     """Unit outward normal of ``face``."""
     if face < 2:
         return 0.0, (1.0 if face == 1 else -1.0), 0.0
