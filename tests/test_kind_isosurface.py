@@ -35,7 +35,8 @@ def _numba(s, O, D, tmin=-np.inf, tmax=np.inf, cap=16):
 # --------------------------------------------------------------------------- expression
 @pytest.mark.parametrize("text, pos", [("x^2 +", 6), ("2x", 2), ("sin(x, y)", 1), ("foo(x)", 1),
                                        ("x $ y", 3), ("(x", 3), ("", 1), ("min(x)", 1),
-                                       ("1.2.3", 1), ("__import__('os')", 12), ("x ** * 2", 6)])
+                                       ("1.2.3", 1), ("__import__('os')", 12), ("x ** * 2", 6),
+                                       ("x + 1e400", 5)])
 def test_expression_errors_name_the_position(text, pos):
     with pytest.raises(WorkbenchError) as e:
         compile_expression(text)
@@ -193,3 +194,11 @@ def test_bad_tables_fail_in_one_line(table_, key):
         I.read(table_, "o", {"material": "m"})
     msg = str(e.value)
     assert msg.startswith(key + ":") and "\n" not in msg
+
+
+def test_no_gradient_gives_a_zero_normal_not_nan():
+    """sqrt(x^2 + y^2 + z^2) has no gradient at the origin (0/0): both twins say zero."""
+    s = _iso("sqrt(x^2 + y^2 + z^2)", 1.0, 1.0, (-2,) * 3, (2,) * 3)
+    assert I.normal(s, 0, np.zeros(3)).tolist() == [0.0, 0.0, 0.0]
+    head, aux = I.params(s, 0)
+    assert I.iso_normal(table(head), 0, aux, 0, 0.0, 0.0, 0.0, np.zeros((MAX_STACK, 4))) == (0.0, 0.0, 0.0)

@@ -122,3 +122,18 @@ def test_bad_tables_fail_in_one_line(t, key):
         R.read(t, "o", {"material": "m"})
     msg = str(e.value)
     assert msg.startswith(key + ":") and "\n" not in msg
+
+
+def test_patch_surfaces_are_outward_convex_polygons_covering_the_surface():
+    p = _prism(STAR, [0.0, 0.5])
+    W = np.diag([2.0, 1.0, -1.0, 1.0])      # a mirror: the winding must follow
+    polys = [v for kind, v in R.patch_surfaces(p, W, 0.1) if kind == "polygon"]
+    area = sum(np.linalg.norm(np.cross(v[1:-1] - v[0], v[2:] - v[0]).sum(0)) / 2 for v in polys)
+    P, _, F = R.mesh(p)
+    Pw = P @ W[:3, :3].T
+    tri = np.cross(Pw[F[:, 1]] - Pw[F[:, 0]], Pw[F[:, 2]] - Pw[F[:, 0]])
+    assert area == pytest.approx(np.linalg.norm(tri, axis=1).sum() / 2, rel=1e-12)
+    c = Pw.mean(0)
+    for v in polys:       # outward: the normal points away from the (star-shaped) solid's centre
+        n = np.cross(v[1:-1] - v[0], v[2:] - v[0]).sum(0)
+        assert n @ (v.mean(0) - c) > 0

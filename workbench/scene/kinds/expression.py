@@ -89,6 +89,8 @@ def _tokens(text: str, fail) -> list[tuple[str, object, int]]:
                 value = float(text[i:j])
             except ValueError:
                 fail(i, f"malformed number {text[i:j]!r}")
+            if not math.isfinite(value):
+                fail(i, f"number {text[i:j]} is beyond the float64 range")
             out.append(("num", value, i))
             i = j
         elif c.isalpha() or c == "_":

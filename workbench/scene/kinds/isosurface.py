@@ -189,13 +189,14 @@ def hits(s: Isosurface, O, D, solid: bool = True) -> list[tuple[float, int]]:
 
 def normal(s: Isosurface, face: int, P) -> np.ndarray:
     """Unit outward normal at P (3,): grad f on the function's surface, the box face's normal
-    on a face of the bounds."""
+    on a face of the bounds; zero where f has no finite, non-zero gradient."""
     if face >= 1:
         n = np.zeros(3)
         n[(face - 1) // 2] = 1.0 if (face - 1) % 2 else -1.0
         return n
     _, g = gradient_numpy(s.program, *np.asarray(P, dtype=np.float64))
-    return g / np.linalg.norm(g)
+    ln = np.linalg.norm(g)
+    return g / ln if np.isfinite(ln) and ln > 0.0 else np.zeros(3)
 
 
 def intersect(s: Isosurface, O, D, tmin: float = 0.0, tmax: float = np.inf):
@@ -362,6 +363,8 @@ def iso_normal(par, k, aux, face, x, y, z, stack):
         sgn = 1.0 if (face - 1) % 2 == 1 else -1.0
         return (sgn if a == 0 else 0.0), (sgn if a == 1 else 0.0), (sgn if a == 2 else 0.0)
     _, gx, gy, gz = evaluate_gradient(aux, int(par[k, 0]), int(par[k, 1]), x, y, z, stack)
+    if not (math.isfinite(gx) and math.isfinite(gy) and math.isfinite(gz)):
+        return 0.0, 0.0, 0.0      # no gradient there (sqrt(0)...): the kernels' zero normal
     return gx, gy, gz
 
 

@@ -22,7 +22,7 @@ import numpy as np
 
 from ...core.tol import tol
 from .. import model as m
-from ..polygon_pieces import ear_triangles
+from ..polygon_pieces import convex_pieces, ear_triangles
 from . import values as val
 from .crossing_events import alternate, sort_hits
 from .lathe import weld
@@ -212,6 +212,26 @@ def solid_mesh(p: Prism, level: int = 1) -> tuple[np.ndarray, np.ndarray]:
     """Closed, welded object-space mesh ``(P, F)`` (exact at any level)."""
     P, _, F = mesh(p)
     return weld(P, F)
+
+
+def patch_surfaces(p: Prism, W: np.ndarray, h: float):
+    """Radiosity: the walls (rectangles) and the caps' convex pieces, as world polygons
+    ``("polygon", (k, 3))`` counter-clockwise seen from outside, for the patch builder to cut
+    at about ``h``."""
+    W = np.asarray(W, dtype=np.float64)
+    mirror = np.linalg.det(W[:3, :3]) < 0.0     # a mirroring transform flips the winding
+    k = len(p.polygon)
+    x, z = p.polygon[:, 0], p.polygon[:, 1]
+    polys = []
+    for face, y in ((0, p.y0), (1, p.y1)):
+        cap = np.stack([x, np.full(k, y), z], -1)
+        newell = np.cross(cap[1:-1] - cap[0], cap[2:] - cap[0]).sum(0)
+        polys.extend(convex_pieces(cap if newell @ normal(p, face) > 0.0 else cap[::-1]))
+    for i in range(k):
+        j = (i + 1) % k
+        quad = np.array([[x[i], p.y0, z[i]], [x[j], p.y0, z[j]], [x[j], p.y1, z[j]], [x[i], p.y1, z[i]]])
+        polys.append(quad if np.cross(quad[1] - quad[0], quad[3] - quad[0]) @ normal(p, 2 + i) > 0.0 else quad[::-1])
+    return [("polygon", (q[::-1] if mirror else q) @ W[:3, :3].T + W[:3, 3]) for q in polys]
 
 
 # --------------------------------------------------------------------------- kernel rows
