@@ -130,3 +130,11 @@ def test_bad_tables_fail_in_one_line(table_, key):
         B.read(table_, "o", {"material": "m"})
     msg = str(e.value)
     assert msg.startswith(key + ":") and "\n" not in msg
+
+
+def test_parse_hands_the_error_to_the_scene_reader():
+    class Ctx:
+        def fail(self, where, msg):
+            raise WorkbenchError(f"scene.toml: {where}: {msg}")
+    with pytest.raises(WorkbenchError, match=r"^scene.toml: o.threshold: missing required key$"):
+        B.parse(Ctx(), {"components": [{"center": [0, 0, 0], "radius": 1}]}, "o", {"material": "m"})

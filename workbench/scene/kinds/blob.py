@@ -88,6 +88,11 @@ def read(t: dict, where: str, common: dict) -> Blob:
     return Blob(components=C, threshold=threshold, **common)
 
 
+def parse(ctx, t: dict, where: str, common: dict) -> Blob:
+    """:func:`read` with its error handed to the scene reader's ``ctx.fail``."""
+    return val.parse_with(ctx, read, t, where, common)
+
+
 def bound_points(b: Blob) -> np.ndarray:
     """(8, 3) corners of :func:`bounds`."""
     lo, hi = bounds(b)

@@ -99,6 +99,11 @@ def read(t: dict, where: str, common: dict) -> Isosurface:
                       bounds_min=lo, bounds_max=hi, program=prog, **common)
 
 
+def parse(ctx, t: dict, where: str, common: dict) -> Isosurface:
+    """:func:`read` with its error handed to the scene reader's ``ctx.fail``."""
+    return val.parse_with(ctx, read, t, where, common)
+
+
 def bound_points(s: Isosurface) -> np.ndarray:
     """(8, 3) corners of the bounds."""
     lo, hi = bounds(s)

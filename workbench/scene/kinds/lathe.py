@@ -92,6 +92,11 @@ def read(t: dict, where: str, common: dict) -> Lathe:
     return Lathe(points=P, **common)
 
 
+def parse(ctx, t: dict, where: str, common: dict) -> Lathe:
+    """:func:`read` with its error handed to the scene reader's ``ctx.fail``."""
+    return val.parse_with(ctx, read, t, where, common)
+
+
 def solid(la: Lathe) -> bool:
     """Has an inside (its profile is closed)."""
     return la.closed

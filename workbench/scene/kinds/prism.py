@@ -96,6 +96,11 @@ def read(t: dict, where: str, common: dict) -> Prism:
     return Prism(polygon=P, y0=y0, y1=y1, **common)
 
 
+def parse(ctx, t: dict, where: str, common: dict) -> Prism:
+    """:func:`read` with its error handed to the scene reader's ``ctx.fail``."""
+    return val.parse_with(ctx, read, t, where, common)
+
+
 def bound_points(p: Prism) -> np.ndarray:
     """(8, 3) corners of :func:`bounds`."""
     lo, hi = bounds(p)

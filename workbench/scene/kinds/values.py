@@ -18,6 +18,16 @@ def fail(where: str, msg: str):
     raise WorkbenchError(f"{where}: {msg}")
 
 
+def parse_with(ctx, read, t: dict, where: str, common: dict):
+    """The registry's ``parse(ctx, t, w, common)``: run a kind's ``read`` and hand its error to
+    ``ctx.fail(where, what)`` (the scene reader's, which names the file)."""
+    try:
+        return read(t, where, common)
+    except WorkbenchError as e:
+        at, _, what = str(e).partition(": ")
+        ctx.fail(at, what)
+
+
 def check_keys(t, where: str, allowed: set[str], required: set[str] = frozenset()):
     """``t`` is a table with only ``allowed`` keys and every ``required`` one."""
     if not isinstance(t, dict):
