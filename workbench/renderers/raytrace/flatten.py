@@ -23,7 +23,7 @@ sheet (transmission goes straight through).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -79,12 +79,15 @@ class SceneData:
     extent: float               # diagonal of the scene's bounds
     n_objects: int
     bvh_build_time: float = 0.0
+    aux: np.ndarray = field(default_factory=lambda: np.zeros(1))
+    """Variable-length data of the kinds that have it (blob components, an isosurface's
+    program, lathe profiles, prism polygons), flat float64; each row holds its offset."""
 
     def kernel_args(self) -> tuple:
         """The geometry tuple passed to every numba kernel."""
         return (self.ptype, self.top, self.xf, self.nm, self.par, self.solid, self.shadow,
                 self.poly_v, self.csg_prog, self.tri_v, self.tri_n, self.tri_uv, self.tri_e,
-                self.tri_prim, *self.bvh, self.ident)
+                self.tri_prim, *self.bvh, self.ident, self.aux)
 
 
 def _material_row(mat: m.Material, front_only: bool = False) -> np.ndarray:
