@@ -91,3 +91,36 @@ def test_events_of_each_row_match_the_readable_crossings():
             ref = mods[k].hits(obj, O, D, True)
             assert np.allclose(out_t[:n], [t for t, _ in ref], rtol=1e-12, atol=1e-12)
             assert out_f[:n].tolist() == [f for _, f in ref]
+
+
+class _Builder:
+    """The ray tracer's builder interface the kinds' ``flatten`` writes through."""
+
+    def __init__(self):
+        self.rows, self.aux, self.n_aux, self.pts = [], [], 0, []
+
+    def bound(self, W, pts):
+        self.pts.append(pts)
+
+    def add_aux(self, data):
+        self.aux.append(data)
+        self.n_aux += len(data)
+        return self.n_aux - len(data)
+
+    def add(self, ptype, index, obj, W, par, *, top=True, solid=True, shadow=True):
+        row = np.zeros(NPAR)
+        row[:len(par)] = par
+        self.rows.append((ptype, row, solid))
+        return len(self.rows) - 1
+
+
+def test_flatten_through_the_builder_gives_the_same_table():
+    b = _Builder()
+    mods = [blob, isosurface, lathe, prism]
+    for k, (mod, obj) in enumerate(zip(mods, OBJECTS)):
+        assert mod.flatten(b, obj, k, np.eye(4), True) == k
+    ptype, par, aux = _table()
+    assert [r[0] for r in b.rows] == ptype.tolist()
+    assert np.array_equal(np.array([r[1] for r in b.rows]), par)
+    assert np.array_equal(np.concatenate(b.aux), aux)
+    assert [r[2] for r in b.rows] == [True, True, True, True] and len(b.pts) == 4

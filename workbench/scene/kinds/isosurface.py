@@ -252,6 +252,17 @@ def analytic_normals(s: Isosurface, P: np.ndarray):
 
 # --------------------------------------------------------------------------- kernel rows
 # (the numba entry points' shared signatures: see .crossing_events)
+
+def flatten(b, obj, index: int, W: np.ndarray, top: bool) -> int:
+    """Its row of the ray tracer's primitive table through the builder ``b`` (the registry's
+    interface): ``b.bound`` its bounds, ``b.add_aux`` its variable-length data (returns the
+    offset), ``b.add`` the row with :func:`params`' head."""
+    b.bound(W, bound_points(obj))
+    head, data = params(obj, 0)
+    head[0] = b.add_aux(data)
+    return b.add(PTYPE, index, obj, W, head, top=top, solid=SOLID)
+
+
 def params(s: Isosurface, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
     """Parameter row head (11,) and aux (the program's code)."""
     return (np.array([aux_offset, s.program.length, s.threshold, s.max_gradient, *s.bounds_min,

@@ -241,6 +241,17 @@ def patch_surfaces(p: Prism, W: np.ndarray, h: float):
 
 # --------------------------------------------------------------------------- kernel rows
 # (the numba entry points' shared signatures: see .crossing_events)
+
+def flatten(b, obj, index: int, W: np.ndarray, top: bool) -> int:
+    """Its row of the ray tracer's primitive table through the builder ``b`` (the registry's
+    interface): ``b.bound`` its bounds, ``b.add_aux`` its variable-length data (returns the
+    offset), ``b.add`` the row with :func:`params`' head."""
+    b.bound(W, bound_points(obj))
+    head, data = params(obj, 0)
+    head[0] = b.add_aux(data)
+    return b.add(PTYPE, index, obj, W, head, top=top, solid=SOLID)
+
+
 def params(p: Prism, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
     """Parameter row head ``[aux offset, vertices, y0, y1, orientation]`` and aux (2 k,)."""
     return (np.array([aux_offset, len(p.polygon), p.y0, p.y1, p.orientation]),
