@@ -9,8 +9,10 @@ Writes ``bench/results/kinds_rate.json`` and prints it.  Run:
 """
 from __future__ import annotations
 
+import datetime
 import json
 import math
+import os
 import platform
 import sys
 import time
@@ -103,8 +105,9 @@ def main(n_rays: int = 50_000) -> dict:
                 break
         rows.append(dict(kind=name, rays=n_rays, seconds=round(dt, 4), mrays_per_s=round(n_rays / dt / 1e6, 3),
                          hit_fraction=round(float(np.isfinite(t).mean()), 3), tessellation=tess))
-    out = dict(bench="kinds_rate", python=platform.python_version(), numba=nb.__version__,
-               machine=platform.machine(), threads=1, results=rows)
+    out = dict(bench="kinds_rate", date=datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+               load_average=[round(x, 2) for x in os.getloadavg()], python=platform.python_version(),
+               numba=nb.__version__, machine=platform.machine(), threads=1, results=rows)
     RESULTS.mkdir(parents=True, exist_ok=True)
     (RESULTS / "kinds_rate.json").write_text(json.dumps(out, indent=2) + "\n")
     return out
