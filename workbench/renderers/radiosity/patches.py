@@ -120,8 +120,8 @@ class PatchSet:
         return tri, np.repeat(np.arange(len(self)), 2)
 
     def geometry(self):
-        """The patches as form-factor :class:`~.formfactors.Geometry`."""
-        from .formfactors import Geometry
+        """The patches as form-factor :class:`~.geometry.Geometry`."""
+        from .geometry import Geometry
         tri, patch = self.triangles()
         return Geometry(tri, patch, self.centres, self.normals, self.areas, list(self.corners),
                         self.grids)
