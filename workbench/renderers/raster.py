@@ -57,7 +57,8 @@ from ..core.errors import WorkbenchError
 from ..scene import features as ft
 from ..scene.model import AreaLight, Camera, Environment, Material, Scene
 from ..scene.clip_planes import auto_near_far
-from ..scene.tessellate import DEFAULT_LEVEL, MAX_LEVEL, Part, tessellate_scene
+from ..scene.parts import Part
+from ..scene.tessellate import DEFAULT_LEVEL, MAX_LEVEL, tessellate_object, tessellate_scene
 from .estimates import raster_bytes
 from ..scene.tessellate_topology import closed_outward, provoking_layout
 from . import gl
@@ -68,7 +69,7 @@ from .raster_shaders import (LIVE_MATERIAL_FIELDS, ProgramCache, base_defines, l
 
 DEPTH_CHOICES = (16, 24, 32)
 #: Object kinds tessellated as closed, outward-wound surfaces.
-CLOSED_KINDS = ("sphere", "box", "csg")
+CLOSED_KINDS = ("sphere", "box", "csg", "blob", "isosurface", "prism")
 #: Texture units of the image samplers.
 UNITS = {"u_tex_image": 0, "u_bump_image": 1, "u_op_image": 2, "u_env_image": 3}
 #: Shader features and why they may be left out.
@@ -169,16 +170,8 @@ def _same(a, b) -> bool:
 
 def _area_light_parts(scene: Scene) -> list[tuple[Part, Material]]:
     """Area lights as emissive polygons of radiance ``color * intensity``."""
-    from ..scene.model import Polygon
-    from ..scene.tessellate import tessellate_object
-    out = []
-    for i, light in enumerate(scene.lights):
-        if isinstance(light, AreaLight):
-            mat = Material(f"area light {i + 1}", color=(0.0, 0.0, 0.0), ka=0.0, kd=0.0, ks=0.0,
-                           emission=tuple(float(x) for x in light.radiance))
-            (part,) = tessellate_object(Polygon(mat.name, vertices=light.vertices, name=mat.name), 1)
-            out.append((part, mat))
-    return out
+    return [(part, mat) for _, polygon, mat in scene.area_light_polygons()
+            for part in tessellate_object(polygon, 1)]
 
 
 _PARTS: OrderedDict = OrderedDict()
@@ -240,7 +233,7 @@ class RasterSession:
         self.part_boxes = np.array([[p.positions.min(0), p.positions.max(0)] for p, _, _ in pairs])
         self.lights = scene.point_lights()
         self._light_values = light_uniforms(self.lights)
-        self._needs = scene.needs()  # its texture entry does not change with update()
+        self._needs = ft.scene_needs(scene)  # its texture entry does not change with update()
         self._gl_images: dict[tuple, object] = {}
         self._gl_objects: list = []  # vertex arrays and buffers, freed by release()
         self._fbos: OrderedDict = OrderedDict()
@@ -432,7 +425,7 @@ class RasterSession:
         return (depth > near).all(1)
 
     def _report(self) -> tuple[list[str], list[str]]:
-        needs = self.scene.needs()
+        needs = ft.scene_needs(self.scene)
         left = [f"{f}: not needed by the scene (not compiled)" for f in SHADER_FEATURES if f not in needs]
         if ft.BUMP in needs and self.mode != "phong":
             left.append(f"bump: {self.mode} shading has no per-fragment normal to perturb")

@@ -34,10 +34,12 @@ import numpy as np
 from numpy.polynomial import Polynomial
 
 from .. import model as m
+from ..parts import make_part
 from . import values as val
 from .marching_cubes import grid_cells, marching_cubes, shade_normals
 
 TYPE = "blob"
+FEATURE = "blobs"
 PTYPE = 7
 """Its ``ptype`` in the ray tracer's primitive table."""
 SOLID = True
@@ -61,6 +63,9 @@ class Blob(m.SceneObject):
     components: np.ndarray = field(default_factory=lambda: np.array([[0.0, 0.0, 0.0, 1.0, 1.0]]))
     threshold: float = 0.5
     kind = "blob"
+
+
+MODEL = Blob
 
 
 # --------------------------------------------------------------------------- parse
@@ -234,6 +239,17 @@ def solid_mesh(b: Blob, level: int) -> tuple[np.ndarray, np.ndarray]:
 def analytic_normals(b: Blob, P: np.ndarray):
     """Object-space normals (-grad F) at points P (n, 3), and no cap."""
     return gradient(b, P), np.zeros(len(P), dtype=bool)
+
+
+def tessellate(obj: Blob, level: int, M: np.ndarray) -> list:
+    """The raster's triangles: one Part of :func:`mesh` at level * LEVEL_CELLS cells."""
+    P, N, F = mesh(obj, LEVEL_CELLS * level)
+    return [make_part(obj, M, P, N, F, None, None)]
+
+
+def patch_surfaces(obj: Blob, W: np.ndarray, h: float):
+    """Radiosity: curved, cut from its tessellation (None)."""
+    return None
 
 
 # --------------------------------------------------------------------------- kernel rows

@@ -27,11 +27,13 @@ import numba as nb
 import numpy as np
 
 from .. import model as m
+from ..parts import make_part
 from . import values as val
 from .expression import Program, compile_expression, evaluate, evaluate_gradient, evaluate_numpy, gradient_numpy
 from .marching_cubes import closed_grid, grid_cells, marching_cubes, pad_outside, shade_normals
 
 TYPE = "isosurface"
+FEATURE = "isosurfaces"
 PTYPE = 8
 """Its ``ptype`` in the ray tracer's primitive table."""
 SOLID = True
@@ -66,6 +68,9 @@ class Isosurface(m.SceneObject):
     def __post_init__(self):
         if self.program is None:
             object.__setattr__(self, "program", compile_expression(self.function))
+
+
+MODEL = Isosurface
 
 
 # --------------------------------------------------------------------------- parse
@@ -248,6 +253,17 @@ def analytic_normals(s: Isosurface, P: np.ndarray):
             N[on, axis] = side
             cap |= on
     return N, cap
+
+
+def tessellate(obj: Isosurface, level: int, M: np.ndarray) -> list:
+    """The raster's triangles: one Part of :func:`mesh` at level * LEVEL_CELLS cells."""
+    P, N, F = mesh(obj, LEVEL_CELLS * level)
+    return [make_part(obj, M, P, N, F, None, None)]
+
+
+def patch_surfaces(obj: Isosurface, W: np.ndarray, h: float):
+    """Radiosity: curved, cut from its tessellation (None)."""
+    return None
 
 
 # --------------------------------------------------------------------------- kernel rows

@@ -31,10 +31,12 @@ import numpy as np
 
 from ...core.tol import tol
 from .. import model as m
+from ..parts import make_part
 from . import values as val
 from .crossing_events import alternate, sort_hits
 
 TYPE = "lathe"
+FEATURE = "lathes"
 PTYPE = 9
 """Its ``ptype`` in the ray tracer's primitive table."""
 SOLID = True
@@ -73,6 +75,9 @@ class Lathe(m.SceneObject):
         r, y = self.points[:, 0], self.points[:, 1]
         area2 = float(np.sum(r * np.roll(y, -1) - np.roll(r, -1) * y))
         return 1.0 if area2 >= 0.0 else -1.0
+
+
+MODEL = Lathe
 
 
 # --------------------------------------------------------------------------- parse
@@ -243,6 +248,17 @@ def weld(P: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     P, same = np.unique(P, axis=0, return_inverse=True)
     F = same.reshape(-1)[F]
     return P, F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 2] != F[:, 0])]
+
+
+def tessellate(obj: Lathe, level: int, M: np.ndarray) -> list:
+    """The raster's triangles: one Part of :func:`mesh` at level * LEVEL_STEPS steps."""
+    P, N, F = mesh(obj, LEVEL_STEPS * level)
+    return [make_part(obj, M, P, N, F, None, None)]
+
+
+def patch_surfaces(obj: Lathe, W: np.ndarray, h: float):
+    """Radiosity: curved, cut from its tessellation (None)."""
+    return None
 
 
 # --------------------------------------------------------------------------- kernel rows

@@ -22,12 +22,14 @@ import numpy as np
 
 from ...core.tol import tol
 from .. import model as m
+from ..parts import make_part
 from ..polygon_pieces import convex_pieces, ear_triangles
 from . import values as val
 from .crossing_events import alternate, sort_hits
 from .lathe import weld
 
 TYPE = "prism"
+FEATURE = "prisms"
 PTYPE = 10
 """Its ``ptype`` in the ray tracer's primitive table."""
 SOLID = True
@@ -54,6 +56,9 @@ class Prism(m.SceneObject):
         """Sign of the polygon's area in (x, z) (shoelace): +1 counter-clockwise from x to z."""
         x, z = self.polygon[:, 0], self.polygon[:, 1]
         return 1.0 if float(np.sum(x * np.roll(z, -1) - np.roll(x, -1) * z)) >= 0.0 else -1.0
+
+
+MODEL = Prism
 
 
 # --------------------------------------------------------------------------- parse
@@ -237,6 +242,12 @@ def patch_surfaces(p: Prism, W: np.ndarray, h: float):
         quad = np.array([[x[i], p.y0, z[i]], [x[j], p.y0, z[j]], [x[j], p.y1, z[j]], [x[i], p.y1, z[i]]])
         polys.append(quad if np.cross(quad[1] - quad[0], quad[3] - quad[0]) @ normal(p, 2 + i) > 0.0 else quad[::-1])
     return [("polygon", (q[::-1] if mirror else q) @ W[:3, :3].T + W[:3, 3]) for q in polys]
+
+
+def tessellate(obj: Prism, level: int, M: np.ndarray) -> list:
+    """The raster's triangles: one Part of :func:`mesh` (exact: ``level`` plays no part)."""
+    P, N, F = mesh(obj)
+    return [make_part(obj, M, P, N, F, None, None)]
 
 
 # --------------------------------------------------------------------------- kernel rows
