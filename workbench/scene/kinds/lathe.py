@@ -261,6 +261,12 @@ def patch_surfaces(obj: Lathe, W: np.ndarray, h: float):
     return None
 
 
+def analytic_normals(obj: Lathe, P: np.ndarray):
+    """Flat triangles for the raster's CSG booleans (None): its mesh's normals are the
+    segments' own along the profile."""
+    return None
+
+
 # --------------------------------------------------------------------------- kernel rows
 # (the numba entry points' shared signatures: see .crossing_events)
 

@@ -250,6 +250,12 @@ def tessellate(obj: Prism, level: int, M: np.ndarray) -> list:
     return [make_part(obj, M, P, N, F, None, None)]
 
 
+def analytic_normals(obj: Prism, P: np.ndarray):
+    """Flat triangles for the raster's CSG booleans (None): its mesh's normals are the
+    segments' own."""
+    return None
+
+
 # --------------------------------------------------------------------------- kernel rows
 # (the numba entry points' shared signatures: see .crossing_events)
 
