@@ -9,27 +9,14 @@ names the file, the key and what was expected) in the window.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 
 from ...core.errors import WorkbenchError
-from .state import AppState, set_scene
+from .state import AppState, Browser, set_scene
 
 PATTERN = "*.toml"
 RELIST_SECONDS = 1.0
 """A shown folder is listed again after this long (files saved meanwhile appear), not every frame."""
-
-
-@dataclass
-class Browser:
-    """The browser's folder, the file selected in it and the last outcome (error or opened)."""
-
-    folder: Path
-    selected: Path | None = None
-    message: str = ""
-    failed: bool = False
-    listed: tuple[list[Path], list[Path]] | None = field(default=None, repr=False)
-    listed_at: float = 0.0
 
 
 def cached_listing(browser: Browser, now: float | None = None) -> tuple[list[Path], list[Path]]:

@@ -93,7 +93,7 @@ def export(state: AppState, folder: Path) -> list[Path]:
     """Write every panel (sRGB PNG), the difference view (colour scale PNG) and
     ``settings.json`` into ``folder``; returns the files written."""
     from ...core.imageio import save_png, save_png8
-    from .panels import colour_scale
+    from .colours import colour_scale
     folder = Path(folder)
     written = [save_png(folder / f"{m}.png", state.images[m])
                for m in state.methods if m in state.images]

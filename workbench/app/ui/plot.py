@@ -19,12 +19,11 @@ import multiprocessing as mp
 import time
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from .jobs import job_key
-from .state import CHILD, RASTER, AppState
+from .state import AppState, ErrorPlot, choosable_methods, method_kind
 
 SETTLE_SECONDS = 0.3
 """The camera and scene must stay unchanged this long before the reference render starts."""
@@ -38,52 +37,14 @@ background instead of painting its frame, plot area and legend, which on llvmpip
 ~2.4 ms of CPU per frame (9.0-9.4 against 11.5-11.8 ms for a whole 1600 x 860 frame)."""
 
 
-@dataclass
-class ErrorPlot:
-    """Points of error against run time for one (scene version, camera).
-
-    ``points[method][option values]`` is ``{"seconds", "rmse", "psnr", "flip", "label"}``.
-    """
-
-    key: tuple | None = None
-    since: float = 0.0
-    candidates: list = field(default_factory=list)
-    reference: str | None = None
-    ref_options: dict = field(default_factory=dict)
-    ref_image: np.ndarray | None = None
-    message: str = ""
-    points: dict = field(default_factory=dict)
-    pending: dict = field(default_factory=dict)
-    failed: dict = field(default_factory=dict)
-    metric: str = "rmse"
-    shown: int = -2
-    gave_up: bool = False
-    board: object = None
-    pool: ProcessPoolExecutor | None = None
-
-    def busy(self, frame: int) -> bool:
-        """Something will arrive without any input: evaluations in the worker, or, while the
-        plot is shown (drawn in frame ``frame`` or the one before), its reference."""
-        if self.pending:
-            return True
-        return self.shown >= frame - 1 and self.ref_image is None and not self.gave_up
-
-    def shutdown(self) -> None:
-        """Cancel the reference render and end the worker process (joined)."""
-        if self.board is not None:
-            self.board.join_all()
-        if self.pool is not None:
-            self.pool.shutdown(wait=True, cancel_futures=True)
-            self.pool = None
-
-
 def _final_image(state: AppState, method: str) -> tuple[np.ndarray, float] | None:
     """(image, run time) of a panel whose image is final for the current request, else None."""
-    if method in RASTER:
+    kind = method_kind(state, method)
+    if kind == "gl":
         if method not in state.images or method not in state.timings:
             return None
         return np.array(state.images[method], np.float32), state.timings[method]
-    if method in CHILD:
+    if kind == "child":
         proc = state.pyrender
         current = (state.scene_version, state.camera, tuple(sorted(state.options[method].items())))
         if proc is None or proc.image_key != current:
@@ -143,7 +104,6 @@ MARKERS = ("circle", "square", "diamond", "up", "down", "left", "right", "cross"
 
 def marker_of(method: str) -> str:
     """The name of ``method``'s marker in :data:`MARKERS` (stable: by registry order)."""
-    from .state import choosable_methods
     allowed = choosable_methods()
     k = allowed.index(method) if method in allowed else len(allowed)
     return MARKERS[k % len(MARKERS)]

@@ -12,7 +12,7 @@ from . import camera as cam
 from .inspect import export, select_ray_tree
 from .layout import window_report
 from .panels import status_text
-from .state import RASTER, AppState, set_display, set_material_value, set_option, shown_image
+from .state import AppState, method_kind, set_display, set_material_value, set_option, shown_image
 
 CPU_WAIT_SECONDS = 120.0
 """How long the check script waits for background jobs before giving up."""
@@ -191,7 +191,7 @@ class Radiosity:
         self.out, self.log, self.t_wait = out, {}, time.perf_counter()
 
     def __call__(self, state: AppState) -> None:
-        from .layout import focus
+        from .placement import focus
         from .patch_view import select_patch
         f = state.frame
         if f == 0:  # the patch view in front of the error plot: no reference render
@@ -281,7 +281,7 @@ class Fps:
                                 cpu_jobs_started=state.jobs.count - self.starts,
                                 panels_window=window_report()["Panels"].get("size"),
                                 raster_ms={m: state.timings.get(m, 0) * 1e3
-                                           for m in state.methods if m in RASTER})
+                                           for m in state.methods if method_kind(state, m) == "gl"})
                 self.t_wait = time.perf_counter()
                 state.quit = not self.wait_cpu
         elif "fps" in self.log and (not state.jobs.busy()
@@ -470,13 +470,13 @@ class Idle:
                     "shown_is_job_image": bool(job is not None and job.image is not None
                                                and np.array_equal(shown, job.image)),
                     "frames": state.frame - self.frame0, "seconds": now - self.t0}
-                from .main import shown_title
+                from .glfw_title import shown_title
                 from .state import set_scene
                 self.log["title_before"] = shown_title()
                 set_scene(state, "csg")
                 self.step = 3
         elif self.step == 3:
-            from .main import shown_title
+            from .glfw_title import shown_title
             self.log["title_after"] = shown_title()
             state.quit = True
 

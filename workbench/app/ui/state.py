@@ -1,21 +1,24 @@
-"""The one state object of the UI: every gui function takes it, nothing lives in module globals."""
+"""The one state object of the UI: every gui function takes it, nothing lives in module globals.
+
+Plain data and the functions that edit it: the views (panels, plot, browser, ...) import this
+module, never the other way round.  What a method is to the window (a GL panel, a CPU job, a
+child process, a progressive job) is asked of its renderer (``ui_kind``,
+:data:`workbench.renderers.base.UI_KINDS`; :func:`method_kind`), so a newly registered method
+appears in the window without any edit here.
+"""
 from __future__ import annotations
 
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
+from ...renderers.base import available, get_renderer
 from ...scene.model import Camera, Scene
 from .images import PanelImages
+from .jobs import RESTART_SETTLE_SECONDS, JobBoard
 
-RASTER = ("flat", "gouraud", "phong")
-"""Methods drawn every frame in the window's own GL context."""
-CPU = ("raycast", "raytrace", "radiosity", "hybrid")
-"""Methods run in background threads."""
-CHILD = ("pyrender",)
-"""Methods rendered in a child process (PyOpenGL's EGL platform cannot share the window's
-process): :mod:`.pyrender_proc`."""
 MAX_PANELS = 6
 FIRST_VIEW = ("phong", "raytrace")
 """The methods of the first view of any scene: a raster method beside the ray tracer (their
@@ -33,6 +36,59 @@ DISPLAY_MODES = ("direct24", "direct16-555", "direct16-565", "direct16-565-fs",
 """Display modes offered per panel (the colour chapter's 24/16-bit direct and indexed CLUTs);
 ``workbench.core.display`` accepts more from the CLI."""
 HARMONIES = ("complementary", "triad", "square", "hexagon")
+
+
+@dataclass
+class Browser:
+    """The file browser's folder, the file selected in it and the last outcome (error or
+    opened); the view is :mod:`.file_browser`."""
+
+    folder: Path
+    selected: Path | None = None
+    message: str = ""
+    failed: bool = False
+    listed: tuple[list[Path], list[Path]] | None = field(default=None, repr=False)
+    listed_at: float = 0.0
+
+
+@dataclass
+class ErrorPlot:
+    """Points of error against run time for one (scene version, camera); the view is
+    :mod:`.plot`.
+
+    ``points[method][option values]`` is ``{"seconds", "rmse", "psnr", "flip", "label"}``.
+    """
+
+    key: tuple | None = None
+    since: float = 0.0
+    candidates: list = field(default_factory=list)
+    reference: str | None = None
+    ref_options: dict = field(default_factory=dict)
+    ref_image: np.ndarray | None = None
+    message: str = ""
+    points: dict = field(default_factory=dict)
+    pending: dict = field(default_factory=dict)
+    failed: dict = field(default_factory=dict)
+    metric: str = "rmse"
+    shown: int = -2
+    gave_up: bool = False
+    board: object = None
+    pool: ProcessPoolExecutor | None = None
+
+    def busy(self, frame: int) -> bool:
+        """Something will arrive without any input: evaluations in the worker, or, while the
+        plot is shown (drawn in frame ``frame`` or the one before), its reference."""
+        if self.pending:
+            return True
+        return self.shown >= frame - 1 and self.ref_image is None and not self.gave_up
+
+    def shutdown(self) -> None:
+        """Cancel the reference render and end the worker process (joined)."""
+        if self.board is not None:
+            self.board.join_all()
+        if self.pool is not None:
+            self.pool.shutdown(wait=True, cancel_futures=True)
+            self.pool = None
 
 
 @dataclass
@@ -84,6 +140,8 @@ class AppState:
     errors: object = None
     patch_pick: object = None
     pyrender: object = None
+    kinds: dict[str, str] = field(default_factory=dict)
+    """method -> its renderer's ``ui_kind`` (:func:`method_kind`)."""
     cut: set = field(default_factory=set)
     """Widgets that ran past their window's right edge in the last frame (``panels.check_fits``)."""
     quit: bool = False
@@ -91,17 +149,23 @@ class AppState:
 
 def choosable_methods() -> list[str]:
     """Registered methods the UI can show (all of them)."""
-    from ...renderers.base import available
     return list(available())
 
 
+def method_kind(state: AppState, method: str) -> str:
+    """What ``method`` is to the window: its renderer's ``ui_kind`` (``"gl"``, ``"cpu"``,
+    ``"child"`` or ``"progressive"``, :data:`workbench.renderers.base.UI_KINDS`), asked once."""
+    kind = state.kinds.get(method)
+    if kind is None:
+        kind = state.kinds[method] = get_renderer(method).ui_kind
+    return kind
+
+
 def default_options(method: str) -> dict:
-    """The method's quality knob at its default value; a progressive method's
-    (:data:`~.jobs.PROGRESSIVE`) at its most accurate, which it refines towards pass by pass."""
-    from ...renderers.base import get_renderer
-    from .jobs import PROGRESSIVE
-    knob = get_renderer(method).knob
-    return {knob.name: knob.values[-1] if method in PROGRESSIVE else knob.default}
+    """The method's quality knob at its default value; a progressive method's (``ui_kind``
+    ``"progressive"``) at its most accurate, which it refines towards pass by pass."""
+    r = get_renderer(method)
+    return {r.knob.name: r.knob.values[-1] if r.ui_kind == "progressive" else r.knob.default}
 
 
 def first_view(scene: Scene, allowed) -> list[str]:
@@ -128,9 +192,6 @@ def new_state(scene_name: str, methods: list[str] | None = None,
     from ...core.errors import WorkbenchError
     from ...scene.io import load_scene
     from ...scene.library import resolve
-    from .file_browser import Browser
-    from .jobs import RESTART_SETTLE_SECONDS, JobBoard
-    from .plot import ErrorPlot
     path = resolve(scene_name)
     scene = load_scene(path)
     allowed = choosable_methods()
