@@ -135,6 +135,9 @@ class Features:
             _record(state, out, "plot")
             plot = state.errors
             np.save(out / "plot_reference.npy", plot.ref_image)
+            for m, image in plot.matched.items():
+                if image is not False:
+                    np.save(out / f"plot_matched_{m}.npy", image)
             self.log["plot"] = {"reference": plot.reference, "ref_options": plot.ref_options,
                                 "points": self._points(state)}
             self.flat_tess = state.options["flat"]["tessellation"]
@@ -147,15 +150,28 @@ class Features:
         self.step += 1
 
     def _plotted(self, state: AppState, counts: dict) -> bool:
-        """The error plot holds ``counts[m]`` points of each method (or the wait timed out)."""
-        have = state.errors.points
-        return (all(len(have.get(m, {})) >= n for m, n in counts.items())
+        """The error plot holds ``counts[m]`` points of each method, each also against the
+        method's matched reference where it has one (or the wait timed out)."""
+        plot = state.errors
+        return (all(len(plot.points.get(m, {})) >= n and
+                    (plot.matched.get(m) is False or len(plot.matched_points.get(m, {})) >= n)
+                    for m, n in counts.items())
                 or time.perf_counter() - self.t_wait > CPU_WAIT_SECONDS)
 
     @staticmethod
     def _points(state: AppState) -> dict:
-        return {m: [{**p, "options": dict(o)} for o, p in pts.items()]
-                for m, pts in state.errors.points.items()}
+        """{method: [point]}: each point's total error, its options and, where evaluated, its
+        errors against the matched reference (``rmse_matched``, ``flip_matched``)."""
+        plot = state.errors
+        out = {}
+        for m, pts in plot.points.items():
+            out[m] = []
+            for o, p in pts.items():
+                split = plot.matched_points.get(m, {}).get(o)
+                out[m].append({**p, "options": dict(o),
+                               **({} if split is None else {"rmse_matched": split["rmse"],
+                                                            "flip_matched": split["flip"]})})
+        return out
 
 
 class Layout:

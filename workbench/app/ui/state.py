@@ -56,7 +56,14 @@ class ErrorPlot:
     """Points of error against run time for one (scene version, camera); the view is
     :mod:`.plot`.
 
-    ``points[method][option values]`` is ``{"seconds", "rmse", "psnr", "flip", "label"}``.
+    ``points[method][option values]`` is ``{"seconds", "rmse", "psnr", "flip", "label"}``
+    against the full reference (the total error); ``matched_points`` holds the same against
+    the method's matched reference (its discretisation error, the error split of
+    :mod:`workbench.compare.reference`), evaluated on its own when that reference arrives.
+    ``matched[method]`` is that reference's image once rendered, or False (the method has
+    none); ``matched_boards`` render them, one :class:`~.jobs.JobBoard` per (reference method,
+    options) (a board runs one job per method); ``matched_message`` says which are still
+    rendering.
     """
 
     key: tuple | None = None
@@ -69,6 +76,11 @@ class ErrorPlot:
     points: dict = field(default_factory=dict)
     pending: dict = field(default_factory=dict)
     failed: dict = field(default_factory=dict)
+    matched: dict = field(default_factory=dict)
+    matched_points: dict = field(default_factory=dict)
+    matched_pending: dict = field(default_factory=dict)
+    matched_boards: dict = field(default_factory=dict)
+    matched_message: str = ""
     metric: str = "rmse"
     shown: int = -2
     gave_up: bool = False
@@ -77,15 +89,21 @@ class ErrorPlot:
 
     def busy(self, frame: int) -> bool:
         """Something will arrive without any input: evaluations in the worker, or, while the
-        plot is shown (drawn in frame ``frame`` or the one before), its reference."""
-        if self.pending:
+        plot is shown (drawn in frame ``frame`` or the one before), its reference or a matched
+        reference still rendering."""
+        if self.pending or self.matched_pending:
             return True
-        return self.shown >= frame - 1 and self.ref_image is None and not self.gave_up
+        return self.shown >= frame - 1 and ((self.ref_image is None and not self.gave_up)
+                                            or bool(self.matched_message))
+
+    def boards(self) -> list:
+        """The boards rendering references: the full one's and the matched ones'."""
+        return [b for b in (self.board, *self.matched_boards.values()) if b is not None]
 
     def shutdown(self) -> None:
-        """Cancel the reference render and end the worker process (joined)."""
-        if self.board is not None:
-            self.board.join_all()
+        """Cancel the reference renders and end the worker process (joined)."""
+        for board in self.boards():
+            board.join_all()
         if self.pool is not None:
             self.pool.shutdown(wait=True, cancel_futures=True)
             self.pool = None
