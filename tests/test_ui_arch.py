@@ -123,18 +123,8 @@ def dummy_methods(monkeypatch):
     base._instances.pop("dummy_cpu", None)
 
 
-class _WindowContext:
-    """A headless context standing in for the window's: its ``screen`` a 1 x 1 framebuffer."""
-
-    def __init__(self, ctx):
-        self._ctx, self.screen = ctx, ctx.simple_framebuffer((1, 1))
-
-    def __getattr__(self, name):
-        return getattr(self._ctx, name)
-
-
 @pytest.mark.gl
-def test_a_method_registered_at_test_time_appears_in_the_window(dummy_methods, gl_ctx):
+def test_a_method_registered_at_test_time_appears_in_the_window(dummy_methods, window_ctx):
     """Registered in the test, not in the UI: listed in the Methods window, accepted as a
     panel, rendered as its kind says (a GL panel drawn in the window's context, a CPU panel
     by a background job), and a point of the error plot once final."""
@@ -143,7 +133,7 @@ def test_a_method_registered_at_test_time_appears_in_the_window(dummy_methods, g
     from workbench.app.ui.state import choosable_methods, method_kind, new_state
     assert {"dummy_cpu", "dummy_gl"} <= set(choosable_methods())
     state = new_state("whitted", ["dummy_gl", "dummy_cpu"], panel_size=32)
-    state.ctx = _WindowContext(gl_ctx)
+    state.ctx = window_ctx
     assert method_kind(state, "dummy_gl") == "gl" and method_kind(state, "dummy_cpu") == "cpu"
     try:
         deadline = time.monotonic() + 30
@@ -159,4 +149,3 @@ def test_a_method_registered_at_test_time_appears_in_the_window(dummy_methods, g
     finally:
         state.jobs.join_all(30)
         release_gl(state)
-        state.ctx.screen.release()

@@ -329,6 +329,7 @@ def linear_source(state: AppState, method: str) -> tuple[object, bool]:
 
 def refresh_raster(state: AppState, method: str) -> bool:
     """Redraw ``method``'s panel if its inputs changed; returns whether it drew."""
+    from ...core.errors import WorkbenchError
     from ...renderers.base import get_renderer
     from ...renderers.raster import RasterSession
     g = gpu(state)
@@ -340,11 +341,24 @@ def refresh_raster(state: AppState, method: str) -> bool:
         # only material or light values changed: same session, live programs
         panel.session_key, panel.drawn, panel.edited = key, None, time.perf_counter()
     elif panel is None or panel.session_key != key:
+        if state.panel_errors.get(method, (None,))[0] == key:
+            return False  # did not build for these inputs: its message stays shown
         if panel is not None:
             g.compiled += panel.session.programs.compiles
             panel.session.release()
-        panel = g.raster[method] = RasterPanel(
-            get_renderer(method).session(state.scene, tessellation=tess, ctx=state.ctx), key)
+            del g.raster[method]
+            g.linear.pop(method, None)
+        try:
+            session = get_renderer(method).session(state.scene, tessellation=tess, ctx=state.ctx)
+        except WorkbenchError as e:  # a user's model that does not compile: one line, no image
+            state.panel_errors[method] = (key, str(e))
+            state.status[method] = str(e)
+            if method in state.images:  # del, not pop: a pending read of a released session
+                del state.images[method]
+            state.ctx.screen.use()
+            return False
+        state.panel_errors.pop(method, None)
+        panel = g.raster[method] = RasterPanel(session, key)
         state.status[method] = f"{panel.session.n_triangles} triangles"
     if (panel.session.live and time.perf_counter() - panel.edited > LIVE_REST_SECONDS
             and g.settle_frame != state.frame):

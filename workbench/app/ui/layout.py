@@ -49,7 +49,7 @@ def splits(window_height: int, panel_height: int) -> list[tuple[str, str, object
 
 def windows(state: AppState) -> list[tuple[str, str, object]]:
     """(label, dock space, gui function of no argument) of every dockable window."""
-    from .file_browser import file_browser
+    from .file_browser import file_browser, shading_picker
     from .inspect import ray_tree_view
     from .lights import light_controls
     from .panels import (colour_wheel, difference_panel, image_panels, method_list, parameters,
@@ -57,7 +57,7 @@ def windows(state: AppState) -> list[tuple[str, str, object]]:
     from .patch_view import patch_view
     from .plot import error_plot
     return [("Scene", "ControlSpace", lambda: (scene_picker(state), file_browser(state))),
-            ("Methods", "MethodSpace", lambda: method_list(state)),
+            ("Methods", "MethodSpace", lambda: (method_list(state), shading_picker(state))),
             ("Parameters", "ParamSpace", lambda: parameters(state)),
             ("Lights", "ParamSpace", lambda: light_controls(state)),
             ("Colour wheel", "ParamSpace", lambda: colour_wheel(state)),

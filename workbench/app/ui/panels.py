@@ -12,7 +12,8 @@ from .colours import colour_scale, hot_table
 from .patch_view import select_patch
 from .placement import PANEL_GAP, PANEL_LINES, focus, panel_grid
 from .state import (DISPLAY_MODES, HARMONIES, MATERIAL_FIELDS, AppState, choosable_methods,
-                    set_display, set_material_value, set_option, set_scene, toggle_method)
+                    set_display, set_material_value, set_option, set_scene, short_name,
+                    toggle_method)
 
 ORBIT_SPEED = 0.01
 """Radians of orbit per pixel of mouse drag."""
@@ -81,15 +82,17 @@ def scene_picker(state: AppState) -> None:
 def method_list(state: AppState) -> None:
     """Checkboxes over the methods (1 to 6 selected), in as many columns as their labels
     fit (two at most); a refused change says why."""
-    methods = choosable_methods()
+    methods = [*choosable_methods(), *state.user_methods]
     style = imgui.get_style()
-    column = imgui.get_frame_height() + label_room(*methods) + style.item_spacing.x
+    column = imgui.get_frame_height() + label_room(*map(short_name, methods)) + style.item_spacing.x
     cols = 2 if 2 * column <= imgui.get_content_region_avail().x else 1
     x0 = imgui.get_cursor_pos_x()
     for k, m in enumerate(methods):
         if k % cols:
             imgui.same_line(x0 + column)
-        changed, on = imgui.checkbox(m, m in state.methods)
+        changed, on = imgui.checkbox(f"{short_name(m)}##{m}", m in state.methods)
+        if short_name(m) != m and imgui.is_item_hovered():
+            imgui.set_tooltip(m)
         check_fits(state, f"method {m}")
         if changed:
             toggle_method(state, m, on)
@@ -197,7 +200,7 @@ def image_panels(state: AppState) -> None:
         imgui.begin_group()
         t = state.timings.get(m)
         imgui.align_text_to_frame_padding()  # every panel's title on the same baseline
-        text_in_width(f"{m}  {'' if t is None else f'{t * 1e3:.1f} ms'}", w)
+        text_in_width(f"{short_name(m)}  {'' if t is None else f'{t * 1e3:.1f} ms'}", w)
         if m in state.images:
             tex = panel_texture(state, m)
             show_image(state, m, tex, imgui.ImVec2(w, h), *cam.view_window(state.view))

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...renderers.base import available, get_renderer
+from ...renderers.base import USER_PREFIX, available, check_methods, get_renderer
 from ...scene.model import Camera, Scene
 from .images import PanelImages
 from .jobs import RESTART_SETTLE_SECONDS, JobBoard
@@ -49,6 +49,8 @@ class Browser:
     failed: bool = False
     listed: tuple[list[Path], list[Path]] | None = field(default=None, repr=False)
     listed_at: float = 0.0
+    pattern: str = "*.toml"
+    """The files listed (``fnmatch`` pattern): scene files, or a shading model's ``*.glsl``."""
 
 
 @dataclass
@@ -158,6 +160,15 @@ class AppState:
     errors: object = None
     patch_pick: object = None
     pyrender: object = None
+    user_methods: list[str] = field(default_factory=list)
+    """Users' shading models (``glsl:PATH``, :func:`add_shading_model`), listed in the Methods
+    window after the registered methods."""
+    shading_browser: Browser | None = None
+    """The file picker of users' shading models (``*.glsl``)."""
+    panel_errors: dict[str, tuple] = field(default_factory=dict)
+    """method -> (what its GL session was to be built from, one-line message) of a GL panel
+    whose session could not be built (a user's model that does not compile): the message is
+    shown, and the build is not tried again until what it is built from changes."""
     kinds: dict[str, str] = field(default_factory=dict)
     """method -> its renderer's ``ui_kind`` (:func:`method_kind`)."""
     cut: set = field(default_factory=set)
@@ -168,6 +179,14 @@ class AppState:
 def choosable_methods() -> list[str]:
     """Registered methods the UI can show (all of them)."""
     return list(available())
+
+
+def short_name(method: str) -> str:
+    """What the window calls a method: its name, or ``glsl:`` and the file's name for a
+    user's shading model ``glsl:PATH`` (the whole path is a tooltip)."""
+    if method.startswith(USER_PREFIX):
+        return USER_PREFIX + Path(method[len(USER_PREFIX):]).name
+    return method
 
 
 def method_kind(state: AppState, method: str) -> str:
@@ -214,16 +233,41 @@ def new_state(scene_name: str, methods: list[str] | None = None,
     scene = load_scene(path)
     allowed = choosable_methods()
     methods = list(methods) if methods else first_view(scene, allowed)
-    bad = [m for m in methods if m not in allowed]
+    user = [m for m in methods if m.startswith(USER_PREFIX)]
+    bad = [m for m in methods if m not in allowed and m not in user]
     if bad or not 1 <= len(methods) <= MAX_PANELS:
-        raise WorkbenchError(f"methods must be 1 to {MAX_PANELS} of {', '.join(allowed)} "
-                             f"(got {', '.join(methods)})")
+        raise WorkbenchError(f"methods must be 1 to {MAX_PANELS} of {', '.join(allowed)} or "
+                             f"{USER_PREFIX}FILE (got {', '.join(methods)})")
+    check_methods(user)  # a user's shading model file that cannot be used: one line
+    examples = Path.cwd() / "examples" / "shading"
     return AppState(scene=scene, scene_path=path, base_scene=scene,
                     camera=panel_camera(scene.camera, panel_size), methods=methods,
-                    options={m: default_options(m) for m in allowed},
+                    options={m: default_options(m) for m in [*allowed, *user]},
                     material=next(iter(scene.materials)), panel_size=panel_size,
                     diff_pair=(methods[0], methods[min(1, len(methods) - 1)]), jobs=JobBoard(RESTART_SETTLE_SECONDS),
-                    browser=Browser(path.parent), errors=ErrorPlot())
+                    browser=Browser(path.parent), errors=ErrorPlot(), user_methods=user,
+                    shading_browser=Browser(examples if examples.is_dir() else Path.cwd(),
+                                            pattern="*.glsl"))
+
+
+def add_shading_model(state: AppState, path) -> str:
+    """Add the user's shading model in the GLSL file ``path``
+    (:mod:`workbench.renderers.user_shading`) as the method ``glsl:PATH`` and show its panel
+    (a seventh panel is refused as by :func:`toggle_method`); returns the method's name.  A
+    file that cannot be used, or whose name would clash with another model's output files,
+    raises :class:`~workbench.core.errors.WorkbenchError` (one line) and changes nothing; a
+    model that does not compile shows its one-line message (the user's file and line) in its
+    panel; adding the file again (once fixed) compiles it again."""
+    from ...renderers.user_shading import method_name
+    m = method_name(path)
+    user = [*state.user_methods, *([] if m in state.user_methods else [m])]
+    check_methods(user)
+    state.user_methods[:] = user
+    state.options.setdefault(m, default_options(m))
+    state.kinds.pop(m, None)
+    state.panel_errors.pop(m, None)
+    toggle_method(state, m, True)
+    return m
 
 
 def set_scene(state: AppState, scene_name: str) -> None:
