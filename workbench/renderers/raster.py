@@ -711,6 +711,7 @@ class _RasterRenderer:
 
     name = ""
     mode = ""
+    ui_kind = "gl"
     knob = Knob("tessellation", (1, 2, 3, 4, 6, 8, 12, 16, 24, 32), DEFAULT_LEVEL,
                 "tessellation level of analytic primitives (sphere: 4L x 8L, see tessellate)")
     options = {
@@ -724,6 +725,11 @@ class _RasterRenderer:
     }
 
     memory_options = ("tessellation",)
+
+    def session(self, scene: Scene, *, tessellation: int = DEFAULT_LEVEL, ctx=None) -> RasterSession:
+        """A :class:`RasterSession` drawing this method (the interactive window's GL panels,
+        ``ui_kind`` ``"gl"``) in ``ctx`` (default: the thread's context)."""
+        return RasterSession(scene, self.mode or self.name, tessellation=tessellation, ctx=ctx)
 
     def estimate_bytes(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
                        **_) -> int:

@@ -1,6 +1,6 @@
 """Each panel's picture, kept on the GPU and redrawn only when what it shows changes.
 
-* Raster methods (flat, Gouraud, Phong) draw through a cached
+* GL methods (``ui_kind`` ``"gl"``: flat, Gouraud, Phong, a user's shading model) draw through a cached
   :class:`~workbench.renderers.raster.RasterSession` (one per scene, method and
   tessellation; replaced sessions are released) into the session's float framebuffer, in the
   window's own moderngl context, and only when the panel's inputs change: the scene version
@@ -20,7 +20,7 @@
 * Pixels come back to the CPU only when asked for: ``state.images[m]`` of a raster panel is a
   pending read (:class:`~.images.PanelImages`), resolved once per draw by the probe, the
   difference view, the export or a script.
-* CPU methods are requested from the :class:`~.jobs.JobBoard`; their texture is refreshed when
+* CPU and progressive methods are requested from the :class:`~.jobs.JobBoard`; their texture is refreshed when
   the job reports new tiles (``Job.version``).
 """
 from __future__ import annotations
@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .state import CHILD, RASTER, AppState, shown_image
+from .state import AppState, method_kind, shown_image
 
 LIVE_REST_SECONDS = 0.5
 """How long edited material or light values must stay unchanged before a GL panel compiles
@@ -329,6 +329,8 @@ def linear_source(state: AppState, method: str) -> tuple[object, bool]:
 
 def refresh_raster(state: AppState, method: str) -> bool:
     """Redraw ``method``'s panel if its inputs changed; returns whether it drew."""
+    from ...core.errors import WorkbenchError
+    from ...renderers.base import get_renderer
     from ...renderers.raster import RasterSession
     g = gpu(state)
     tess = int(state.options[method]["tessellation"])
@@ -339,11 +341,24 @@ def refresh_raster(state: AppState, method: str) -> bool:
         # only material or light values changed: same session, live programs
         panel.session_key, panel.drawn, panel.edited = key, None, time.perf_counter()
     elif panel is None or panel.session_key != key:
+        if state.panel_errors.get(method, (None,))[0] == key:
+            return False  # did not build for these inputs: its message stays shown
         if panel is not None:
             g.compiled += panel.session.programs.compiles
             panel.session.release()
-        panel = g.raster[method] = RasterPanel(
-            RasterSession(state.scene, method, tessellation=tess, ctx=state.ctx), key)
+            del g.raster[method]
+            g.linear.pop(method, None)
+        try:
+            session = get_renderer(method).session(state.scene, tessellation=tess, ctx=state.ctx)
+        except WorkbenchError as e:  # a user's model that does not compile: one line, no image
+            state.panel_errors[method] = (key, str(e))
+            state.status[method] = str(e)
+            if method in state.images:  # del, not pop: a pending read of a released session
+                del state.images[method]
+            state.ctx.screen.use()
+            return False
+        state.panel_errors.pop(method, None)
+        panel = g.raster[method] = RasterPanel(session, key)
         state.status[method] = f"{panel.session.n_triangles} triangles"
     if (panel.session.live and time.perf_counter() - panel.edited > LIVE_REST_SECONDS
             and g.settle_frame != state.frame):
@@ -392,7 +407,8 @@ def refresh_cpu(state: AppState, method: str) -> None:
         state.status[method] = (f"done: {job.spp} spp, noise {job.noise:.3g}"
                                 if job.progressive and job.noise is not None else "done")
     elif job.progressive:
-        target = state.options[method]["spp"]
+        from ...renderers.base import get_renderer
+        target = state.options[method][get_renderer(method).knob.name]
         state.status[method] = (f"refining: {job.spp}/{target} spp" +
                                 ("" if job.noise is None else f", noise {job.noise:.3g}"))
     else:
@@ -411,9 +427,10 @@ def update_images(state: AppState) -> None:
     from .pyrender_proc import refresh_pyrender
     state.jobs.keep_only(state.methods)
     for m in state.methods:
-        if m in RASTER:
+        kind = method_kind(state, m)
+        if kind == "gl":
             refresh_raster(state, m)
-        elif m in CHILD:
+        elif kind == "child":
             refresh_pyrender(state)
         else:
             refresh_cpu(state, m)

@@ -93,9 +93,10 @@ def export(state: AppState, folder: Path) -> list[Path]:
     """Write every panel (sRGB PNG), the difference view (colour scale PNG) and
     ``settings.json`` into ``folder``; returns the files written."""
     from ...core.imageio import save_png, save_png8
-    from .panels import colour_scale
+    from ...renderers.base import file_stem
+    from .colours import colour_scale
     folder = Path(folder)
-    written = [save_png(folder / f"{m}.png", state.images[m])
+    written = [save_png(folder / f"{file_stem(m)}.png", state.images[m])
                for m in state.methods if m in state.images]
     err = state.images.get("difference")
     if err is not None:

@@ -12,7 +12,7 @@ from . import camera as cam
 from .inspect import export, select_ray_tree
 from .layout import window_report
 from .panels import status_text
-from .state import RASTER, AppState, set_display, set_material_value, set_option, shown_image
+from .state import AppState, method_kind, set_display, set_material_value, set_option, shown_image
 
 CPU_WAIT_SECONDS = 120.0
 """How long the check script waits for background jobs before giving up."""
@@ -135,6 +135,9 @@ class Features:
             _record(state, out, "plot")
             plot = state.errors
             np.save(out / "plot_reference.npy", plot.ref_image)
+            for m, image in plot.matched.items():
+                if image is not False:
+                    np.save(out / f"plot_matched_{m}.npy", image)
             self.log["plot"] = {"reference": plot.reference, "ref_options": plot.ref_options,
                                 "points": self._points(state)}
             self.flat_tess = state.options["flat"]["tessellation"]
@@ -147,15 +150,28 @@ class Features:
         self.step += 1
 
     def _plotted(self, state: AppState, counts: dict) -> bool:
-        """The error plot holds ``counts[m]`` points of each method (or the wait timed out)."""
-        have = state.errors.points
-        return (all(len(have.get(m, {})) >= n for m, n in counts.items())
+        """The error plot holds ``counts[m]`` points of each method, each also against the
+        method's matched reference where it has one (or the wait timed out)."""
+        plot = state.errors
+        return (all(len(plot.points.get(m, {})) >= n and
+                    (plot.matched.get(m) is False or len(plot.matched_points.get(m, {})) >= n)
+                    for m, n in counts.items())
                 or time.perf_counter() - self.t_wait > CPU_WAIT_SECONDS)
 
     @staticmethod
     def _points(state: AppState) -> dict:
-        return {m: [{**p, "options": dict(o)} for o, p in pts.items()]
-                for m, pts in state.errors.points.items()}
+        """{method: [point]}: each point's total error, its options and, where evaluated, its
+        errors against the matched reference (``rmse_matched``, ``flip_matched``)."""
+        plot = state.errors
+        out = {}
+        for m, pts in plot.points.items():
+            out[m] = []
+            for o, p in pts.items():
+                split = plot.matched_points.get(m, {}).get(o)
+                out[m].append({**p, "options": dict(o),
+                               **({} if split is None else {"rmse_matched": split["rmse"],
+                                                            "flip_matched": split["flip"]})})
+        return out
 
 
 class Layout:
@@ -191,7 +207,7 @@ class Radiosity:
         self.out, self.log, self.t_wait = out, {}, time.perf_counter()
 
     def __call__(self, state: AppState) -> None:
-        from .layout import focus
+        from .placement import focus
         from .patch_view import select_patch
         f = state.frame
         if f == 0:  # the patch view in front of the error plot: no reference render
@@ -281,7 +297,7 @@ class Fps:
                                 cpu_jobs_started=state.jobs.count - self.starts,
                                 panels_window=window_report()["Panels"].get("size"),
                                 raster_ms={m: state.timings.get(m, 0) * 1e3
-                                           for m in state.methods if m in RASTER})
+                                           for m in state.methods if method_kind(state, m) == "gl"})
                 self.t_wait = time.perf_counter()
                 state.quit = not self.wait_cpu
         elif "fps" in self.log and (not state.jobs.busy()
@@ -470,13 +486,13 @@ class Idle:
                     "shown_is_job_image": bool(job is not None and job.image is not None
                                                and np.array_equal(shown, job.image)),
                     "frames": state.frame - self.frame0, "seconds": now - self.t0}
-                from .main import shown_title
+                from .glfw_title import shown_title
                 from .state import set_scene
                 self.log["title_before"] = shown_title()
                 set_scene(state, "csg")
                 self.step = 3
         elif self.step == 3:
-            from .main import shown_title
+            from .glfw_title import shown_title
             self.log["title_after"] = shown_title()
             state.quit = True
 

@@ -634,6 +634,7 @@ class RaycastRenderer(_WhittedBase):
     """Eye rays and shadow feelers with the shared local model (no secondary rays)."""
 
     name = "raycast"
+    ui_kind = "cpu"
     recursive = False
     knob = Knob("spp", (1, 2, 4, 8, 16), 1, "samples per pixel")
     options = dict(_COMMON)
@@ -644,6 +645,7 @@ class RaytraceRenderer(_WhittedBase):
     """Whitted ray tracer: raycast plus recursive reflection and refraction."""
 
     name = "raytrace"
+    ui_kind = "cpu"
     knob = Knob("max_depth", (1, 2, 3, 4, 5, 6, 8, 12), 5,
                 "maximum number of ray generations in a path (primary = 1)")
     options = {**_COMMON,
