@@ -4,7 +4,6 @@ methods that the window learns about from their renderers (``ui_kind``), so a me
 registered at test time shows in the window's method list and panels without any UI edit."""
 from __future__ import annotations
 
-import ast
 import time
 from pathlib import Path
 
@@ -12,73 +11,22 @@ import numpy as np
 import pytest
 
 import workbench
+from test_lint import _cycles, import_graph
 from workbench.renderers import registry
 from workbench.renderers.base import UI_KINDS, RenderResult, available, get_renderer
 
 ROOT = Path(__file__).resolve().parents[1]
-UI = ROOT / "workbench" / "app" / "ui"
-
-
-def _imports(path: Path, package: str) -> set[str]:
-    """Dotted names of the modules ``path`` imports anywhere in it (relative ones resolved
-    against ``package``; ``from . import x`` counts as module ``package.x``)."""
-    out = set()
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-        if isinstance(node, ast.Import):
-            out.update(a.name for a in node.names)
-        elif isinstance(node, ast.ImportFrom):
-            base = package.split(".")
-            base = base[:len(base) - node.level + 1] if node.level else []
-            mod = ".".join([*base, *([node.module] if node.module else [])])
-            out.add(mod)
-            out.update(f"{mod}.{a.name}" for a in node.names)
-    return out
-
-
-def _cycle(graph: dict[str, set[str]]) -> list[str] | None:
-    """One cycle of ``graph`` (a path of names whose last is its first), or None."""
-    state: dict[str, int] = {}  # 1: on the current path, 2: done
-    path: list[str] = []
-
-    def visit(n):
-        state[n] = 1
-        path.append(n)
-        for m in sorted(graph[n]):
-            if state.get(m) == 1:
-                return path[path.index(m):] + [m]
-            if m not in state:
-                found = visit(m)
-                if found:
-                    return found
-        state[n] = 2
-        path.pop()
-        return None
-
-    for n in sorted(graph):
-        if n not in state:
-            found = visit(n)
-            if found:
-                return found
-    return None
-
-
-def ui_graph() -> dict[str, set[str]]:
-    names = {f"workbench.app.ui.{p.stem}": p for p in UI.glob("*.py") if p.stem != "__init__"}
-    return {n: {m for m in _imports(p, "workbench.app.ui") if m in names and m != n}
-            for n, p in names.items()}
-
-
-def test_cycle_finder_finds_a_cycle():
-    assert _cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": set()}) == ["a", "b", "c", "a"]
-    assert _cycle({"a": {"b"}, "b": set()}) is None
 
 
 def test_ui_package_has_no_import_cycles():
-    graph = ui_graph()
-    assert len(graph) >= 15 and "workbench.app.ui.state" in graph["workbench.app.ui.panels"]
-    assert _cycle(graph) is None, " -> ".join(_cycle(graph))
-    # state is plain data: it imports no view
-    assert graph["workbench.app.ui.state"] <= {"workbench.app.ui.images", "workbench.app.ui.jobs"}
+    """The whole package's circles are checked in test_lint; here the ui's own shape: views
+    depend on the state, and the state (plain data) imports no view."""
+    graph = import_graph()
+    ui = {n: {m for m in t if m.startswith("workbench.app.ui.")} for n, t in graph.items()
+          if n.startswith("workbench.app.ui.")}
+    assert len(ui) >= 15 and "workbench.app.ui.state" in ui["workbench.app.ui.panels"]
+    assert not _cycles(ui), _cycles(ui)
+    assert ui["workbench.app.ui.state"] <= {"workbench.app.ui.images", "workbench.app.ui.jobs"}
 
 
 def test_every_registered_method_says_what_it_is_to_the_window():
