@@ -6,18 +6,18 @@
 // Output: linear RGB and alpha into a float32 colour attachment.
 #include "varyings.glsl"
 #ifdef NEEDS_SURFACE
-in vec3 v_world;
+INTERP in vec3 v_world;
 #ifdef MODE_FLAT
 flat in vec3 v_normal;
 #else
-in vec3 v_normal;
+INTERP in vec3 v_normal;
 #endif
 #endif
 #ifdef NEEDS_OBJ
-in vec3 v_obj;
+INTERP in vec3 v_obj;
 #endif
 #ifdef HAS_UV
-in vec2 v_uv;
+INTERP in vec2 v_uv;
 const bool HAS_UV_ATTR = true;
 #else
 const vec2 v_uv = vec2(0.0);
@@ -33,8 +33,8 @@ const bool HAS_UV_ATTR = false;
 flat in vec3 v_diffuse;
 flat in vec3 v_specular;
 #elif defined(MODE_GOURAUD)
-in vec3 v_diffuse;
-in vec3 v_specular;
+INTERP in vec3 v_diffuse;
+INTERP in vec3 v_specular;
 #endif
 
 uniform vec3 u_eye;

@@ -22,25 +22,25 @@ uniform mat4 u_clip_from_world;
 uniform vec3 u_eye;
 
 #ifdef NEEDS_SURFACE
-out vec3 v_world;
+INTERP out vec3 v_world;
 #ifdef MODE_FLAT
 flat out vec3 v_normal;  // the polygon's (provoking vertex)
 #else
-out vec3 v_normal;
+INTERP out vec3 v_normal;
 #endif
 #endif
 #ifdef NEEDS_OBJ
-out vec3 v_obj;
+INTERP out vec3 v_obj;
 #endif
 #ifdef HAS_UV
-out vec2 v_uv;
+INTERP out vec2 v_uv;
 #endif
 #if defined(MODE_FLAT)
 flat out vec3 v_diffuse;
 flat out vec3 v_specular;
 #elif defined(MODE_GOURAUD)
-out vec3 v_diffuse;
-out vec3 v_specular;
+INTERP out vec3 v_diffuse;
+INTERP out vec3 v_specular;
 #endif
 
 void main() {

@@ -42,7 +42,7 @@ polygon as the course draws it.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -50,6 +50,7 @@ from ..core import transform as tf
 from ..core.errors import WorkbenchError
 from ..core.tol import tol
 from . import model as m
+from .mesh_normals import mean_face_normals
 from .polygon_pieces import convex_pieces
 
 DEFAULT_LEVEL = 6
@@ -436,3 +437,33 @@ def tessellate_scene(scene: m.Scene, level: int = DEFAULT_LEVEL) -> list[Part]:
     for obj in scene.objects:
         parts.extend(tessellate_object(obj, level))
     return parts
+
+
+def area_light_parts(scene: m.Scene) -> list[tuple[Part, m.Material]]:
+    """Area lights as emissive polygons of radiance ``color * intensity`` (what the raster
+    methods draw of them), each with its own material."""
+    out = []
+    for i, light in enumerate(scene.lights):
+        if isinstance(light, m.AreaLight):
+            mat = m.Material(f"area light {i + 1}", color=(0.0, 0.0, 0.0), ka=0.0, kd=0.0, ks=0.0,
+                             emission=tuple(float(x) for x in light.radiance))
+            (part,) = tessellate_object(m.Polygon(mat.name, vertices=light.vertices, name=mat.name), 1)
+            out.append((part, mat))
+    return out
+
+
+#: Vertex-normal rules of the raster methods' ``normals`` option: ``"smooth"`` keeps the
+#: tessellation's (analytic for spheres and quadrics, area-weighted for meshes), ``"face_mean"``
+#: is the course's plain mean of the incident triangles' normals.
+NORMAL_RULES = ("smooth", "face_mean")
+
+
+def with_normal_rule(part: Part, rule: str) -> Part:
+    """``part`` with its vertex normals by ``rule`` (:data:`NORMAL_RULES`; ``"face_mean"``:
+    :func:`.mesh_normals.mean_face_normals`, the course's "moyenne des normales aux faces
+    incidentes", over the part's triangles)."""
+    if rule == "smooth":
+        return part
+    if rule != "face_mean":
+        raise WorkbenchError(f"normals must be one of {', '.join(NORMAL_RULES)}, got {rule!r}")
+    return replace(part, normals=mean_face_normals(part.positions, part.faces, part.normals))
