@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -48,7 +49,7 @@ from . import texturing as tx
 from .base import Knob, Option, RenderResult
 from .estimates import raster_bytes
 from .local_model import shade
-from .zbuffer_scan import Polygons, new_frame, scan_polygons
+from .zbuffer_scan import Frame, Polygons, new_frame, scan_polygons
 
 MODES = ("flat", "gouraud", "phong")
 #: Columns of the per-vertex attributes: world point, shading normal, object-space point, uv,
@@ -115,7 +116,11 @@ def corner_attributes(part: Part, mat: Material, mode: str, scene: Scene, eye: n
 
 def clip_near(clip: np.ndarray, attrs: np.ndarray) -> tuple[list[np.ndarray], list[np.ndarray], np.ndarray]:
     """Clip triangles against the near plane ``z_c >= -w_c`` (Sutherland-Hodgman in clip
-    space; a new vertex's attributes at the same clip-space parameter ``t`` along its edge).
+    space).  A new vertex at clip-space parameter ``t`` along edge [a, b] gets the attributes
+    at the screen-space parameter ``s = t w_b / ((1 - t) w_a + t w_b)`` (the point of the
+    projected edge it projects to), so that they stay linear in screen space over the whole
+    triangle, as the course's scanline formulas define them; when a corner is behind the eye
+    (``w <= 0``: no screen position) there is no such interpolation, and ``t`` is used.
 
     Parameters
     ----------
@@ -141,6 +146,9 @@ def clip_near(clip: np.ndarray, attrs: np.ndarray) -> tuple[list[np.ndarray], li
             if inside[t, c] != inside[t, n]:
                 s = d[t, c] / (d[t, c] - d[t, n])
                 cp.append(clip[t, c] + s * (clip[t, n] - clip[t, c]))
+                wa, wb = clip[t, c, 3], clip[t, n, 3]
+                if wa > 0.0 and wb > 0.0:
+                    s = s * wb / ((1.0 - s) * wa + s * wb)
                 ap.append(attrs[t, c] + s * (attrs[t, n] - attrs[t, c]))
         clip_polys.append(np.array(cp))
         attr_polys.append(np.array(ap))
@@ -159,7 +167,7 @@ def to_window(clip: np.ndarray, width: int, height: int) -> np.ndarray:
 def _polygons(parts, clip_from_world: np.ndarray, width: int, height: int, corner_attrs):
     """Every triangle of ``parts`` as window-space polygons (:class:`~.zbuffer_scan.Polygons`),
     the id of each polygon being its triangle's index over all parts.  Returns
-    ``(polys, n_clipped)``."""
+    ``(polys, clipped)``, ``clipped`` (T,) bool: the triangles the near plane cuts."""
     P = np.concatenate([p.positions[p.faces] for p in parts])        # (T, 3, 3)
     A = np.concatenate(corner_attrs)                                   # (T, 3, K)
     clip = np.concatenate([P, np.ones(P.shape[:2] + (1,))], -1) @ clip_from_world.T
@@ -174,7 +182,74 @@ def _polygons(parts, clip_from_world: np.ndarray, width: int, height: int, corne
     start = np.concatenate([[0], np.cumsum(count)[:-1]]).astype(np.int64)
     finite = np.add.reduceat(~np.isfinite(xyz).all(1), start) == 0 if len(start) else np.zeros(0, bool)
     polys = Polygons(xyz, attrs, start[finite], count[finite], ident[finite])
-    return polys, len(cp)
+    clipped = np.zeros(len(clip), dtype=bool)
+    clipped[crossing] = True
+    return polys, clipped
+
+
+class Raster(NamedTuple):
+    """What :func:`rasterise` leaves for shading: the (part, material) pairs, the filled
+    :class:`~.zbuffer_scan.Frame`, the clip planes, and per triangle (over all parts, the ids
+    in ``frame.ident``) whether the near plane cuts it."""
+
+    pairs: list
+    frame: Frame
+    near: float
+    far: float
+    clipped: np.ndarray
+
+
+def rasterise(scene: Scene, camera: Camera, *, tessellation: int, normals: str, shading: str, blinn: bool,
+              depth_bits: int, near: float, far: float, timings: dict) -> Raster:
+    """Steps 1 to 4 of the module docstring (tessellate, light per vertex or polygon, project and
+    clip, scan-convert); phases timed into ``timings``."""
+    t0 = time.perf_counter()
+    pairs = [(with_normal_rule(p, normals), scene.materials[p.material])
+             for p in tessellate_scene(scene, tessellation)]
+    pairs += area_light_parts(scene)
+    timings["tessellate"] = time.perf_counter() - t0
+    boxes = np.array([[p.positions.min(0), p.positions.max(0)] for p, _ in pairs]).reshape(-1, 2, 3)
+    n0, f0 = auto_near_far(camera, boxes)
+    near, far = near or n0, far or f0
+    if not 0.0 < near < far:
+        raise WorkbenchError(f"clip planes need 0 < near < far, got near {near:.6g} and far {far:.6g}")
+    eye = np.asarray(camera.position, dtype=np.float64)
+    clip_from_world = camera.clip_from_camera(near, far) @ camera.camera_from_world()
+    t0 = time.perf_counter()
+    frame = new_frame(camera.width, camera.height, N_ATTRS, depth_bits)
+    parts = [p for p, _ in pairs]
+    polys, clipped = None, np.zeros(0, dtype=bool)
+    if sum(p.n_triangles for p in parts):
+        corner = [corner_attributes(p, m, shading, scene, eye, blinn) for p, m in pairs]
+        polys, clipped = _polygons(parts, clip_from_world, camera.width, camera.height, corner)
+    timings["vertices"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    compiled = bool(scan_polygons.signatures)
+    if polys is not None and len(polys.start):
+        scan_polygons(polys, frame)
+    timings["scan"] = time.perf_counter() - t0
+    timings["compile"] = 0.0 if compiled or polys is None else timings["scan"]
+    return Raster(pairs, frame, near, far, clipped)
+
+
+def near_clipped_pixels(raster: Raster) -> np.ndarray:
+    """(H, W) bool: pixels whose visible triangle the near plane cuts.  (GL's clipper must
+    give the new corners screen-linear ``noperspective`` values too: llvmpipe gives NaN or 0
+    on some of these pixels, measured in ``tests/test_zbuffer.py``.)"""
+    ident = raster.frame.ident
+    if not len(raster.clipped):
+        return np.zeros(ident.shape, dtype=bool)
+    return (ident >= 0) & raster.clipped[np.maximum(ident, 0)]
+
+
+def near_clipped_mask(scene: Scene, width: int, height: int, tessellation: int = DEFAULT_LEVEL,
+                      normals: str = "smooth") -> np.ndarray:
+    """:func:`near_clipped_pixels` of ``scene`` seen by its camera at ``width x height`` (what
+    the tests and ``bench/zbuffer.py`` set apart when comparing with GL)."""
+    raster = rasterise(scene, scene.camera.with_resolution(width, height), tessellation=tessellation,
+                       normals=normals, shading="flat", blinn=False, depth_bits=24, near=0.0, far=0.0,
+                       timings={})
+    return near_clipped_pixels(raster)
 
 
 def _shade_pixels(A: np.ndarray, Ng: np.ndarray, mat: Material, mode: str, scene: Scene,
@@ -244,36 +319,10 @@ class ZBufferRenderer:
         timings: dict[str, float] = {}
         camera = scene.camera.with_resolution(width, height)
         needs = scene.needs()
-        t0 = time.perf_counter()
-        pairs = [(with_normal_rule(p, normals), scene.materials[p.material])
-                 for p in tessellate_scene(scene, tessellation)]
-        pairs += area_light_parts(scene)
-        timings["tessellate"] = time.perf_counter() - t0
-        boxes = np.array([[p.positions.min(0), p.positions.max(0)] for p, _ in pairs]).reshape(-1, 2, 3)
-        n0, f0 = auto_near_far(camera, boxes)
-        near, far = near or n0, far or f0
-        if not 0.0 < near < far:
-            raise WorkbenchError(f"clip planes need 0 < near < far, got near {near:.6g} and far {far:.6g}")
+        raster = rasterise(scene, camera, tessellation=tessellation, normals=normals, shading=shading,
+                           blinn=blinn, depth_bits=depth_bits, near=near, far=far, timings=timings)
+        frame, pairs, near, far = raster.frame, raster.pairs, raster.near, raster.far
         eye = np.asarray(camera.position, dtype=np.float64)
-        clip_from_world = camera.clip_from_camera(near, far) @ camera.camera_from_world()
-
-        t0 = time.perf_counter()
-        frame = new_frame(width, height, N_ATTRS, depth_bits)
-        parts = [p for p, _ in pairs]
-        n_tri = sum(p.n_triangles for p in parts)
-        if n_tri:
-            corner = [corner_attributes(p, m, shading, scene, eye, blinn) for p, m in pairs]
-            polys, n_clipped = _polygons(parts, clip_from_world, width, height, corner)
-        else:
-            polys, n_clipped = None, 0
-        timings["vertices"] = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        compiled = bool(scan_polygons.signatures)
-        if polys is not None and len(polys.start):
-            scan_polygons(polys, frame)
-        timings["scan"] = time.perf_counter() - t0
-        timings["compile"] = 0.0 if compiled or polys is None else timings["scan"]
-
         t0 = time.perf_counter()
         image = self._shade(frame, pairs, shading, scene, camera, eye, blinn, needs)
         timings["shade"] = time.perf_counter() - t0
@@ -284,7 +333,8 @@ class ZBufferRenderer:
         left = [f"{f}: not needed by the scene (not built)" for f in BUILT if f not in needs]
         left += [why for f, why in LEFT_OUT.items() if f in needs]
         used = sorted(f for f in needs if f not in LEFT_OUT)
-        stats = {"triangles": n_tri, "near_clipped": n_clipped, "near": near, "far": far,
+        stats = {"triangles": sum(p.n_triangles for p, _ in pairs), "near_clipped": int(raster.clipped.sum()),
+                 "near_clipped_pixels": int(near_clipped_pixels(raster).sum()), "near": near, "far": far,
                  "depth_bits": depth_bits, "fragments": int(frame.counts[0]),
                  "depth_passes": int(frame.counts[1]), "shading": shading, "normals": normals}
         return RenderResult(self.name, image.astype(np.float32), timings, stats, used, left,
