@@ -4,10 +4,9 @@ For each scene (those without bump or opacity maps, which ``zbuffer`` leaves out
 mode, ``zbuffer`` and the GL method of the same mode with ``interpolation=screen`` render the
 scene at ``--size``; a pixel differs when a channel differs by more than 0.01 (linear).
 Differing pixels are split into those whose visible triangle the near plane cuts
-(``zbuffer.near_clipped_mask``: GL's clipper must give the new corners screen-linear
-``noperspective`` values; llvmpipe gives NaN or 0 on some of them, counted in
-``gl_nonfinite``) and the others (pixel centres on triangle edges, depth ties, float32 texture
-patterns).
+(``zbuffer.near_clipped_mask``: both must give the new corners screen-linear values; GLSL's
+``noperspective`` on llvmpipe gave NaN there, counted in ``gl_nonfinite``) and the others
+(pixel centres on triangle edges, depth ties, float32 texture patterns).
 Times: warm wall-clock seconds of ``workbench.render`` (the second of two calls), zbuffer's
 phases (vertices, scan, shade) apart.
 

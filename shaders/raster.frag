@@ -6,18 +6,18 @@
 // Output: linear RGB and alpha into a float32 colour attachment.
 #include "varyings.glsl"
 #ifdef NEEDS_SURFACE
-INTERP in vec3 v_world;
+in vec3 v_world;
 #ifdef MODE_FLAT
 flat in vec3 v_normal;
 #else
-INTERP in vec3 v_normal;
+in vec3 v_normal;
 #endif
 #endif
 #ifdef NEEDS_OBJ
-INTERP in vec3 v_obj;
+in vec3 v_obj;
 #endif
 #ifdef HAS_UV
-INTERP in vec2 v_uv;
+in vec2 v_uv;
 const bool HAS_UV_ATTR = true;
 #else
 const vec2 v_uv = vec2(0.0);
@@ -33,9 +33,10 @@ const bool HAS_UV_ATTR = false;
 flat in vec3 v_diffuse;
 flat in vec3 v_specular;
 #elif defined(MODE_GOURAUD)
-INTERP in vec3 v_diffuse;
-INTERP in vec3 v_specular;
+in vec3 v_diffuse;
+in vec3 v_specular;
 #endif
+#include "screen_space.glsl"
 
 uniform vec3 u_eye;
 // the material's C, E and kr: literals MAT_COLOR, MAT_EMISSION, MAT_KR (material_defines)

@@ -9,11 +9,3 @@
 #if defined(MODE_PHONG) || defined(ENV_MAP)
 #define NEEDS_SURFACE
 #endif
-// INTERP: the interpolation qualifier of every smooth varying.  SCREEN_SPACE (the course's
-// scanline formulas, linear in screen space along edges and spans) makes them noperspective;
-// GL's default is perspective-correct.
-#ifdef SCREEN_SPACE
-#define INTERP noperspective
-#else
-#define INTERP
-#endif

@@ -202,7 +202,8 @@ class RasterSession:
         :class:`~.user_shading.ShadingProgram`, see :mod:`.user_shading`).
     interpolation : ``"perspective"`` (GL's default, perspective-correct varyings) or
         ``"screen"``: the course's scanline formulas, linear in screen space along edges and
-        spans (GLSL ``noperspective``, the ``SCREEN_SPACE`` define).
+        spans (as GLSL ``noperspective``; the ``SCREEN_SPACE`` define,
+        ``shaders/include/screen_space.glsl``).
     normals : vertex normals, ``"smooth"`` (the tessellation's) or ``"face_mean"`` (the
         course's plain mean of the incident faces' normals,
         :func:`~workbench.scene.tessellate.with_normal_rule`).

@@ -207,8 +207,9 @@ def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: i
     ``needs``: ``scene.needs()`` when the caller has it.  ``user_model``: a user's shading
     model replaces the local model (``USER_MODEL``, ``shaders/include/user_model.glsl``; the
     lights are compiled in whatever kd and ks are, since the user's model may use neither).
-    ``screen_space``: ``SCREEN_SPACE``, every smooth varying ``noperspective`` (linear in
-    screen space, the course's scanline interpolation; ``shaders/include/varyings.glsl``).
+    ``screen_space``: ``SCREEN_SPACE``, every smooth varying linear in screen space (the
+    course's scanline interpolation, GLSL's ``noperspective`` made robust to near-plane
+    clipping: ``shaders/include/screen_space.glsl``).
     """
     needs = scene.needs() if needs is None else needs
     d = base_defines()

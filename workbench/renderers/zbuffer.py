@@ -23,11 +23,10 @@ Step 5 runs once per pixel after the scan, on the attributes the winning polygon
 the same image as shading each fragment when it passes the test, for opaque surfaces.
 
 Differences from the GL images drawn with ``interpolation=screen`` (measured by
-``tests/test_zbuffer.py``): pixels whose centre lies on or within float32 rounding of an edge
-(GL's rasterisation rules and coverage), depth ties between surfaces that meet or coincide
-(float32 z and the driver's fixed-point conversion against float64 here), texture pattern
-boundaries (float32), and triangles clipped by the near plane (their new vertices' attributes
-are interpolated in clip space here).
+``tests/test_zbuffer.py`` and ``bench/zbuffer.py``: at most 0.01 % of the pixels): pixels
+whose centre lies on or within float32 rounding of an edge (GL's rasterisation rules and
+coverage), depth ties between surfaces that meet or coincide (float32 z and the driver's
+fixed-point conversion against float64 here), texture pattern boundaries (float32).
 """
 from __future__ import annotations
 
@@ -233,9 +232,9 @@ def rasterise(scene: Scene, camera: Camera, *, tessellation: int, normals: str, 
 
 
 def near_clipped_pixels(raster: Raster) -> np.ndarray:
-    """(H, W) bool: pixels whose visible triangle the near plane cuts.  (GL's clipper must
-    give the new corners screen-linear ``noperspective`` values too: llvmpipe gives NaN or 0
-    on some of these pixels, measured in ``tests/test_zbuffer.py``.)"""
+    """(H, W) bool: pixels whose visible triangle the near plane cuts (where the new corners'
+    values decide the image: :func:`clip_near`; GLSL ``noperspective`` varyings got NaN there
+    on llvmpipe, hence ``shaders/include/screen_space.glsl``)."""
     ident = raster.frame.ident
     if not len(raster.clipped):
         return np.zeros(ident.shape, dtype=bool)
