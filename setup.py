@@ -1,6 +1,6 @@
 """Package discovery and the data-folder mapping (the rest of the metadata is in pyproject.toml).
 
-The repository keeps ``shaders/``, ``scenes/`` and ``stress/`` at its top level; a wheel installs
+The repository keeps ``shaders/``, ``scenes/``, ``stress/`` and ``examples/`` at its top level; a wheel installs
 each inside the package as ``workbench/_data/NAME`` (package ``workbench._data.NAME`` mapped to
 the folder ``NAME``).  ``workbench.core.resources.data_dir`` finds them in either layout.
 Written here rather than in pyproject.toml because setuptools' ``packages.find`` cannot be
@@ -8,7 +8,7 @@ combined with extra mapped packages: ``find_packages`` keeps new subpackages inc
 """
 from setuptools import find_packages, setup
 
-DATA_FOLDERS = ("shaders", "scenes", "stress")
+DATA_FOLDERS = ("shaders", "scenes", "stress", "examples")
 
 setup(
     packages=find_packages(include=["workbench*"]) + [f"workbench._data.{d}" for d in DATA_FOLDERS],

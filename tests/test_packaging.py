@@ -24,7 +24,7 @@ import pytest
 import workbench
 
 ROOT = Path(__file__).resolve().parents[1]
-PROJECT_FILES = ("pyproject.toml", "setup.py", "README.md", "workbench", "shaders", "scenes", "stress")
+PROJECT_FILES = ("pyproject.toml", "setup.py", "README.md", "workbench", "shaders", "scenes", "stress", "examples")
 W, H = 64, 48
 
 
@@ -103,7 +103,7 @@ def test_wheel_installs_data_and_renders_phong_from_another_folder(wheel_site, g
     # the data folders are inside the installed package (not found through the checkout)
     for name, probe in (("shaders", "raster.frag"), ("shaders", "include/lighting.glsl"),
                         ("scenes", "whitted.toml"), ("scenes", "assets/earth_latlong.png"),
-                        ("stress", "cases.toml")):
+                        ("stress", "cases.toml"), ("examples", "shading/toon.glsl")):
         assert (site / "workbench" / "_data" / name / probe).is_file(), (name, probe)
     cli, api, info = _render_both_ways("phong", site, env, work)
     for key in ("file", "shaders", "scenes", "stress"):
@@ -116,6 +116,9 @@ def test_wheel_installs_data_and_renders_phong_from_another_folder(wheel_site, g
     # the installed `workbench` script (its shebang is this interpreter) and the bundled scenes
     stdout, _ = _run([str(site / "bin" / "workbench"), "scenes"], env, work)
     assert "whitted" in stdout and "cornell" in stdout
+    # the example shading models are installed too, and a bare name finds them
+    stdout, _ = _run([sys.executable, "-m", "workbench", "methods"], env, work)
+    assert f"glsl:toon = {site.resolve() / 'workbench' / '_data' / 'examples' / 'shading' / 'toon.glsl'}" in stdout
 
 
 @pytest.mark.slow  # the installed copy has its own numba cache: the cold JIT compile takes 30-70 s

@@ -14,7 +14,8 @@ from radiosity_shapes import grid  # noqa: E402
 
 import workbench  # noqa: E402
 from workbench.core.tol import tol  # noqa: E402
-from workbench.renderers.radiosity.formfactors import geometry_from_polygons, point_polygon  # noqa: E402
+from workbench.renderers.radiosity.formfactors import point_polygon  # noqa: E402
+from workbench.renderers.radiosity.geometry import geometry_from_polygons  # noqa: E402
 from workbench.renderers.radiosity.raycast import RayRows  # noqa: E402
 
 

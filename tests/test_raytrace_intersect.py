@@ -7,8 +7,10 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 import workbench
-from workbench.renderers.raytrace import csg, kernels, shapes
-from workbench.scene.io import quadric_matrix, scene_from_dict
+from workbench.renderers.raytrace import kernels, shapes
+from workbench.scene.io import scene_from_dict
+from workbench.scene.kinds import csg, quadric, sphere
+from workbench.scene.kinds.quadric import quadric_matrix
 
 
 def scene(objects, materials=None, lights=(), **extra):
@@ -27,7 +29,7 @@ def cast(sc, O, D):
 
 def test_sphere_away_from_origin_t4_and_t6():
     """DESIGN errata 1: origin 0, direction +z, centre (0, 0, 5), r = 1 -> t = 4 and 6."""
-    assert [t for t, _ in shapes.sphere((0, 0, 5), 1.0, np.zeros(3), np.array([0, 0, 1.0]))] == pytest.approx([4, 6])
+    assert [t for t, _ in sphere.roots((0, 0, 5), 1.0, np.zeros(3), np.array([0, 0, 1.0]))] == pytest.approx([4, 6])
     ok, t0, t1 = kernels.sphere_roots(np.array([[0, 0, 5, 1.0]]), 0, 0, 0, 0, 0, 0, 1.0)
     assert ok and (t0, t1) == pytest.approx((4, 6))
     sc = scene([{"type": "sphere", "center": [0, 0, 5], "radius": 1.0}])
@@ -83,8 +85,8 @@ def test_quadric_normals_are_the_gradient():
 def test_quadric_with_zero_quadratic_coefficient():
     """A = 0 (errata 2): a ray along a paraboloid's axis has one linear root."""
     Q, _ = quadric_matrix("paraboloid", (1.0, 1.0, 1.0))
-    A, B, C = shapes.quadric_coefficients(Q, np.array([0, 5.0, 0]), np.array([0, -1.0, 0]))
-    assert A == 0.0 and shapes.solve_quadratic(A, B, C) == pytest.approx([5.0])
+    A, B, C = quadric.quadric_coefficients(Q, np.array([0, 5.0, 0]), np.array([0, -1.0, 0]))
+    assert A == 0.0 and quadric.solve_quadratic(A, B, C) == pytest.approx([5.0])
     sc = scene([{"type": "quadric", "shape": "paraboloid", "bounds": {"min": [-2] * 3, "max": [2] * 3}}])
     t, n, obj = cast(sc, [[0, 5, 0], [0.5, 5, 0]], [[0, -1, 0], [0, -1, 0]])
     assert t == pytest.approx([5.0, 5.0 - 0.25])

@@ -10,6 +10,7 @@ import workbench
 from workbench.renderers import local_model
 from workbench.renderers.raytrace import reference
 from workbench.scene.io import scene_from_dict
+from workbench.scene.media import enclosing_media
 
 
 def make(objects, materials, lights=(), camera=None, **scene_kw):
@@ -271,8 +272,8 @@ def test_a_camera_inside_an_absorbing_medium_sees_through_it(path, monkeypatch):
     d = -cd + np.sqrt(cd ** 2 - CAM_IN_GLASS @ CAM_IN_GLASS + 4.0)  # to the sphere, radius 2
     expected = bare * np.exp(-np.array([0.3, 0.15, 0.0]) * d[..., None])
     assert np.allclose(inside, expected, rtol=1e-5, atol=1e-7)  # float32 images
-    assert [m.name for m in reference.enclosing_media(sc, CAM_IN_GLASS)] == ["glass"]
-    assert reference.enclosing_media(sc, [0, 0, 3]) == []
+    assert [m.name for m in enclosing_media(sc, CAM_IN_GLASS)] == ["glass"]
+    assert enclosing_media(sc, [0, 0, 3]) == []
 
 
 def test_camera_inside_refracting_glass_equals_the_reference():
@@ -295,7 +296,7 @@ def test_enclosing_media_by_point_in_solid():
     from workbench.scene.generate import generate_mesh
     g = lambda kt=1.0: {"color": [1, 1, 1], "kt": kt, "ior": 1.5}  # noqa: E731
     mats = {f"g{i}": g() for i in range(1, 6)} | {"opaque": g(0.0)}
-    names = lambda sc, p: [mt.name for mt in reference.enclosing_media(sc, p)]  # noqa: E731
+    names = lambda sc, p: [mt.name for mt in enclosing_media(sc, p)]  # noqa: E731
     nested = make([{"type": "sphere", "center": [0, 0, 0], "radius": r, "material": f"g{r}"} for r in (3, 1, 5, 2, 4)], mats)
     assert names(nested, [0.1, 0.2, 0.0]) == ["g5", "g4", "g3", "g2", "g1"]
     assert names(nested, [0.0, 2.5, 0.0]) == ["g5", "g4", "g3"]

@@ -9,6 +9,7 @@ import pytest
 
 from workbench.scene import library
 from workbench.scene.io import SceneError, load_scene, scene_from_dict
+from workbench.scene.features import scene_needs
 
 BASE = {
     "scene": {"name": "t"},
@@ -31,14 +32,14 @@ def _with(path, value):
 @pytest.mark.parametrize("path", library.bundled(), ids=lambda p: p.stem)
 def test_bundled_scene_loads_with_header(path):
     s = load_scene(path)
-    assert s.objects and s.needs()
+    assert s.objects and scene_needs(s)
     assert len(library.header(path)) > 40, "each bundled scene says what it demonstrates"
 
 
 def test_minimal_scene_is_built():
     s = scene_from_dict(BASE)
     assert s.objects[0].radius == 1.0 and s.materials["m"].color == (1.0, 0.0, 0.0)
-    assert {"spheres", "point_lights"} <= s.needs()
+    assert {"spheres", "point_lights"} <= scene_needs(s)
 
 
 @pytest.mark.parametrize("data, key, expect", [
@@ -91,7 +92,7 @@ def test_mesh_from_obj_file_and_relative_path(tmp_path):
         path = "tri.obj"
     """))
     s = load_scene(tmp_path / "s.toml")
-    assert s.objects[0].faces.shape == (2, 3) and "meshes" in s.needs()
+    assert s.objects[0].faces.shape == (2, 3) and "meshes" in scene_needs(s)
 
 
 def test_nothing_half_loaded_scene_is_immutable():
@@ -104,10 +105,10 @@ def test_nothing_half_loaded_scene_is_immutable():
 
 def test_needs_follow_materials_and_lights():
     d = _with(["materials", "m"], {"kr": 0.5, "kt": 0.5, "ior": 1.5, "texture": {"type": "checker", "projection": "planar"}})
-    f = scene_from_dict(d).needs()
+    f = scene_needs(scene_from_dict(d))
     assert {"reflection", "refraction", "textures"} <= f and "bump" not in f and "emitters" not in f
     d = _with(["lights"], [])
-    assert "shadows" not in scene_from_dict(d).needs()
+    assert "shadows" not in scene_needs(scene_from_dict(d))
 
 
 def test_area_light_stand_ins_carry_its_power():

@@ -7,7 +7,7 @@ import pytest
 
 from workbench.core import transform as tf
 from workbench.scene import model as m
-from workbench.scene.io import quadric_matrix
+from workbench.scene.kinds.quadric import quadric_matrix
 from workbench.scene.tessellate import tessellate_object, tessellate_scene
 
 

@@ -231,3 +231,25 @@ def test_compare_stops_on_a_compile_error(tmp_path):
                                "--size", "32x24", "--reference", "phong", "--repeat", "0"))
     assert err.startswith(f"workbench: error: {f}:3:")
     assert not (out / "report.json").exists()
+
+
+def test_bare_name_is_a_bundled_example(tmp_path, monkeypatch):
+    """``glsl:toon`` works from any folder (a wheel's user has no checkout): the bundled
+    example of that stem; a file of that name in the working folder wins; an unknown bare name
+    lists the examples."""
+    monkeypatch.chdir(tmp_path)
+    assert load_model("toon").path == str(TOON.resolve())
+    assert load_model("oren_nayar.glsl").path == str(OREN_NAYAR.resolve())
+    own = tmp_path / "toon.glsl"
+    own.write_text("vec3 shade(vec3 P, vec3 N, vec3 V, vec3 L, Material m) { return N; }\n")
+    assert load_model("toon.glsl").path == str(own.resolve())
+    with pytest.raises(WorkbenchError, match=r"'nope': no such file \(bundled examples: oren_nayar, toon\)"):
+        load_model("nope")
+    with pytest.raises(WorkbenchError, match=r"no such file$"):
+        load_model("sub/nope.glsl")
+
+
+def test_methods_lists_the_user_form_and_the_examples():
+    out = subprocess.run([sys.executable, "-m", "workbench", "methods"], capture_output=True, text=True, check=True).stdout
+    assert "glsl:FILE" in out
+    assert f"glsl:toon = {TOON.resolve()}" in out and f"glsl:oren_nayar = {OREN_NAYAR.resolve()}" in out

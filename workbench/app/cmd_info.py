@@ -1,5 +1,6 @@
 """``workbench info SCENE``: camera, lights, materials, objects and needs of a scene."""
 from __future__ import annotations
+from ..scene.features import scene_needs
 
 
 def add_parser(sub):
@@ -23,5 +24,5 @@ def run(args) -> int:
               f"kr {m.kr} kt {m.kt} ior {m.ior}" + (f" [{', '.join(extra)}]" if extra else ""))
     for o in s.objects:
         print(f"  object {o.kind}{' ' + o.name if o.name else ''}: material {o.material}")
-    print(f"  needs: {', '.join(sorted(s.needs()))}")
+    print(f"  needs: {', '.join(sorted(scene_needs(s)))}")
     return 0

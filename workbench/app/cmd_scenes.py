@@ -1,5 +1,6 @@
 """``workbench scenes``: the bundled scenes with what each demonstrates and needs."""
 from __future__ import annotations
+from ..scene.features import scene_needs
 
 
 def add_parser(sub):
@@ -12,7 +13,7 @@ def run(args) -> int:
     from ..scene.library import bundled, header
     for path in bundled():
         try:
-            needs = ", ".join(sorted(load_scene(path).needs()))
+            needs = ", ".join(sorted(scene_needs(load_scene(path))))
         except SceneError as e:
             needs = f"(does not load: {e})"
         print(f"{path.stem}\n    {header(path)}\n    needs: {needs}")

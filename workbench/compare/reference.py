@@ -123,7 +123,7 @@ class Reference:
 def candidates(scene: Scene) -> list[tuple[str, str]]:
     """Full-reference candidates in rule order, each with the reason it would be chosen."""
     out = []
-    if F.EMITTERS in scene.needs():
+    if F.EMITTERS in F.scene_needs(scene):
         out.append(("pathtrace", "scene has emitters: unbiased path tracing (Kajiya 1986), converged"))
     out.append(("raytrace", "point-lit scene: the Whitted ray tracer is exact for the course's model "
                             "(local model, shadows, ideal reflection and refraction)"))

@@ -34,6 +34,7 @@ from .outputs import dumps, jsonable, loads, machine_info, staged
 from .metrics import metrics
 from .reference import References, matched_reason, physical_differences
 from .runs import MethodRun, timed_run
+from ..scene.features import scene_needs
 
 
 def _fmt_opts(opts: dict) -> str:
@@ -107,7 +108,7 @@ def compare(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
         "kind": "compare", "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "command": command,
         "scene": {"name": scene.name, "source": scene.source, "description": scene.description,
-                  "needs": sorted(scene.needs())},
+                  "needs": sorted(scene_needs(scene))},
         "size": [w, h], "repeat": repeat,
         "timing_protocol": "one cold call (compile reported apart) then `repeat` warm calls, "
                            "sequential in one process; time_s = median of the warm calls",

@@ -34,6 +34,7 @@ from .metrics import metrics
 from .outputs import dumps, jsonable, machine_info, staged
 from .reference import SAMPLING_NOTE, References
 from .runs import timed_run
+from ..scene.features import scene_needs
 
 CSV_FIELDS = ["method", "knob", "value", "status", "reason", "time_s", "cold_s", "compile_s", "rmse",
               "psnr", "flip", "rmse_matched", "flip_matched", "matched_reference", "nonfinite_pixels",
@@ -190,7 +191,7 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
     result = {
         "kind": "study", "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "command": command, "quick": quick, "repeat": repeat, "size": [w, h], "jobs": jobs,
-        "scene": {"name": scene.name, "source": scene.source, "needs": sorted(scene.needs())},
+        "scene": {"name": scene.name, "source": scene.source, "needs": sorted(scene_needs(scene))},
         "reference": ref_info, "matched_references": matched,
         "timing_protocol": "per point: 1 cold call (compile reported apart) + `repeat` warm calls, all "
                            "sequential in one process; time_s = median of warm wall times; error "

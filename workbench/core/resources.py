@@ -1,6 +1,6 @@
 """Where the bundled data folders are: the one place that knows the two layouts.
 
-The repository keeps ``shaders/``, ``scenes/`` and ``stress/`` at its top level (beside the
+The repository keeps ``shaders/``, ``scenes/``, ``stress/`` and ``examples/`` at its top level (beside the
 ``workbench`` package).  A wheel installs them inside the package, as ``workbench/_data/NAME``
 (``setup.py`` maps each folder to the package ``workbench._data.NAME``).  So:
 
@@ -19,7 +19,7 @@ from pathlib import Path
 
 from .errors import WorkbenchError
 
-FOLDERS = ("shaders", "scenes", "stress")
+FOLDERS = ("shaders", "scenes", "stress", "examples")
 """The bundled folders, by their name in the repository."""
 
 

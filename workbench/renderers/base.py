@@ -28,7 +28,7 @@ from ..core.errors import WorkbenchError
 from ..core.memory import ENV as MEMORY_ENV
 from ..core.memory import gib, memory_limit
 from ..scene.model import Scene
-from .registry import BUILTIN, OPT_IN
+from .registry import BUILTIN, OPT_IN, USER_SHADING
 
 
 @dataclass(frozen=True)
@@ -128,8 +128,8 @@ def get_renderer(method: str) -> Renderer:
     renderer of the user's shading model in PATH (checked: a missing or invalid file raises
     :class:`WorkbenchError`), not registered nor cached."""
     if method.startswith(USER_PREFIX):
-        from .user_shading import renderer_from_path
-        return renderer_from_path(method[len(USER_PREFIX):], name=method)
+        mod, attr = USER_SHADING.split(":")
+        return getattr(importlib.import_module(mod), attr)(method[len(USER_PREFIX):], name=method)
     if method not in BUILTIN:
         raise WorkbenchError(f"unknown method {method!r} (available: {', '.join(available())})")
     if method not in _instances:

@@ -47,6 +47,7 @@ from ..scene.model import Scene
 from ..scene.tessellate import MAX_LEVEL
 from .base import Knob, Option, RenderResult
 from .mitsuba_export import RR_DEPTH, export_scene
+from ..scene.features import scene_needs
 
 FALLBACK_VARIANT = "scalar_rgb"
 FAST_VARIANT = "llvm_ad_rgb"
@@ -243,6 +244,6 @@ class MitsubaRenderer:
                  "samples_per_second": spp * width * height / max(t_render, tol.zero),
                  "render_cpu_seconds": info["cpu"], "child_peak_rss_bytes": info["peak_rss_bytes"],
                  "stderr": stderr, "stderr_rms": float(np.sqrt(np.mean(stderr.astype(np.float64) ** 2)))}
-        needs = scene.needs()
+        needs = scene_needs(scene)
         used = sorted(f for f in needs if not any(x.startswith(f + ":") for x in ex.left_out))
         return RenderResult(self.name, image, timings, stats, used, list(ex.left_out), std_error=stderr)

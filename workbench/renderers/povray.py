@@ -142,8 +142,8 @@ class PovrayRenderer:
                  "refracted_rays": int(_stat(log, r"Refracted Rays:\s+(\d+)")),
                  "sdl_bytes": len(ex.sdl)}
         left = list(ex.left_out)
-        if ft.SHADOWS in scene.needs() and any(mt.kt > 0 for mt in scene.materials.values()):
+        if ft.SHADOWS in ft.scene_needs(scene) and any(mt.kt > 0 for mt in scene.materials.values()):
             left.append(f"{ft.SHADOWS}: transmissive occluders attenuate shadows by kt (POV-Ray's filtered "
                         "shadows: the ray tracer's transmissive_shadows = true)")
-        used = sorted(f for f in scene.needs() if not any(x.startswith(f + ":") for x in left))
+        used = sorted(f for f in ft.scene_needs(scene) if not any(x.startswith(f + ":") for x in left))
         return RenderResult(self.name, image, timings, stats, used, left)

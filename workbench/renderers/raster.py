@@ -57,8 +57,9 @@ from ..core.errors import WorkbenchError
 from ..scene import features as ft
 from ..scene.model import AreaLight, Camera, Environment, Material, Scene
 from ..scene.clip_planes import auto_near_far
-from ..scene.tessellate import (DEFAULT_LEVEL, MAX_LEVEL, NORMAL_RULES, Part, area_light_parts,
-                                tessellate_scene, with_normal_rule)
+from ..scene.parts import Part
+from ..scene.tessellate import (DEFAULT_LEVEL, MAX_LEVEL, NORMAL_RULES, area_light_parts, tessellate_scene,
+                                with_normal_rule)
 from .estimates import raster_bytes
 from ..scene.tessellate_topology import closed_outward, provoking_layout
 from . import gl
@@ -240,7 +241,7 @@ class RasterSession:
         self.part_boxes = np.array([[p.positions.min(0), p.positions.max(0)] for p, _, _ in pairs])
         self.lights = scene.point_lights()
         self._light_values = light_uniforms(self.lights)
-        self._needs = scene.needs()  # its texture entry does not change with update()
+        self._needs = ft.scene_needs(scene)  # its texture entry does not change with update()
         self._gl_images: dict[tuple, object] = {}
         self._gl_objects: list = []  # vertex arrays and buffers, freed by release()
         self._fbos: OrderedDict = OrderedDict()
@@ -433,7 +434,7 @@ class RasterSession:
         return (depth > near).all(1)
 
     def _report(self) -> tuple[list[str], list[str]]:
-        needs = self.scene.needs()
+        needs = ft.scene_needs(self.scene)
         left = [f"{f}: not needed by the scene (not compiled)" for f in SHADER_FEATURES if f not in needs]
         if ft.BUMP in needs and self.mode != "phong":
             left.append(f"bump: {self.mode} shading has no per-fragment normal to perturb")

@@ -204,14 +204,14 @@ def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: i
     compiles what any value of them needs (the lights, ``SPECULAR``, ``ENV_MAP`` for an
     environment-mapped material, whatever kd, ks and kr are); ``live_lights`` reads the lights'
     positions and colours from uniform arrays (``LIVE_LIGHTS``, :func:`light_uniforms`).
-    ``needs``: ``scene.needs()`` when the caller has it.  ``user_model``: a user's shading
+    ``needs``: ``ft.scene_needs(scene)`` when the caller has it.  ``user_model``: a user's shading
     model replaces the local model (``USER_MODEL``, ``shaders/include/user_model.glsl``; the
     lights are compiled in whatever kd and ks are, since the user's model may use neither).
     ``screen_space``: ``SCREEN_SPACE``, every smooth varying linear in screen space (the
     course's scanline interpolation, GLSL's ``noperspective`` made robust to near-plane
     clipping: ``shaders/include/screen_space.glsl``).
     """
-    needs = scene.needs() if needs is None else needs
+    needs = ft.scene_needs(scene) if needs is None else needs
     d = base_defines()
     d[MODES[mode]] = ""
     d["SCENE_AMBIENT"] = _vec3(scene.ambient)

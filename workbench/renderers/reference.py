@@ -364,7 +364,7 @@ class PyrenderRenderer:
             res = _child(scene.source, width, height, tessellation, 1)
         else:
             res = _in_worker(_render_here, scene, width, height, tessellation)
-        needs = scene.needs()
+        needs = ft.scene_needs(scene)
         left = list(res["left_out"])
         for f, why in ((ft.SHADOWS, "shadow maps not enabled (the local models have none)"),
                        (ft.REFLECTION, "no mirror reflection in pyrender (kr mapped to metalness)"),

@@ -25,3 +25,7 @@ BUILTIN: dict[str, str] = {
 }
 
 OPT_IN: frozenset[str] = frozenset({"mitsuba"})
+
+USER_SHADING = "workbench.renderers.user_shading:renderer_from_path"
+"""The factory of ``glsl:PATH`` methods (a user's shading model), loaded by name like the rest:
+it is a raster renderer, and the raster imports :mod:`.base`."""

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..core.errors import ShaderSourceError, WorkbenchError
+from ..core.resources import data_dir
 from ..scene.model import Scene
 from .base import USER_PREFIX as PREFIX, Option, RenderResult
 from .raster import _RasterRenderer
@@ -163,6 +164,32 @@ def _parameter(path: str, lineno: int, words: list[str], rest: str) -> Parameter
     return Parameter(name, default, rest, lineno)
 
 
+def bundled_examples() -> dict[str, Path]:
+    """The example shading models installed with the workbench (``examples/shading/*.glsl``),
+    by file stem: ``glsl:toon`` names ``examples/shading/toon.glsl`` in a checkout or a wheel."""
+    return {f.stem: f for f in sorted((data_dir("examples") / "shading").glob("*.glsl"))}
+
+
+def resolve_path(path: str | Path) -> Path:
+    """The file a ``glsl:`` method names: ``path`` itself when it exists, else, for a bare name
+    without a folder (``toon`` or ``toon.glsl``), the bundled example of that stem.
+
+    Raises
+    ------
+    WorkbenchError
+        One line naming the missing file (and the bundled examples, for a bare name).
+    """
+    p = Path(path).expanduser()
+    if p.exists():
+        return p
+    bare = len(p.parts) == 1 and p.suffix in ("", ".glsl")
+    examples = bundled_examples() if bare else {}
+    if p.stem in examples:
+        return examples[p.stem]
+    hint = f" (bundled examples: {', '.join(examples)})" if bare and examples else ""
+    raise WorkbenchError(f"shading model {str(path)!r}: no such file{hint}")
+
+
 def load_model(path: str | Path) -> ShadingModel:
     """Read and check a user's shading model (exists, is readable UTF-8 text of at most
     :data:`MAX_BYTES`, defines ``shade``, declares valid parameters).
@@ -172,9 +199,7 @@ def load_model(path: str | Path) -> ShadingModel:
     WorkbenchError
         One line naming the file and what is wrong.
     """
-    p = Path(path).expanduser()
-    if not p.exists():
-        raise WorkbenchError(f"shading model {str(path)!r}: no such file")
+    p = resolve_path(path)
     if not p.is_file():
         raise WorkbenchError(f"shading model {str(path)!r}: not a file")
     p = p.resolve()

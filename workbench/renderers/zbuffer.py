@@ -42,8 +42,9 @@ from ..core.transform import normalize
 from ..scene import features as ft
 from ..scene.clip_planes import auto_near_far
 from ..scene.model import Camera, Material, Scene
-from ..scene.tessellate import (DEFAULT_LEVEL, MAX_LEVEL, NORMAL_RULES, Part, area_light_parts,
-                                tessellate_scene, with_normal_rule)
+from ..scene.parts import Part
+from ..scene.tessellate import (DEFAULT_LEVEL, MAX_LEVEL, NORMAL_RULES, area_light_parts, tessellate_scene,
+                                with_normal_rule)
 from . import texturing as tx
 from .base import Knob, Option, RenderResult
 from .estimates import raster_bytes
@@ -317,7 +318,7 @@ class ZBufferRenderer:
         self._check(tessellation, depth_bits, near, far)
         timings: dict[str, float] = {}
         camera = scene.camera.with_resolution(width, height)
-        needs = scene.needs()
+        needs = ft.scene_needs(scene)
         raster = rasterise(scene, camera, tessellation=tessellation, normals=normals, shading=shading,
                            blinn=blinn, depth_bits=depth_bits, near=near, far=far, timings=timings)
         frame, pairs, near, far = raster.frame, raster.pairs, raster.near, raster.far

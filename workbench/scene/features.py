@@ -6,6 +6,7 @@ Feature names are plain strings (stable, printed by ``workbench scenes`` and lis
 from __future__ import annotations
 
 from . import model as m
+from .kinds import kind_of, leaves
 
 TEXTURES = "textures"
 SOLID_TEXTURES = "solid_textures"
@@ -34,10 +35,6 @@ AREA_LIGHTS = "area_lights"
 ALL = (TEXTURES, SOLID_TEXTURES, IMAGE_TEXTURES, BUMP, ENVIRONMENT, OPACITY, SHADOWS, SPECULAR,
        REFLECTION, REFRACTION, ABSORPTION, CSG, QUADRICS, SPHERES, PLANES, BOXES, POLYGONS, MESHES,
        TRANSFORMS, EMITTERS, POINT_LIGHTS, DIRECTIONAL_LIGHTS, AREA_LIGHTS)
-
-_KIND = {"sphere": SPHERES, "plane": PLANES, "box": BOXES, "quadric": QUADRICS,
-         "polygon": POLYGONS, "mesh": MESHES, "csg": CSG}
-
 
 def material_needs(mat: m.Material) -> set[str]:
     """Features one material uses."""
@@ -68,14 +65,13 @@ def material_needs(mat: m.Material) -> set[str]:
 
 
 def _object_needs(obj: m.SceneObject, scene: m.Scene, f: set[str]):
+    """Its kind's feature (and its operands'), transforms, its materials' features."""
     import numpy as np
-    f.add(_KIND[obj.kind])
-    if not np.allclose(obj.world_from_object, np.eye(4)):
-        f.add(TRANSFORMS)
-    f |= material_needs(scene.materials[obj.material])
-    if isinstance(obj, m.CSG):
-        for child in (obj.left, obj.right):
-            _object_needs(child, scene, f)
+    for o in leaves(obj):
+        f.add(kind_of(o).FEATURE)
+        if not np.allclose(o.world_from_object, np.eye(4)):
+            f.add(TRANSFORMS)
+        f |= material_needs(scene.materials[o.material])
 
 
 def scene_needs(scene: m.Scene) -> frozenset[str]:
@@ -89,7 +85,7 @@ def scene_needs(scene: m.Scene) -> frozenset[str]:
                m.AreaLight: AREA_LIGHTS}[type(light)])
         if isinstance(light, m.AreaLight):
             f.add(EMITTERS)
-    if scene.lights and (len(scene.objects) > 1 or scene.objects[0].kind in ("mesh", "csg", "quadric")):
+    if scene.lights and (len(scene.objects) > 1 or not kind_of(scene.objects[0]).CONVEX):
         f.add(SHADOWS)
     if scene.environment is not None:
         f.add(ENVIRONMENT)

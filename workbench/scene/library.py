@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..core.resources import data_dir
+from .readers import SceneError
 
 SCENES_DIR = data_dir("scenes")
 DEFAULT_SCENE = "whitted"
@@ -27,7 +28,6 @@ def header(path: Path) -> str:
 
 def resolve(name: str | Path) -> Path:
     """A scene file path from a path or a bundled scene's name (``"cornell"``)."""
-    from .io import SceneError
     if not isinstance(name, (str, Path)):
         raise SceneError(f"a scene is given by a file path or a bundled scene's name (str), got "
                          f"{type(name).__name__} {name!r}")

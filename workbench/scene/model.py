@@ -398,6 +398,10 @@ class CSG(SceneObject):
 
 
 # --------------------------------------------------------------------------- scene
+AREA_LIGHT_PREFIX = "__area_light_"
+"""Material name prefix of area lights' polygons (:meth:`Scene.area_light_polygons`)."""
+
+
 @dataclass(frozen=True, eq=False)
 class Scene:
     """A whole scene.  ``source`` is the file it came from (for messages and relative paths)."""
@@ -413,16 +417,25 @@ class Scene:
     environment: Environment | None = None
     source: str = ""
 
-    def needs(self) -> frozenset[str]:
-        """The features this scene uses (see :mod:`workbench.scene.features`)."""
-        from .features import scene_needs
-        return scene_needs(self)
-
     def point_lights(self) -> list[PointLight | DirectionalLight]:
         """Point and directional lights, area lights replaced by their stand-ins."""
         out: list[PointLight | DirectionalLight] = []
         for light in self.lights:
             out.extend(light.stand_ins() if isinstance(light, AreaLight) else [light])
+        return out
+
+    def area_light_polygons(self) -> list[tuple[int, Polygon, Material]]:
+        """Every area light as the emissive polygon the methods see, the one place where an
+        area light becomes a surface: ``(k, polygon, material)`` for light ``k`` of
+        :attr:`lights`, the polygon's material named ``__area_light_k`` (black, no ka/kd/ks;
+        ``emission`` its radiance ``color * intensity``), not part of :attr:`materials`."""
+        out = []
+        for k, light in enumerate(self.lights):
+            if isinstance(light, AreaLight):
+                name = f"{AREA_LIGHT_PREFIX}{k}"
+                mat = Material(name, color=(0.0, 0.0, 0.0), ka=0.0, kd=0.0, ks=0.0,
+                               emission=tuple(float(x) for x in light.radiance))
+                out.append((k, Polygon(name, vertices=light.vertices, name=name), mat))
         return out
 
     def material_of(self, obj: SceneObject) -> Material:

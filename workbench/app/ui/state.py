@@ -8,6 +8,7 @@ import numpy as np
 
 from ...scene.model import Camera, Scene
 from .images import PanelImages
+from ...scene.features import scene_needs
 
 RASTER = ("flat", "gouraud", "phong")
 """Methods drawn every frame in the window's own GL context."""
@@ -106,9 +107,9 @@ def default_options(method: str) -> dict:
 
 def first_view(scene: Scene, allowed) -> list[str]:
     """The methods shown when none are named: :data:`FIRST_VIEW`, plus :data:`EMITTER_VIEW`
-    when the scene has emitters (``Scene.needs()``), each where registered."""
+    when the scene has emitters (``features.scene_needs``), each where registered."""
     from ...scene.features import EMITTERS
-    wanted = [*FIRST_VIEW, *(EMITTER_VIEW if EMITTERS in scene.needs() else ())]
+    wanted = [*FIRST_VIEW, *(EMITTER_VIEW if EMITTERS in scene_needs(scene) else ())]
     return [m for m in wanted if m in allowed]
 
 

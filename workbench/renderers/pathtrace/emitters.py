@@ -19,7 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...core.tol import tol
-from ..raytrace.flatten import BOX, MESH, POLYGON, RECT, SceneData
+from ...scene.kinds import BOX, MESH, POLYGON, RECT
+from ..raytrace.flatten import SceneData
 
 _BOX_QUADS = ((0, 2, 6, 4), (1, 5, 7, 3), (0, 4, 5, 1), (2, 3, 7, 6), (0, 1, 3, 2), (4, 6, 7, 5))
 """Faces of a box as corner indices (corner ``c``: bit 0 = x max, bit 1 = y max, bit 2 = z max)."""

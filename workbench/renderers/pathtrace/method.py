@@ -93,7 +93,7 @@ class PathTraceRenderer:
         return RenderResult(self.name, ses.image, timings, stats, *self._features(scene, ses), std_error=se)
 
     def _features(self, scene: Scene, ses: PathTraceSession):
-        needs = scene.needs()
+        needs = F.scene_needs(scene)
         left = ["ambient: off (the path tracer computes the indirect light it stands in for)"]
         if ses.transport != "full":
             why = f"transport={ses.transport}: "

@@ -19,9 +19,10 @@ import numpy as np
 from ...core.errors import WorkbenchError
 from ...core.tol import tol
 from ...scene import model as m
+from ...scene.kinds import MESH
 from .. import local_model
 from ..raytrace import reference as rt
-from ..raytrace.flatten import MESH, flatten
+from ..raytrace.flatten import flatten
 from ..raytrace.whitted import camera_frame
 from .emitters import build_emitters
 from .session import FRESNEL, MIS, PIXEL_FILTER, TRANSPORT

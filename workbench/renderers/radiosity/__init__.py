@@ -14,7 +14,8 @@ Modules: :mod:`.patches` (scene -> patches), :mod:`.formfactors` (analytic, disp
 """
 from __future__ import annotations
 
-from .formfactors import FormFactors, geometry_from_polygons
+from .formfactors import FormFactors
+from .geometry import geometry_from_polygons
 from .formfactors import compute as _compute
 from .solvers import SolveResult, solve  # noqa: F401
 

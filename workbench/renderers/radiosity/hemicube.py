@@ -39,7 +39,7 @@ from ...core.errors import WorkbenchError
 from ...core.resources import data_dir
 from ...core.tol import tol
 from .. import gl
-from .formfactors import Geometry
+from .geometry import Geometry
 
 SHADERS = data_dir("shaders")
 MAX_FACES = 80          # must match MAX_FACES in radiosity_item_vs.glsl

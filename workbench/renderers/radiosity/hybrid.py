@@ -95,7 +95,7 @@ class HybridRenderer:
         stats = dict(sol.stats)
         stats["objects_as_radiosity_meshes"] = replaced
         stats.update({f"raytrace_{k}": v for k, v in rt.stats.items()})
-        needs = scene.needs()
+        needs = ft.scene_needs(scene)
         specular_ok = {ft.REFLECTION, ft.REFRACTION, ft.ABSORPTION, ft.SPECULAR}
         used = sorted(set(sol.features_used) | (needs & specular_ok))
         left_out = [e for e in sol.left_out if e.split(":")[0] not in specular_ok]

@@ -183,7 +183,7 @@ def solve_scene(scene: Scene, opts: dict, method: str) -> Solution:
     extent = scene_extent(scene)
     patches, left_out = patches_from_scene(scene, opts["patch_size"] * extent)
     timings["patches"] = time.perf_counter() - t0
-    needs = scene.needs()
+    needs = ft.scene_needs(scene)
     left_out = left_out + [f"{f}: {REASONS.get(f, 'not used by radiosity')}"
                            for f in sorted(needs - HANDLED)]
     if len(patches) == 0 or not (patches.emission > 0).any():

@@ -26,7 +26,9 @@ from ...core import transform as tf
 from ...core.errors import WorkbenchError
 from ...core.tol import tol
 from ...scene import model as m
-from ...scene.polygon_pieces import convex_pieces
+from ...scene.kinds import kind_of
+from ...scene.kinds.mesh import edge_max
+from ...scene.tessellate import tessellate_object
 
 MAX_CURVED_LEVEL = 24   # finest tessellation level asked of workbench.scene.tessellate
 
@@ -118,8 +120,8 @@ class PatchSet:
         return tri, np.repeat(np.arange(len(self)), 2)
 
     def geometry(self):
-        """The patches as form-factor :class:`~.formfactors.Geometry`."""
-        from .formfactors import Geometry
+        """The patches as form-factor :class:`~.geometry.Geometry`."""
+        from .geometry import Geometry
         tri, patch = self.triangles()
         return Geometry(tri, patch, self.centres, self.normals, self.areas, list(self.corners),
                         self.grids)
@@ -232,31 +234,11 @@ def split_polygon(poly: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(verts), np.concatenate(cells)
 
 
-def _box_faces(b: m.Box) -> list[np.ndarray]:
-    """Six faces (4, 3) of an object-space box, counter-clockwise seen from outside."""
-    x0, y0, z0 = b.min
-    x1, y1, z1 = b.max
-    return [np.array(f, dtype=np.float64) for f in (
-        [(x0, y0, z0), (x0, y0, z1), (x0, y1, z1), (x0, y1, z0)],   # -x
-        [(x1, y0, z0), (x1, y1, z0), (x1, y1, z1), (x1, y0, z1)],   # +x
-        [(x0, y0, z0), (x1, y0, z0), (x1, y0, z1), (x0, y0, z1)],   # -y
-        [(x0, y1, z0), (x0, y1, z1), (x1, y1, z1), (x1, y1, z0)],   # +y
-        [(x0, y0, z0), (x0, y1, z0), (x1, y1, z0), (x1, y0, z0)],   # -z
-        [(x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)],   # +z
-    )]
-
-
-def _edge_max(P: np.ndarray, F: np.ndarray) -> float:
-    t = P[F]
-    return float(np.linalg.norm(t - np.roll(t, 1, axis=1), axis=-1).max()) if len(F) else 0.0
-
-
 def _curved(obj, h: float) -> list:
     """World-space triangle meshes (vertices, faces, material name) of a curved object from
     :mod:`workbench.scene.tessellate`, at the level whose triangles are about ``h`` long."""
-    from ...scene.tessellate import tessellate_object
     base = tessellate_object(obj, 1)
-    e1 = max((_edge_max(p.positions, p.faces) for p in base), default=0.0)
+    e1 = max((edge_max(p.positions, p.faces) for p in base), default=0.0)
     level = int(np.clip(np.ceil(e1 / h), 1, MAX_CURVED_LEVEL)) if np.isfinite(h) else 1
     parts = base if level == 1 else tessellate_object(obj, level)
     return [(p.positions, p.faces, p.material) for p in parts]
@@ -271,23 +253,9 @@ def _surfaces(scene: m.Scene, h: float) -> tuple[list, list[str]]:
     for i, obj in enumerate(scene.objects):
         name = obj.name or f"{obj.kind}_{i}"
         mat = scene.material_of(obj)
-        W = obj.world_from_object
         emis = np.asarray(mat.emission, dtype=np.float64)
-        polys: list[np.ndarray] = []
-        if isinstance(obj, m.Polygon):
-            polys = convex_pieces(obj.vertices)
-        elif isinstance(obj, m.Plane):
-            polys = [obj.corners()]
-        elif isinstance(obj, m.Box):
-            polys = _box_faces(obj)
-        elif isinstance(obj, m.Mesh):
-            Pw = tf.transform_points(W, np.asarray(obj.vertices))
-            F = np.asarray(obj.faces, dtype=np.int64)
-            if _edge_max(Pw, F) <= h:
-                out.append(("mesh", (Pw, F), mat, emis, obj, name))
-            else:
-                polys = list(np.asarray(obj.vertices)[F])
-        else:
+        surfaces = kind_of(obj).patch_surfaces(obj, obj.world_from_object, h)
+        if surfaces is None:  # curved: one patch per triangle of its tessellation
             try:
                 parts = _curved(obj, h)
             except WorkbenchError as e:
@@ -297,13 +265,12 @@ def _surfaces(scene: m.Scene, h: float) -> tuple[list, list[str]]:
                 pm = scene.materials[mname]
                 out.append(("mesh", (P, F), pm, np.asarray(pm.emission, dtype=np.float64), obj,
                             name if len(parts) == 1 else f"{name}[{k}]"))
-        for k, p in enumerate(polys):
-            pw = tf.transform_points(W, np.asarray(p))
-            out.append(("polygon", pw, mat, emis, obj, name if len(polys) == 1 else f"{name}[{k}]"))
-    for i, light in enumerate(scene.lights):
-        if isinstance(light, m.AreaLight):
-            out.append(("polygon", np.asarray(light.vertices), None, light.radiance, light,
-                        f"area_light_{i}"))
+            continue
+        for k, (kind, geo) in enumerate(surfaces):
+            out.append((kind, geo, mat, emis, obj, name if len(surfaces) == 1 else f"{name}[{k}]"))
+    for k, polygon, mat in scene.area_light_polygons():
+        out.append(("polygon", np.asarray(polygon.vertices), None, np.asarray(mat.emission),
+                    scene.lights[k], f"area_light_{k}"))
     return out, left_out
 
 
@@ -373,7 +340,7 @@ def count_patches(scene: m.Scene, patch_size: float) -> int:
     for obj in meshes:  # as _surfaces, vectorised: one patch per triangle, or n^2 if too long
         Pw = tf.transform_points(obj.world_from_object, np.asarray(obj.vertices))
         fans.append(Pw[np.asarray(obj.faces, dtype=np.int64)])
-        if _edge_max(Pw, np.asarray(obj.faces, dtype=np.int64)) <= patch_size:
+        if edge_max(Pw, np.asarray(obj.faces, dtype=np.int64)) <= patch_size:
             total += len(fans.pop())
     rest = replace(scene, objects=tuple(o for o in scene.objects if not isinstance(o, m.Mesh)))
     for kind, geo, *_ in _surfaces(rest, patch_size)[0]:

@@ -12,7 +12,7 @@ import numpy as np
 
 from ...core.errors import WorkbenchError
 from ...core.tol import offset_scale, tol
-from .formfactors import Geometry
+from .geometry import Geometry
 
 
 def raycast(geom: Geometry, rays: int = 4096, seed: int = 0) -> np.ndarray:

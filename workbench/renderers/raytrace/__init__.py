@@ -1,12 +1,13 @@
 """CPU ray caster and Whitted ray tracer (``raycast``, ``raytrace``), the public
 ``intersect`` (``workbench.raytrace.intersect``) and ``ray_tree``.
 
-Modules: :mod:`.flatten` (scene -> arrays), :mod:`.bvh` (binned SAH BVH), :mod:`.kernels`
-(numba: intersection, shading with shadow feelers, child rays; the fused per-pixel kernel),
-:mod:`.whitted` (the two renderers: the fused path, or the wavefront loop with textures
-through :mod:`workbench.renderers.texturing`), and the
-readable reference :mod:`.shapes` + :mod:`.csg` + :mod:`.reference` (one ray at a time, the
-course's trace / shade / intersect structure; tested against the kernels).
+Modules: :mod:`.flatten` (scene -> arrays, through each object kind's ``flatten``), :mod:`.bvh`
+(binned SAH BVH), :mod:`.kernels` (numba: intersection, shading with shadow feelers, child rays;
+the fused per-pixel kernel), :mod:`.whitted` (the two renderers: the fused path, or the wavefront
+loop with textures through :mod:`workbench.renderers.texturing`), and the readable reference
+:mod:`.reference` with each object kind's ``hits`` and ``normal`` (:mod:`workbench.scene.kinds`)
+and :mod:`.shapes` (triangles) (one ray at a time, the course's
+trace / shade / intersect structure; tested against the kernels).
 
 Options of both methods (``workbench methods`` lists them): ``spp`` and ``seed`` (stratified
 jitter), ``shadows``, ``transmissive_shadows`` (an occluder with k_t attenuates a shadow

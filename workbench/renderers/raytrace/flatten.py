@@ -15,7 +15,7 @@ Primitive table (``P`` rows)
 ``mat`` (P,) int: material index into the material table.
 ``xf`` (P, 12): rows of ``object_from_world[:3, :4]``; ``nm`` (P, 9): world normal matrix
 (``object_from_world[:3, :3].T``, row-major) mapping object normals to world normals.
-``par`` (P, 20): per type parameters (see :func:`_params`).
+``par`` (P, 20): per type parameters (see each kind's ``flatten`` in :mod:`workbench.scene.kinds`).
 ``solid`` (P,) bool: a closed surface with an inside (refraction enters a medium), else a thin
 sheet (transmission goes straight through).
 ``shadow`` (P,) bool: casts shadows (area lights' own polygons do not).
@@ -28,23 +28,20 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ...core.errors import NotApplicable, WorkbenchError
 from ...core.tol import tol
 from ...scene import model as m
-from ...scene.polygon_pieces import convex_pieces
+from ...scene.kinds import kind_of
 
 if TYPE_CHECKING:
     from .bvh import Bvh4
 
-SPHERE, RECT, BOX, POLYGON, QUADRIC, CSGNODE, MESH = range(7)
-CSG_UNION, CSG_INTERSECTION, CSG_DIFFERENCE = -1, -2, -3
-CSG_DEPTH = 16
-"""Interval lists a CSG program may hold at once (the kernels' scratch stack; numba does not
-check bounds, so deeper trees are refused when the scene is flattened)."""
+OPACITY_CUT = 0.5
+"""Opacity maps (model.Opacity): alpha below this cuts the surface out."""
+MAX_CUTOUTS = 64
+"""Cut-out surfaces a ray passes through before it stops."""
 SHADOW_CROSSINGS = 32
 """Surfaces a shadow feeler goes on through (transmissive with ``transmissive_shadows``, cut out
 or partly opaque by an opacity map) before it stops with the visibility gathered so far."""
-_CSG_OPS = {"union": CSG_UNION, "intersection": CSG_INTERSECTION, "difference": CSG_DIFFERENCE}
 NPAR = 20
 _IDENTITY_ROWS = np.eye(4)[:3].reshape(-1)
 
@@ -113,6 +110,8 @@ def light_rows(lights) -> np.ndarray:
 
 
 class _Builder:
+    """What the kinds' ``flatten`` functions write into (:mod:`workbench.scene.kinds`)."""
+
     def __init__(self, scene: m.Scene):
         self.scene = scene
         self.rows: list[dict] = []
@@ -125,107 +124,36 @@ class _Builder:
         self.front_only: set[int] = set()
         self.bounds: list[np.ndarray] = []
 
-    def add(self, kind, obj_index, mat, world_from_object, par, *, top=True, solid=True, shadow=True):
+    def add(self, ptype: int, obj_index: int, obj: m.SceneObject, world_from_object, par, *,
+            top=True, solid=True, shadow=True) -> int:
+        """A primitive row of kind ``ptype`` for scene object ``obj_index`` with ``obj``'s
+        material; ``par`` (at most ``NPAR`` numbers) is zero-padded.  Returns the row."""
         ofw = np.linalg.inv(world_from_object)
-        row = dict(ptype=kind, top=top, obj=obj_index, mat=mat, xf=ofw[:3, :4].reshape(-1),
-                   nm=ofw[:3, :3].T.reshape(-1), par=par, solid=solid, shadow=shadow,
-                   wfo=np.asarray(world_from_object, dtype=np.float64), has_uv=False)
+        row_par = np.zeros(NPAR)
+        row_par[:len(par)] = par
+        row = dict(ptype=ptype, top=top, obj=obj_index, mat=self.mat_index[obj.material],
+                   xf=ofw[:3, :4].reshape(-1), nm=ofw[:3, :3].T.reshape(-1), par=row_par, solid=solid,
+                   shadow=shadow, wfo=np.asarray(world_from_object, dtype=np.float64), has_uv=False)
         self.rows.append(row)
         return len(self.rows) - 1
 
-    def _bound(self, world_from_object, pts):
+    def bound(self, world_from_object, pts):
+        """Object-space points (n, 3) that the scene's extent must hold."""
         pts = np.asarray(pts, dtype=np.float64).reshape(-1, 3)
         self.bounds.append(pts @ world_from_object[:3, :3].T + world_from_object[:3, 3])
 
     def leaf(self, o: m.SceneObject, obj_index: int, parent: np.ndarray, *, top: bool) -> int:
+        """Rows of object ``o`` under transform ``parent`` (its kind's ``flatten``)."""
         W = parent @ np.asarray(o.world_from_object)
-        mat = self.mat_index[o.material]
-        par = np.zeros(NPAR)
-        if isinstance(o, m.Sphere):
-            par[:4] = (*o.center, o.radius)
-            c, r = np.asarray(o.center), o.radius
-            self._bound(W, [c + r * (2 * np.array(s) - 1) for s in np.ndindex(2, 2, 2)])
-            return self.add(SPHERE, obj_index, mat, W, par, top=top)
-        if isinstance(o, m.Plane):
-            u, v, n = o.frame()
-            par[:14] = (*o.point, *u, *v, *n, o.size[0] / 2, o.size[1] / 2)
-            self._bound(W, o.corners())
-            return self.add(RECT, obj_index, mat, W, par, top=top, solid=False)
-        if isinstance(o, m.Box):
-            par[:6] = (*o.min, *o.max)
-            lo, hi = np.asarray(o.min), np.asarray(o.max)
-            self._bound(W, [np.where(np.array(s, bool), hi, lo) for s in np.ndindex(2, 2, 2)])
-            return self.add(BOX, obj_index, mat, W, par, top=top)
-        if isinstance(o, m.Polygon):
-            pieces = convex_pieces(o.vertices)
-            if len(pieces) > 1 and not top:
-                raise NotApplicable(f"object {o.name or obj_index}: a concave polygon inside a CSG "
-                                    "tree is not supported by the ray tracer")
-            return [self.polygon(p, obj_index, mat, W, top=top) for p in pieces][-1]
-        if isinstance(o, m.Quadric):
-            Q = np.asarray(o.Q)
-            par[:10] = (Q[0, 0], Q[0, 1], Q[0, 2], Q[0, 3], Q[1, 1], Q[1, 2], Q[1, 3], Q[2, 2], Q[2, 3], Q[3, 3])
-            par[10:16] = (*o.bounds_min, *o.bounds_max)
-            lo, hi = np.asarray(o.bounds_min), np.asarray(o.bounds_max)
-            self._bound(W, [np.where(np.array(s, bool), hi, lo) for s in np.ndindex(2, 2, 2)])
-            return self.add(QUADRIC, obj_index, mat, W, par, top=top)
-        if isinstance(o, m.Mesh):
-            if not top:
-                raise NotApplicable(f"object {o.name or obj_index}: a mesh inside a CSG tree is not "
-                                    "supported by the ray tracer (use spheres, boxes or quadrics)")
-            k = self.add(MESH, obj_index, mat, W, par, top=False, solid=True)
-            self.rows[k]["has_uv"] = o.uvs is not None
-            self.meshes.append((k, o, W))
-            self._bound(W, np.asarray(o.vertices))
-            return k
-        if isinstance(o, m.CSG):
-            raise AssertionError("CSG handled by csg()")
-        raise NotApplicable(f"object kind {o.kind!r} is not supported by the ray tracer")
+        return kind_of(o).flatten(self, o, obj_index, W, top)
 
-    def polygon(self, verts, obj_index, mat, W, *, top=True, shadow=True, front_only=False):
-        v = np.asarray(verts, dtype=np.float64)
-        n = np.cross(v[1:-1] - v[0], v[2:] - v[0]).sum(0)
-        n = n / np.linalg.norm(n)
-        par = np.zeros(NPAR)
-        par[:7] = (*n, float(n @ v.mean(0)), self.n_poly, len(v), 0.0)
-        self.poly_v.append(v)
-        self.n_poly += len(v)
-        self._bound(W, v)
-        return self.add(POLYGON, obj_index, mat, W, par, top=top, solid=False, shadow=shadow)
-
-    def csg_program(self, o: m.CSG, obj_index: int, parent: np.ndarray):
-        W = parent @ np.asarray(o.world_from_object)
-        for child in (o.left, o.right):
-            if isinstance(child, m.CSG):
-                self.csg_program(child, obj_index, W)
-            else:
-                self.prog.append(self.leaf(child, obj_index, W, top=False))
-        self.prog.append(_CSG_OPS[o.op])
-
-    def object(self, o: m.SceneObject, i: int):
-        if isinstance(o, m.CSG):
-            start = len(self.prog)
-            self.csg_program(o, i, np.eye(4))
-            depth = top = 0
-            for code in self.prog[start:]:  # leaves push an interval list, operators pop two
-                top += 1 if code >= 0 else -1
-                depth = max(depth, top)
-            if depth > CSG_DEPTH:
-                raise WorkbenchError(f"CSG object {o.name or i + 1}: its tree needs {depth} interval lists "
-                                     f"at once, the ray tracer holds {CSG_DEPTH} (nest it more evenly)")
-            par = np.zeros(NPAR)
-            par[:2] = (start, len(self.prog) - start)
-            self.add(CSGNODE, i, self.mat_index[o.material], np.eye(4), par, top=True)
-        else:
-            self.leaf(o, i, np.eye(4), top=True)
-
-    def area_light(self, light: m.AreaLight, k: int):
-        mat = m.Material(f"__area_light_{k}", color=(0.0, 0.0, 0.0), ka=0.0, kd=0.0, ks=0.0,
-                         emission=tuple(float(x) for x in light.radiance))
+    def area_light(self, k: int, polygon: m.Polygon, mat: m.Material):
+        """Area light ``k``'s polygon: emissive from its front only, casting no shadow."""
         self.materials.append(mat)
+        self.mat_index[mat.name] = len(self.materials) - 1
         self.front_only.add(len(self.materials) - 1)
-        self.polygon(light.vertices, len(self.scene.objects) + k, len(self.materials) - 1, np.eye(4),
-                     shadow=False)
+        kind_of(polygon).flatten(self, polygon, len(self.scene.objects) + k, np.eye(4), True,
+                                 shadow=False)
 
 
 def _triangles(meshes):
@@ -259,10 +187,9 @@ def flatten(scene: m.Scene) -> SceneData:
     import time
     b = _Builder(scene)
     for i, o in enumerate(scene.objects):
-        b.object(o, i)
-    for k, light in enumerate(scene.lights):
-        if isinstance(light, m.AreaLight):
-            b.area_light(light, k)
+        b.leaf(o, i, np.eye(4), top=True)
+    for k, polygon, mat in scene.area_light_polygons():
+        b.area_light(k, polygon, mat)
     rows = b.rows
 
     def col(key, dtype):

@@ -27,9 +27,10 @@ import numpy as np
 from numba import prange
 
 from ...core.tol import tol
+from ...scene.kinds import BOX, CSGNODE, POLYGON, QUADRIC, RECT, SPHERE
+from ...scene.kinds.csg import CSG_DEPTH, CSG_DIFFERENCE, CSG_INTERSECTION, CSG_UNION
 from .bvh import MAX_DEPTH
-from .flatten import (BOX, CSG_DEPTH, CSG_DIFFERENCE, CSG_INTERSECTION, CSG_UNION, CSGNODE, POLYGON,
-                      QUADRIC, RECT, SHADOW_CROSSINGS, SPHERE)
+from .flatten import SHADOW_CROSSINGS
 
 CHUNK = 64
 FAST_MATH = {"nsz", "arcp"}

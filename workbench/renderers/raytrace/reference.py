@@ -21,10 +21,12 @@ import numpy as np
 
 from ...core.tol import offset_scale, tol
 from ...scene import model as m
+from ...scene.features import scene_needs
+from ...scene.kinds import MESH, crossings, kind_of
+from ...scene.media import enclosing_media
 from .. import local_model
-from . import csg, shapes
-from .flatten import SHADOW_CROSSINGS
-from .whitted import MAX_CUTOUTS, OPACITY_CUT
+from . import shapes
+from .flatten import MAX_CUTOUTS, OPACITY_CUT, SHADOW_CROSSINGS
 
 DEFAULTS = dict(max_depth=5, threshold=1e-3, fresnel="none", transmissive_shadows=False,
                 blinn=False, shadows=True)
@@ -66,15 +68,11 @@ class Context:
         self.lights = scene.point_lights()
         self.items = [Item(i, o, np.asarray(o.world_from_object)) for i, o in enumerate(scene.objects)]
         self.materials = dict(scene.materials)
-        for k, light in enumerate(scene.lights):
-            if isinstance(light, m.AreaLight):
-                name = f"__area_light_{k}"
-                self.materials[name] = m.Material(name, (0.0, 0.0, 0.0), 0.0, 0.0, 0.0,
-                                                  emission=tuple(light.radiance))
-                self.items.append(Item(len(scene.objects) + k, m.Polygon(name, vertices=light.vertices),
-                                       np.eye(4), shadow=False))
+        for k, polygon, mat in scene.area_light_polygons():
+            self.materials[mat.name] = mat
+            self.items.append(Item(len(scene.objects) + k, polygon, np.eye(4), shadow=False))
         self.texturing = None
-        if {"textures", "bump", "environment", "opacity"} & scene.needs():
+        if {"textures", "bump", "environment", "opacity"} & scene_needs(scene):
             from .. import texturing
             self.texturing = texturing
 
@@ -83,35 +81,6 @@ class Context:
 
 
 # ----------------------------------------------------------------------------- intersection
-def intersect(node: m.SceneObject, W: np.ndarray, O, D, eps: float, in_csg=False) -> list[csg.Crossing]:
-    """Crossings of the line ``O + t D`` with a (CSG) object, sorted by ``t``.  A CSG node
-    combines the interval lists of its children (the course's recursive ``intersect``); a
-    primitive is intersected in its object space (``prim_intersect``)."""
-    if isinstance(node, m.CSG):
-        Wn = W @ np.asarray(node.world_from_object)
-        left = intersect(node.left, Wn, O, D, eps, True)
-        if not left and node.op != "union":
-            return []
-        right = intersect(node.right, Wn, O, D, eps, True)
-        return csg.combine(node.op, left, right, eps)
-    Wl = W @ np.asarray(node.world_from_object)
-    inv = np.linalg.inv(Wl)
-    o, d = inv[:3, :3] @ O + inv[:3, 3], inv[:3, :3] @ D
-    if isinstance(node, m.Sphere):
-        hits = shapes.sphere(node.center, node.radius, o, d)
-    elif isinstance(node, m.Box):
-        hits = shapes.box(node.min, node.max, o, d)
-    elif isinstance(node, m.Quadric):
-        hits = shapes.quadric_solid(node, o, d) if in_csg else shapes.quadric_surface(node, o, d)
-    elif isinstance(node, m.Plane):
-        hits = shapes.rectangle(node, o, d)
-    elif isinstance(node, m.Polygon):
-        hits = shapes.polygon(node.vertices, o, d)
-    else:
-        raise TypeError(node.kind)
-    return [csg.Crossing(t, (node, Wl), f) for t, f in hits]
-
-
 def _mesh_hit(ctx, item, O, D, tmin, tmax):
     mesh, W = item.obj, item.W
     V = np.asarray(mesh.vertices) @ W[:3, :3].T + W[:3, 3]
@@ -146,19 +115,20 @@ def closest(ctx: Context, O, D, tmin, tmax=np.inf, shadow=False) -> Hit | None:
     for item in ctx.items:
         if shadow and not item.shadow:
             continue
-        if isinstance(item.obj, m.Mesh):
+        if kind_of(item.obj).PTYPE == MESH:  # world triangles (a BVH in the kernels)
             h = _mesh_hit(ctx, item, O, D, tmin, best.t if best else tmax)
             best = h or best
             continue
-        for c in intersect(item.obj, np.eye(4), O, D, eps):
+        for c in crossings(item.obj, np.eye(4), O, D, eps):
             if tmin < c.t < (best.t if best else tmax):
                 leaf, Wl = c.leaf
                 P = O + c.t * D
                 inv = np.linalg.inv(Wl)
                 p_obj = inv[:3, :3] @ P + inv[:3, 3]
-                n = inv[:3, :3].T @ shapes.object_normal(leaf, c.face, p_obj)
+                kind = kind_of(leaf)
+                n = inv[:3, :3].T @ kind.normal(leaf, c.face, p_obj)
                 n = (-n if c.flip else n) / np.linalg.norm(n)
-                solid = not isinstance(leaf, (m.Plane, m.Polygon))
+                solid = kind.SOLID
                 best = Hit(c.t, P, n, n, item, ctx.materials[leaf.material], p_obj, Wl, solid=solid)
                 break
             if c.t >= tmin:
@@ -294,7 +264,7 @@ def shade(ctx, hit: Hit, D, recurs, weight, media, node):
     if tx is not None and mat.bump is not None:
         Ns = tx.bump_normal(mat, hit.P_obj[None], (Ns @ hit.W[:3, :3])[None], Ns[None], hit.W,
                             None if hit.uv is None else hit.uv[None])[0]
-    if mat.name.startswith("__area_light") and not front:
+    if mat.name.startswith(m.AREA_LIGHT_PREFIX) and not front:
         mat = replace(mat, emission=(0.0, 0.0, 0.0))
     emitted = hit.emission if front else 0.0  # vertex emission: front side only (Mesh.vertex_emission)
     vis = np.ones((len(ctx.lights), 1))
@@ -353,83 +323,6 @@ def shade(ctx, hit: Hit, D, recurs, weight, media, node):
         color = color + k * raytrace(ctx, origin, direction, recurs + 1, weight * k, tuple(md), tmin, sub)
         child["ray"] = sub[0]
     return color
-
-
-def _containing_leaf(node: m.SceneObject, W: np.ndarray, p) -> str | None:
-    """The material of the leaf of solid ``node`` (parent transform ``W``) whose inside holds
-    ``p`` and is part of the solid (not subtracted), None if ``p`` is not inside.  Inside:
-    sphere, box, a quadric's ``P^T Q P < 0`` within its bounds, a mesh's generalised winding
-    number above 1/2 (Jacobson et al. 2013: open patches and stray triangles count for about
-    0), CSG by its boolean; planes and polygons have no inside.  Points on a surface are
-    outside (strict inequalities)."""
-    if isinstance(node, m.CSG):
-        Wn = W @ np.asarray(node.world_from_object)
-        left, right = _containing_leaf(node.left, Wn, p), _containing_leaf(node.right, Wn, p)
-        if node.op == "union":
-            return left or right
-        if node.op == "intersection":
-            return left if left and right else None
-        return left if left and not right else None
-    Wl = W @ np.asarray(node.world_from_object)
-    inv = np.linalg.inv(Wl)
-    q = inv[:3, :3] @ p + inv[:3, 3]
-    if isinstance(node, m.Sphere):
-        inside = np.linalg.norm(q - np.asarray(node.center)) < node.radius
-    elif isinstance(node, m.Box):
-        inside = bool(np.all(q > node.min) and np.all(q < node.max))
-    elif isinstance(node, m.Quadric):
-        P = np.r_[q, 1.0]
-        inside = P @ np.asarray(node.Q) @ P < 0.0 and bool(np.all(q >= node.bounds_min) and np.all(q <= node.bounds_max))
-    elif isinstance(node, m.Mesh):
-        a, b, c = (np.asarray(node.vertices)[np.asarray(node.faces)[:, k]] - q for k in range(3))
-        la, lb, lc = (np.linalg.norm(v, axis=1) for v in (a, b, c))
-        # solid angle of each triangle seen from q (Van Oosterom & Strackee 1983)
-        num = np.einsum("ij,ij->i", a, np.cross(b, c))
-        den = la * lb * lc + np.einsum("ij,ij->i", a, b) * lc + np.einsum("ij,ij->i", b, c) * la \
-            + np.einsum("ij,ij->i", c, a) * lb
-        inside = abs(np.sum(2.0 * np.arctan2(num, den))) / (4.0 * np.pi) > 0.5
-    else:
-        inside = False
-    return node.material if inside else None
-
-
-def enclosing_media(scene: m.Scene, point) -> list[m.Material]:
-    """Materials of the transmissive solids (``kt > 0``) whose inside holds ``point``,
-    outermost first: the media stack of rays leaving it, e.g. the camera's primary rays inside
-    a glass.  Nested solids are ordered by the volume of their world bounding boxes (a solid
-    inside another has the smaller box)."""
-    p = np.asarray(point, dtype=np.float64)
-    found = []
-    for o in scene.objects:
-        if not isinstance(o, m.CSG) and scene.materials[o.material].kt <= 0.0:
-            continue  # (a mesh's winding number costs a pass over its triangles)
-        name = _containing_leaf(o, np.eye(4), p)
-        if name is not None and scene.materials[name].kt > 0.0:
-            lo, hi = _world_bounds(o, np.eye(4))
-            found.append((float(np.prod(hi - lo)), scene.materials[name]))
-    return [mat for _, mat in sorted(found, key=lambda x: -x[0])]
-
-
-def _world_bounds(node: m.SceneObject, W: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Axis-aligned world box of a solid (of its leaves' boxes, for CSG)."""
-    if isinstance(node, m.CSG):
-        Wn = W @ np.asarray(node.world_from_object)
-        boxes = [_world_bounds(c, Wn) for c in (node.left, node.right)]
-        return np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
-    Wl = W @ np.asarray(node.world_from_object)
-    if isinstance(node, m.Sphere):
-        c, r = np.asarray(node.center), node.radius
-        lo, hi = c - r, c + r
-    elif isinstance(node, m.Box):
-        lo, hi = np.asarray(node.min, float), np.asarray(node.max, float)
-    elif isinstance(node, m.Quadric):
-        lo, hi = np.asarray(node.bounds_min, float), np.asarray(node.bounds_max, float)
-    else:
-        v = np.asarray(node.vertices, float)
-        lo, hi = v.min(0), v.max(0)
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-    w = corners @ Wl[:3, :3].T + Wl[:3, 3]
-    return w.min(0), w.max(0)
 
 
 # ----------------------------------------------------------------------------- entry points

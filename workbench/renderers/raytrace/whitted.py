@@ -39,13 +39,9 @@ from ...core.tol import tol
 from ...scene import features as F
 from ...scene.model import Scene
 from ..base import Knob, Option, RenderResult
-from .flatten import SHADOW_CROSSINGS, SceneData, flatten
+from .flatten import MAX_CUTOUTS, OPACITY_CUT, SHADOW_CROSSINGS, SceneData, flatten
 
 _RAYS_PER_BAND = 1 << 16
-# Opacity maps (model.Opacity): alpha below OPACITY_CUT cuts the surface out; a ray passes
-# through at most MAX_CUTOUTS cut-out surfaces.
-OPACITY_CUT = 0.5
-MAX_CUTOUTS = 64
 
 
 def _callback(v):
@@ -130,7 +126,7 @@ def estimate_trace_bytes(scene: Scene, width: int, height: int, opts: dict, recu
     # the wavefront: the largest iteration of a band (capped by _Tracer.ray_cap)
     cap = wavefront_cap(scene, width, height, spp, G, float(opts.get("threshold", 0.0)), recursive)
     total += _BYTES_PER_WAVEFRONT_RAY * cap
-    if F.OPACITY in scene.needs():
+    if F.OPACITY in F.scene_needs(scene):
         total += _BYTES_PER_FEELER * len(scene.lights) * cap
     return int(total)
 
@@ -143,9 +139,9 @@ def wavefront_cap(scene: Scene, width: int, height: int, spp: int, G: int, thres
     n0 = min(height, max(1, _RAYS_PER_BAND // (width * spp))) * width * spp
     mats = scene.materials.values()
     branches = (int(recursive and any(m.kr > 0 for m in mats)) + int(recursive and any(m.kt > 0 for m in mats))
-                + int(F.OPACITY in scene.needs()))
+                + int(F.OPACITY in F.scene_needs(scene)))
     grow = _growth(scene, G, threshold, max(branches, 1))
-    if F.OPACITY in scene.needs():
+    if F.OPACITY in F.scene_needs(scene):
         grow *= 2.0  # continuations are not threshold-tested: at most one per ray and iteration
     return int(min(n0 * grow, 2.0 ** 62))
 
@@ -201,7 +197,7 @@ class _Colorizer:
     def __init__(self, scene: Scene, sd: SceneData):
         self.scene, self.sd = scene, sd
         self.base = sd.mat_tab[:, 0:3]
-        needs = scene.needs()
+        needs = F.scene_needs(scene)
         self.tex = None
         self.missing: list[str] = []
         wanted = [f for f in (F.TEXTURES, F.BUMP, F.OPACITY, F.ENVIRONMENT) if f in needs]
@@ -360,7 +356,7 @@ class _Tracer:
     def __init__(self, scene: Scene, sd: SceneData, opts: dict, recursive: bool):
         self.scene, self.sd = scene, sd
         self.col = _Colorizer(scene, sd)
-        needs = scene.needs()
+        needs = F.scene_needs(scene)
         self.do_shadow = bool(len(sd.lights)) and opts["shadows"]
         refl = recursive and any(m.kr > 0 for m in sd.materials)
         refr = recursive and any(m.kt > 0 for m in sd.materials)
@@ -374,7 +370,7 @@ class _Tracer:
                                float(opts["transmissive_shadows"]), float(opts["blinn"]),
                                float(self.do_shadow), float(refl), float(refr), tol.ray_offset,
                                tol.t_min, tol.zero, sd.extent, float(not self.env)])
-        from .reference import enclosing_media
+        from ...scene.media import enclosing_media
         names = [mt.name for mt in sd.materials]
         self.media = [names.index(mt.name) for mt in enclosing_media(scene, scene.camera.position)][-4:]
         self.kopts = np.r_[self.kopts, len(self.media), self.media + [0] * (4 - len(self.media))]
@@ -604,7 +600,7 @@ class _WhittedBase:
         return estimate_trace_bytes(scene, width, height, o, self.recursive)
 
     def _features(self, scene, tr):
-        needs = scene.needs()
+        needs = F.scene_needs(scene)
         left = list(tr.col.missing)
         if not tr.do_shadow:
             left.append(f"{F.SHADOWS}: no lights (no shadow rays traced)" if not len(tr.sd.lights)

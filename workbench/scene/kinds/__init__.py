@@ -1,0 +1,133 @@
+"""Object kinds as plugins (pbrt-v4's ``Shape::Create``, Mitsuba 3's plugins): one module per
+kind of ``[[objects]]`` table, and :data:`KINDS`, the registry by scene-file ``type`` name.
+
+Adding a kind = one new module here + one line in :data:`KINDS` (+ its case in the ray tracer's
+numba dispatch over ``ptype``, :mod:`workbench.renderers.raytrace.kernels`).  Renderers ask the
+registry (:func:`kind_of`) instead of testing classes.  Kind modules are in the scene layer:
+they import ``workbench.core``, the scene's :mod:`..model`, :mod:`..readers`, :mod:`..parts`,
+other kind modules, numpy and numba, never ``workbench.renderers`` nor this registry (a
+composite kind is handed the dispatch, see below).
+
+What a kind module provides
+---------------------------
+Constants
+
+``TYPE``        the scene file's ``type = "..."`` name (the registry key; ``obj.kind`` of its objects).
+``MODEL``       its dataclass (kept in :mod:`workbench.scene.model`, beside :class:`Scene`).
+``FEATURE``     its entry of the needs manifest (a name in :data:`workbench.scene.features.ALL`).
+``PTYPE``       its ``ptype`` in the ray tracer's primitive table (a unique int; the kernels
+                dispatch on it).
+``SOLID``       True when it has an inside: a CSG leaf, a medium for refraction; False for a
+                thin sheet (transmission goes straight through).
+``CONVEX``      True when it cannot shadow itself (one such object alone needs no shadow rays).
+``COMPOSITE``   True only for kinds made of other objects (CSG), see below.
+``KEYS``, ``REQUIRED``  the keys of its table beside the common ones (``type``, ``material``,
+                ``transform``, ``name``, ``tessellation``), and which of them are required.
+
+Functions (``W`` and ``M`` are (4, 4) ``world_from_object`` including any CSG parents)
+
+``parse(ctx, t, w, common) -> MODEL``  validate table ``t`` (named ``w`` in messages) with the
+    readers of :mod:`..readers`; ``common`` holds the common fields already read.  Bad input:
+    ``ctx.fail(where, what)``, one line naming the key and what was expected.
+``bound_points(obj) -> (n, 3)``  object-space points whose hull holds the object.
+``tessellate(obj, level, M) -> list[Part]``  triangles for the raster methods (:mod:`..parts`).
+``solid_mesh(obj, level) -> (P (V, 3), F (F, 3))``  SOLID kinds: a closed, welded object-space
+    mesh for the raster's CSG booleans.
+``analytic_normals(obj, P (3T, 3)) -> (normals (3T, 3), cap (3T,) bool) | None``  SOLID kinds:
+    object-space shading normals at points of its CSG triangles (None: flat triangles).
+``patch_surfaces(obj, W, h) -> list | None``  radiosity: ``("polygon", (k, 3) world convex
+    polygon)`` and ``("mesh", (P (V, 3), F (F, 3)))`` surfaces; None for a curved kind, which
+    the patch builder cuts from its tessellation at triangles about ``h`` long.
+``flatten(b, obj, index, W, top) -> row``  its rows of the kernels' primitive table, through
+    the ray tracer's builder ``b``: ``b.add(PTYPE, index, obj, W, par, top=, solid=,
+    shadow=)`` (``par``: at most ``NPAR`` floats, the kernel functions' parameters),
+    ``b.bound(W, points)`` (the scene's extent), and for kinds with variable-length data the
+    builder's arrays (``b.poly_v``, ``b.meshes``).
+``hits(obj, O, D, solid) -> [(t, face), ...]``  readable intersection of the object-space line
+    ``O + t D`` (every crossing, sorted; a SOLID kind's alternate entering / leaving; ``solid``
+    is True for a CSG leaf).  ``face`` (int) picks the normal.  Meshes have none (the
+    reference tracer intersects their world triangles).
+``normal(obj, face, P) -> (3,)``  outward object-space normal (not normalised) at point ``P``.
+``inside(obj, q) -> bool``  strict inside test of object-space point ``q`` (False for sheets).
+
+The numba functions (intersection and normal by ``par`` row) live in
+:mod:`workbench.renderers.raytrace.kernels`, which imports the ``PTYPE`` constants from here.
+
+Composite kinds (``COMPOSITE = True``: CSG) take the dispatch as an argument instead of
+importing it: ``parse(ctx, t, w, common, child, kind_of)``, ``children(obj)``,
+``tessellate(obj, level, parent, kind_of)``, ``crossings(obj, W, O, D, eps, crossings_of)``,
+``containing(obj, W, p, containing_of)``, ``world_bounds(obj, W, bounds_of)``; their
+``flatten`` calls ``b.leaf(child, index, W, top=False)`` for operands.
+"""
+from __future__ import annotations
+
+from types import MappingProxyType, ModuleType
+
+import numpy as np
+
+from ...core.errors import WorkbenchError
+from .. import model as m
+from . import box, csg, mesh, plane, polygon, quadric, sphere
+
+KINDS = MappingProxyType({k.TYPE: k for k in (sphere, plane, box, quadric, polygon, mesh, csg)})
+"""The registry: scene-file ``type`` name -> kind module."""
+
+SPHERE, RECT, BOX, POLYGON = sphere.PTYPE, plane.PTYPE, box.PTYPE, polygon.PTYPE
+QUADRIC, CSGNODE, MESH = quadric.PTYPE, csg.PTYPE, mesh.PTYPE
+
+
+def kind_of(obj: m.SceneObject) -> ModuleType:
+    """The kind module of a scene object (by its ``kind``)."""
+    try:
+        return KINDS[obj.kind]
+    except KeyError:
+        raise WorkbenchError(f"unknown object kind {obj.kind!r} (known: {', '.join(KINDS)})") from None
+
+
+def crossings(obj: m.SceneObject, W: np.ndarray, O, D, eps: float, solid: bool = False) -> list[csg.Crossing]:
+    """Readable intersection: crossings of the world line ``O + t D`` with ``obj`` whose parent
+    transform is ``W``, sorted by ``t``; a primitive is intersected in its object space (the
+    course's "objet transformé: appliquer la transformation au rayon"), a CSG node combines
+    its operands' interval lists.  ``solid``: ``obj`` is a CSG operand."""
+    Wl = W @ np.asarray(obj.world_from_object)
+    kind = kind_of(obj)
+    if kind.COMPOSITE:
+        return kind.crossings(obj, Wl, O, D, eps, crossings)
+    inv = np.linalg.inv(Wl)
+    o, d = inv[:3, :3] @ O + inv[:3, 3], inv[:3, :3] @ D
+    return [csg.Crossing(t, (obj, Wl), f) for t, f in kind.hits(obj, o, d, solid)]
+
+
+def containing(obj: m.SceneObject, W: np.ndarray, p) -> str | None:
+    """The material of the leaf of ``obj`` (parent transform ``W``) whose inside holds world
+    point ``p`` and is part of the solid, None if ``p`` is not inside (on a surface is outside)."""
+    Wl = W @ np.asarray(obj.world_from_object)
+    kind = kind_of(obj)
+    if kind.COMPOSITE:
+        return kind.containing(obj, Wl, p, containing)
+    inv = np.linalg.inv(Wl)
+    return obj.material if kind.inside(obj, inv[:3, :3] @ p + inv[:3, 3]) else None
+
+
+def world_bounds(obj: m.SceneObject, W: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Axis-aligned world box ``(lo (3,), hi (3,))`` of ``obj`` (parent transform ``W``): its
+    object-space bounding box's corners moved to world space."""
+    Wl = W @ np.asarray(obj.world_from_object)
+    kind = kind_of(obj)
+    if kind.COMPOSITE:
+        return kind.world_bounds(obj, Wl, world_bounds)
+    pts = np.asarray(kind.bound_points(obj), dtype=np.float64)
+    lo, hi = pts.min(0), pts.max(0)
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    w = corners @ Wl[:3, :3].T + Wl[:3, 3]
+    return w.min(0), w.max(0)
+
+
+def leaves(obj: m.SceneObject) -> list[m.SceneObject]:
+    """``obj`` and every object inside it (CSG operands, depth first)."""
+    kind = kind_of(obj)
+    out = [obj]
+    if kind.COMPOSITE:
+        for child in kind.children(obj):
+            out.extend(leaves(child))
+    return out

@@ -1,0 +1,68 @@
+"""Object kind ``plane``: a finite rectangle (``size``) centred at ``point`` with unit ``normal``;
+a thin sheet (no inside)."""
+from __future__ import annotations
+
+import numpy as np
+
+from ...core import transform as tf
+from .. import model as m, readers as rd
+from ..parts import make_part, polygons
+
+TYPE = "plane"
+MODEL = m.Plane
+FEATURE = "planes"
+PTYPE = RECT = 1
+SOLID = False
+COMPOSITE = False
+CONVEX = True
+KEYS = frozenset({"point", "normal", "size", "u_axis"})
+REQUIRED = frozenset({"normal", "size"})
+
+
+def parse(ctx: rd.Ctx, t: dict, w: str, common: dict) -> m.Plane:
+    size = rd.vec(ctx, t, w, "size", n=2)
+    if min(size) <= 0:
+        ctx.fail(f"{w}.size", f"expected two positive numbers [width, height], got {list(size)}")
+    return m.Plane(**common, point=rd.vec(ctx, t, w, "point", (0.0, 0.0, 0.0)),
+                   normal=tuple(tf.normalize(rd.vec(ctx, t, w, "normal", nonzero=True))),
+                   size=size, u_axis=rd.vec(ctx, t, w, "u_axis", (1.0, 0.0, 0.0), nonzero=True))
+
+
+def bound_points(p: m.Plane) -> np.ndarray:
+    return p.corners()
+
+
+def tessellate(p: m.Plane, level: int, M: np.ndarray) -> list:
+    """The rectangle cut in ``2 level x 2 level`` cells."""
+    return [make_part(p, M, *polygons([p.corners()], 2 * level))]
+
+
+def patch_surfaces(p: m.Plane, W: np.ndarray, h: float):
+    return [("polygon", tf.transform_points(W, np.asarray(p.corners())))]
+
+
+def flatten(b, p: m.Plane, index: int, W: np.ndarray, top: bool) -> int:
+    """Primitive row: ``par = (point (3), u (3), v (3), n (3), w/2, h/2)``."""
+    u, v, n = p.frame()
+    b.bound(W, p.corners())
+    return b.add(PTYPE, index, p, W, (*p.point, *u, *v, *n, p.size[0] / 2, p.size[1] / 2), top=top,
+                 solid=SOLID)
+
+
+def hits(p: m.Plane, O, D, solid: bool) -> list[tuple[float, int]]:
+    """Finite rectangle: plane ``(P - P0).n = 0``, then ``|(P - P0).u| <= w/2``, same for v."""
+    u, v, n = p.frame()
+    den = D @ n
+    if den == 0.0:
+        return []
+    t = ((np.asarray(p.point) - O) @ n) / den
+    q = O + t * D - np.asarray(p.point)
+    return [(t, 0)] if abs(q @ u) <= p.size[0] / 2 and abs(q @ v) <= p.size[1] / 2 else []
+
+
+def normal(p: m.Plane, face: int, P) -> np.ndarray:
+    return p.frame()[2]
+
+
+def inside(p: m.Plane, q) -> bool:
+    return False

@@ -1,0 +1,96 @@
+"""Object kind ``polygon``: a planar polygon, counter-clockwise seen from its front; a concave
+one is cut into convex pieces (:mod:`..polygon_pieces`).  A thin sheet (no inside).  Area
+lights become polygons of this kind (:meth:`workbench.scene.model.Scene.area_light_polygons`)."""
+from __future__ import annotations
+
+import numpy as np
+
+from ...core import transform as tf
+from ...core.errors import NotApplicable
+from .. import model as m, readers as rd
+from ..parts import make_part, polygons
+from ..polygon_pieces import convex_pieces
+
+TYPE = "polygon"
+MODEL = m.Polygon
+FEATURE = "polygons"
+PTYPE = POLYGON = 3
+SOLID = False
+COMPOSITE = False
+CONVEX = True
+KEYS = frozenset({"vertices"})
+REQUIRED = frozenset({"vertices"})
+
+
+def parse(ctx: rd.Ctx, t: dict, w: str, common: dict) -> m.Polygon:
+    return m.Polygon(**common, vertices=m._ro(rd.polygon_vertices(ctx, t, w)))
+
+
+def bound_points(p: m.Polygon) -> np.ndarray:
+    return np.asarray(p.vertices, dtype=np.float64)
+
+
+def tessellate(p: m.Polygon, level: int, M: np.ndarray) -> list:
+    """Fan of triangles of each convex piece, each cut in ``level^2``; one flat-shading point
+    (the mean of the vertices) for the whole polygon."""
+    P, N, F, fn, fc = polygons(convex_pieces(p.vertices), level)
+    fc[:] = np.asarray(p.vertices).mean(0)
+    return [make_part(p, M, P, N, F, fn, fc)]
+
+
+def patch_surfaces(p: m.Polygon, W: np.ndarray, h: float):
+    return [("polygon", tf.transform_points(W, np.asarray(q))) for q in convex_pieces(p.vertices)]
+
+
+# --------------------------------------------------------------------------- ray tracing
+def flatten(b, p: m.Polygon, index: int, W: np.ndarray, top: bool, *, shadow: bool = True) -> int:
+    """One primitive row per convex piece: ``par = (n (3), n . centroid, first vertex in
+    poly_v, vertex count, 0)``; returns the last row."""
+    pieces = convex_pieces(p.vertices)
+    if len(pieces) > 1 and not top:
+        raise NotApplicable(f"object {p.name or index}: a concave polygon inside a CSG "
+                            "tree is not supported by the ray tracer")
+    return [_convex_row(b, q, index, p, W, top, shadow) for q in pieces][-1]
+
+
+def _convex_row(b, verts, index, p, W, top, shadow) -> int:
+    v = np.asarray(verts, dtype=np.float64)
+    n = np.cross(v[1:-1] - v[0], v[2:] - v[0]).sum(0)
+    n = n / np.linalg.norm(n)
+    row = b.add(PTYPE, index, p, W, (*n, float(n @ v.mean(0)), b.n_poly, len(v), 0.0), top=top,
+                solid=SOLID, shadow=shadow)
+    b.poly_v.append(v)
+    b.n_poly += len(v)
+    b.bound(W, v)
+    return row
+
+
+def hits(p: m.Polygon, O, D, solid: bool) -> list[tuple[float, int]]:
+    """Planar polygon: the closest hit of its convex pieces (the polygon itself, or the
+    triangles of a concave one)."""
+    found = [h for piece in convex_pieces(p.vertices) for h in convex_hits(piece, O, D)]
+    return [min(found)] if found else []
+
+
+def convex_hits(v, O, D) -> list[tuple[float, int]]:
+    """Convex planar polygon (k, 3): plane hit, then the point is left of every edge (seen
+    from the front, vertices counter-clockwise)."""
+    n = np.cross(v[1:-1] - v[0], v[2:] - v[0]).sum(0)
+    n = n / np.linalg.norm(n)
+    den = D @ n
+    if den == 0.0:
+        return []
+    t = (n @ v.mean(0) - n @ O) / den
+    q = O + t * D
+    for a, c in zip(v, np.roll(v, -1, axis=0)):
+        if np.cross(c - a, q - a) @ n < 0.0:
+            return []
+    return [(t, 0)]
+
+
+def normal(p: m.Polygon, face: int, P) -> np.ndarray:
+    return np.asarray(p.normal)
+
+
+def inside(p: m.Polygon, q) -> bool:
+    return False
