@@ -36,6 +36,7 @@ flat in vec3 v_specular;
 in vec3 v_diffuse;
 in vec3 v_specular;
 #endif
+#include "screen_space.glsl"
 
 uniform vec3 u_eye;
 // the material's C, E and kr: literals MAT_COLOR, MAT_EMISSION, MAT_KR (material_defines)

@@ -19,6 +19,9 @@ in vec3 in_centroid;
 #endif
 
 uniform mat4 u_clip_from_world;
+#ifdef SCREEN_SPACE
+out float v_screen_w;  // screen_space.glsl
+#endif
 uniform vec3 u_eye;
 
 #ifdef NEEDS_SURFACE
@@ -65,4 +68,25 @@ void main() {
     local_terms(P, N, S, v_diffuse, v_specular);
 #endif
     gl_Position = u_clip_from_world * vec4(in_position, 1.0);
+#ifdef SCREEN_SPACE
+    // screen_space.glsl: every smooth varying travels as a * w, beside w
+    float w = gl_Position.w;
+    v_screen_w = w;
+#ifdef NEEDS_SURFACE
+    v_world *= w;
+#ifndef MODE_FLAT
+    v_normal *= w;
+#endif
+#endif
+#ifdef NEEDS_OBJ
+    v_obj *= w;
+#endif
+#ifdef HAS_UV
+    v_uv *= w;
+#endif
+#ifdef MODE_GOURAUD
+    v_diffuse *= w;
+    v_specular *= w;
+#endif
+#endif
 }

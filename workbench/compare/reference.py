@@ -74,7 +74,7 @@ whole sample budget on the few pixels that straddle a light's edge)."""
 _RAYCAST_LOCAL = ("raycast", {"shadows": False, "spp": 1},
                   "the same local model ray-cast on the analytic surfaces, no shadows, pixel centres")
 MATCHED: dict[str, tuple[str, dict, str]] = {
-    "flat": _RAYCAST_LOCAL, "gouraud": _RAYCAST_LOCAL, "phong": _RAYCAST_LOCAL,
+    "flat": _RAYCAST_LOCAL, "gouraud": _RAYCAST_LOCAL, "phong": _RAYCAST_LOCAL, "zbuffer": _RAYCAST_LOCAL,
     "raycast": ("raycast", {"spp": CONVERGED_SPP}, "the ray caster itself, box-filtered (its knob is spp)"),
     "raytrace": ("raytrace", {"max_depth": 12}, "the Whitted ray tracer at depth 12, pixel centres"),
     "povray": ("raytrace", {"max_depth": 12, "transmissive_shadows": True},

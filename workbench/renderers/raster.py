@@ -58,7 +58,8 @@ from ..scene import features as ft
 from ..scene.model import AreaLight, Camera, Environment, Material, Scene
 from ..scene.clip_planes import auto_near_far
 from ..scene.parts import Part
-from ..scene.tessellate import DEFAULT_LEVEL, MAX_LEVEL, tessellate_object, tessellate_scene
+from ..scene.tessellate import (DEFAULT_LEVEL, MAX_LEVEL, NORMAL_RULES, area_light_parts, tessellate_scene,
+                                with_normal_rule)
 from .estimates import raster_bytes
 from ..scene.tessellate_topology import closed_outward, provoking_layout
 from . import gl
@@ -68,6 +69,8 @@ from .raster_shaders import (LIVE_MATERIAL_FIELDS, ProgramCache, base_defines, l
                              light_uniforms, material_defines, material_uniforms)
 
 DEPTH_CHOICES = (16, 24, 32)
+#: Varying interpolation: GL's perspective-correct one, or the course's screen-space scanline.
+INTERPOLATIONS = ("perspective", "screen")
 #: Object kinds tessellated as closed, outward-wound surfaces.
 CLOSED_KINDS = ("sphere", "box", "csg")
 #: Texture units of the image samplers.
@@ -168,12 +171,6 @@ def _same(a, b) -> bool:
         return False
 
 
-def _area_light_parts(scene: Scene) -> list[tuple[Part, Material]]:
-    """Area lights as emissive polygons of radiance ``color * intensity``."""
-    return [(part, mat) for _, polygon, mat in scene.area_light_polygons()
-            for part in tessellate_object(polygon, 1)]
-
-
 _PARTS: OrderedDict = OrderedDict()
 
 
@@ -204,11 +201,18 @@ class RasterSession:
         outside them (:meth:`_cull_groups`; the image is the same, the triangle work halves).
     shading : a user's shading model in place of the local model (Phong only; a
         :class:`~.user_shading.ShadingProgram`, see :mod:`.user_shading`).
+    interpolation : ``"perspective"`` (GL's default, perspective-correct varyings) or
+        ``"screen"``: the course's scanline formulas, linear in screen space along edges and
+        spans (as GLSL ``noperspective``; the ``SCREEN_SPACE`` define,
+        ``shaders/include/screen_space.glsl``).
+    normals : vertex normals, ``"smooth"`` (the tessellation's) or ``"face_mean"`` (the
+        course's plain mean of the incident faces' normals,
+        :func:`~workbench.scene.tessellate.with_normal_rule`).
     """
 
     def __init__(self, scene: Scene, mode: str, *, tessellation: int = DEFAULT_LEVEL,
                  blinn: bool = False, depth_bits: int = 24, ctx=None, backface_culling: bool = True,
-                 shading=None):
+                 shading=None, interpolation: str = "perspective", normals: str = "smooth"):
         if mode not in ("flat", "gouraud", "phong"):
             raise WorkbenchError(f"unknown raster mode {mode!r}")
         if shading is not None and mode != "phong":
@@ -216,7 +220,10 @@ class RasterSession:
         self.shading = shading
         if depth_bits not in DEPTH_CHOICES:
             raise WorkbenchError(f"depth_bits must be one of {DEPTH_CHOICES}, got {depth_bits}")
+        if interpolation not in INTERPOLATIONS:
+            raise WorkbenchError(f"interpolation must be one of {', '.join(INTERPOLATIONS)}, got {interpolation!r}")
         self.scene, self.mode, self.depth_bits, self.blinn = scene, mode, depth_bits, blinn
+        self.interpolation = interpolation
         #: materials (names) and whether the lights are drawn by live programs
         #: (:meth:`update`; :meth:`settle` compiles their values back in)
         self.live_materials: set[str] = set()
@@ -225,8 +232,9 @@ class RasterSession:
         self.programs = ProgramCache(self.ctx)
         self.timings: dict[str, float] = {}
         t0 = time.perf_counter()
-        pairs = [(p, scene.materials[p.material], p.material) for p in _parts(scene, tessellation)]
-        pairs += [(p, m, None) for p, m in _area_light_parts(scene)]
+        pairs = [(with_normal_rule(p, normals), scene.materials[p.material], p.material)
+                 for p in _parts(scene, tessellation)]
+        pairs += [(p, m, None) for p, m in area_light_parts(scene)]
         self.timings["tessellate"] = time.perf_counter() - t0
         self.n_triangles = sum(p.n_triangles for p, _, _ in pairs)
         #: (K, 2, 3) world box of every part: the automatic clip planes (.scene.clip_planes)
@@ -352,7 +360,8 @@ class RasterSession:
                                        has_uv=d.has_uv, blinn=self.blinn, depth_bits=self.depth_bits,
                                        allow_bump=self.mode == "phong", live_material=live_mat,
                                        live_lights=self.live_lights, needs=self._needs,
-                                       user_model=self.shading is not None)
+                                       user_model=self.shading is not None,
+                                       screen_space=self.interpolation == "screen")
             prog = self.programs.get("raster", defines, user=self.shading)
             vao = d.vaos.get(id(prog))
             if vao is None:
@@ -677,19 +686,21 @@ _MAX_SESSIONS = 6
 
 
 def session_for(scene: Scene, mode: str, tessellation: int, blinn: bool, depth_bits: int,
-                shading=None) -> tuple[RasterSession, bool]:
+                shading=None, interpolation: str = "perspective",
+                normals: str = "smooth") -> tuple[RasterSession, bool]:
     """A cached :class:`RasterSession` for the scene's content (camera excluded) and shading
     model (``shading``: a user's, by its source text and parameter values); returns
     ``(session, created)``."""
     ctx = gl.context()
     key = (id(ctx), id(scene.objects), id(scene.materials), id(scene.lights), id(scene.environment),
-           scene.ambient, mode, tessellation, blinn, depth_bits, None if shading is None else shading.key)
+           scene.ambient, mode, tessellation, blinn, depth_bits, None if shading is None else shading.key,
+           interpolation, normals)
     hit = _SESSIONS.get(key)
     if hit is not None and hit[1] is scene.objects:
         _SESSIONS.move_to_end(key)
         return hit[0], False
     session = RasterSession(scene, mode, tessellation=tessellation, blinn=blinn, depth_bits=depth_bits, ctx=ctx,
-                            shading=shading)
+                            shading=shading, interpolation=interpolation, normals=normals)
     _SESSIONS[key] = (session, scene.objects)
     if len(_SESSIONS) > _MAX_SESSIONS:
         _SESSIONS.popitem(last=False)[1][0].release()
@@ -722,6 +733,12 @@ class _RasterRenderer:
         "view": Option(str, "color", "color image or depth view (white near, black far)", ("color", "depth")),
         "near": Option(float, 0.0, "near clip plane (0: the camera's, or from the scene bounds)"),
         "far": Option(float, 0.0, "far clip plane (0: the camera's, or from the scene bounds)"),
+        "interpolation": Option(str, "perspective", "varyings perspective-correct (GL) or linear in "
+                                "screen space (the course's scanline formulas, GLSL noperspective)",
+                                INTERPOLATIONS),
+        "normals": Option(str, "smooth", "vertex normals: the tessellation's (analytic, area-weighted) "
+                          "or face_mean (the course's plain mean of the incident faces' normals)",
+                          NORMAL_RULES),
     }
 
     memory_options = ("tessellation",)
@@ -742,13 +759,15 @@ class _RasterRenderer:
 
     def render(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
                blinn: bool = False, depth_bits: int = 24, view: str = "color", near: float = 0.0,
-               far: float = 0.0, shading=None) -> RenderResult:
+               far: float = 0.0, shading=None, interpolation: str = "perspective",
+               normals: str = "smooth") -> RenderResult:
         if not 1 <= tessellation <= MAX_LEVEL:
             raise WorkbenchError(f"method {self.name!r}: tessellation must be within 1..{MAX_LEVEL}, "
                                  f"got {tessellation}")
         if near < 0 or far < 0 or (near and far and far <= near):
             raise WorkbenchError(f"method {self.name!r}: need 0 < near < far, got near={near}, far={far}")
-        session, created = session_for(scene, self.mode or self.name, tessellation, blinn, depth_bits, shading)
+        session, created = session_for(scene, self.mode or self.name, tessellation, blinn, depth_bits, shading,
+                                       interpolation, normals)
         t0 = time.perf_counter()
         image, depth, (n, f) = session.draw(scene.camera.with_resolution(width, height),
                                             near=near or None, far=far or None, with_depth=True)
@@ -761,7 +780,8 @@ class _RasterRenderer:
             image = depth_view(depth, n, f)
         stats = {"gl_renderer": gl.renderer_name(session.ctx), "triangles": session.n_triangles,
                  "near": n, "far": f, "depth_bits": depth_bits, "programs": len(session.programs.programs),
-                 "draw_calls": len(session.draws), "session_reused": not created}
+                 "draw_calls": len(session.draws), "session_reused": not created,
+                 "interpolation": interpolation, "normals": normals}
         return RenderResult(self.name, image, timings, stats, list(session.features_used),
                             list(session.left_out), depth=depth)
 

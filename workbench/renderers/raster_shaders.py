@@ -182,7 +182,8 @@ def light_uniforms(lights) -> dict[str, np.ndarray]:
 def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: int,
                      has_uv: bool, blinn: bool, depth_bits: int, allow_bump: bool,
                      live_material: bool = False, live_lights: bool = False,
-                     needs: frozenset[str] | None = None, user_model: bool = False) -> dict[str, object]:
+                     needs: frozenset[str] | None = None, user_model: bool = False,
+                     screen_space: bool = False) -> dict[str, object]:
     """The ``#define``s of one draw: what the scene needs and this material uses, nothing else.
 
     ``MODE_*`` (flat, gouraud, phong); the scene's ambient and the material's constants as
@@ -206,6 +207,9 @@ def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: i
     ``needs``: ``ft.scene_needs(scene)`` when the caller has it.  ``user_model``: a user's shading
     model replaces the local model (``USER_MODEL``, ``shaders/include/user_model.glsl``; the
     lights are compiled in whatever kd and ks are, since the user's model may use neither).
+    ``screen_space``: ``SCREEN_SPACE``, every smooth varying linear in screen space (the
+    course's scanline interpolation, GLSL's ``noperspective`` made robust to near-plane
+    clipping: ``shaders/include/screen_space.glsl``).
     """
     needs = ft.scene_needs(scene) if needs is None else needs
     d = base_defines()
@@ -245,6 +249,8 @@ def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: i
         d["ENV_KIND"] = ENV_KIND[scene.environment.kind if scene.environment else "sky"]
     if depth_bits == 16:
         d["DEPTH_LEVELS"] = ""
+    if screen_space:
+        d["SCREEN_SPACE"] = ""
     return d
 
 
