@@ -14,6 +14,29 @@ int cube_face(vec3 d) {
     if (a.y >= a.z) return d.y >= 0.0 ? 2 : 3;
     return d.z >= 0.0 ? 4 : 5;
 }
+
+// Normalised device x, y of direction d on its face (cube_face), and m = d.F, its distance
+// along the face's axis F: the 90-degree cameras of raster_standins.FACES (look_at with those
+// up vectors) see camera x = d.r, y = d.u, depth d.F, with (r, u) per face
+// +x: (z, y), -x: (-z, y), +y: (x, z), -y: (-x, z), +z: (-x, y), -z: (x, y).  Computed from
+// the components instead of reading each face's matrix per fragment (llvmpipe pays for
+// dynamically indexed uniforms).
+vec2 cube_ndc(vec3 d, int face, out float m) {
+    float s = (face == 0 || face == 2 || face == 5) ? 1.0 : -1.0;
+    vec3 a = abs(d);
+    vec2 q;
+    if (face < 2) {
+        m = a.x;
+        q = vec2(s * d.z, d.y);
+    } else if (face < 4) {
+        m = a.y;
+        q = vec2(s * d.x, d.z);
+    } else {
+        m = a.z;
+        q = vec2(s * d.x, d.y);
+    }
+    return q / max(m, TOL_ZERO);
+}
 #endif
 
 #ifdef ENV_CUBE
@@ -22,30 +45,27 @@ int cube_face(vec3 d) {
 // matrices, its centre and its faces' (near, far).
 uniform sampler2D u_env_cube;
 uniform sampler2D u_env_depth;
-uniform mat4 u_env_clip[6];
 uniform vec3 u_env_centre;
 uniform vec2 u_env_range;
 
-// Texture coordinates of direction dir (from c) in the atlas (the half-texel clamp keeps the
-// bilinear filter inside the face's tile); face: its face.
-vec2 env_uv(vec3 dir, out int face) {
-    face = cube_face(dir);
-    vec4 c = u_env_clip[face] * vec4(u_env_centre + dir, 1.0);
+// Texture coordinates of unit direction dir (from c) in the atlas (the half-texel clamp keeps
+// the bilinear filter inside the face's tile); m: dir's component along its face's axis.
+vec2 env_uv(vec3 dir, out float m) {
+    int face = cube_face(dir);
     float h = 0.5 / float(ENV_RES);
-    vec2 uv = clamp(c.xy / max(c.w, TOL_ZERO) * 0.5 + 0.5, vec2(h), vec2(1.0 - h));
+    vec2 uv = clamp(cube_ndc(dir, face, m) * 0.5 + 0.5, vec2(h), vec2(1.0 - h));
     vec2 tile = vec2(float(face - 3 * (face / 3)), float(face / 3));
     return (tile + uv) / vec2(3.0, 2.0);
 }
 
 // Distance from c to the surface the map sees in unit direction dir: the window depth w of
 // its face gives the depth along the face's axis z = n f / (f - w (f - n)), and the distance
-// is z / |dir . axis| (the largest component of dir); the background gives about f.
+// is z / m (m = dir's component along that axis); the background gives about f.
 float env_distance(vec3 dir) {
-    int f;
-    float w = textureLod(u_env_depth, env_uv(dir, f), 0.0).r;
+    float m;
+    float w = textureLod(u_env_depth, env_uv(dir, m), 0.0).r;
     float n = u_env_range.x, fa = u_env_range.y;
-    vec3 a = abs(dir);
-    return n * fa / (fa - w * (fa - n)) / max(max(a.x, a.y), max(a.z, TOL_ZERO));
+    return n * fa / (fa - w * (fa - n)) / max(m, TOL_ZERO);
 }
 
 // Radiance the ray P + t D (t > 0) meets, looked up in the map with parallax correction by
@@ -65,8 +85,8 @@ vec3 env_ray(vec3 P, vec3 D) {
         float t = -b + sqrt(max(b * b - xx + r * r, 0.0));
         dir = x + max(t, 0.0) * D;
     }
-    int f;
-    return textureLod(u_env_cube, env_uv(safe_normalize(dir), f), 0.0).rgb;
+    float m;
+    return textureLod(u_env_cube, env_uv(safe_normalize(dir), m), 0.0).rgb;
 }
 
 #ifdef ENV_KT
@@ -106,7 +126,8 @@ vec3 env_terms(vec3 P, vec3 N, vec3 S, vec3 C) {
 // Shadow maps (Williams 1978): one tile of SHADOW_RES^2 depths per directional light
 // (orthographic) and six per point light (a cube), in one depth texture of SHADOW_COLS
 // tiles per row.  SHADOW_BASE[k]: first tile of light k; SHADOW_CUBE[k]: a point light;
-// SHADOW_POS[k]: its position (or the direction towards a directional light); SHADOW_BIAS:
+// SHADOW_POS[k]: its position (or the direction towards a directional light); SHADOW_RANGE[k]:
+// a point light's cube faces' (near, far); SHADOW_BIAS:
 // the world distance a receiver is moved towards the light before the depth test (too small:
 // acne, surfaces shadow themselves; too large: shadows detach, "peter panning").
 uniform sampler2D u_shadow_atlas;
@@ -114,16 +135,29 @@ uniform mat4 u_shadow_clip[SHADOW_TILES];
 const int SHADOW_BASE[N_LIGHTS] = SHADOW_BASE_LIST;
 const bool SHADOW_CUBE[N_LIGHTS] = SHADOW_CUBE_LIST;
 const vec3 SHADOW_POS[N_LIGHTS] = SHADOW_POS_LIST;
+const vec2 SHADOW_RANGE[N_LIGHTS] = SHADOW_RANGE_LIST;
 
 // 1 where light k reaches P (the depth stored in its map is not nearer than P), else 0.  One
 // point sample, no filtering: the map's texels show as jagged shadow edges (aliasing).
 float shadow_visibility(int k, vec3 P) {
     vec3 towards = SHADOW_CUBE[k] ? SHADOW_POS[k] - P : SHADOW_POS[k];
     vec3 Pb = P + SHADOW_BIAS * safe_normalize(towards);
-    int tile = SHADOW_BASE[k] + (SHADOW_CUBE[k] ? cube_face(Pb - SHADOW_POS[k]) : 0);
-    vec4 c = u_shadow_clip[tile] * vec4(Pb, 1.0);
-    if (c.w <= 0.0) return 1.0;
-    vec3 ndc = c.xyz / c.w;
+    int tile = SHADOW_BASE[k];
+    vec3 ndc;
+    if (SHADOW_CUBE[k]) {
+        // the face's perspective (gluPerspective, 90 degrees): z_ndc = (f + n) / (f - n)
+        // - 2 f n / ((f - n) m) at distance m along the face's axis
+        vec3 d = Pb - SHADOW_POS[k];
+        int face = cube_face(d);
+        float m;
+        ndc.xy = cube_ndc(d, face, m);
+        float n = SHADOW_RANGE[k].x, f = SHADOW_RANGE[k].y;
+        ndc.z = (f + n) / (f - n) - 2.0 * f * n / ((f - n) * max(m, TOL_ZERO));
+        tile += face;
+    } else {
+        vec4 c = u_shadow_clip[tile] * vec4(Pb, 1.0);  // orthographic: w = 1
+        ndc = c.xyz;
+    }
     if (abs(ndc.x) > 1.0 || abs(ndc.y) > 1.0 || ndc.z > 1.0) return 1.0;
     ivec2 texel = clamp(ivec2(floor((ndc.xy * 0.5 + 0.5) * float(SHADOW_RES))), ivec2(0),
                         ivec2(SHADOW_RES - 1));

@@ -270,7 +270,8 @@ class RasterSession:
         # compile time (a 1 x 1 frame)
         t0 = time.perf_counter()
         self.draw(scene.camera.with_resolution(1, 1))
-        self.timings["compile"] = self.programs.compile_seconds + time.perf_counter() - t0
+        self.timings["compile"] = (self.programs.compile_seconds + time.perf_counter() - t0
+                                   - self.timings.get("standin_maps", 0.0))
 
     @property
     def left_out(self) -> list[str]:
@@ -329,7 +330,7 @@ class RasterSession:
         self.plan = sti.plan(self._needs, options, self.mode, user_model=self.shading is not None,
                              n_lights=len(self.lights))
         self.shadow_layout = self.shadow_atlas = None
-        self._shadows_drawn = False
+        self._shadows_drawn = self._env_drawn = False
         self.env_maps: dict = {}
         if self.plan.shadows:
             self.shadow_layout = sti.shadow_layout(self.lights, self.part_boxes, options.shadow_resolution,
@@ -450,7 +451,6 @@ class RasterSession:
         u = _Uniforms(prog)
         env = self.env_maps.get(d.group) if d.standins is not None and d.standins.env_res else None
         if env is not None:
-            u.set("u_env_clip", sti.mat4_array(env.clips))
             u.set("u_env_centre", tuple(float(x) for x in env.centre))
             u.set("u_env_range", (float(env.near), float(env.far)))
         if d.standins is not None and d.standins.shadows is not None:
@@ -569,6 +569,7 @@ class RasterSession:
             self._light_values = light_uniforms(lights)
         self.live_materials |= edited
         self.live_lights = self.live_lights or lights_edited
+        self._env_drawn = False  # the maps show the edited materials at the next frame
         for d in self.draws:
             if d.name is not None:
                 d.material = scene.materials[d.name]
@@ -654,19 +655,38 @@ class RasterSession:
 
     def draw_to(self, fbo, camera: Camera, near: float | None = None, far: float | None = None):
         """Draw the scene seen by ``camera`` into ``fbo`` (colour attachment 0 + depth), after
-        the stand-ins' maps (shadow maps once per session, environment maps every frame).
-        Returns the (near, far) used."""
+        the stand-ins' maps when the scene changed since they were drawn (shadow maps: at the
+        first frame, since a light or geometry edit builds a new session; environment maps: at
+        the first frame and after every edit :meth:`update` takes).  Neither depends on the
+        camera, so a camera move redraws neither.  Returns the (near, far) used."""
         n0, f0 = self.near_far(camera)
         near, far = near or n0, far or f0
         if not 0.0 < near < far:
             raise WorkbenchError(f"clip planes need 0 < near < far, got near {near:.6g} and far {far:.6g}")
-        if self.shadow_atlas is not None and not self._shadows_drawn:
-            self._draw_shadow_maps()
-        for env in self.env_maps.values():
-            for viewport, face in env.faces():
-                self._draw_pass(env.fbo, viewport, face, env.near, env.far, skip=env.key)
+        if (self.shadow_atlas is not None and not self._shadows_drawn) or (self.env_maps and not self._env_drawn):
+            t0 = time.perf_counter()
+            if self.shadow_atlas is not None and not self._shadows_drawn:
+                self._draw_shadow_maps()
+            if self.env_maps and not self._env_drawn:
+                self.draw_environment_maps()
+            self.timings["standin_maps"] = time.perf_counter() - t0
         self._draw_pass(fbo, (0, 0, fbo.width, fbo.height), camera, near, far)
         return near, far
+
+    def draw_environment_maps(self, rounds: int = 2) -> None:
+        """Draw every environment map's six faces from its object's centre, the object left
+        out, with the image's programs.  Mapped objects see each other's maps as last drawn:
+        ``rounds`` passes over all maps (from maps cleared to the background) give
+        ``rounds - 1`` bounces between them (a mirror sees the glass ball refracting the
+        mirror's first-round map)."""
+        bg = tuple(float(x) for x in self.scene.background)
+        for env in self.env_maps.values():
+            env.fbo.clear(*bg, 0.0, depth=1.0)
+        for _ in range(rounds):
+            for env in self.env_maps.values():
+                for viewport, face in env.faces():
+                    self._draw_pass(env.fbo, viewport, face, env.near, env.far, skip=env.key)
+        self._env_drawn = True
 
     def _draw_shadow_maps(self) -> None:
         """Depth of every surface (area lights' polygons excepted: their stand-in lights sit on

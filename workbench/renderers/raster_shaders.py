@@ -261,7 +261,7 @@ def standin_defines(material: Material, s, *, lit: bool) -> dict[str, object]:
     refraction through the same map), ``TINT_PASS`` + ``MAT_KT`` (the multiplicative pass of
     blended transparency), and for a lit material ``SHADOW_MAPS`` with the shadow atlas's
     layout (``SHADOW_RES``, ``SHADOW_COLS``, ``SHADOW_TILES``, the per-light lists
-    ``SHADOW_BASE_LIST``, ``SHADOW_CUBE_LIST``, ``SHADOW_POS_LIST`` and the world-space
+    ``SHADOW_BASE_LIST``, ``SHADOW_CUBE_LIST``, ``SHADOW_POS_LIST``, ``SHADOW_RANGE_LIST`` and the world-space
     ``SHADOW_BIAS``)."""
     d: dict[str, object] = {}
     if s.env_res > 0:
@@ -277,6 +277,7 @@ def standin_defines(material: Material, s, *, lit: bool) -> dict[str, object]:
         d["SHADOW_BASE_LIST"] = "int[](" + ", ".join(str(int(b)) for b in L.base) + ")"
         d["SHADOW_CUBE_LIST"] = "bool[](" + ", ".join("true" if c else "false" for c in L.cube) + ")"
         d["SHADOW_POS_LIST"] = "vec3[](" + ", ".join(_vec3(p) for p in L.pos) + ")"
+        d["SHADOW_RANGE_LIST"] = "vec2[](" + ", ".join(f"vec2({_float(n)}, {_float(f)})" for n, f in L.ranges) + ")"
         d["SHADOW_BIAS"] = _float(L.bias_world)
     return d
 

@@ -2,16 +2,20 @@
 renderer in place of the ray tracer's secondary rays.
 
 * **Dynamic environment maps** ("surimpression de scène sur objet: objet réfléchissant"): for
-  each object with a reflective (kr > 0) or, without blending, transmissive (kt > 0) material,
-  a cube map of the scene seen from the object's centre (the object itself left out), drawn
-  every frame with the same shaders and programs as the image; Phong looks it up per fragment,
-  Gouraud per vertex.  Reflection: ``kr env(R)``, ``R = 2 (N.S) N - S``; refraction (kt
+  each object with a reflective (kr > 0) or transmissive (kt > 0) solid material, a cube map
+  of the scene seen from the object's centre (the object itself left out), drawn with the same
+  shaders and programs as the image whenever the scene changes (at the session's first frame
+  and after every live edit, :meth:`.raster.RasterSession.update`; the map does not depend on
+  the camera, so a camera move does not redraw it; two rounds give one bounce between mapped
+  objects); Phong looks it up per fragment, Gouraud per vertex.  Reflection: ``kr env(R)``, ``R = 2 (N.S) N - S``; refraction (kt
   without blending): ``kt C env(T)`` with ``T`` the direction refracted once at the surface
   (Snell's law, ior).  Known failures, by construction: no self-reflection (the object is not
   in its own map), parallax (the map is seen from the centre, not from the surface point:
-  nearby objects appear at the wrong place, the floor under a mirror ball is most wrong),
-  one bounce delayed between two mapped objects (each sees the other's map of the previous
-  frame), and refraction bends the ray once instead of at entry and exit.
+  nearby objects appear at the wrong place, the floor under a mirror ball is most wrong;
+  ``envmap_iterations`` > 0 corrects it with distance impostors, see standins.glsl, except
+  where the corrected ray passes behind a surface the centre does not see), one bounce
+  between two mapped objects, and refraction through a solid that is taken as a sphere
+  about its centre (two interfaces, no internal reflections).
   Refraction assumes a sphere about the map's centre through the surface point: the ray
   refracts in, crosses the chord and refracts out (exact directions for a sphere, two
   interfaces); solids (:data:`SOLID_KINDS`) with a kt material refract this way when the map is
@@ -292,7 +296,8 @@ def directional_clip(towards_light, boxes: np.ndarray) -> np.ndarray:
 class ShadowLayout:
     """The shadow atlas: ``tiles`` tiles of ``resolution``^2 on a ``cols`` x ``rows`` grid;
     per light its first tile ``base``, whether it is a cube (point light) ``cube`` and its
-    position (or direction towards it) ``pos``; ``bias_world`` the bias in world units;
+    position (or direction towards it) ``pos``, a point light's faces' (near, far) ``ranges``
+    ((0, 0) for a directional light); ``bias_world`` the bias in world units;
     ``clips`` (tiles, 4, 4) the tiles' ``clip_from_world``."""
 
     resolution: int
@@ -302,6 +307,7 @@ class ShadowLayout:
     base: tuple
     cube: tuple
     pos: tuple
+    ranges: tuple
     bias_world: float
     clips: np.ndarray
 
@@ -309,21 +315,23 @@ class ShadowLayout:
 def shadow_layout(lights, boxes: np.ndarray, resolution: int, bias: float) -> ShadowLayout:
     """The atlas of the (point and directional) ``lights`` over the scene's (K, 2, 3) boxes."""
     from .raster_shaders import light_values
-    base, cube, pos, clips = [], [], [], []
+    base, cube, pos, ranges, clips = [], [], [], [], []
     for light in lights:
         p, _ = light_values(light)
         base.append(len(clips))
         pos.append(tuple(float(x) for x in p))
         if isinstance(light, DirectionalLight):
             cube.append(False)
+            ranges.append((0.0, 0.0))
             clips.append(directional_clip(p, boxes))
         else:
             cube.append(True)
             cams, near, far = cube_cameras(p, boxes, resolution)
+            ranges.append((near, far))
             clips.extend(clip_of(cam, near, far) for cam in cams)
     cols, rows = atlas_grid(len(clips))
     return ShadowLayout(resolution, cols, rows, len(clips), tuple(base), tuple(cube), tuple(pos),
-                        bias * scene_extent(boxes), np.array(clips))
+                        tuple(ranges), bias * scene_extent(boxes), np.array(clips))
 
 
 @dataclass(frozen=True)
@@ -347,13 +355,13 @@ def _tile_viewport(tile: int, cols: int, res: int) -> tuple[int, int, int, int]:
 
 class EnvironmentMap:
     """One object's dynamic cube map: six tiles (3 x 2) of ``resolution``^2 RGBA float32 with
-    their depth, seen from ``centre`` (``cameras`` from :func:`cube_cameras`; ``clips`` their (6, 4, 4) ``clip_from_world``)."""
+    their depth, seen from ``centre`` by ``cameras`` (:func:`cube_cameras`) between ``near``
+    and ``far``."""
 
     def __init__(self, ctx, key, centre: np.ndarray, boxes: np.ndarray, resolution: int):
         import moderngl
         self.key, self.centre, self.resolution = key, np.asarray(centre, dtype=np.float64), resolution
         self.cameras, self.near, self.far = cube_cameras(self.centre, boxes, resolution)
-        self.clips = np.stack([clip_of(cam, self.near, self.far) for cam in self.cameras])
         size = (3 * resolution, 2 * resolution)
         self.color = ctx.texture(size, 4, dtype="f4")
         self.color.filter = (moderngl.LINEAR, moderngl.LINEAR)
