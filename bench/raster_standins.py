@@ -7,9 +7,9 @@ needing none keep their frame rate.
   PSNR and FLIP against the scene's full reference (:func:`workbench.compare.reference.
   choose_reference`: the Whitted ray tracer, depth 12, 16 stratified samples per pixel, from the
   reference cache), and the frame rate of ``draw_to`` + ``finish`` (as bench/raster_fps.py:
-  every stand-in map a frame needs is drawn inside it, i.e. the environment maps; the shadow maps
-  are drawn once per session and counted in ``setup_seconds``), the CPU time per frame and the
-  time with read-back;
+  the maps are drawn when the scene changes, not per camera move: a frame is the image pass with
+  its map lookups), the CPU time per frame, the time with read-back, and (``*_maps_redrawn``) a
+  frame that also redraws every environment map (what each live edit of the scene costs);
 * ``sweeps``: all stand-ins with one knob varied (``envmap_resolution``, ``envmap_iterations``,
   ``shadow_resolution``, ``shadow_bias``);
 * ``unneeded``: every bundled scene's plan (which stand-ins the default options build) and, for
@@ -17,7 +17,8 @@ needing none keep their frame rate.
 
     .venv/bin/python bench/raster_standins.py [--seconds 1.0] [--width 512] [--height 384]
 
-Writes ``bench/results/raster_standins.json`` and ``.md`` and prints the table.
+Writes ``bench/results/raster_standins.json`` and ``.md`` (and prints the table) and the figure
+``docs/images/whitted_standins.png`` (``--figure-only``: just the figure).
 """
 from __future__ import annotations
 
@@ -61,12 +62,19 @@ def measure(scene, mode: str, reference, width: int, height: int, seconds: float
 
     r = _rate(frame, seconds)
     full = _rate(lambda: session.draw(cam, with_depth=True), seconds / 2)
+    redraw = {}
+    if session.env_maps:
+        def frame_and_maps():
+            session.draw_environment_maps()
+            frame()
+        e = _rate(frame_and_maps, seconds / 2)
+        redraw = {"fps_maps_redrawn": round(e["fps"], 1), "cpu_ms_maps_redrawn": round(e["cpu_ms"], 2)}
     row = {"mode": mode, **{k: v for k, v in options.items()},
            "standins_built": sorted(session.standins_used), "env_maps": len(session.env_maps),
            "shadow_tiles": session.shadow_layout.tiles if session.shadow_layout else 0,
            "setup_seconds": round(setup, 3), "compile_seconds": round(session.timings["compile"], 3),
            "fps": round(r["fps"], 1), "fps_best": round(r["fps_best"], 1), "cpu_ms_per_frame": round(r["cpu_ms"], 2),
-           "ms_with_readback": round(1e3 / full["fps_median"], 2)}
+           "ms_with_readback": round(1e3 / full["fps_median"], 2), **redraw}
     if m:
         row.update(rmse=round(m["rmse"], 5), psnr=round(m["psnr"], 2), flip=round(m["flip"], 4))
     session.release()
@@ -74,16 +82,49 @@ def measure(scene, mode: str, reference, width: int, height: int, seconds: float
     return row
 
 
+FIGURE = Path(__file__).resolve().parents[1] / "docs" / "images" / "whitted_standins.png"
+
+
+def figure(scene, reference, width: int, height: int) -> None:
+    """docs/images/whitted_standins.png: the Whitted reference, Phong with stand-ins off, with
+    environment maps seen from the centre (``envmap_iterations=0``: parallax), with all stand-ins
+    at their defaults, and the absolute error of the last (x4), each panel labelled with its RMSE."""
+    import numpy as np
+    from PIL import Image, ImageDraw
+    from workbench.core.imageio import to_srgb8
+    panels = [("Whitted reference", reference)]
+    for label, opts in [("phong, standins=off", {"standins": "off"}),
+                        ("all, envmap_iterations=0 (parallax)", {"envmap_iterations": 0}),
+                        ("phong, all stand-ins", {})]:
+        img = workbench.render(scene, "phong", width=width, height=height, **opts).image
+        panels.append((f"{label}: RMSE {metrics(img, reference)['rmse']:.4f}", img))
+    panels.append(("|all - reference| x 4", np.clip(4.0 * np.abs(panels[-1][1] - reference), 0.0, 1.0)))
+    tiles = []
+    for label, img in panels:
+        im = Image.fromarray(to_srgb8(img))
+        ImageDraw.Draw(im).text((6, 6), label, fill=(0, 0, 0))
+        tiles.append(np.asarray(im))
+    half = [np.asarray(Image.fromarray(x).resize((width // 2, height // 2))) for x in tiles]
+    FIGURE.parent.mkdir(parents=True, exist_ok=True)
+    Image.fromarray(np.concatenate([np.concatenate(half[:3], 1), np.concatenate(half[3:] + [255 + 0 * half[0]], 1)],
+                                   0).astype(np.uint8)).save(FIGURE)
+    print("wrote", FIGURE)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=1.0)
     ap.add_argument("--width", type=int, default=512)
     ap.add_argument("--height", type=int, default=384)
+    ap.add_argument("--figure-only", action="store_true", help="only write docs/images/whitted_standins.png")
     args = ap.parse_args()
     W, H, sec = args.width, args.height, args.seconds
     load_before = os.getloadavg()
     scene = workbench.load_scene("whitted")
     ref = choose_reference(scene, W, H)
+    figure(scene, ref.image, W, H)
+    if args.figure_only:
+        return
     steps = []
     for label, standins in STEPS:
         for mode in ("phong", "gouraud") if label in ("none", "+shadows = all") else ("phong",):
@@ -135,6 +176,9 @@ def markdown(r: dict) -> str:
         out += ["", f"Phong, all stand-ins, `{knob}` swept:", "", "| value | RMSE | fps (best) | CPU ms/frame |",
                 "|---|---|---|---|"]
         out += [f"| {x[knob]} | {x['rmse']:.4f} | {x['fps']} ({x['fps_best']}) | {x['cpu_ms_per_frame']} |" for x in rows]
+    out += ["", "Frames that also redraw the environment maps (a live edit): "
+            + "; ".join(f"{s['step']} {s['mode']}: {s['fps_maps_redrawn']} fps, {s['cpu_ms_maps_redrawn']} CPU ms"
+                        for s in r["steps"] if "fps_maps_redrawn" in s)]
     out += ["", "Bundled scenes: stand-ins built by default (Phong); scenes needing none, frame rate at 512 x 512 "
             "with stand-ins on / off:", "", "| scene | stand-ins built | phong fps on / off | gouraud fps on / off |",
             "|---|---|---|---|"]

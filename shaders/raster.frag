@@ -86,7 +86,7 @@ void main() {
     vec3 specular = v_specular;
 #if defined(MODE_GOURAUD) && defined(SHADOW_MAPS)
     for (int k = 0; k < N_LIGHTS; ++k) {
-        float vis = shadow_visibility(k, v_world);
+        float vis = shadow_visibility(k, v_world, N);
         diffuse += vis * v_light_d[k];
         specular += vis * v_light_s[k];
     }

@@ -82,7 +82,7 @@ void local_terms(vec3 P, vec3 N, vec3 S, out vec3 diffuse, out vec3 specular) {
     // stand-in shadows (standins.glsl): light k's colour times its shadow-map visibility at P
     int k = 0;
 #define X(POINT, INV_SQ, LOBE, pos, color, lobe_normal) \
-    add_light(POINT, INV_SQ, LOBE, pos, (color) * shadow_visibility(k++, P), lobe_normal, P, N, S, NdS, \
+    add_light(POINT, INV_SQ, LOBE, pos, (color) * shadow_visibility(k++, P, N), lobe_normal, P, N, S, NdS, \
               diffuse, specular);
 #else
 #define X(POINT, INV_SQ, LOBE, pos, color, lobe_normal) \

@@ -127,9 +127,10 @@ vec3 env_terms(vec3 P, vec3 N, vec3 S, vec3 C) {
 // (orthographic) and six per point light (a cube), in one depth texture of SHADOW_COLS
 // tiles per row.  SHADOW_BASE[k]: first tile of light k; SHADOW_CUBE[k]: a point light;
 // SHADOW_POS[k]: its position (or the direction towards a directional light); SHADOW_RANGE[k]:
-// a point light's cube faces' (near, far); SHADOW_BIAS:
-// the world distance a receiver is moved towards the light before the depth test (too small:
-// acne, surfaces shadow themselves; too large: shadows detach, "peter panning").
+// a point light's cube faces' (near, far); SHADOW_BIAS: the world distance a receiver is moved
+// towards the light and along its normal before the depth test (the normal offset keeps
+// surfaces lit at grazing angles, where a depth map's texel spans a long stretch of depth, from
+// shadowing themselves; too small: acne; too large: shadows detach, "peter panning").
 uniform sampler2D u_shadow_atlas;
 uniform mat4 u_shadow_clip[SHADOW_TILES];
 const int SHADOW_BASE[N_LIGHTS] = SHADOW_BASE_LIST;
@@ -137,11 +138,12 @@ const bool SHADOW_CUBE[N_LIGHTS] = SHADOW_CUBE_LIST;
 const vec3 SHADOW_POS[N_LIGHTS] = SHADOW_POS_LIST;
 const vec2 SHADOW_RANGE[N_LIGHTS] = SHADOW_RANGE_LIST;
 
-// 1 where light k reaches P (the depth stored in its map is not nearer than P), else 0.  One
+// 1 where light k reaches P (unit shading normal N, towards the viewer: the side a light
+// that counts lights) when the depth stored in its map is not nearer than P, else 0.  One
 // point sample, no filtering: the map's texels show as jagged shadow edges (aliasing).
-float shadow_visibility(int k, vec3 P) {
+float shadow_visibility(int k, vec3 P, vec3 N) {
     vec3 towards = SHADOW_CUBE[k] ? SHADOW_POS[k] - P : SHADOW_POS[k];
-    vec3 Pb = P + SHADOW_BIAS * safe_normalize(towards);
+    vec3 Pb = P + SHADOW_BIAS * (safe_normalize(towards) + N);
     int tile = SHADOW_BASE[k];
     vec3 ndc;
     if (SHADOW_CUBE[k]) {

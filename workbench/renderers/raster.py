@@ -453,8 +453,11 @@ class RasterSession:
         if env is not None:
             u.set("u_env_centre", tuple(float(x) for x in env.centre))
             u.set("u_env_range", (float(env.near), float(env.far)))
-        if d.standins is not None and d.standins.shadows is not None:
-            u.set("u_shadow_clip", sti.mat4_array(d.standins.shadows.clips))
+        if d.standins is not None and d.standins.shadows is not None and "u_shadow_clip" in prog:
+            # only directional lights' tiles are read: the compiler keeps the array up to the
+            # last one, whose length the data must match
+            n = prog["u_shadow_clip"].array_length
+            u.set("u_shadow_clip", sti.mat4_array(d.standins.shadows.clips[:n]))
         if mat.bump is not None:  # per part, not per material
             u.set("u_grad_from_object", np.linalg.inv(part.world_from_object[:3, :3]))
         env = self.scene.environment

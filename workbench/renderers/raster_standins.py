@@ -60,12 +60,12 @@ KINDS = ("envmap", "blend", "shadows")
 ENV_RESOLUTIONS = (8, 2048)
 SHADOW_RESOLUTIONS = (16, 8192)
 DEFAULT_ENV_RESOLUTION = 128
-DEFAULT_SHADOW_RESOLUTION = 1024
+DEFAULT_SHADOW_RESOLUTION = 512
 DEFAULT_ENV_ITERATIONS = 3
 """Parallax-correction steps of an environment-map lookup (distance impostors; 0: the classic
 map seen from the object's centre)."""
 MAX_ENV_ITERATIONS = 16
-DEFAULT_SHADOW_BIAS = 0.002
+DEFAULT_SHADOW_BIAS = 0.001
 """Shadow-map bias as a fraction of the scene's extent (the diagonal of its bounds)."""
 
 #: Cube faces: viewing direction and up vector, in the order of ``cube_face`` in standins.glsl.
