@@ -202,3 +202,28 @@ def test_light_edit_with_shadow_maps_asks_for_a_new_session(gl_ctx):
     moved = replace(w, lights=[replace(w.lights[0], position=(-3.0, 6.0, -5.0))] + list(w.lights[1:]))
     assert not s.update(moved)
     s.release()
+
+
+@pytest.mark.parametrize("light", [{"type": "directional", "direction": [0.3, -1.0, 0.2]},
+                                   {"type": "area", "vertices": [[-0.5, 6, -0.5], [0.5, 6, -0.5], [0.5, 6, 0.5],
+                                                                 [-0.5, 6, 0.5]], "stand_in": 2}])
+def test_directional_and_area_light_shadows_fall_where_the_light_points(gl_ctx, light):
+    """A sphere over a floor: its shadow map darkens the floor point the light's ray through
+    the sphere's centre reaches (orthographic map; an area light's 4 stand-in point lights), and
+    not a floor point off to the side."""
+    d = {"camera": {"position": [0.0, 5.0, 8.0], "look_at": [0.0, 0.0, 0.0], "fov_y": 40.0, "resolution": [64, 48]},
+         "scene": {"ambient": [0.0, 0.0, 0.0]},
+         "lights": [dict(light, intensity=1.0 if light["type"] == "directional" else 40.0)],
+         "materials": {"m": {"color": [0.8, 0.8, 0.8], "kd": 0.8}},
+         "objects": [{"type": "sphere", "name": "ball", "material": "m", "center": [0.0, 1.5, 0.0], "radius": 0.7},
+                     {"type": "plane", "name": "floor", "material": "m", "point": [0.0, 0.0, 0.0],
+                      "normal": [0.0, 1.0, 0.0], "size": [12.0, 12.0]}]}
+    scene = scene_from_dict(d)
+    on = workbench.render(scene, "phong").image
+    off = workbench.render(scene, "phong", standins="off").image
+    down = np.array(light.get("direction", [0.0, -1.0, 0.0]), dtype=np.float64)
+    under = np.array([0.0, 1.5, 0.0]) + down * (1.5 / -down[1])    # the centre's shadow on the floor
+    row, col = _pixel(scene, under)
+    assert off[row, col].max() > 0.05 and on[row, col].max() < 0.5 * off[row, col].max(), (on[row, col], off[row, col])
+    row, col = _pixel(scene, (3.0, 0.0, 2.0))
+    assert np.allclose(on[row, col], off[row, col], atol=1e-4)
