@@ -11,6 +11,10 @@ All three use the local model of :mod:`.local_model` (GLSL mirror in
 ``shaders/include/lighting.glsl``) and the textures of :mod:`.texturing` (mirror in
 ``shaders/include/texturing.glsl``).
 
+Gouraud and Phong also draw stand-ins for the global effects the scene needs (environment
+maps, blending, shadow maps: :mod:`.raster_standins`, option ``standins``, on by default in
+:func:`render`; a :class:`RasterSession` builds them when given ``standins``).
+
 Interactive use (the UI calls this every frame)::
 
     session = RasterSession(scene, "phong", tessellation=6)   # tessellate + upload once
