@@ -5,6 +5,7 @@
 // with its normal (flat varyings: the provoking vertex of each triangle carries the polygon's
 // normal and centroid, tessellate_topology.provoking_layout).  Gouraud: lighting at the vertex
 // with the averaged normal.
+#include "standins.glsl"
 #include "lighting.glsl"
 #include "varyings.glsl"
 
@@ -45,6 +46,14 @@ flat out vec3 v_specular;
 out vec3 v_diffuse;
 out vec3 v_specular;
 #endif
+#if defined(MODE_GOURAUD) && defined(SHADOW_MAPS)
+// stand-in shadows: each light's terms apart, weighed per fragment (lighting.glsl light_terms)
+out vec3 v_light_d[N_LIGHTS];
+out vec3 v_light_s[N_LIGHTS];
+#endif
+#if defined(MODE_GOURAUD) && defined(ENV_CUBE)
+out vec3 v_env;  // stand-in environment map looked up per vertex (standins.glsl env_terms)
+#endif
 
 void main() {
 #ifdef NEEDS_SURFACE
@@ -66,6 +75,14 @@ void main() {
     vec3 S = safe_normalize(u_eye - P);
     vec3 N = face_viewer(safe_normalize(in_normal), S);
     local_terms(P, N, S, v_diffuse, v_specular);
+#if defined(MODE_GOURAUD) && defined(SHADOW_MAPS)
+    v_diffuse = MAT_KA * SCENE_AMBIENT;
+    v_specular = vec3(0.0);
+    light_terms(P, N, S, v_light_d, v_light_s);
+#endif
+#if defined(MODE_GOURAUD) && defined(ENV_CUBE)
+    v_env = env_terms(P, N, S, MAT_COLOR);
+#endif
 #endif
     gl_Position = u_clip_from_world * vec4(in_position, 1.0);
 #ifdef SCREEN_SPACE
