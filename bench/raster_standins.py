@@ -36,6 +36,7 @@ from workbench.compare.reference import choose_reference
 from workbench.renderers import gl
 from workbench.renderers import raster_standins as sti
 from workbench.renderers.raster import RasterSession
+from workbench.scene.features import scene_needs
 from workbench.scene.library import bundled
 
 OUT = Path(__file__).resolve().parent / "results" / "raster_standins"
@@ -134,7 +135,7 @@ def main():
     unneeded = []
     for path in bundled():
         s = workbench.load_scene(path.stem)
-        p = sti.plan(s.needs(), sti.StandinOptions(), "phong", user_model=False, n_lights=len(s.point_lights()))
+        p = sti.plan(scene_needs(s), sti.StandinOptions(), "phong", user_model=False, n_lights=len(s.point_lights()))
         row = {"scene": path.stem, "standins_built": sorted(p.covered)}
         if not p.any:
             for mode in ("phong", "gouraud"):

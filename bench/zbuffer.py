@@ -51,9 +51,9 @@ def main() -> None:
         scene = workbench.load_scene(name)
         for mode in ("flat", "gouraud", "phong"):
             z, tz = _timed(scene, "zbuffer", w, h, shading=mode)
-            _, tg = _timed(scene, mode, w, h, interpolation="screen")
+            _, tg = _timed(scene, mode, w, h, interpolation="screen", standins="off")
             g = get_renderer(mode).render(scene.with_camera(scene.camera.with_resolution(w, h)), w, h,
-                                          interpolation="screen").image
+                                          interpolation="screen", standins="off").image
             clipped = near_clipped_mask(scene, w, h)
             diff = np.abs(z.image - np.nan_to_num(g, nan=0.0)).max(-1) > DIFFERS
             rows.append({"scene": name, "mode": mode, "pixels": w * h,

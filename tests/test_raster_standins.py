@@ -167,7 +167,7 @@ def test_nothing_is_built_that_the_scene_does_not_need(gl_ctx):
     # whitted: two mapped spheres (mirror, glass), one atlas of 2 point lights x 6 faces (the
     # session render() uses by default, shared with the other tests)
     w = workbench.load_scene("whitted")
-    s, _ = session_for(w, "phong", DEFAULT_LEVEL, False, 24, None, sti.StandinOptions())
+    s, _ = session_for(w, "phong", DEFAULT_LEVEL, False, 24, None, standins=sti.StandinOptions())
     assert set(s.env_maps) == {"mirror", "glass"} and s.shadow_layout.tiles == 12
     assert sti.standin_bytes(w, sti.StandinOptions(envmap_resolution=16, shadow_resolution=32), "phong") \
         == 2 * 6 * 16 ** 2 * 20 + 4 * 3 * 32 ** 2 * 4

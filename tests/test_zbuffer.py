@@ -1,7 +1,8 @@
 """The CPU Z-buffer (``zbuffer``) and the raster methods' "as taught" options (issue 15, items 5
 and 6): the course's scanline interpolation and its orientation dependence, the p-bit integer
 depth buffer, the plain-mean vertex normals, and the Z-buffer as the pixel-by-pixel twin of
-the GL flat / Gouraud / Phong images drawn with ``interpolation=screen``."""
+the GL flat / Gouraud / Phong images drawn with ``interpolation=screen`` (and ``standins=off``:
+the Z-buffer draws the bare local model)."""
 from __future__ import annotations
 
 import numpy as np
@@ -137,7 +138,7 @@ def _twin_check(names):
         for mode in ("flat", "gouraud", "phong"):
             z = workbench.render(scene, "zbuffer", width=160, height=120, shading=mode).image
             g = get_renderer(mode).render(scene.with_camera(scene.camera.with_resolution(160, 120)), 160, 120,
-                                          interpolation="screen").image
+                                          interpolation="screen", standins="off").image
             assert np.isfinite(z).all() and np.isfinite(g).all(), (name, mode)
             clipped = near_clipped_mask(scene, 160, 120)
             diff = _differing(z, g)
@@ -179,15 +180,15 @@ def test_screen_space_option_is_what_makes_gl_the_twin(gl_ctx):
     of the faces' normals instead of the analytic normals)."""
     scene = workbench.load_scene("scenes/whitted.toml")
     z = workbench.render(scene, "zbuffer", width=160, height=120).image
-    persp = workbench.render(scene, "gouraud", width=160, height=120).image
+    persp = workbench.render(scene, "gouraud", width=160, height=120, standins="off").image
     small = scene.with_camera(scene.camera.with_resolution(160, 120))
-    screen = get_renderer("gouraud").render(small, 160, 120, interpolation="screen").image  # NaNs kept
+    screen = get_renderer("gouraud").render(small, 160, 120, interpolation="screen", standins="off").image  # NaNs kept
     assert _differing(z, persp).mean() > 0.02
     assert np.isfinite(screen).all()
     assert _differing(z, screen).mean() < 0.002
-    mean = workbench.render(scene, "gouraud", width=160, height=120, normals="face_mean").image
+    mean = workbench.render(scene, "gouraud", width=160, height=120, normals="face_mean", standins="off").image
     assert np.abs(mean - persp).max() > 1e-3
     zm = workbench.render(scene, "zbuffer", width=160, height=120, normals="face_mean").image
     sm = get_renderer("gouraud").render(scene.with_camera(scene.camera.with_resolution(160, 120)), 160, 120,
-                                        interpolation="screen", normals="face_mean").image
+                                        interpolation="screen", normals="face_mean", standins="off").image
     assert _differing(zm, sm).mean() < 0.002

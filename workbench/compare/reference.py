@@ -287,7 +287,7 @@ def matched_spec(method: str, scene: Scene | None = None) -> tuple[str, dict, st
     shadows (else the table :data:`MATCHED`: the bare local model)."""
     spec = MATCHED.get(method)
     if spec is not None and scene is not None and method in ("gouraud", "phong"):
-        needs = scene.needs()
+        needs = F.scene_needs(scene)
         if F.REFLECTION in needs or F.REFRACTION in needs:
             spec = _STANDIN_WHITTED
         elif F.SHADOWS in needs and scene.lights:

@@ -219,7 +219,7 @@ def standin_bytes(scene: Scene, options: StandinOptions | None, mode: str, *, us
     leaf of an object with such a material) ``6 R^2 (16 + 4)`` (colour and depth), and the
     shadow atlas's ``cols x rows x S^2 x 4``."""
     lights = scene.point_lights()
-    p = plan(scene.needs(), options, mode, user_model=user_model, n_lights=len(lights))
+    p = plan(ft.scene_needs(scene), options, mode, user_model=user_model, n_lights=len(lights))
     total = 0
     if p.envmap:
         n = sum(1 for o in scene.objects for leaf in _leaves(o)
