@@ -24,6 +24,7 @@ def _git(*args, **kw):
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(3600)   # two cold numba compiles (each tree its own cache) and 72 renders
 def test_images_of_every_kind_are_bit_identical_to_before_the_move(tmp_path):
     if _git("rev-parse", "--is-inside-work-tree").returncode != 0:
         pytest.skip("not a git checkout: the tree before the move cannot be extracted")
