@@ -31,7 +31,7 @@ from concurrent.futures.process import BrokenProcessPool
 import numpy as np
 
 from .jobs import job_key
-from .state import AppState, ErrorPlot, choosable_methods, method_kind
+from .state import AppState, ErrorPlot, choosable_methods, method_kind, short_name
 
 SETTLE_SECONDS = 0.3
 """The camera and scene must stay unchanged this long before the reference render starts."""
@@ -301,9 +301,11 @@ def error_plot(state: AppState) -> None:
     imgui.text_disabled(plot.message)
     if plot.matched_message:
         imgui.text_disabled(plot.matched_message)
+    elif plot.matched_pending:
+        imgui.text_disabled(f"evaluating {len(plot.matched_pending)} error(s) against matched references...")
     none = [m for m in state.methods if plot.matched.get(m) is False]
     if none:
-        imgui.text_disabled(f"no matched reference: {', '.join(none)} (total error only)")
+        imgui.text_disabled(f"no matched reference: {', '.join(map(short_name, none))} (total error only)")
     imgui.pop_text_wrap_pos()
     lines = plotted_lines(plot, state.methods, plot.metric)
     for name in CLEAR_FILLS:
@@ -323,11 +325,12 @@ def error_plot(state: AppState) -> None:
             m = label.removesuffix(MATCHED_SUFFIX)
             colour = colours.setdefault(m, implot.get_colormap_color(len(colours)))
             marker = getattr(implot.Marker_, marker_of(m))
+            shown = short_name(m) + label[len(m):]  # a user's model by its file's name
             if label == m:
-                implot.plot_line(label, xs, ys, implot.Spec(line_color=colour, marker=marker, marker_size=5))
+                implot.plot_line(shown, xs, ys, implot.Spec(line_color=colour, marker=marker, marker_size=5))
             else:  # dashes of the same colour, smaller markers (one legend entry: same label)
-                implot.plot_line(label, *dashed(xs, ys), implot.Spec(line_color=colour))
-                implot.plot_scatter(label, xs, ys, implot.Spec(line_color=colour, marker=marker,
+                implot.plot_line(shown, *dashed(xs, ys), implot.Spec(line_color=colour))
+                implot.plot_scatter(shown, xs, ys, implot.Spec(line_color=colour, marker=marker,
                                                                marker_size=3))
         implot.end_plot()
     implot.pop_style_color(len(CLEAR_FILLS))

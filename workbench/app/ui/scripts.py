@@ -21,8 +21,10 @@ PLOT_WAIT_SECONDS = 10.0
 
 
 def _record(state: AppState, out: Path, phase: str) -> None:
+    """Each panel's image as ``{phase}_{file stem}.npy`` (a user's model: ``glsl_<name>``)."""
+    from ...renderers.base import file_stem
     for m in state.methods:
-        np.save(out / f"{phase}_{m}.npy", np.asarray(state.images[m], np.float32))
+        np.save(out / f"{phase}_{file_stem(m)}.npy", np.asarray(state.images[m], np.float32))
 
 
 def _spec_material(state: AppState) -> str:
