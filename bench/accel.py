@@ -7,13 +7,14 @@ objects with empty space between them: where a uniform subdivision and a SAH tre
 For each structure: build time (``timings["bvh_build"]`` of the render: the structure and the
 reordering of the triangle arrays; best of the runs), trace time of a ``raycast`` render
 (``timings["trace"]``, best of ``--repeat`` warm runs), nodes visited and triangle tests per
-camera ray (option ``traversal_stats``), triangle rows held (the octree repeats triangles) and
+camera ray (option ``traversal_stats``: its pass's time ``stats_pass_s`` beside the trace time of the same
+render, ``stats_render_trace_s``; the rendering kernels themselves carry no counters), triangle rows held (the octree repeats triangles) and
 the memory estimate.  The images of the three structures are compared (equal: ``same_image``).
 
-BVH build before / after: ``build_bvh4`` on the mesh scene's triangles in a child process for
-each tree of the code (``--before``: a git revision, default ``f2e4b0a``, the last one before
-the rewrite, exported with ``git archive`` to a temporary folder; after: this checkout), best
-and median of 15 builds, wall and CPU seconds; the two trees' arrays are compared (the
+BVH build before / after: ``build_bvh4`` on the mesh scene's triangles in one child process
+that loads both versions of ``bvh.py`` (``--before``: a git revision, default ``f2e4b0a``, the
+last one before the rewrite, exported with ``git archive`` to a temporary folder; after: this
+checkout) and alternates them, best and median of 15 builds each, wall and CPU seconds; the two trees' arrays are compared (the
 rewrite makes the same tree, so the BVH's quality (nodes visited, trace time) is unchanged).
 
 Writes ``bench/results/accel.json`` and ``accel.md``.  Run:
@@ -38,23 +39,34 @@ RESULTS = ROOT / "bench" / "results"
 ACCELS = ("bvh", "octree", "none")
 
 BUILD_CHILD = r"""
-import hashlib, json, sys, time
+import hashlib, importlib.util, json, sys, time
 import numpy as np
-from workbench.renderers.raytrace.bvh import build_bvh4
+from workbench.renderers.raytrace import bvh as after
+spec = importlib.util.spec_from_file_location("bvh_before", sys.argv[2])
+before = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(before)
 tri = np.load(sys.argv[1])
-build_bvh4(tri[:64])  # JIT or cache load, outside the measurement
-wall, cpu = [], []
-for _ in range(15):
-    t0, c0 = time.perf_counter(), time.process_time()
-    order, bvh = build_bvh4(tri)
-    wall.append(time.perf_counter() - t0)
-    cpu.append(time.process_time() - c0)
-h = hashlib.sha256(order.tobytes())
-for a in bvh:
-    h.update(np.ascontiguousarray(a).tobytes())
-print(json.dumps(dict(wall_best_s=min(wall), wall_median_s=float(np.median(wall)), cpu_best_s=min(cpu),
-                      cpu_median_s=float(np.median(cpu)), nodes_4wide=int(len(bvh.node)), leaves=int(len(bvh.leaf)),
-                      tree_sha256=h.hexdigest())))
+codes = {"before": before.build_bvh4, "after": after.build_bvh4}
+for f in codes.values():
+    f(tri[:64])  # JIT or cache load, outside the measurement
+wall = {k: [] for k in codes}
+cpu = {k: [] for k in codes}
+for _ in range(15):  # alternating, so that both see the same load
+    for k, f in codes.items():
+        t0, c0 = time.perf_counter(), time.process_time()
+        f(tri)
+        wall[k].append(time.perf_counter() - t0)
+        cpu[k].append(time.process_time() - c0)
+out = {}
+for k, f in codes.items():
+    order, bvh = f(tri)
+    h = hashlib.sha256(order.tobytes())
+    for a in bvh:
+        h.update(np.ascontiguousarray(a).tobytes())
+    out[k] = dict(wall_best_s=min(wall[k]), wall_median_s=float(np.median(wall[k])), cpu_best_s=min(cpu[k]),
+                  cpu_median_s=float(np.median(cpu[k])), nodes_4wide=int(len(bvh.node)), leaves=int(len(bvh.leaf)),
+                  tree_sha256=h.hexdigest())
+print(json.dumps(out))
 """
 
 
@@ -79,10 +91,12 @@ def structures(scene, w, h, repeat):
     out, images = {}, {}
     for a in ACCELS:
         runs = [workbench.render(scene, "raycast", width=w, height=h, accel=a) for _ in range(repeat)]
-        st = workbench.render(scene, "raycast", width=w, height=h, accel=a, traversal_stats=True).stats
+        counted = workbench.render(scene, "raycast", width=w, height=h, accel=a, traversal_stats=True)
+        st = counted.stats
         images[a] = runs[-1].image
         out[a] = dict(build_s=min(x.timings["bvh_build"] for x in runs),
                       trace_s=min(x.timings["trace"] for x in runs),
+                      stats_pass_s=counted.timings["traversal_stats"], stats_render_trace_s=counted.timings["trace"],
                       nodes_per_ray=st["accel_nodes_per_ray"],
                       triangle_tests_per_ray=st["accel_triangle_tests_per_ray"],
                       primitive_tests_per_ray=st["accel_primitive_tests_per_ray"],
@@ -109,13 +123,13 @@ def build_before_after(before: str):
         old.mkdir()
         arch = subprocess.run(["git", "archive", before, "workbench"], cwd=ROOT, capture_output=True, check=True)
         subprocess.run(["tar", "-x", "-C", str(old)], input=arch.stdout, check=True)
-        for name, tree in (("before", old), ("after", ROOT)):
-            env = dict(os.environ, PYTHONPATH=str(tree), NUMBA_CACHE_DIR=str(Path(tmp) / f"cache_{name}"))
-            p = subprocess.run([sys.executable, "-c", BUILD_CHILD, str(path)], capture_output=True, text=True,
-                               cwd=tmp, env=env)
-            if p.returncode != 0:
-                raise RuntimeError(p.stderr[-3000:])
-            res[name] = json.loads(p.stdout.strip().splitlines()[-1])
+        env = dict(os.environ, PYTHONPATH=str(ROOT), NUMBA_CACHE_DIR=str(Path(tmp) / "cache"))
+        p = subprocess.run([sys.executable, "-c", BUILD_CHILD, str(path),
+                            str(old / "workbench" / "renderers" / "raytrace" / "bvh.py")],
+                           capture_output=True, text=True, cwd=tmp, env=env)
+        if p.returncode != 0:
+            raise RuntimeError(p.stderr[-3000:])
+        res.update(json.loads(p.stdout.strip().splitlines()[-1]))
     res["same_tree"] = res["before"]["tree_sha256"] == res["after"]["tree_sha256"]
     return res
 
@@ -126,12 +140,12 @@ def markdown(res) -> str:
     for name, rows in res["scenes"].items():
         lines += [f"## {name} ({rows['bvh']['triangles']} triangles)", "",
                   "| accel | build (ms) | trace (ms) | nodes / ray | triangle tests / ray | triangle rows | "
-                  "memory estimate (MiB) | same image |", "|---|---|---|---|---|---|---|---|"]
+                  "memory estimate (MiB) | same image | statistics pass (ms) |", "|---|---|---|---|---|---|---|---|---|"]
         for a in ACCELS:
             r = rows[a]
             lines.append(f"| {a} | {1e3 * r['build_s']:.1f} | {1e3 * r['trace_s']:.1f} | {r['nodes_per_ray']:.2f} | "
                          f"{r['triangle_tests_per_ray']:.1f} | {r['triangle_rows']} | {r['memory_estimate_mb']:.0f} | "
-                         f"{'yes' if r['same_image_as_bvh'] else 'NO'} |")
+                         f"{'yes' if r['same_image_as_bvh'] else 'NO'} | {1e3 * r['stats_pass_s']:.1f} |")
         lines.append("")
     b = res["bvh_build"]
     lines += [f"## BVH build, {b['triangles']} triangles (mesh scene), best / median of 15", "",
@@ -156,6 +170,8 @@ def main(argv=None) -> dict:
     res = {"machine": f"{os.cpu_count()} CPUs (shared)", "load_average_start": os.getloadavg(), "size": f"{w}x{h}",
            "command": "python bench/accel.py " + " ".join(argv if argv is not None else sys.argv[1:])}
     t0 = time.perf_counter()
+    for a in ACCELS:  # JIT or cache load of the kernels and the counting pass, outside the measurements
+        workbench.render(many_scene(), "raycast", width=8, height=6, accel=a, traversal_stats=True)
     res["scenes"] = {"mesh": structures(workbench.load_scene("mesh"), w, h, args.repeat),
                      "many": structures(many_scene(), w, h, args.repeat)}
     res["bvh_build"] = build_before_after(args.before)

@@ -170,3 +170,21 @@ def test_a_bad_accel_value_is_one_line_and_exit_2(tmp_path):
     assert r.returncode == 2
     assert r.stderr.strip().count("\n") == 0 and "accel" in r.stderr and "bvh, octree, none" in r.stderr
     assert "Traceback" not in r.stderr and not (tmp_path / "x.png").exists()
+
+
+def test_octree_of_coincident_triangles_stays_within_its_reference_budget():
+    # 600 copies of one triangle: every cut would copy them all into one octant, level after
+    # level; the depth and the reference budget end it, and rays still find the triangle
+    from workbench.renderers.raytrace import kernels
+    from workbench.renderers.raytrace.octree import REF_FACTOR, build_octree
+    tri = np.tile([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], (600, 1))
+    tri[:300, 2] = tri[:300, 5] = tri[:300, 8] = 0.5  # and 300 copies of a parallel one, 0.5 behind
+    refs, _ = build_octree(tri)
+    assert len(tri) <= len(refs) <= REF_FACTOR * len(tri)
+    stack = np.empty((kernels.BVH_STACK, 2))
+    for a, order, tree in _structures(tri):
+        arrays = (tree.node, tree.child, tree.leaf, tree.first, tree.tv4)
+        t, k, _, _ = kernels.bvh_hit(arrays, 0.2, 0.2, -1.0, 0.0, 0.0, 1.0, 0.0, np.inf, np.bool_(False), stack)
+        assert abs(t - 1.0) <= 1e-12 and k >= 0 and tri[order[k], 2] == 0.0, a
+        t, k, _, _ = kernels.bvh_hit(arrays, 0.2, 0.2, 2.0, 0.0, 0.0, -1.0, 0.0, np.inf, np.bool_(False), stack)
+        assert abs(t - 1.5) <= 1e-12 and tri[order[k], 2] == 0.5, a
