@@ -22,7 +22,7 @@ from ...scene import model as m
 from ..raytrace.flatten import flatten, light_rows
 from ..raytrace.whitted import TEX_COLS, camera_frame, fused_textures
 from .emitters import build_emitters
-from .geometry import triangulated
+from .geometry import FRONT_ONLY, triangulated
 
 FRESNEL = {"none": 0, "schlick": 1, "exact": 2}
 MIS = {"balance": 1.0, "power": 2.0}
@@ -93,6 +93,9 @@ class PathTraceSession:
         self.scene = scene.with_camera(scene.camera.with_resolution(width, height))
         self.width, self.height, self.seed = int(width), int(height), int(seed)
         sd = flatten(triangulated(self.scene) if triangulate else self.scene)
+        for i, mt in enumerate(sd.materials):  # area lights as triangles: still front-face emitters
+            if mt.name.startswith(FRONT_ONLY):
+                sd.mat_tab[i, 16] = 1.0
         self.sd = sd
         self.emitters = build_emitters(sd)
         full = transport == "full"
@@ -119,7 +122,8 @@ class PathTraceSession:
         self.opts = np.array([FRESNEL[fresnel], tol.ray_offset, tol.t_min, tol.zero, sd.extent,
                               tol.normal_cancel, rr_start, max_bounces, float(self.textured), MIS[mis],
                               *background, len(media), *(media + [0] * (4 - len(media))),
-                              TRANSPORT[transport], PIXEL_FILTER[pixel_filter]])
+                              TRANSPORT[transport], PIXEL_FILTER[pixel_filter],
+                              float(len(sd.tri_v) > 0 and not sd.top.any())])
         self.shading = (sd.mat, sd.mat_tab, np.ascontiguousarray(tex), lights)
         self.geo = sd.kernel_args()
         self.cam = camera_frame(self.scene.camera, self.width, self.height)
