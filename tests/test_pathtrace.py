@@ -222,6 +222,24 @@ def test_area_light_traced_as_triangles_keeps_one_emitting_side(tmp_path):
     assert (se > 0).all() and np.all(np.abs(diff) <= 5.0 * se)
 
 
+def test_area_light_at_grazing_angles_does_not_shadow_itself(tmp_path):
+    """A small area light (0.2 x 0.2, facing down, 1 above the plane, behind the camera) lights
+    the plane in view at grazing angles (|cos| 0.1 to 0.3 at the light): the path tracer matches
+    the Whitted ray tracer's stand-in, one inverse-square point light with a cosine lobe at the
+    light's centre and of its power (the small-light limit: off by (size / distance)^2 < 0.2 %).
+    The shadow feeler once ran along ``l`` from its pushed origin and met the light's own plane
+    short of its margin wherever |cos_l| < 1/2: every pixel was black (kernel and twin alike)."""
+    v = [[-0.1, 1.0, 4.9], [0.1, 1.0, 4.9], [0.1, 1.0, 5.1], [-0.1, 1.0, 5.1]]  # normal -y
+    sc = scene(tmp_path, PLANE + f'[[lights]]\ntype = "area"\nvertices = {v}\ncolor = [30.0, 20.0, 10.0]\n')
+    pt = workbench.render(sc, "pathtrace", spp=16, pixel_filter="center")
+    wh = workbench.render(sc, "raytrace", spp=1)
+    assert (wh.image.max(axis=2) > 0).sum() > 150
+    assert np.all(np.abs(pt.image - wh.image) <= 5.0 * pt.std_error + 5e-3 * wh.image + 1e-7)
+    mean, se = reference.render_pixels(sc, 16, 12, [(1, 8), (6, 3)], 8, pixel_filter="center", seed=2)
+    expect = wh.image[[1, 6], [8, 3]]
+    assert np.all(np.abs(mean - expect) <= 5.0 * se + 5e-3 * expect + 1e-7) and (mean > 0).all()
+
+
 @pytest.mark.parametrize("name", [p.stem for p in bundled()])
 def test_every_bundled_scene_finite(name):
     r = workbench.render(workbench.load_scene(name), "pathtrace", width=8, height=6, spp=2)

@@ -447,10 +447,19 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                         p_b = P_nd * (m_d * cos_s * INV_PI + a_s * ps) / m_nd
                         p_l = (lpdf_tri[mt] if mt >= 0 else lpdf_prim[em_prim[e]]) * dist * dist / abs(cos_l)
                         if p_l > 0.0:
-                            sx_, sy_, sz_, tmx = _feeler(px, py, pz, gx, gy, gz, lx, ly, lz, dist, off)
+                            # the feeler aims from its pushed origin at q itself: along l it would
+                            # meet the light's plane up to off / |cos_l| short of q, past its 2 off
+                            # margin where |cos_l| < 1/2 (a light seen at a grazing angle shadowed
+                            # its own sample)
+                            sx_, sy_, sz_, _ = _feeler(px, py, pz, gx, gy, gz, lx, ly, lz, dist, off)
+                            wx, wy, wz = qx - sx_, qy - sy_, qz - sz_
+                            wd = math.sqrt(wx * wx + wy * wy + wz * wz)
+                            kb = -1
                             counts[2] += 1
-                            _, kb, _, _, _, _ = cast(geo, bvh, tri_prim, only_tris, sx_, sy_, sz_, lx, ly, lz, tmin_here, tmx,
-                                                     np.bool_(True), zero, off, scr)
+                            if wd > 2.0 * off:
+                                _, kb, _, _, _, _ = cast(geo, bvh, tri_prim, only_tris, sx_, sy_, sz_, wx / wd,
+                                                         wy / wd, wz / wd, tmin_here, wd - 2.0 * off,
+                                                         np.bool_(True), zero, off, scr)
                             if kb < 0:
                                 wl = mis_weight(p_l, p_b, beta_mis) * cos_s / p_l
                                 Lr += br * (adr * INV_PI + fs) * ler * wl
