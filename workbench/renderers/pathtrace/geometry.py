@@ -9,9 +9,9 @@ Only what a triangle mesh describes identically is converted: convex polygons an
 opacity map (those read the polygon's own object-space mapping) and no transmission (a mesh is
 a solid, a polygon a thin sheet).  Convex area lights become triangle meshes too, of the black
 emissive material the ray tracer gives them (named ``__area_light_<k>_tris``, after
-``flatten``'s ``__area_light_<k>``), whose emission the path tracer keeps to the front face (:data:`FRONT_ONLY` names them for the
-session, which sets the ``front_only_emitter`` column): a scene of polygons is then all
-triangles, and every ray a BVH traversal alone.
+``flatten``'s ``__area_light_<k>``), whose emission the path tracer keeps to the front face
+(:data:`FRONT_ONLY` names them for the session, which sets the ``front_only_emitter`` column): a
+scene of polygons is then all triangles, and every ray a BVH traversal alone.
 """
 from __future__ import annotations
 

@@ -14,10 +14,12 @@ One path per sample, from the camera (uniform jitter in the pixel: the box-filte
   through thin sheets), from ``kr, kt`` with the ray tracer's Fresnel option; all scaled by
   ``1 / max(1, kd max(C) + ks + kr + kt)`` so that no surface reflects more than it receives;
 * next-event estimation at non-delta vertices: one emitter triangle point
-  (:mod:`.emitters`, MIS with the BSDF strategy) and every point / directional light (delta
-  lights: no MIS; a light of value ``I`` gives the irradiance ``pi I S cos`` with ``S`` its
-  falloff and spot factor, so that a Lambertian surface reflects ``kd C I S cos``: the course's
-  diffuse term, and the convention of the area lights' point stand-ins);
+  (:mod:`.emitters`, MIS with the BSDF strategy; the shadow feeler aims from its origin, pushed
+  off the surface, at that point, and stops ``2 off`` short of it) and every point /
+  directional light (delta lights: no MIS; a light of value ``I`` gives the irradiance
+  ``pi I S cos`` with ``S`` its falloff and spot factor, so that a Lambertian surface reflects
+  ``kd C I S cos``: the course's diffuse term, and the convention of the area lights' point
+  stand-ins);
 * the next direction: a lobe chosen with probability proportional to its weight, then for the
   non-delta pair the one-sample mixture of the cosine and Phong densities;
 * Russian roulette from the ``rr_start``-th bounce on: survive with

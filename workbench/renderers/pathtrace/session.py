@@ -62,8 +62,9 @@ class PathTraceSession:
     seed : int, >= 0.  fresnel : ``none`` | ``schlick`` | ``exact`` (split of kr, kt as the ray
     tracer's option).  rr_start : bounce from which Russian roulette plays (>= 1).
     max_bounces : hard stop of a path (>= 1).  mis : ``power`` (exponent 2) or ``balance``.
-    triangulate : trace plain opaque polygons and rectangles as triangles through the BVH
-    (:mod:`.geometry`; the same surfaces, faster), else as the ray tracer's polygons.
+    triangulate : trace plain opaque polygons and rectangles, and convex area lights, as
+    triangles through the BVH (:mod:`.geometry`; the same surfaces, faster: a scene of triangles
+    only casts every ray straight into the BVH, ``opts[20]``), else as the ray tracer's polygons.
     transport : ``full`` | ``diffuse`` | ``eye_specular`` (:data:`TRANSPORT`; the latter two
     ignore point and directional lights, textures and vertex emission).
     pixel_filter : ``box`` | ``center`` (:data:`PIXEL_FILTER`).
