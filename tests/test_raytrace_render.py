@@ -14,7 +14,7 @@ from workbench.scene import library
 from workbench.scene.io import scene_from_dict
 
 SMALL = {"whitted": (32, 24), "cornell": (10, 10), "csg": (32, 24), "quadrics": (32, 24),
-         "globe": (24, 18), "bricks": (24, 18), "envmap": (24, 18), "mesh": (8, 6)}
+         "globe": (24, 18), "bricks": (24, 18), "envmap": (24, 18), "mesh": (8, 6), "kinds": (24, 18)}
 
 
 @pytest.mark.parametrize("name", sorted(SMALL))

@@ -77,7 +77,7 @@ DEPTH_CHOICES = (16, 24, 32)
 #: Varying interpolation: GL's perspective-correct one, or the course's screen-space scanline.
 INTERPOLATIONS = ("perspective", "screen")
 #: Object kinds tessellated as closed, outward-wound surfaces.
-CLOSED_KINDS = ("sphere", "box", "csg")
+CLOSED_KINDS = ("sphere", "box", "csg", "blob", "isosurface", "prism")
 #: Texture units of the image samplers.
 UNITS = {"u_tex_image": 0, "u_bump_image": 1, "u_op_image": 2, "u_env_image": 3, "u_env_cube": 4,
          "u_shadow_atlas": 5, "u_env_depth": 6}

@@ -310,7 +310,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
             bg_ *= math.exp(-mat_tab[ma, 11] * t)
             bb *= math.exp(-mat_tab[ma, 12] * t)
         px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
-        surface(geo, k, f, tri, b1, b2, px, py, pz, ncancel, h_ng, h_ns, h_uv, h_po, h_ev, 0)
+        surface(geo, k, f, tri, b1, b2, px, py, pz, ncancel, h_ng, h_ns, h_uv, h_po, h_ev, 0, scr[0])
         mi = mat_of[k]
         gx, gy, gz = h_ng[0, 0], h_ng[0, 1], h_ng[0, 2]
         cos_g = -(gx * dx + gy * dy + gz * dz)

@@ -21,7 +21,7 @@ from .patches import PatchSet, patches_from_scene, scene_extent
 
 #: features radiosity builds, and why it leaves out each of the others
 HANDLED = {ft.EMITTERS, ft.AREA_LIGHTS, ft.POLYGONS, ft.PLANES, ft.BOXES, ft.MESHES, ft.SPHERES,
-           ft.QUADRICS, ft.CSG, ft.TRANSFORMS, ft.SHADOWS}
+           ft.QUADRICS, ft.CSG, ft.TRANSFORMS, ft.SHADOWS, ft.BLOBS, ft.ISOSURFACES, ft.LATHES, ft.PRISMS}
 REASONS = {
     ft.POINT_LIGHTS: "radiosity only knows emitting surfaces (area lights, emissive materials)",
     ft.DIRECTIONAL_LIGHTS: "radiosity only knows emitting surfaces (area lights, emissive materials)",

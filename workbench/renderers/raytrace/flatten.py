@@ -23,7 +23,7 @@ sheet (transmission goes straight through).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -76,12 +76,15 @@ class SceneData:
     extent: float               # diagonal of the scene's bounds
     n_objects: int
     bvh_build_time: float = 0.0
+    aux: np.ndarray = field(default_factory=lambda: np.zeros(1))
+    """Variable-length data of the kinds that have it (blob components, an isosurface's
+    program, lathe profiles, prism polygons), flat float64; each row holds its offset."""
 
     def kernel_args(self) -> tuple:
         """The geometry tuple passed to every numba kernel."""
         return (self.ptype, self.top, self.xf, self.nm, self.par, self.solid, self.shadow,
                 self.poly_v, self.csg_prog, self.tri_v, self.tri_n, self.tri_uv, self.tri_e,
-                self.tri_prim, *self.bvh, self.ident)
+                self.tri_prim, *self.bvh, self.ident, self.aux)
 
 
 def _material_row(mat: m.Material, front_only: bool = False) -> np.ndarray:
@@ -123,6 +126,15 @@ class _Builder:
         self.mat_index = {mt.name: i for i, mt in enumerate(self.materials)}
         self.front_only: set[int] = set()
         self.bounds: list[np.ndarray] = []
+        self.aux: list[np.ndarray] = []
+        self.n_aux = 0
+
+    def add_aux(self, data) -> int:
+        """Append a kind's variable-length data (flat floats) to the aux array; its offset."""
+        data = np.asarray(data, dtype=np.float64).reshape(-1)
+        self.aux.append(data)
+        self.n_aux += len(data)
+        return self.n_aux - len(data)
 
     def add(self, ptype: int, obj_index: int, obj: m.SceneObject, world_from_object, par, *,
             top=True, solid=True, shadow=True) -> int:
@@ -224,4 +236,5 @@ def flatten(scene: m.Scene, accel: str = "bvh") -> SceneData:
         bvh=bvh,
         materials=b.materials, mat_tab=np.ascontiguousarray(mat_tab),
         lights=np.ascontiguousarray(light_rows(scene.point_lights()).reshape(-1, 14)),
-        extent=max(extent, tol.zero), n_objects=len(scene.objects), bvh_build_time=bvh_time)
+        extent=max(extent, tol.zero), n_objects=len(scene.objects), bvh_build_time=bvh_time,
+        aux=np.ascontiguousarray(np.concatenate(b.aux) if b.aux else np.zeros(1)))

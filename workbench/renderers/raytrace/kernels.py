@@ -28,7 +28,9 @@ from numba import prange
 
 from ...core.tol import tol
 from ...scene.kinds import BOX, CSGNODE, POLYGON, QUADRIC, RECT, SPHERE
+from ...scene.kinds import blob as kb, isosurface as ki, lathe as kl, prism as kp
 from ...scene.kinds.csg import CSG_DEPTH, CSG_DIFFERENCE, CSG_INTERSECTION, CSG_UNION
+from ...scene.kinds.expression import MAX_STACK
 from .bvh import MAX_DEPTH
 from .flatten import SHADOW_CROSSINGS
 
@@ -233,9 +235,12 @@ def _quadric_hit(k, par, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
 
 
 @nb.njit(error_model="numpy", inline="always")
-def prim_hit(k, ptype, par, poly_v, ox, oy, oz, dx, dy, dz, ux, uy, uz, inv_s, tmin, tmax, zero):
+def prim_hit(k, ptype, par, poly_v, aux, ox, oy, oz, dx, dy, dz, ux, uy, uz, inv_s, tmin, tmax, zero,
+             out_t, out_f, stack):
     """Closest hit ``tmin < t < tmax`` of analytic primitive ``k`` (object-space ray with
-    direction ``d``; spheres use its unit direction ``u`` and ``inv_s = 1 / |d|``).
+    direction ``d``; spheres use its unit direction ``u`` and ``inv_s = 1 / |d|``).  The
+    kinds with variable-length data (blob, isosurface, lathe, prism: :mod:`workbench.scene.kinds`)
+    read it from ``aux`` and use the scratch ``out_t``, ``out_f``, ``stack``.
     Returns ``(t, face)``, ``t = inf`` on a miss."""
     kind = ptype[k]
     if kind == SPHERE:
@@ -270,11 +275,19 @@ def prim_hit(k, ptype, par, poly_v, ox, oy, oz, dx, dy, dz, ux, uy, uz, inv_s, t
         return _polygon_hit(k, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax)
     if kind == QUADRIC:
         return _quadric_hit(k, par, ox, oy, oz, dx, dy, dz, tmin, tmax, zero)
+    if kind == kb.PTYPE:
+        return kb.blob_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack)
+    if kind == ki.PTYPE:
+        return ki.iso_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack)
+    if kind == kl.PTYPE:
+        return kl.lathe_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack)
+    if kind == kp.PTYPE:
+        return kp.prism_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack)
     return np.inf, 0
 
 
 @nb.njit(**NO_REFCOUNT)
-def leaf_events(k, ptype, par, ox, oy, oz, dx, dy, dz, zero, et, ep, ef):
+def leaf_events(k, ptype, par, aux, ox, oy, oz, dx, dy, dz, zero, et, ep, ef, stack):
     """Interval list (entering / leaving events along the whole line) of solid leaf ``k``:
     sphere, box, or quadric inside ``P^T Q P < 0`` intersected with its bounds box.
     Writes ``et`` (t), ``ep`` (signed primitive code ``k + 1``), ``ef`` (face); returns the count."""
@@ -335,7 +348,20 @@ def leaf_events(k, ptype, par, ox, oy, oz, dx, dy, dz, zero, et, ep, ef):
                 ef[m], ef[m + 1] = fa, fb
                 m += 2
         return m
-    return 0
+    m = 0
+    cap = et.shape[0]
+    if kind == kb.PTYPE:
+        m = kb.blob_events(par, k, aux, ox, oy, oz, dx, dy, dz, et, ef, cap, stack)
+    elif kind == ki.PTYPE:
+        m = ki.iso_events(par, k, aux, ox, oy, oz, dx, dy, dz, et, ef, cap, stack)
+    elif kind == kl.PTYPE:
+        m = kl.lathe_events(par, k, aux, ox, oy, oz, dx, dy, dz, et, ef, cap, stack)
+    elif kind == kp.PTYPE:
+        m = kp.prism_events(par, k, aux, ox, oy, oz, dx, dy, dz, et, ef, cap, stack)
+    m -= m % 2            # a list cut at the capacity ends inside: close the last interval
+    for i in range(m):
+        ep[i] = k + 1
+    return m
 
 
 @nb.njit(error_model="numpy", inline="always")
@@ -390,8 +416,8 @@ def combine(op, ta, pa, fa, na, tb, pb, fb, nb_, to, po, fo, eps):
 
 
 @nb.njit(**NO_REFCOUNT)
-def csg_hit(start, length, prog, ptype, xf, par, ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps,
-            st, sp_, sf, sn):
+def csg_hit(start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps,
+            st, sp_, sf, sn, stack):
     """Evaluate a CSG postfix program along a ray (the course's recursive ``intersect``, made
     iterative).  Returns ``(t, code, face)`` of the first boundary in ``(tmin, tmax)``."""
     top = 0
@@ -399,8 +425,8 @@ def csg_hit(start, length, prog, ptype, xf, par, ox, oy, oz, dx, dy, dz, tmin, t
         c = prog[q]
         if c >= 0:
             lo = _to_object(xf, c, ox, oy, oz, dx, dy, dz)
-            sn[top] = leaf_events(c, ptype, par, lo[0], lo[1], lo[2], lo[3], lo[4], lo[5], zero,
-                                  st[top], sp_[top], sf[top])
+            sn[top] = leaf_events(c, ptype, par, aux, lo[0], lo[1], lo[2], lo[3], lo[4], lo[5], zero,
+                                  st[top], sp_[top], sf[top], stack)
             top += 1
         else:
             a, b = top - 2, top - 1
@@ -630,7 +656,7 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
     BVH over triangles).  Returns ``(t, prim, face, tri, b1, b2)``; ``prim = -1`` on a miss,
     negative ``face`` is never returned (a flipped CSG normal is ``face + 16``)."""
     (ptype, top, xf, nm, par, solid, shadow, poly_v, prog, tri_v, tri_n, tri_uv, tri_e,
-     tri_prim, bvh_node, bvh_child, bvh_leaf, bvh_first, bvh_tv4, bvh_bounds, ident) = geo
+     tri_prim, bvh_node, bvh_child, bvh_leaf, bvh_first, bvh_tv4, bvh_bounds, ident, aux) = geo
     best, bp, bf, btri, bb1, bb2 = tmax, -1, 0, -1, 0.0, 0.0
     inv_w = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
     for k in range(ptype.shape[0]):
@@ -643,14 +669,15 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
             lo = _to_object(xf, k, ox, oy, oz, dx, dy, dz)
             inv_s = 1.0 / math.sqrt(lo[3] * lo[3] + lo[4] * lo[4] + lo[5] * lo[5])
         if ptype[k] == CSGNODE:
-            t, code, f = csg_hit(int(par[k, 0]), int(par[k, 1]), prog, ptype, xf, par, ox, oy, oz,
-                                 dx, dy, dz, tmin, best, zero, eps, st, sp_, sf, sn)
+            t, code, f = csg_hit(int(par[k, 0]), int(par[k, 1]), prog, ptype, xf, par, aux, ox, oy, oz,
+                                 dx, dy, dz, tmin, best, zero, eps, st, sp_, sf, sn, stack)
             if t < best:
                 best, bp, bf = t, abs(code) - 1, f + (16 if code < 0 else 0)
                 btri = -1
         else:
-            t, f = prim_hit(k, ptype, par, poly_v, lo[0], lo[1], lo[2], lo[3], lo[4], lo[5],
-                            lo[3] * inv_s, lo[4] * inv_s, lo[5] * inv_s, inv_s, tmin, best, zero)
+            t, f = prim_hit(k, ptype, par, poly_v, aux, lo[0], lo[1], lo[2], lo[3], lo[4], lo[5],
+                            lo[3] * inv_s, lo[4] * inv_s, lo[5] * inv_s, inv_s, tmin, best, zero,
+                            st[0], sf[0], stack)
             if t < best:
                 best, bp, bf, btri = t, k, f, -1
         if any_hit and bp >= 0:
@@ -668,9 +695,17 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
 
 
 @nb.njit(error_model="numpy", inline="always")
-def object_normal(k, face, ptype, par, x, y, z):
+def object_normal(k, face, ptype, par, aux, x, y, z, stack):
     """Outward normal (unnormalised) of primitive ``k`` at object-space point, by face."""
     kind = ptype[k]
+    if kind == kb.PTYPE:
+        return kb.blob_normal(par, k, aux, face, x, y, z, stack)
+    if kind == ki.PTYPE:
+        return ki.iso_normal(par, k, aux, face, x, y, z, stack)
+    if kind == kl.PTYPE:
+        return kl.lathe_normal(par, k, aux, face, x, y, z, stack)
+    if kind == kp.PTYPE:
+        return kp.prism_normal(par, k, aux, face, x, y, z, stack)
     if face >= 1 and (kind == BOX or kind == QUADRIC):
         a = (face - 1) // 2
         s = 1.0 if (face - 1) % 2 == 1 else -1.0
@@ -696,12 +731,13 @@ def _normalize(x, y, z):
 
 
 @nb.njit(error_model="numpy", inline="always")
-def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_uv, out_po, out_e, i):
+def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_uv, out_po, out_e, i,
+            stack):
     """Geometric (outward) normal, shading normal, uv (meshes; analytic primitives leave the
     mapping to the texturing module), object-space point and vertex emission at a hit, written
-    to row ``i`` of the output arrays."""
+    to row ``i`` of the output arrays (``stack``: scratch of an isosurface's gradient)."""
     (ptype, top, xf, nm, par, solid, shadow, poly_v, prog, tri_v, tri_n, tri_uv, tri_e,
-     tri_prim, bvh_node, bvh_child, bvh_leaf, bvh_first, bvh_tv4, bvh_bounds, ident) = geo
+     tri_prim, bvh_node, bvh_child, bvh_leaf, bvh_first, bvh_tv4, bvh_bounds, ident, aux) = geo
     x = xf[k, 0] * px + xf[k, 1] * py + xf[k, 2] * pz + xf[k, 3]
     y = xf[k, 4] * px + xf[k, 5] * py + xf[k, 6] * pz + xf[k, 7]
     z = xf[k, 8] * px + xf[k, 9] * py + xf[k, 10] * pz + xf[k, 11]
@@ -730,7 +766,7 @@ def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_
         return
     f = face - 16 if face >= 16 else face
     sgn = -1.0 if face >= 16 else 1.0
-    ux, uy, uz = object_normal(k, f, ptype, par, x, y, z)
+    ux, uy, uz = object_normal(k, f, ptype, par, aux, x, y, z, stack)
     wx = sgn * (nm[k, 0] * ux + nm[k, 1] * uy + nm[k, 2] * uz)
     wy = sgn * (nm[k, 3] * ux + nm[k, 4] * uy + nm[k, 5] * uz)
     wz = sgn * (nm[k, 6] * ux + nm[k, 7] * uy + nm[k, 8] * uz)
@@ -743,8 +779,10 @@ def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_
 @nb.njit(error_model="numpy", inline="always")
 def scratch():
     """Per-thread work arrays of :func:`closest`: the BVH traversal stack (rows: entry distance,
-    child code: a 4-wide node or a leaf) and the CSG stack of interval lists (times, signed primitive codes, faces, counts)."""
-    return (np.empty((BVH_STACK, 2)), np.empty((CSG_DEPTH, CSG_EVENTS)),
+    child code: a 4-wide node or a leaf; also the operand stack (rows: value, gradient) of an
+    isosurface's expression, which is never evaluated during a traversal) and the CSG stack of
+    interval lists (times, signed primitive codes, faces, counts)."""
+    return (np.empty((max(BVH_STACK, MAX_STACK), 4)), np.empty((CSG_DEPTH, CSG_EVENTS)),
             np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64),
             np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64), np.empty(CSG_DEPTH, dtype=np.int64))
 
@@ -789,7 +827,7 @@ def trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_on
         t_out[i], prim_out[i] = t, k
         if k >= 0:
             surface(geo, k, f, tri, b1, b2, ox + t * D[i, 0], oy + t * D[i, 1],
-                    oz + t * D[i, 2], ncancel, ng, ns, uv, po, ev, i)
+                    oz + t * D[i, 2], ncancel, ng, ns, uv, po, ev, i, stack)
 
 
 @nb.njit(error_model="numpy", inline="always")
@@ -1308,7 +1346,7 @@ def pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts
                     depth_map[p] = t * (dx * fwd[0] + dy * fwd[1] + dz * fwd[2]) if k >= 0 else np.inf
                 if k >= 0:
                     surface(geo, k, f, tri, b1, b2, ox + t * dx, oy + t * dy, oz + t * dz, ncancel,
-                            h_ng, h_ns, h_uv, h_po, h_ev, 0)
+                            h_ng, h_ns, h_uv, h_po, h_ev, 0, stack)
                     mi = mat_of[k]
                     if mat_tab[mi, 17] > 0.5:
                         tr_, tg_, tb_ = checker_color(tex_tab, mi, h_po[0, 0], h_po[0, 1], h_po[0, 2])

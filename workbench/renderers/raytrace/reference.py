@@ -23,6 +23,7 @@ from ...core.tol import offset_scale, tol
 from ...scene import model as m
 from ...scene.features import scene_needs
 from ...scene.kinds import MESH, crossings, kind_of
+from ...scene.kinds.csg import is_solid
 from ...scene.media import enclosing_media
 from .. import local_model
 from . import shapes
@@ -128,7 +129,7 @@ def closest(ctx: Context, O, D, tmin, tmax=np.inf, shadow=False) -> Hit | None:
                 kind = kind_of(leaf)
                 n = inv[:3, :3].T @ kind.normal(leaf, c.face, p_obj)
                 n = (-n if c.flip else n) / np.linalg.norm(n)
-                solid = kind.SOLID
+                solid = is_solid(leaf, kind_of)
                 best = Hit(c.t, P, n, n, item, ctx.materials[leaf.material], p_obj, Wl, solid=solid)
                 break
             if c.t >= tmin:

@@ -18,7 +18,9 @@ Constants
 ``PTYPE``       its ``ptype`` in the ray tracer's primitive table (a unique int; the kernels
                 dispatch on it).
 ``SOLID``       True when it has an inside: a CSG leaf, a medium for refraction; False for a
-                thin sheet (transmission goes straight through).
+                thin sheet (transmission goes straight through).  A kind whose objects differ (a
+                lathe: solid when its profile is closed) also has ``solid(obj) -> bool``
+                (:func:`.csg.is_solid` asks it).
 ``CONVEX``      True when it cannot shadow itself (one such object alone needs no shadow rays).
 ``COMPOSITE``   True only for kinds made of other objects (CSG), see below.
 ``KEYS``, ``REQUIRED``  the keys of its table beside the common ones (``type``, ``material``,
@@ -67,9 +69,10 @@ import numpy as np
 
 from ...core.errors import WorkbenchError
 from .. import model as m
-from . import box, csg, mesh, plane, polygon, quadric, sphere
+from . import blob, box, csg, isosurface, lathe, mesh, plane, polygon, prism, quadric, sphere
 
-KINDS = MappingProxyType({k.TYPE: k for k in (sphere, plane, box, quadric, polygon, mesh, csg)})
+KINDS = MappingProxyType({k.TYPE: k for k in (sphere, plane, box, quadric, polygon, mesh, csg,
+                                              blob, isosurface, lathe, prism)})
 """The registry: scene-file ``type`` name -> kind module."""
 
 SPHERE, RECT, BOX, POLYGON = sphere.PTYPE, plane.PTYPE, box.PTYPE, polygon.PTYPE

@@ -54,9 +54,17 @@ def parse(ctx: rd.Ctx, t: dict, w: str, common: dict, child, kind_of) -> m.CSG:
     left = child(t["left"], f"{w}.left", common["material"])
     right = child(t["right"], f"{w}.right", common["material"])
     for side, c in (("left", left), ("right", right)):
-        if not kind_of(c).SOLID:
-            ctx.fail(f"{w}.{side}.type", f"CSG needs solids; a {c.kind} has no inside")
+        if not is_solid(c, kind_of):
+            ctx.fail(f"{w}.{side}.type", f"CSG needs solids; a {c.kind} has no inside"
+                     + (" (an open lathe profile: end it where it starts, or on the axis)" if c.kind == "lathe" else ""))
     return m.CSG(**common, op=op, left=left, right=right)
+
+
+def is_solid(obj: m.SceneObject, kind_of) -> bool:
+    """Has an inside: its kind's ``SOLID``, or, for a kind whose objects differ (a lathe is a
+    solid when its profile is closed), its ``solid(obj)``."""
+    kind = kind_of(obj)
+    return kind.solid(obj) if hasattr(kind, "solid") else kind.SOLID
 
 
 def children(node: m.CSG) -> tuple:
@@ -67,7 +75,7 @@ def children(node: m.CSG) -> tuple:
 def _leaf_manifold(leaf: m.SceneObject, M: np.ndarray, level: int, leaf_id: int, kind_of):
     """Closed manifold of one leaf in world space, vertex properties (x, y, z, leaf_id)."""
     import manifold3d
-    if not kind_of(leaf).SOLID:
+    if not is_solid(leaf, kind_of):
         raise WorkbenchError(f"CSG needs solids; a {leaf.kind} has no inside")
     P, F = kind_of(leaf).solid_mesh(leaf, level)
     Pw = tf.transform_points(M, P)

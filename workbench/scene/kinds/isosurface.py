@@ -1,0 +1,408 @@
+"""``isosurface``: the solid ``f(x, y, z) < threshold`` inside a box (POV-Ray's ``isosurface``
+with ``contained_by { box }``, closed where the solid meets the box), ``f`` a user expression
+(:mod:`.expression`, compiled once) with a declared Lipschitz bound ``max_gradient`` >= |grad f|.
+
+Ray intersection (both twins, the same steps): clip the ray to the box (slabs); the solid's
+status along the chord is ``g(t) = f(O + t D) - threshold < 0`` (NaN counts as outside).
+March by sphere tracing (Hart, "Sphere tracing", The Visual Computer 12, 1996): with
+``L = max_gradient |D|`` a Lipschitz bound of g in t, g keeps its sign over ``|g(t)| / L``, so
+the step ``h = max(|g(t)| / L, h_min)`` cannot jump a crossing unless it is the floor
+``h_min = MIN_STEP (t1 - t0)``, a fixed fraction of the chord (only features thinner than
+that along the ray, where the surface also comes within ``h_min L`` of the ray in value, may
+be missed).  A change of status between two steps is narrowed to adjacent floating-point
+numbers (bisection in the readable twin, the Illinois method in the numba one): the accuracy
+of the hit is that of evaluating f.  Normals: the exact
+gradient of f by forward-mode automatic differentiation of the program; on the box's faces,
+the face's normal.
+
+Aux layout: the program's ``(opcode, argument)`` pairs; parameter row ``[aux offset, program
+length, threshold, max_gradient, lo (3), hi (3), stack depth]``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numba as nb
+import numpy as np
+
+from .. import model as m
+from ..parts import make_part
+from . import values as val
+from .expression import Program, compile_expression, evaluate, evaluate_gradient, evaluate_numpy, gradient_numpy
+from .marching_cubes import closed_grid, grid_cells, marching_cubes, pad_outside, shade_normals
+
+TYPE = "isosurface"
+FEATURE = "isosurfaces"
+PTYPE = 8
+"""Its ``ptype`` in the ray tracer's primitive table."""
+SOLID = True
+CONVEX = False
+COMPOSITE = False
+KEYS = frozenset({"function", "threshold", "max_gradient", "bounds"})
+REQUIRED = frozenset({"function", "max_gradient", "bounds"})
+LEVEL_CELLS = 8
+"""Marching-cubes cells along the longest side of the bounds per tessellation level."""
+MIN_STEP = 2.0 ** -16
+"""Smallest marching step, as a fraction of the ray's chord through the bounds (bounds the
+work per ray by 2^16 steps)."""
+BISECTIONS = 200
+"""Bisection steps cap: enough to reach adjacent floats from any bracket of finite width."""
+GRADIENT_CHECK = 17
+"""Samples per axis of the grid on which the declared ``max_gradient`` is checked at load."""
+
+
+@dataclass(frozen=True, eq=False)
+class Isosurface(m.SceneObject):
+    """``function`` < ``threshold`` inside ``[bounds_min, bounds_max]``; ``program`` is the
+    compiled function (made from ``function`` when not given)."""
+
+    function: str = "x^2 + y^2 + z^2"
+    threshold: float = 1.0
+    max_gradient: float = 4.0
+    bounds_min: tuple = (-1.5, -1.5, -1.5)
+    bounds_max: tuple = (1.5, 1.5, 1.5)
+    program: Program | None = None
+    kind = "isosurface"
+
+    def __post_init__(self):
+        if self.program is None:
+            object.__setattr__(self, "program", compile_expression(self.function))
+
+
+MODEL = Isosurface
+
+
+# --------------------------------------------------------------------------- parse
+def read(t: dict, where: str, common: dict) -> Isosurface:
+    """Read ``{function = "...", threshold = T, max_gradient = L, bounds = {min, max}}``.
+
+    The declared ``max_gradient`` is checked against |grad f| on a ``GRADIENT_CHECK^3`` grid
+    over the bounds: a bound below a sampled gradient is refused (the root search would step
+    over surfaces), naming the point."""
+    val.check_keys(t, where, val.COMMON | KEYS, REQUIRED)
+    if not isinstance(t.get("function"), str):
+        val.fail(f"{where}.function", f"expected an expression of x, y, z as a string, got {t.get('function')!r}")
+    try:
+        prog = compile_expression(t["function"])
+    except Exception as e:  # noqa: BLE001 -- WorkbenchError, re-raised with the key in front
+        val.fail(f"{where}.function", str(e))
+    threshold = val.number(t, where, "threshold", 0.0)
+    L = val.number(t, where, "max_gradient", lo=0.0, lo_open=True)
+    lo, hi = val.box(t, where, "bounds")
+    axes = [np.linspace(a, b, GRADIENT_CHECK) for a, b in zip(lo, hi)]
+    X, Y, Z = np.meshgrid(*axes, indexing="ij")
+    _, g = gradient_numpy(prog, X, Y, Z)
+    norm = np.linalg.norm(g, axis=-1)
+    norm = np.where(np.isfinite(norm), norm, 0.0)
+    worst = np.unravel_index(np.argmax(norm), norm.shape)
+    if norm[worst] > L:
+        p = [float(a[i]) for a, i in zip(axes, worst)]
+        val.fail(f"{where}.max_gradient", f"{L:g} is below |grad f| = {norm[worst]:.6g} found at "
+                 f"{[round(c, 6) for c in p]}: the root search could step over the surface")
+    return Isosurface(function=t["function"], threshold=threshold, max_gradient=L,
+                      bounds_min=lo, bounds_max=hi, program=prog, **common)
+
+
+def parse(ctx, t: dict, where: str, common: dict) -> Isosurface:
+    """:func:`read` with its error handed to the scene reader's ``ctx.fail``."""
+    return val.parse_with(ctx, read, t, where, common)
+
+
+def bound_points(s: Isosurface) -> np.ndarray:
+    """(8, 3) corners of the bounds."""
+    lo, hi = bounds(s)
+    return np.array([np.where(np.array(q, bool), hi, lo) for q in np.ndindex(2, 2, 2)])
+
+
+def bounds(s: Isosurface) -> tuple[np.ndarray, np.ndarray]:
+    return np.asarray(s.bounds_min, dtype=np.float64), np.asarray(s.bounds_max, dtype=np.float64)
+
+
+# --------------------------------------------------------------------------- readable twin
+def inside(s: Isosurface, P) -> np.ndarray:
+    """f(P) < threshold and P in the bounds (bool, shape of P without its last axis)."""
+    P = np.asarray(P, dtype=np.float64)
+    lo, hi = bounds(s)
+    f = evaluate_numpy(s.program, P[..., 0], P[..., 1], P[..., 2])
+    return (f < s.threshold) & (P >= lo).all(-1) & (P <= hi).all(-1)
+
+
+def _slab(lo, hi, O, D):
+    """Kay & Kajiya slabs: ``(t0, face0, t1, face1)`` of the line in the box, or None; face =
+    1 + 2 axis + (1 on the max side)."""
+    t0, t1, f0, f1 = -np.inf, np.inf, 0, 0
+    for a in range(3):
+        if D[a] == 0.0:
+            if not lo[a] <= O[a] <= hi[a]:
+                return None
+            continue
+        ta, tb = (lo[a] - O[a]) / D[a], (hi[a] - O[a]) / D[a]
+        fa, fb = 1 + 2 * a, 2 + 2 * a
+        if ta > tb:
+            ta, tb, fa, fb = tb, ta, fb, fa
+        if ta > t0:
+            t0, f0 = ta, fa
+        if tb < t1:
+            t1, f1 = tb, fb
+    return (t0, f0, t1, f1) if t0 < t1 else None
+
+
+def crossings(s: Isosurface, O, D) -> list[tuple[float, int]]:
+    """Every crossing of the solid's boundary by the line ``O + t D`` (object space), sorted,
+    as ``(t, face)`` (face 0: the function's surface; 1..6: a face of the bounds); they
+    alternate entering / leaving."""
+    O, D = np.asarray(O, dtype=np.float64), np.asarray(D, dtype=np.float64)
+    lo, hi = bounds(s)
+    chord = _slab(lo, hi, O, D)
+    if chord is None:
+        return []
+    t0, f0, t1, f1 = chord
+
+    def g(t):
+        return float(evaluate_numpy(s.program, *(O + t * D))) - s.threshold
+
+    L = s.max_gradient * float(np.linalg.norm(D))
+    h_min = MIN_STEP * (t1 - t0)
+    out = []
+    t, gt = t0, g(t0)
+    status = gt < 0.0
+    if status:
+        out.append((t0, f0))
+    while t < t1:
+        h = abs(gt) / L if math.isfinite(gt) else h_min
+        tn = min(t + max(h, h_min), t1)
+        gn = g(tn)
+        if (gn < 0.0) != status:
+            a, b = t, tn
+            for _ in range(BISECTIONS):
+                mid = 0.5 * (a + b)
+                if mid <= a or mid >= b:
+                    break
+                if (g(mid) < 0.0) == status:
+                    a = mid
+                else:
+                    b = mid
+            out.append((b, 0))
+            status = not status
+            tn, gn = b, g(b)
+        t, gt = tn, gn
+    if status:
+        out.append((t1, f1))
+    return out
+
+
+def hits(s: Isosurface, O, D, solid: bool = True) -> list[tuple[float, int]]:
+    """The registry's name for :func:`crossings` (an isosurface is always a solid)."""
+    return crossings(s, O, D)
+
+
+def normal(s: Isosurface, face: int, P) -> np.ndarray:
+    """Unit outward normal at P (3,): grad f on the function's surface, the box face's normal
+    on a face of the bounds; zero where f has no finite, non-zero gradient."""
+    if face >= 1:
+        n = np.zeros(3)
+        n[(face - 1) // 2] = 1.0 if (face - 1) % 2 else -1.0
+        return n
+    _, g = gradient_numpy(s.program, *np.asarray(P, dtype=np.float64))
+    ln = np.linalg.norm(g)
+    return g / ln if np.isfinite(ln) and ln > 0.0 else np.zeros(3)
+
+
+def intersect(s: Isosurface, O, D, tmin: float = 0.0, tmax: float = np.inf):
+    """First crossing ``tmin < t < tmax``: ``(t, unit normal)``, or ``(inf, None)``."""
+    for t, f in crossings(s, O, D):
+        if tmin < t < tmax:
+            return t, normal(s, f, np.asarray(O) + t * np.asarray(D))
+    return np.inf, None
+
+
+# --------------------------------------------------------------------------- tessellation
+def mesh(s: Isosurface, resolution: int):
+    """Marching cubes over the bounds (``resolution`` cells along their longest side), closed
+    on the bounds' faces: ``(P (V, 3), N (V, 3) unit outward normals, F (T, 3) int64)``."""
+    P, F = _closed_mesh(s, resolution)
+    return shade_normals(P, F, lambda Q: gradient_numpy(s.program, Q[:, 0], Q[:, 1], Q[:, 2])[1], *bounds(s))
+
+
+def _closed_mesh(s: Isosurface, resolution: int) -> tuple[np.ndarray, np.ndarray]:
+    """Marching cubes of ``f - threshold`` over the bounds, padded outside (closed on them)."""
+    lo, hi = bounds(s)
+    xs, ys, zs = closed_grid(lo, hi, grid_cells(lo, hi, resolution, f"isosurface {s.name!r}"))
+    X, Y, Z = np.meshgrid(xs[1:-1], ys[1:-1], zs[1:-1], indexing="ij")
+    return marching_cubes(pad_outside(evaluate_numpy(s.program, X, Y, Z) - s.threshold), xs, ys, zs)
+
+
+def solid_mesh(s: Isosurface, level: int) -> tuple[np.ndarray, np.ndarray]:
+    """Closed object-space mesh ``(P (V, 3), F (T, 3))`` at ``LEVEL_CELLS * level`` cells (for
+    the raster's CSG booleans; caps included, vertices shared)."""
+    return _closed_mesh(s, LEVEL_CELLS * level)
+
+
+def analytic_normals(s: Isosurface, P: np.ndarray):
+    """Object-space normals at points P (n, 3): grad f, or the face's normal on the bounds
+    (``cap`` True there)."""
+    P = np.asarray(P, dtype=np.float64)
+    lo, hi = bounds(s)
+    N = gradient_numpy(s.program, P[:, 0], P[:, 1], P[:, 2])[1]
+    cap = np.zeros(len(P), dtype=bool)
+    for axis in range(3):
+        for side, plane in ((-1.0, lo[axis]), (1.0, hi[axis])):
+            on = P[:, axis] == plane
+            N[on] = 0.0
+            N[on, axis] = side
+            cap |= on
+    return N, cap
+
+
+def tessellate(obj: Isosurface, level: int, M: np.ndarray) -> list:
+    """The raster's triangles: one Part of :func:`mesh` at level * LEVEL_CELLS cells."""
+    P, N, F = mesh(obj, LEVEL_CELLS * level)
+    return [make_part(obj, M, P, N, F, None, None)]
+
+
+def patch_surfaces(obj: Isosurface, W: np.ndarray, h: float):
+    """Radiosity: curved, cut from its tessellation (None)."""
+    return None
+
+
+# --------------------------------------------------------------------------- kernel rows
+# (the numba entry points' shared signatures: see .crossing_events)
+
+def flatten(b, obj, index: int, W: np.ndarray, top: bool) -> int:
+    """Its row of the ray tracer's primitive table through the builder ``b`` (the registry's
+    interface): ``b.bound`` its bounds, ``b.add_aux`` its variable-length data (returns the
+    offset), ``b.add`` the row with :func:`params`' head."""
+    b.bound(W, bound_points(obj))
+    head, data = params(obj, 0)
+    head[0] = b.add_aux(data)
+    return b.add(PTYPE, index, obj, W, head, top=top, solid=SOLID)
+
+
+def params(s: Isosurface, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
+    """Parameter row head (11,) and aux (the program's code)."""
+    return (np.array([aux_offset, s.program.length, s.threshold, s.max_gradient, *s.bounds_min,
+                      *s.bounds_max, s.program.depth], dtype=np.float64),
+            np.ascontiguousarray(s.program.code))
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _g(par, k, aux, ox, oy, oz, dx, dy, dz, t, stack):
+    return evaluate(aux, int(par[k, 0]), int(par[k, 1]), ox + t * dx, oy + t * dy, oz + t * dz,
+                    stack) - par[k, 2]
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _narrow(par, k, aux, ox, oy, oz, dx, dy, dz, a, fa, b, fb, stack):
+    """The end past the change of ``g < 0`` in ``[a, b]`` (values ``fa``, ``fb``), narrowed to
+    adjacent floats by the Illinois method (regula falsi halving the value kept at an end that
+    stays twice; Dowell & Jarratt, BIT 11, 1971), bisecting wherever the secant point is not
+    strictly inside the bracket (a NaN value, a flat stretch)."""
+    sa = fa < 0.0
+    side = 0
+    for _ in range(BISECTIONS):
+        m = 0.5 * (a + b)
+        if m <= a or m >= b:
+            break
+        c = (a * fb - b * fa) / (fb - fa)
+        if not (a < c < b):
+            c = m
+        fc = _g(par, k, aux, ox, oy, oz, dx, dy, dz, c, stack)
+        if (fc < 0.0) == sa:
+            a, fa = c, fc
+            if side == -1:
+                fb *= 0.5
+            side = -1
+        else:
+            b, fb = c, fc
+            if side == 1:
+                fa *= 0.5
+            side = 1
+    return b
+
+
+@nb.njit(cache=True, error_model="numpy")
+def iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, cap, stack):
+    """Crossings ``tmin < t < tmax`` of the solid's boundary (see :func:`crossings`), written to
+    ``out_t``, ``out_f`` (face), at most ``cap``; returns their count.  ``stack``: (depth, 4)
+    scratch of the program's evaluators."""
+    t0, t1, f0, f1 = -np.inf, np.inf, 0, 0
+    for a in range(3):
+        o = ox if a == 0 else (oy if a == 1 else oz)
+        d = dx if a == 0 else (dy if a == 1 else dz)
+        lo, hi = par[k, 4 + a], par[k, 7 + a]
+        if d == 0.0:
+            if not lo <= o <= hi:
+                return 0
+            continue
+        ta, tb = (lo - o) / d, (hi - o) / d
+        fa, fb = 1 + 2 * a, 2 + 2 * a
+        if ta > tb:
+            ta, tb, fa, fb = tb, ta, fb, fa
+        if ta > t0:
+            t0, f0 = ta, fa
+        if tb < t1:
+            t1, f1 = tb, fb
+    if not t0 < t1:
+        return 0
+    L = par[k, 3] * math.sqrt(dx * dx + dy * dy + dz * dz)
+    h_min = MIN_STEP * (t1 - t0)
+    m = 0
+    t = t0
+    gt = _g(par, k, aux, ox, oy, oz, dx, dy, dz, t, stack)
+    status = gt < 0.0
+    if status and tmin < t0 < tmax:
+        out_t[m], out_f[m] = t0, f0
+        m += 1
+    while t < t1 and t < tmax and m < cap:
+        h = abs(gt) / L if math.isfinite(gt) else h_min
+        tn = min(t + max(h, h_min), t1)
+        gn = _g(par, k, aux, ox, oy, oz, dx, dy, dz, tn, stack)
+        if (gn < 0.0) != status:
+            b = _narrow(par, k, aux, ox, oy, oz, dx, dy, dz, t, gt, tn, gn, stack)
+            if tmin < b < tmax:
+                out_t[m], out_f[m] = b, 0
+                m += 1
+            status = not status
+            tn, gn = b, _g(par, k, aux, ox, oy, oz, dx, dy, dz, b, stack)
+        t, gt = tn, gn
+    if status and m < cap and tmin < t1 < tmax:
+        out_t[m], out_f[m] = t1, f1
+        m += 1
+    return m
+
+
+@nb.njit(cache=True, error_model="numpy")
+def iso_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
+    """Nearest hit ``tmin < t < tmax``: ``(t, face)``, ``(inf, 0)`` on a miss."""
+    if iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, 1, stack) == 1:
+        return out_t[0], out_f[0]
+    return np.inf, 0
+
+
+@nb.njit(cache=True, error_model="numpy")
+def iso_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
+    """Interval list along the whole line (entering / leaving alternate); returns the count."""
+    return iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, -np.inf, np.inf, out_t, out_f, cap, stack)
+
+
+@nb.njit(cache=True, error_model="numpy")
+def iso_normal(par, k, aux, face, x, y, z, stack):
+    """Outward normal at the object-space point (not normalised); ``stack``: (depth, 4)
+    scratch of the gradient evaluator."""
+    if face >= 1:
+        a = (face - 1) // 2
+        sgn = 1.0 if (face - 1) % 2 == 1 else -1.0
+        return (sgn if a == 0 else 0.0), (sgn if a == 1 else 0.0), (sgn if a == 2 else 0.0)
+    _, gx, gy, gz = evaluate_gradient(aux, int(par[k, 0]), int(par[k, 1]), x, y, z, stack)
+    if not (math.isfinite(gx) and math.isfinite(gy) and math.isfinite(gz)):
+        return 0.0, 0.0, 0.0      # no gradient there (sqrt(0)...): the kernels' zero normal
+    return gx, gy, gz
+
+
+@nb.njit(cache=True, error_model="numpy")
+def iso_inside(par, k, aux, x, y, z, stack):
+    """f(x, y, z) < threshold inside the bounds."""
+    if not (par[k, 4] <= x <= par[k, 7] and par[k, 5] <= y <= par[k, 8] and par[k, 6] <= z <= par[k, 9]):
+        return False
+    return evaluate(aux, int(par[k, 0]), int(par[k, 1]), x, y, z, stack) < par[k, 2]

@@ -1,0 +1,404 @@
+"""``lathe``: surface of revolution about the y axis of a profile polyline of ``(r, y)`` points
+(POV-Ray's ``lathe`` with ``linear_spline``).
+
+Each segment ``(r0, y0) -> (r1, y1)`` sweeps a piece of a cone (a cylinder when ``r0 = r1``;
+an annulus of the plane ``y = y0`` when ``y0 = y1``).  With the segment's radius
+``R(y) = r0 + (y - y0) k``, ``k = (r1 - r0) / (y1 - y0)``, and the ray ``O + t D``:
+``R(t) = A + B t``, ``A = r0 + (O_y - y0) k``, ``B = D_y k``, the points of the cone satisfy
+
+    (D_x^2 + D_z^2 - B^2) t^2 + 2 (O_x D_x + O_z D_z - A B) t + (O_x^2 + O_z^2 - A^2) = 0
+
+(solved in the stable form, DESIGN errata 7); a root counts when its y lies in the segment's
+range (with the rounding slack ``tol.cut (|O| + |t D|)``, as cut quadrics) and on the cone's
+nappe ``R(t) >= 0``.  The normal is the segment's: ``(n_r x / rho, n_y, n_r z / rho)`` with
+``(n_r, n_y)`` perpendicular to the segment in the (r, y) plane, pointing out of the profile
+(its winding decides, by the shoelace area; an open profile's normal points to the right of
+its direction of travel, radially outwards for a profile going up).
+
+The lathe is a solid (an inside for CSG, refraction) when its profile is closed: its first
+and last points coincide, or both lie on the axis (r = 0).  Inside: the point's ``(rho, y)``
+is inside the closed profile (even-odd rule).
+
+Aux layout: ``(r, y)`` per point; parameter row ``[aux offset, points, closed, orientation]``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numba as nb
+import numpy as np
+
+from ...core.tol import tol
+from .. import model as m
+from ..parts import make_part
+from . import values as val
+from .crossing_events import alternate, sort_hits
+
+TYPE = "lathe"
+FEATURE = "lathes"
+PTYPE = 9
+"""Its ``ptype`` in the ray tracer's primitive table."""
+SOLID = True
+"""When its profile is closed (:func:`solid`); an open lathe is a sheet."""
+CONVEX = False
+COMPOSITE = False
+KEYS = frozenset({"points"})
+REQUIRED = KEYS
+LEVEL_STEPS = 8
+"""Angular steps per tessellation level (as a sphere's segments)."""
+MAX_POINTS = 256
+TOL_CUT = tol.cut
+TOL_ZERO = tol.zero
+"""``tol.cut`` and ``tol.zero`` as compile-time constants of the kernels."""
+
+
+@dataclass(frozen=True, eq=False)
+class Lathe(m.SceneObject):
+    """Profile ``points`` (k, 2) of ``(r, y)``, r >= 0."""
+
+    points: np.ndarray = field(default_factory=lambda: np.array([[1.0, -1.0], [1.0, 1.0]]))
+    kind = "lathe"
+
+    @property
+    def closed(self) -> bool:
+        """A solid: first and last points equal, or both on the axis."""
+        p = self.points
+        return bool((p[0] == p[-1]).all() or (p[0, 0] == 0.0 and p[-1, 0] == 0.0))
+
+    @property
+    def orientation(self) -> float:
+        """+1 when the profile, closed by its last-to-first edge, winds counter-clockwise in the
+        (r, y) plane (or is open), -1 when clockwise: the sign that makes normals outward."""
+        if not self.closed:
+            return 1.0
+        r, y = self.points[:, 0], self.points[:, 1]
+        area2 = float(np.sum(r * np.roll(y, -1) - np.roll(r, -1) * y))
+        return 1.0 if area2 >= 0.0 else -1.0
+
+
+MODEL = Lathe
+
+
+# --------------------------------------------------------------------------- parse
+def read(t: dict, where: str, common: dict) -> Lathe:
+    """Read ``{points = [[r, y], ...]}`` (at least 2 points, r >= 0, no zero-length segment)."""
+    val.check_keys(t, where, val.COMMON | KEYS, REQUIRED)
+    P = val.points(t, where, "points", 2, least=2, most=MAX_POINTS)
+    if (P[:, 0] < 0).any():
+        i = int(np.argmax(P[:, 0] < 0))
+        val.fail(f"{where}.points[{i}]", f"radius must be >= 0, got {P[i, 0]!r}")
+    seg = np.diff(P, axis=0)
+    if ((seg == 0).all(1)).any():
+        i = int(np.argmax((seg == 0).all(1)))
+        val.fail(f"{where}.points[{i + 1}]", "repeats the previous point (a zero-length segment)")
+    if (P[:, 0] == 0.0).all():
+        val.fail(f"{where}.points", "every point is on the axis (r = 0): the profile sweeps no surface")
+    return Lathe(points=P, **common)
+
+
+def parse(ctx, t: dict, where: str, common: dict) -> Lathe:
+    """:func:`read` with its error handed to the scene reader's ``ctx.fail``."""
+    return val.parse_with(ctx, read, t, where, common)
+
+
+def solid(la: Lathe) -> bool:
+    """Has an inside (its profile is closed)."""
+    return la.closed
+
+
+def bound_points(la: Lathe) -> np.ndarray:
+    """(8, 3) corners of :func:`bounds`."""
+    lo, hi = bounds(la)
+    return np.array([np.where(np.array(s, bool), hi, lo) for s in np.ndindex(2, 2, 2)])
+
+
+def bounds(la: Lathe) -> tuple[np.ndarray, np.ndarray]:
+    r = la.points[:, 0].max()
+    return (np.array([-r, la.points[:, 1].min(), -r]), np.array([r, la.points[:, 1].max(), r]))
+
+
+# --------------------------------------------------------------------------- readable twin
+def _quadratic(a: float, b: float, c: float) -> list[float]:
+    """Real roots, stable form; linear when ``|a c| <= tol.zero b^2``; a double root is none."""
+    if abs(a * c) <= tol.zero * b * b:
+        return [] if b == 0.0 else [-c / b]
+    disc = b * b - 4.0 * a * c
+    if not disc > 0.0:
+        return []
+    q = -0.5 * (b + math.copysign(math.sqrt(disc), b))
+    return [q / a, c / q if q != 0.0 else -q / a]
+
+
+def segment_hits(la: Lathe, i: int, O, D) -> list[float]:
+    """Parameters t where the line meets the surface swept by segment ``i``."""
+    (r0, y0), (r1, y1) = la.points[i], la.points[i + 1]
+    ox, oy, oz = O
+    dx, dy, dz = D
+    out = []
+    if y0 == y1:                         # annulus of the plane y = y0
+        if dy != 0.0:
+            t = (y0 - oy) / dy
+            rho = math.hypot(ox + t * dx, oz + t * dz)
+            if min(r0, r1) <= rho <= max(r0, r1):
+                out.append(t)
+        return out
+    k = (r1 - r0) / (y1 - y0)
+    A, B = r0 + (oy - y0) * k, dy * k
+    for t in _quadratic(dx * dx + dz * dz - B * B, 2.0 * (ox * dx + oz * dz - A * B), ox * ox + oz * oz - A * A):
+        slack = TOL_CUT * (max(abs(ox), abs(oy), abs(oz)) + abs(t) * max(abs(dx), abs(dy), abs(dz)))
+        y = oy + t * dy
+        if min(y0, y1) - slack <= y <= max(y0, y1) + slack and A + B * t >= -slack * abs(k):
+            out.append(t)
+    return out
+
+
+def inside(la: Lathe, P) -> np.ndarray:
+    """Even-odd test of ``(rho, y)`` against the closed profile (False everywhere when open)."""
+    P = np.asarray(P, dtype=np.float64)
+    rho, y = np.hypot(P[..., 0], P[..., 2]), P[..., 1]
+    res = np.zeros(rho.shape, dtype=bool)
+    if not la.closed:
+        return res
+    p = la.points
+    for (ra, ya), (rb, yb) in zip(p, np.roll(p, -1, axis=0)):
+        if ya == yb:
+            continue
+        cross = (ya > y) != (yb > y)
+        r_at = ra + (y - ya) * (rb - ra) / (yb - ya)
+        res ^= cross & (rho < r_at)
+    return res
+
+
+def crossings(la: Lathe, O, D) -> list[tuple[float, int]]:
+    """Crossings ``(t, segment)`` of the line with the surface, sorted.  A closed lathe's
+    alternate entering / leaving (:func:`.crossing_events.alternate`); an open one's are
+    every hit."""
+    O, D = np.asarray(O, dtype=np.float64), np.asarray(D, dtype=np.float64)
+    hits = [(t, i) for i in range(len(la.points) - 1) for t in segment_hits(la, i, O, D)]
+    if not la.closed:
+        return sorted(hits)
+    return alternate(hits, lambda t: bool(inside(la, O + t * D)))
+
+
+def hits(la: Lathe, O, D, solid: bool = False) -> list[tuple[float, int]]:
+    """The registry's name for :func:`crossings`."""
+    return crossings(la, O, D)
+
+
+def normal(la: Lathe, face: int, P) -> np.ndarray:
+    """Unit normal of segment ``face`` at P (3,) (outward for a closed lathe)."""
+    (r0, y0), (r1, y1) = la.points[face], la.points[face + 1]
+    nr, ny = la.orientation * (y1 - y0), -la.orientation * (r1 - r0)
+    rho = math.hypot(P[0], P[2])
+    if rho == 0.0:
+        return np.array([0.0, math.copysign(1.0, ny), 0.0])
+    n = np.array([nr * P[0] / rho, ny, nr * P[2] / rho])
+    return n / np.linalg.norm(n)
+
+
+def intersect(la: Lathe, O, D, tmin: float = 0.0, tmax: float = np.inf):
+    """First hit ``tmin < t < tmax``: ``(t, unit normal)``, or ``(inf, None)``."""
+    O, D = np.asarray(O, dtype=np.float64), np.asarray(D, dtype=np.float64)
+    hits = [(t, i) for i in range(len(la.points) - 1) for t in segment_hits(la, i, O, D) if tmin < t < tmax]
+    if not hits:
+        return np.inf, None
+    t, i = min(hits)
+    return t, normal(la, i, O + t * D)
+
+
+# --------------------------------------------------------------------------- tessellation
+def mesh(la: Lathe, steps: int):
+    """Each segment swept in ``steps`` angular steps: ``(P, N, F)`` with the segment's normal on
+    its own vertices (smooth around the axis, creased between segments)."""
+    ang = np.linspace(0.0, 2.0 * np.pi, steps + 1)
+    c, s = np.cos(ang), np.sin(ang)
+    c[-1], s[-1] = 1.0, 0.0          # the seam's two copies at exactly the same place
+    Ps, Ns, Fs, base = [], [], [], 0
+    for i in range(len(la.points) - 1):
+        (r0, y0), (r1, y1) = la.points[i], la.points[i + 1]
+        nr, ny = la.orientation * (y1 - y0), -la.orientation * (r1 - r0)
+        ln = math.hypot(nr, ny)
+        nr, ny = nr / ln, ny / ln
+        ring = [np.stack([r * c, np.full_like(c, y), r * s], -1) for r, y in ((r0, y0), (r1, y1))]
+        Ps.append(np.concatenate(ring))
+        Ns.append(np.tile(np.stack([nr * c, np.full_like(c, ny), nr * s], -1), (2, 1)))
+        a = np.arange(steps)
+        q = np.stack([a, a + 1, steps + 2 + a, steps + 1 + a], -1) + base
+        Fs.append(np.concatenate([q[:, [0, 1, 2]], q[:, [0, 2, 3]]]))
+        base += 2 * (steps + 1)
+    P, N, F = np.concatenate(Ps), np.concatenate(Ns), np.concatenate(Fs)
+    fn = np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]])
+    keep = np.linalg.norm(fn, axis=1) > 0.0
+    F, fn = F[keep], fn[keep]
+    back = (fn * N[F].sum(1)).sum(1) < 0.0
+    F[back] = F[back][:, ::-1]
+    return P, N, F.astype(np.int64)
+
+
+def solid_mesh(la: Lathe, level: int) -> tuple[np.ndarray, np.ndarray]:
+    """Closed, welded object-space mesh ``(P, F)`` of a closed lathe at ``LEVEL_STEPS * level``
+    steps (for the raster's CSG booleans)."""
+    P, _, F = mesh(la, LEVEL_STEPS * level)
+    return weld(P, F)
+
+
+def weld(P: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Merge vertices at the same position; drop the triangles that collapse."""
+    P, same = np.unique(P, axis=0, return_inverse=True)
+    F = same.reshape(-1)[F]
+    return P, F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 2] != F[:, 0])]
+
+
+def tessellate(obj: Lathe, level: int, M: np.ndarray) -> list:
+    """The raster's triangles: one Part of :func:`mesh` at level * LEVEL_STEPS steps."""
+    P, N, F = mesh(obj, LEVEL_STEPS * level)
+    return [make_part(obj, M, P, N, F, None, None)]
+
+
+def patch_surfaces(obj: Lathe, W: np.ndarray, h: float):
+    """Radiosity: curved, cut from its tessellation (None)."""
+    return None
+
+
+def analytic_normals(obj: Lathe, P: np.ndarray):
+    """Flat triangles for the raster's CSG booleans (None): its mesh's normals are the
+    segments' own along the profile."""
+    return None
+
+
+# --------------------------------------------------------------------------- kernel rows
+# (the numba entry points' shared signatures: see .crossing_events)
+
+def flatten(b, obj, index: int, W: np.ndarray, top: bool) -> int:
+    """Its row of the ray tracer's primitive table through the builder ``b`` (the registry's
+    interface): ``b.bound`` its bounds, ``b.add_aux`` its variable-length data (returns the
+    offset), ``b.add`` the row with :func:`params`' head."""
+    b.bound(W, bound_points(obj))
+    head, data = params(obj, 0)
+    head[0] = b.add_aux(data)
+    return b.add(PTYPE, index, obj, W, head, top=top, solid=solid(obj))
+
+
+def params(la: Lathe, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
+    """Parameter row head ``[aux offset, points, closed, orientation]`` and aux (2 k,)."""
+    return (np.array([aux_offset, len(la.points), float(la.closed), la.orientation]),
+            np.ascontiguousarray(la.points, dtype=np.float64).reshape(-1))
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _segment_roots(aux, j, ox, oy, oz, dx, dy, dz, zero):
+    """Up to two hits ``(n, t0, t1)`` of the surface of the segment at aux[j:j+4]."""
+    r0, y0, r1, y1 = aux[j], aux[j + 1], aux[j + 2], aux[j + 3]
+    if y0 == y1:
+        if dy == 0.0:
+            return 0, 0.0, 0.0
+        t = (y0 - oy) / dy
+        rho = math.hypot(ox + t * dx, oz + t * dz)
+        if min(r0, r1) <= rho <= max(r0, r1):
+            return 1, t, 0.0
+        return 0, 0.0, 0.0
+    k = (r1 - r0) / (y1 - y0)
+    A, B = r0 + (oy - y0) * k, dy * k
+    a = dx * dx + dz * dz - B * B
+    b = 2.0 * (ox * dx + oz * dz - A * B)
+    c = ox * ox + oz * oz - A * A
+    n = 0
+    ra, rb = 0.0, 0.0
+    if abs(a * c) <= zero * b * b:
+        if b == 0.0:
+            return 0, 0.0, 0.0
+        ra, n = -c / b, 1
+    else:
+        disc = b * b - 4.0 * a * c
+        if not disc > 0.0:
+            return 0, 0.0, 0.0
+        q = -0.5 * (b + math.copysign(math.sqrt(disc), b))
+        ra, rb, n = q / a, (c / q if q != 0.0 else -q / a), 2
+    m, t0, t1 = 0, 0.0, 0.0
+    for i in range(n):
+        t = ra if i == 0 else rb
+        slack = TOL_CUT * (max(abs(ox), abs(oy), abs(oz)) + abs(t) * max(abs(dx), abs(dy), abs(dz)))
+        y = oy + t * dy
+        if min(y0, y1) - slack <= y <= max(y0, y1) + slack and A + B * t >= -slack * abs(k):
+            if m == 0:
+                t0 = t
+            else:
+                t1 = t
+            m += 1
+    return m, t0, t1
+
+
+@nb.njit(cache=True, error_model="numpy")
+def lathe_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
+    """Nearest hit ``tmin < t < tmax``: ``(t, segment)``, ``(inf, 0)`` on a miss."""
+    off, n = int(par[k, 0]), int(par[k, 1])
+    best, bf = tmax, -1
+    for i in range(n - 1):
+        cnt, t0, t1 = _segment_roots(aux, off + 2 * i, ox, oy, oz, dx, dy, dz, TOL_ZERO)
+        for r in range(cnt):
+            t = t0 if r == 0 else t1
+            if tmin < t < best:
+                best, bf = t, i
+    if bf < 0:
+        return np.inf, 0
+    return best, bf
+
+
+@nb.njit(cache=True, error_model="numpy")
+def lathe_inside(par, k, aux, x, y, z, stack):
+    """Even-odd test of ``(rho, y)`` against the closed profile."""
+    if par[k, 2] == 0.0:
+        return False
+    off, n = int(par[k, 0]), int(par[k, 1])
+    rho = math.hypot(x, z)
+    res = False
+    for i in range(n):
+        j = off + 2 * i
+        jn = off + 2 * ((i + 1) % n)
+        ra, ya, rb, yb = aux[j], aux[j + 1], aux[jn], aux[jn + 1]
+        if ya != yb and ((ya > y) != (yb > y)) and rho < ra + (y - ya) * (rb - ra) / (yb - ya):
+            res = not res
+    return res
+
+
+@nb.njit(cache=True, error_model="numpy")
+def lathe_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
+    """Interval list of a closed lathe along the whole line (entering / leaving alternate),
+    written to ``out_t``, ``out_f`` (segment); returns the count (hits past ``cap`` are
+    dropped: a line meets at most two per segment)."""
+    off, n = int(par[k, 0]), int(par[k, 1])
+    m = 0
+    for i in range(n - 1):
+        cnt, t0, t1 = _segment_roots(aux, off + 2 * i, ox, oy, oz, dx, dy, dz, TOL_ZERO)
+        for r in range(cnt):
+            if m < cap:
+                out_t[m], out_f[m] = (t0 if r == 0 else t1), i
+                m += 1
+    sort_hits(out_t, out_f, m)
+    w, status = 0, False
+    for i in range(m):
+        t = out_t[i]
+        nxt = out_t[i + 1] if i + 1 < m else np.inf
+        if nxt == t:
+            continue
+        tm = 0.5 * (t + nxt)
+        after = nxt < np.inf and lathe_inside(par, k, aux, ox + tm * dx, oy + tm * dy, oz + tm * dz, stack)
+        if after != status:
+            out_t[w], out_f[w] = t, out_f[i]
+            w += 1
+            status = after
+    return w
+
+
+@nb.njit(cache=True, error_model="numpy")
+def lathe_normal(par, k, aux, face, x, y, z, stack):
+    """Normal of segment ``face`` at the object-space point (unit)."""
+    j = int(par[k, 0]) + 2 * face
+    o = par[k, 3]
+    nr, ny = o * (aux[j + 3] - aux[j + 1]), -o * (aux[j + 2] - aux[j])
+    rho = math.hypot(x, z)
+    if rho == 0.0:
+        return 0.0, math.copysign(1.0, ny), 0.0
+    ln = math.hypot(nr, ny)
+    return nr * x / (rho * ln), ny / ln, nr * z / (rho * ln)
