@@ -129,6 +129,7 @@ def main() -> None:
     cases = {"static_camera_raytrace_running": lambda: measure(a.scene, a.size, a.window, True, "fps_static"),
              "drag_with_raytrace_panel": lambda: measure(a.scene, a.size, a.window, True, "fps"),
              "drag_gl_only": lambda: measure(a.scene, a.size, a.window, False, "fps"),
+             "drag_indexed": lambda: measure(a.scene, a.size, a.window, False, "fps_indexed"),
              "material_drag": lambda: measure(a.scene, a.size, a.window, False, "fps_material_drag"),
              "slider_drag": lambda: measure(a.scene, a.size, a.window, False, "fps_slider_drag"),
              "raytrace_without_window": lambda: raytrace_without_window(a.scene, a.size),

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .state import CHILD, RASTER, AppState, shown_image
+from .state import CHILD, RASTER, AppState
 
 LIVE_REST_SECONDS = 0.5
 """How long edited material or light values must stay unchanged before a GL panel compiles
@@ -265,12 +265,18 @@ class PanelGPU:
     """GL programs compiled by raster sessions since released (tests count compiles)."""
     settle_frame: int = -1
     """The frame of the last ``RasterSession.settle`` step (one per frame)."""
+    backdrops: dict[str, tuple] = field(default_factory=dict)
+    """CPU panel -> (id of its current job, the image shown before that job): :func:`over_stale`."""
+    modes: object = None
+    """:class:`.display_modes.ModeDisplay`: panels shown through another mode than direct24."""
 
 
 def gpu(state: AppState) -> PanelGPU:
     """``state.gpu``, created on first use in the window's context."""
     if state.gpu is None:
-        state.gpu = PanelGPU(DisplayPasses(state.ctx), ScreenBlits(state.ctx))
+        from .display_modes import ModeDisplay
+        state.gpu = PanelGPU(DisplayPasses(state.ctx), ScreenBlits(state.ctx),
+                             modes=ModeDisplay(state.ctx, getattr(state.jobs, "notify", None)))
     return state.gpu
 
 
@@ -403,13 +409,36 @@ def refresh_cpu(state: AppState, method: str) -> None:
         image = job.snapshot()
         # the previous job's image is kept while its successor waits, unless it has another
         # size (a scene switch changed the panels' aspect): then black until the new one comes
-        state.images[method] = image if image.shape == shape else np.zeros(shape, np.float32)
+        state.images[method] = (over_stale(state, method, job, image)
+                                if image.shape == shape else np.zeros(shape, np.float32))
+
+
+def over_stale(state: AppState, method: str, job, image: np.ndarray) -> np.ndarray:
+    """What a CPU panel shows of ``job``'s ``image`` (H, W, 3): the image once done; before,
+    its rendered bands (rows ``0 .. job.rows_done``; a progressive job's image once it has a
+    sample) over the panel's previous image (its *backdrop*, taken when the job first shows),
+    so a restarted render never blanks the panel (it used to show black until its bands came)."""
+    g = gpu(state)
+    held = g.backdrops.get(method)
+    if held is None or held[0] != id(job):
+        prev = state.images[method] if method in state.images else None
+        held = g.backdrops[method] = (id(job), prev)
+    back = held[1]
+    if job.done or back is None or back.shape != image.shape:
+        return image
+    if job.progressive:
+        return image if job.spp > 0 else back
+    out = back.copy()
+    out[:job.rows_done] = image[:job.rows_done]
+    return out
 
 
 def update_images(state: AppState) -> None:
     """Bring every selected panel up to date (called once per frame, before the widgets)."""
     from .pyrender_proc import refresh_pyrender
     state.jobs.keep_only(state.methods)
+    if state.gpu is not None:  # a removed panel's approximation keeps nothing awake
+        state.gpu.modes.approximate &= set(state.methods)
     for m in state.methods:
         if m in RASTER:
             refresh_raster(state, m)
@@ -425,21 +454,26 @@ def in_progress(state: AppState) -> bool:
     values still to compile back in.  The loop then runs at full rate (capped while a job runs,
     :func:`.main.frame_rest`); otherwise it idles."""
     proc = state.pyrender
+    g = state.gpu
     return (state.jobs.busy() or (proc is not None and proc.busy) or state.errors.busy(state.frame)
-            or (state.gpu is not None and any(p.session.live for p in state.gpu.raster.values())))
+            or (g is not None and (any(p.session.live for p in g.raster.values())
+                                   or g.modes.busy())))
 
 
 def panel_texture(state: AppState, method: str):
     """The RGBA8 texture showing ``method``'s panel through its display mode; rebuilt only
-    when the image or the mode changed."""
+    when the image or the mode changed (another mode than direct24:
+    :func:`.display_modes.panel_texture`, cheap while the image changes)."""
+    from .display_modes import panel_texture as mode_texture
     mode = state.display.get(method, "direct24")
+    if mode != "direct24":
+        gpu(state).shown.pop(method, None)
+        return mode_texture(state, method, mode, gpu(state).modes)
+    gpu(state).modes.forget(method)
     key = (state.images.version(method), mode)
     if stale(state, method, key) or method not in state.textures:
-        if mode == "direct24":
-            source, flip = linear_source(state, method)
-            gpu(state).passes.encode(source, display_texture(state, method, source.size), flip)
-        else:
-            upload_linear(state, method, shown_image(state, method))
+        source, flip = linear_source(state, method)
+        gpu(state).passes.encode(source, display_texture(state, method, source.size), flip)
     return state.textures[method]
 
 
@@ -521,6 +555,7 @@ def release_gl(state: AppState) -> None:
             tex.release()
         state.gpu.passes.release()
         state.gpu.blits.release()
+        state.gpu.modes.release()
         state.gpu = None
     for tex in state.textures.values():
         tex.release()

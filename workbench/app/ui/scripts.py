@@ -249,16 +249,22 @@ class Fps:
     ``step`` 0 leaves the camera alone).  ``raytrace_spp`` sets the ray tracer's samples per
     pixel (a longer background job).  With ``wait_cpu`` the count also ends when no background
     job runs any more (the rate is the one *while* a job runs), then the session stays open
-    until the jobs end and logs the ray trace's run time with the window open."""
+    until the jobs end and logs the ray trace's run time with the window open.  ``display``
+    sets every panel's display mode first (e.g. an indexed CLUT)."""
 
     def __init__(self, out: Path, seconds: float = 10.0, warmup: int = 10, step: float = 0.002,
-                 raytrace_spp: int | None = None, wait_cpu: bool = False):
+                 raytrace_spp: int | None = None, wait_cpu: bool = False,
+                 display: str | None = None):
         self.out, self.seconds, self.warmup, self.step, self.log = out, seconds, warmup, step, {}
-        self.spp, self.wait_cpu, self.t0 = raytrace_spp, wait_cpu, None
+        self.spp, self.wait_cpu, self.t0, self.display = raytrace_spp, wait_cpu, None, display
 
     def __call__(self, state: AppState) -> None:
         if state.frame == 0 and self.spp is not None:
             set_option(state, "raytrace", "spp", self.spp)
+        if state.frame == 0 and self.display is not None:
+            for m in state.methods:
+                set_display(state, m, self.display)
+            self.log["display"] = self.display
         if self.step:
             state.camera = cam.orbit(state.camera, self.step, 0.0)
         if state.frame == self.warmup:
@@ -290,6 +296,84 @@ class Fps:
             self.log.update(raytrace_seconds=None if job is None else job.seconds,
                             raytrace_options=state.options["raytrace"])
             state.quit = True
+
+
+class DragCheck:
+    """A camera drag with display modes and a ray-traced panel: once the ray trace is done,
+    ``mode`` is set on every GL panel and the script waits for their exact images; then
+    ``frames`` frames each orbit the camera, logging per frame what each GL panel shows
+    (``display_modes`` kind: "fast" or "exact"), its distinct colours, the exact computations
+    started, whether the ray-traced panel still holds its image and what the probe reads at
+    three pixels (one-pixel reads); then the camera rests until the GL panels are exact again
+    and the ray trace has restarted and ended, logging rows of the ray-traced panel that went
+    black meanwhile, and each GL panel's display texture against the CLI's mode
+    (``shown_M.npy``, ``cli_M.npy``)."""
+
+    def __init__(self, out: Path, mode: str = "indexed16-mediancut", frames: int = 8):
+        self.out, self.mode, self.frames, self.log = out, mode, frames, {"drag": []}
+        self.step, self.k, self.t0 = 0, 0, time.perf_counter()
+
+    def _gl(self, state: AppState) -> list[str]:
+        return [m for m in state.methods if m in RASTER]
+
+    def _exact(self, state: AppState) -> bool:
+        md = state.gpu.modes
+        return all(md.shown.get(m, (None, None, ""))[:3] == (state.images.version(m), self.mode,
+                                                              "exact") for m in self._gl(state))
+
+    def _texture(self, state: AppState, m: str) -> np.ndarray:
+        h, w = state.camera.height, state.camera.width
+        return np.frombuffer(state.textures[m].read(), np.uint8).reshape(h, w, -1)[..., :3]
+
+    def __call__(self, state: AppState) -> None:
+        from ...core.display import apply_display_mode
+        from ...core.imageio import to_srgb8
+        now, md = time.perf_counter(), state.gpu.modes if state.gpu is not None else None
+        timeout = now - self.t0 > CPU_WAIT_SECONDS
+        h, w = state.camera.height, state.camera.width
+        if self.step == 0 and state.frame >= 2 and (not state.jobs.busy() or timeout):
+            for m in self._gl(state):
+                set_display(state, m, self.mode)
+            self.step, self.t0 = 1, now
+        elif self.step == 1 and (self._exact(state) or timeout):
+            self.log["exact_before_drag"] = self._exact(state)
+            self.before = state.images["raytrace"].copy()
+            self.started0 = md.started
+            self.step = 2
+        elif self.step == 2:
+            if self.k:  # what the previous frame's orbit shows now
+                pixels = [(h // 2, w // 2), (h // 3, w // 4), (h - 1, w - 1)]
+                probe = {m: [state.images.pixel(m, i, j, (h, w)).tolist() for i, j in pixels]
+                         for m in state.methods}
+                shown = state.images["raytrace"]
+                self.log["drag"].append({
+                    "kinds": {m: md.shown[m][2] for m in self._gl(state)},
+                    "colours": {m: int(len(np.unique(self._texture(state, m).reshape(-1, 3), axis=0)))
+                                for m in self._gl(state)},
+                    "exact_started": md.started - self.started0,
+                    "raytrace_kept": bool(np.array_equal(shown, self.before)),
+                    "probe": probe,
+                    "probe_full": {m: [state.images[m][i, j].tolist() for i, j in pixels]
+                                   for m in state.methods}})
+            if self.k < self.frames:
+                state.camera = cam.orbit(state.camera, 0.05, 0.0)
+                self.k += 1
+            else:
+                self.step, self.t0, self.black_rows = 3, now, 0
+        elif self.step == 3:
+            image = state.images["raytrace"]
+            black = (np.abs(image).max(-1).max(-1) == 0) & (np.abs(self.before).max(-1).max(-1) > 0)
+            self.black_rows = max(self.black_rows, int(black.sum()))
+            job = state.jobs.current.get("raytrace")
+            if (self._exact(state) and job is not None and job.image is not None
+                    and job.key[1] == state.camera) or timeout:
+                self.log.update(exact_after_rest=self._exact(state), raytrace_black_rows=self.black_rows,
+                                rest_seconds=now - self.t0, exact_started=md.started - self.started0)
+                for m in self._gl(state):
+                    np.save(self.out / f"shown_{m}.npy", self._texture(state, m))
+                    np.save(self.out / f"cli_{m}.npy",
+                            to_srgb8(apply_display_mode(state.images[m], self.mode)))
+                state.quit = True
 
 
 def _compiles(state: AppState) -> int:
@@ -549,6 +633,8 @@ def gl_object_counts(state: AppState, names: int = 4096) -> dict:
 
 SCRIPTS = {"check": Check, "features": Features, "radiosity": Radiosity, "pyrender": Pyrender,
            "fps": Fps,
+           "fps_indexed": lambda out: Fps(out, display="indexed16-kmeans-fs"),
+           "drag_check": DragCheck,
            "fps_static": lambda out: Fps(out, step=0.0, raytrace_spp=16, wait_cpu=True),
            "gpu_panels": GpuPanels, "slider_frames": SliderFrames,
            "fps_material_drag": lambda out: SliderFps(out, "material"),
