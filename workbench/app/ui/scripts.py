@@ -9,7 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from . import camera as cam
-from .inspect import export, select_ray_tree
+from .export import export
+from .inspect import select_ray_tree
 from .layout import window_report
 from .panels import status_text
 from .state import RASTER, AppState, set_display, set_material_value, set_option, shown_image
@@ -376,6 +377,39 @@ class DragCheck:
                 state.quit = True
 
 
+class ExportCheck:
+    """Frame 2: orbit the camera, override a material (the first sphere's ``ks``) and light
+    0 (intensity, and where it is), set the first panel's display mode to ``mode`` and the
+    knobs; then wait for the background jobs and export into ``out/export`` (logging the
+    status line), and quit."""
+
+    def __init__(self, out: Path, mode: str = "indexed16-mediancut"):
+        self.out, self.mode, self.log, self.t0 = out, mode, {}, time.perf_counter()
+
+    def __call__(self, state: AppState) -> None:
+        from .state import light_fields, light_value, set_light_value
+        if state.frame == 2:
+            state.camera = cam.orbit(state.camera, 0.3, 0.1)
+            mat = _spec_material(state)
+            set_material_value(state, mat, "ks", 0.9)
+            light = state.base_scene.lights[0]
+            where = light_fields(light)[0]
+            p = np.asarray(light_value(light, where), float)
+            set_light_value(state, 0, where, tuple(p + np.array([0.5, 0.3, -0.2])))
+            set_light_value(state, 0, "intensity", float(light.intensity) * 0.7)
+            set_display(state, state.methods[0], self.mode)
+            if "phong" in state.methods:
+                set_option(state, "phong", "tessellation", 2)
+            if "raytrace" in state.methods:
+                set_option(state, "raytrace", "max_depth", 3)
+            self.t0 = time.perf_counter()
+        elif state.frame > 4 and (not state.jobs.busy()
+                                  or time.perf_counter() - self.t0 > CPU_WAIT_SECONDS):
+            self.log["exported"] = [p.name for p in export(state, self.out / "export")]
+            self.log["status"] = state.status["export"]
+            state.quit = True
+
+
 def _compiles(state: AppState) -> int:
     """GL programs compiled so far by the GL panels' sessions, released ones included."""
     if state.gpu is None:
@@ -634,7 +668,7 @@ def gl_object_counts(state: AppState, names: int = 4096) -> dict:
 SCRIPTS = {"check": Check, "features": Features, "radiosity": Radiosity, "pyrender": Pyrender,
            "fps": Fps,
            "fps_indexed": lambda out: Fps(out, display="indexed16-kmeans-fs"),
-           "drag_check": DragCheck,
+           "drag_check": DragCheck, "export_check": ExportCheck,
            "fps_static": lambda out: Fps(out, step=0.0, raytrace_spp=16, wait_cpu=True),
            "gpu_panels": GpuPanels, "slider_frames": SliderFrames,
            "fps_material_drag": lambda out: SliderFps(out, "material"),
