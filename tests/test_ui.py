@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -32,11 +31,7 @@ def session(xvfb, tmp_path_factory):
                         "--test-script", "check", "--out", str(out), "--frames", "2000"],
                        cwd=ROOT, env=env, capture_output=True, text=True, timeout=400)
     summary = json.loads((out / "summary.json").read_text()) if (out / "summary.json").exists() else None
-    shot, doc = out / "ui.png", ROOT / "docs" / "images" / "ui.png"
-    if shot.exists() and (not doc.exists() or os.environ.get("WORKBENCH_UPDATE_SCREENSHOT")):
-        doc.parent.mkdir(parents=True, exist_ok=True)  # the test artefact, kept once
-        shutil.copy(shot, doc)
-    return out, summary, p
+    return out, summary, p  # (the README's screenshot comes from test_ui_screens.py)
 
 
 def _img(out: Path, phase: str, m: str) -> np.ndarray:

@@ -410,6 +410,48 @@ class ExportCheck:
             state.quit = True
 
 
+class Screens:
+    """What a user sees of the default view: once nothing is in progress (the jobs, the error
+    plot's reference and points; at most :data:`CPU_WAIT_SECONDS`) and a few frames later,
+    the window as the X server shows it (``xwd``, :mod:`.screenshot`) is saved as
+    ``screen.png`` with, logged, the widgets cut at a window's right edge over those frames,
+    the window report, the blit rectangles, the panels' size, the plot's points, and each
+    panel's display texture (``shown_M.npy``) to find it on screen."""
+
+    def __init__(self, out: Path, frames: int = 4):
+        self.out, self.frames, self.log = out, frames, {"cut": []}
+        self.t0, self.rested = time.perf_counter(), None
+
+    def __call__(self, state: AppState) -> None:
+        from . import screenshot
+        from .frames import in_progress
+        from .main import window_title
+        busy = in_progress(state) and time.perf_counter() - self.t0 < CPU_WAIT_SECONDS
+        if state.frame < 2 or busy:
+            self.rested = None
+            return
+        if self.rested is None:
+            self.rested = state.frame
+        if state.frame > self.rested:  # widgets drawn in a rested frame
+            self.log["cut"] = sorted(set(self.log["cut"]) | state.cut)
+        if state.frame < self.rested + self.frames:
+            return
+        h, w = state.camera.height, state.camera.width
+        for m in [*state.methods, "difference"]:
+            if m in state.textures:
+                tex = state.textures[m]
+                tw, th = tex.size
+                np.save(self.out / f"shown_{m}.npy", np.frombuffer(
+                    tex.read(), np.uint8).reshape(th, tw, -1)[..., :3])
+        shot = screenshot.save(window_title(state), self.out / "screen.png")
+        self.log.update(screen=list(shot.shape), windows=window_report(),
+                        blits=[[m, list(r)] for m, r in state.gpu.blits.last],
+                        camera=[w, h], methods=list(state.methods), timed_out=not
+                        (time.perf_counter() - self.t0 < CPU_WAIT_SECONDS),
+                        plot_points={m: len(p) for m, p in state.errors.points.items()})
+        state.quit = True
+
+
 def _compiles(state: AppState) -> int:
     """GL programs compiled so far by the GL panels' sessions, released ones included."""
     if state.gpu is None:
@@ -668,7 +710,7 @@ def gl_object_counts(state: AppState, names: int = 4096) -> dict:
 SCRIPTS = {"check": Check, "features": Features, "radiosity": Radiosity, "pyrender": Pyrender,
            "fps": Fps,
            "fps_indexed": lambda out: Fps(out, display="indexed16-kmeans-fs"),
-           "drag_check": DragCheck, "export_check": ExportCheck,
+           "drag_check": DragCheck, "export_check": ExportCheck, "screens": Screens,
            "fps_static": lambda out: Fps(out, step=0.0, raytrace_spp=16, wait_cpu=True),
            "gpu_panels": GpuPanels, "slider_frames": SliderFrames,
            "fps_material_drag": lambda out: SliderFps(out, "material"),
