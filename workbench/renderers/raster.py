@@ -576,8 +576,9 @@ class RasterSession:
         Returns the (near, far) used."""
         import moderngl
         ctx = self.ctx
-        n0, f0 = self.near_far(camera)
-        near, far = near or n0, far or f0
+        if not (near and far):  # the automatic planes only when needed (Python, per draw)
+            n0, f0 = self.near_far(camera)
+            near, far = near or n0, far or f0
         if not 0.0 < near < far:
             raise WorkbenchError(f"clip planes need 0 < near < far, got near {near:.6g} and far {far:.6g}")
         V = camera.camera_from_world()

@@ -265,6 +265,8 @@ class PanelGPU:
     """GL programs compiled by raster sessions since released (tests count compiles)."""
     settle_frame: int = -1
     """The frame of the last ``RasterSession.settle`` step (one per frame)."""
+    near_far: dict = field(default_factory=dict)
+    """{"camera": the camera, boxes bytes: (near, far)}: :func:`shared_near_far`."""
     backdrops: dict[str, tuple] = field(default_factory=dict)
     """CPU panel -> (id of its current job, the image shown before that job): :func:`over_stale`."""
     modes: object = None
@@ -363,7 +365,7 @@ def refresh_raster(state: AppState, method: str) -> bool:
         return False
     t0 = time.perf_counter()
     fbo = panel.session.framebuffer(cam.width, cam.height)
-    panel.session.draw_to(fbo, cam)
+    panel.session.draw_to(fbo, cam, *shared_near_far(g, panel.session, cam))
     state.ctx.finish()  # the time shown is the draw's, not just its submission
     state.ctx.screen.use()  # back to the window's framebuffer for imgui
     state.timings[method] = time.perf_counter() - t0
@@ -373,6 +375,18 @@ def refresh_raster(state: AppState, method: str) -> bool:
     g.linear[method] = (fbo.color_attachments[0], True, state.images.version(method))
     panel.drawn, panel.draws = cam, panel.draws + 1
     return True
+
+
+def shared_near_far(g: PanelGPU, session, cam) -> tuple[float, float]:
+    """The automatic clip planes of ``session`` for ``cam``, computed once per camera for
+    sessions with the same parts' boxes (the GL panels of one scene and tessellation share
+    them: 3-10 ms of Python each on a loaded machine, every frame of a drag)."""
+    key = session.part_boxes.tobytes()
+    if g.near_far.get("camera") != cam:
+        g.near_far = {"camera": cam}
+    if key not in g.near_far:
+        g.near_far[key] = session.near_far(cam)
+    return g.near_far[key]
 
 
 def read_pixel(fbo, i: int, j: int, shape: tuple[int, int]) -> np.ndarray | None:
