@@ -644,14 +644,16 @@ class Idle:
 class Soak:
     """A long session in a loop: ``rounds`` rounds of a scene switch (through ``scenes``),
     a method added or removed, a knob change, camera orbits and a difference pair change,
-    waiting between rounds until the background jobs have ended.  Logs, every round, the
+    waiting between rounds until the background jobs have ended (``rounds`` rounds, or rounds
+    until ``seconds`` have passed).  Logs, every round, its time since the start, the
     process RSS, the jobs the board keeps, and the GL textures, framebuffers, buffers and
     programs alive in the window's context (:func:`gl_object_counts`)."""
 
-    def __init__(self, out: Path, rounds: int = 24,
-                 scenes=("whitted", "csg", "cornell", "quadrics")):
+    def __init__(self, out: Path, rounds: int | None = 24,
+                 scenes=("whitted", "csg", "cornell", "quadrics"), seconds: float | None = None):
         self.out, self.rounds, self.scenes, self.log = out, rounds, scenes, {"rounds": []}
         self.round, self.t_wait, self.phase = 0, time.perf_counter(), 0
+        self.seconds, self.t_start = seconds, time.perf_counter()
 
     def __call__(self, state: AppState) -> None:
         from .state import set_scene
@@ -668,7 +670,9 @@ class Soak:
                                    "jobs_kept": len(state.jobs.started),
                                    "scene": state.scene_path.stem, "methods": list(state.methods),
                                    **counts})
-        if self.round >= self.rounds:
+        self.log["rounds"][-1]["seconds"] = time.perf_counter() - self.t_start
+        if ((self.rounds is not None and self.round >= self.rounds) or (
+                self.seconds is not None and time.perf_counter() - self.t_start >= self.seconds)):
             state.quit = True
             return
         k = self.round
@@ -716,4 +720,5 @@ SCRIPTS = {"check": Check, "features": Features, "radiosity": Radiosity, "pyrend
            "fps_material_drag": lambda out: SliderFps(out, "material"),
            "fps_slider_drag": lambda out: SliderFps(out, "material+light"),
            "layout": Layout, "idle": Idle, "idle_quick": lambda out: Idle(out, seconds=3.0),
-           "soak": Soak, "soak_quick": lambda out: Soak(out, rounds=10)}
+           "soak": Soak, "soak_quick": lambda out: Soak(out, rounds=10),
+           "soak_10min": lambda out: Soak(out, rounds=None, seconds=600.0)}
