@@ -177,6 +177,53 @@ class ModeDisplay:
         """A panel shows an approximation or an exact computation runs."""
         return bool(self.approximate) or any(t.is_alive() for _, _, t in self.workers.values())
 
+    def step(self, panel: str, version: int, mode_name: str, image, has_texture: bool,
+             now: float | None = None):
+        """What ``panel``'s display texture must become this frame for image ``version``
+        through ``mode_name`` (not ``direct24``); ``image()`` gives the linear image (a GPU
+        read-back for a GL panel: called only when a CLUT or the exact mode needs it), and
+        ``has_texture`` says whether the texture exists.  Returns None (keep it), ``("pass",
+        mode, table)`` (run :meth:`run` with that CLUT table or None) or ``("upload",
+        linear)`` (the exact image: show it as is).  See the module docstring."""
+        from ...core.display import display_mode
+        now = time.perf_counter() if now is None else now
+        mode = display_mode(mode_name)
+        seen = self.changed.get(panel)
+        if seen is None or seen[0] != version:
+            seen = self.changed[panel] = (version, now)
+
+        def wanted(kind):
+            return self.shown.get(panel) != (version, mode_name, kind) or not has_texture
+
+        if gpu_exact(mode):
+            self.approximate.discard(panel)
+            if wanted("gpu"):
+                self.shown[panel] = (version, mode_name, "gpu")
+                return ("pass", mode, None)
+            return None
+        with self.lock:
+            exact = self.exact.get(panel)
+        if exact is not None and exact[:2] == (version, mode_name):
+            self.approximate.discard(panel)
+            if wanted("exact"):
+                self.shown[panel] = (version, mode_name, "exact")
+                if mode.kind == "indexed":  # the next drag maps to this image's CLUT
+                    self.table((panel, mode_name), shown_palette(exact[2]))
+                return ("upload", exact[2])
+            return None
+        if now - seen[1] >= DISPLAY_REST_SECONDS:
+            self.start_exact(panel, version, mode_name, image())
+        self.approximate.add(panel)
+        if not wanted("fast"):
+            return None
+        self.shown[panel] = (version, mode_name, "fast")
+        table = None
+        if mode.kind == "indexed":
+            table = self.tables.get((panel, mode_name))
+            if table is None:
+                table = self.table((panel, mode_name), drag_palette(image(), mode))
+        return ("pass", mode, table)
+
     def release(self) -> None:
         """Join the workers, free the GL objects."""
         for _, _, t in self.workers.values():
@@ -188,47 +235,3 @@ class ModeDisplay:
         for obj in (self.dummy_table, self.vao, self.prog):
             if obj is not None:
                 obj.release()
-
-
-def panel_texture(state, method: str, mode_name: str, md: ModeDisplay, now: float | None = None):
-    """The RGBA8 display texture of ``method`` through ``mode_name`` (not ``direct24``), from
-    the GPU pass, its approximation while the image changes, or the exact CPU result once it
-    rests (see the module docstring).  ``md`` is the window's :class:`ModeDisplay`."""
-    from ...core.display import display_mode
-    from .frames import display_texture, linear_source, upload_linear
-    now = time.perf_counter() if now is None else now
-    mode = display_mode(mode_name)
-    version = state.images.version(method)
-    seen = md.changed.get(method)
-    if seen is None or seen[0] != version:
-        seen = md.changed[method] = (version, now)
-    if gpu_exact(mode):
-        md.approximate.discard(method)
-        if md.shown.get(method) != (version, mode_name, "gpu") or method not in state.textures:
-            source, flip = linear_source(state, method)
-            md.run(source, flip, display_texture(state, method, source.size), mode)
-            md.shown[method] = (version, mode_name, "gpu")
-        return state.textures[method]
-    with md.lock:
-        exact = md.exact.get(method)
-    if exact is not None and exact[:2] == (version, mode_name):
-        if md.shown.get(method) != (version, mode_name, "exact") or method not in state.textures:
-            upload_linear(state, method, exact[2])
-            md.shown[method] = (version, mode_name, "exact")
-            if mode.kind == "indexed":  # the next drag maps to this image's CLUT
-                md.table((method, mode_name), shown_palette(exact[2]))
-        md.approximate.discard(method)
-        return state.textures[method]
-    if now - seen[1] >= DISPLAY_REST_SECONDS:
-        md.start_exact(method, version, mode_name, state.images[method])
-    if md.shown.get(method) != (version, mode_name, "fast") or method not in state.textures:
-        table = None
-        if mode.kind == "indexed":
-            table = md.tables.get((method, mode_name))
-            if table is None:
-                table = md.table((method, mode_name), drag_palette(state.images[method], mode))
-        source, flip = linear_source(state, method)
-        md.run(source, flip, display_texture(state, method, source.size), mode, table)
-        md.shown[method] = (version, mode_name, "fast")
-    md.approximate.add(method)
-    return state.textures[method]

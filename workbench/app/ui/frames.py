@@ -477,12 +477,19 @@ def in_progress(state: AppState) -> bool:
 def panel_texture(state: AppState, method: str):
     """The RGBA8 texture showing ``method``'s panel through its display mode; rebuilt only
     when the image or the mode changed (another mode than direct24:
-    :func:`.display_modes.panel_texture`, cheap while the image changes)."""
-    from .display_modes import panel_texture as mode_texture
+    :meth:`.display_modes.ModeDisplay.step`, cheap while the image changes)."""
     mode = state.display.get(method, "direct24")
     if mode != "direct24":
-        gpu(state).shown.pop(method, None)
-        return mode_texture(state, method, mode, gpu(state).modes)
+        g = gpu(state)
+        g.shown.pop(method, None)
+        todo = g.modes.step(method, state.images.version(method), mode,
+                            lambda: state.images[method], method in state.textures)
+        if todo is not None and todo[0] == "pass":
+            source, flip = linear_source(state, method)
+            g.modes.run(source, flip, display_texture(state, method, source.size), *todo[1:])
+        elif todo is not None:
+            upload_linear(state, method, todo[1])
+        return state.textures[method]
     gpu(state).modes.forget(method)
     key = (state.images.version(method), mode)
     if stale(state, method, key) or method not in state.textures:
