@@ -39,7 +39,10 @@ frames) and the results go to ``bench/results/ui_fps.json``:
 
 ``--cases a,b`` runs only those cases and keeps the other entries of the results file.
 
-``gui_ms_mean`` is the time in the frame's Python callbacks (panel updates + widgets); the rest
+``cpu_ms_per_frame`` is the process CPU time (every thread: Python, llvmpipe's rasterizer
+threads, jobs) per frame counted: the work a frame costs, which the machine's load does not
+inflate as it does the frame rate (on a machine shared with other work the rate measures the
+share of the cores the window got).  ``gui_ms_mean`` is the time in the frame's Python callbacks (panel updates + widgets); the rest
 of a frame is imgui's rendering of the window on llvmpipe and the buffer swap.  The window is
 ``--window`` (default 1600 x 900 (was 860): the docking layout's panels window, the full width above the
 control row, then holds the three 512 px panels side by side, so all three are on screen;

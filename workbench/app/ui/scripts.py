@@ -271,6 +271,7 @@ class Fps:
         if state.frame == self.warmup:
             self.t0, self.busy_frames, self.gui, self.frame_ms = time.perf_counter(), 0, 0.0, []
             self.counts, self.starts = _gpu_counts(state), state.jobs.count
+            self.cpu0 = process_cpu_seconds()
         elif self.t0 is not None and "fps" not in self.log:
             busy = state.jobs.busy()
             self.busy_frames += busy
@@ -282,6 +283,7 @@ class Fps:
                 (d0, r0), (d1, r1) = self.counts, _gpu_counts(state)
                 q = np.percentile(self.frame_ms, [10, 50, 90, 99]).round(1).tolist()
                 self.log.update(frames=n, seconds=dt, fps=n / dt, gui_ms_mean=self.gui / n * 1e3,
+                                cpu_ms_per_frame=(process_cpu_seconds() - self.cpu0) / n * 1e3,
                                 frame_ms_p10_50_90_99=q,
                                 frames_with_cpu_job_running=self.busy_frames,
                                 gl_panel_draws=d1 - d0, read_backs=r1 - r0,
