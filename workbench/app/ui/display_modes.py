@@ -86,8 +86,9 @@ class ModeDisplay:
     ``changed[panel]``: (image version, when it was first seen); ``tables[(panel, mode)]``:
     the panel's CLUT table texture; ``exact[panel]``: (version, mode, linear image shown
     exactly) from the worker; ``workers[panel]``: (version, mode, thread) of the exact
-    computation running; ``approximate``: panels showing an approximation now (the window
-    stays awake until they are exact, :func:`needs_frames`); ``notify`` wakes the window."""
+    computation running; ``shown[panel]``: (version, mode, "gpu" | "fast" | "exact") of what
+    its texture holds; ``approximate``: panels showing an approximation now (the window stays
+    awake until they are exact: :meth:`busy`); ``notify`` wakes the window."""
 
     def __init__(self, ctx, notify=None):
         from ...renderers.raster_shaders import SHADER_DIR

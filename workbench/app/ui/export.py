@@ -171,7 +171,7 @@ def export(state: AppState, folder: Path) -> list[Path]:
         names += [f"{m}.png", f"{m}.npy"]
     err = state.images.get("difference")
     if err is not None and not set(state.diff_pair) & set(skipped):
-        save_png8(tmp / "difference.png", colour_scale(err, max(float(err.max()), 1e-6)))
+        save_png8(tmp / "difference.png", colour_scale(err, float(err.max())))
         np.save(tmp / "difference.npy", np.asarray(err, np.float32))
         names += ["difference.png", "difference.npy"]
     (tmp / "scene.toml").write_text(toml_text(scene_document(state)), encoding="utf-8")
