@@ -245,6 +245,8 @@ class RasterSession:
         #: (:meth:`update`; :meth:`settle` compiles their values back in)
         self.live_materials: set[str] = set()
         self.live_lights = False
+        #: area lights' polygon materials ("area light N") whose radiance is live
+        self.live_areas: set[str] = set()
         self.ctx = ctx or gl.context()
         self.programs = ProgramCache(self.ctx)
         self.timings: dict[str, float] = {}
@@ -424,7 +426,8 @@ class RasterSession:
         on the same buffers) and its uniforms.  A live program does not depend on the values
         it reads, so a draw whose variant is unchanged keeps its program and only gets the
         new values."""
-        live_mat = d.name is not None and d.name in self.live_materials
+        live_mat = (d.name in self.live_materials if d.name is not None
+                    else d.material.name in self.live_areas)
         if d.variant != (live_mat, self.live_lights):
             defines = material_defines(self.scene, d.material, self.mode, n_lights=len(self.lights),
                                        has_uv=d.has_uv, blinn=self.blinn, depth_bits=self.depth_bits,
@@ -539,7 +542,9 @@ class RasterSession:
         """Take ``scene`` if it differs from the session's only in values that live programs
         read from uniforms: materials' colour, emission, ka, kd, ks, kr, shininess (and kt,
         ior, absorption, which no raster method uses), point and directional lights' position
-        or direction, colour and intensity.  The edited materials' draws (all lit draws for a
+        or direction, colour and intensity, and area lights' colour and intensity (their
+        stand-ins' uniforms and their polygon's emission; a moved polygon is geometry).  The
+        edited materials' draws (all lit draws for a
         light edit) switch to live programs (compiled once per variant, then only uniforms
         change: no recompile, no upload); :meth:`settle` compiles the values back in.
         Returns False, changing nothing, for any other difference (new objects, environment,
@@ -561,10 +566,14 @@ class RasterSession:
             if replace(o, **{k: getattr(m, k) for k in _VALUE_FIELDS}) != m:
                 return False
             edited.add(name)
-        for a, b in zip(scene.lights, old.lights):
+        areas = {}
+        for i, (a, b) in enumerate(zip(scene.lights, old.lights)):
             if isinstance(a, AreaLight) or isinstance(b, AreaLight):
-                if not _same(a, b):  # its polygon is geometry: a new session
-                    return False
+                if type(a) is not type(b) or not _same(replace(b, color=a.color,
+                                                               intensity=a.intensity), a):
+                    return False  # its polygon (or stand-in grid) is geometry: a new session
+                if not _same(a, b):  # radiance only: the polygon's emission, live
+                    areas[f"area light {i + 1}"] = tuple(float(x) for x in a.radiance)
         lights = scene.point_lights()
         if [light_kind(x) for x in lights] != [light_kind(x) for x in self.lights]:
             return False
@@ -578,12 +587,15 @@ class RasterSession:
         if lights_edited:
             self._light_values = light_uniforms(lights)
         self.live_materials |= edited
+        self.live_areas |= set(areas)
         self.live_lights = self.live_lights or lights_edited
         self._env_drawn = False  # the maps show the edited materials at the next frame
         for d in self.draws:
             if d.name is not None:
                 d.material = scene.materials[d.name]
-            if d.name in edited or lights_edited:
+            elif d.material.name in areas:
+                d.material = replace(d.material, emission=areas[d.material.name])
+            if d.name in edited or lights_edited or (d.name is None and d.material.name in areas):
                 self._bind(d)  # a live program (cached after its first use), new uniforms
             if d.tint is not None:
                 d.tint.material = d.material
@@ -598,7 +610,7 @@ class RasterSession:
         code at its first draw, so a caller that draws after each call spreads the work over
         frames); once no draw is live, release the literal programs no draw uses any more
         (live ones are kept for the next edit).  Returns True when no draw is live."""
-        self.live_materials, self.live_lights = set(), False
+        self.live_materials, self.live_lights, self.live_areas = set(), False, set()
         start = self.programs.compiles
         for d in self.draws + [d.tint for d in self.draws if d.tint is not None]:
             if d.variant != (False, False):
@@ -669,8 +681,9 @@ class RasterSession:
         first frame, since a light or geometry edit builds a new session; environment maps: at
         the first frame and after every edit :meth:`update` takes).  Neither depends on the
         camera, so a camera move redraws neither.  Returns the (near, far) used."""
-        n0, f0 = self.near_far(camera)
-        near, far = near or n0, far or f0
+        if not (near and far):  # the automatic planes only when needed (Python, per draw)
+            n0, f0 = self.near_far(camera)
+            near, far = near or n0, far or f0
         if not 0.0 < near < far:
             raise WorkbenchError(f"clip planes need 0 < near < far, got near {near:.6g} and far {far:.6g}")
         if (self.shadow_atlas is not None and not self._shadows_drawn) or (self.env_maps and not self._env_drawn):

@@ -277,6 +277,7 @@ class ZBufferRenderer:
     """The registered ``zbuffer`` method (see the module docstring)."""
 
     name = "zbuffer"
+    ui_kind = "cpu"
     knob = Knob("tessellation", (1, 2, 3, 4, 6, 8, 12, 16, 24, 32), DEFAULT_LEVEL,
                 "tessellation level of analytic primitives (sphere: 4L x 8L, see tessellate)")
     options = {

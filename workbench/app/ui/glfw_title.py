@@ -22,3 +22,8 @@ def shown_title() -> str:
     """The title the window has now (GLFW's), for scripts and tests."""
     glfw = glfw_library()
     return (glfw.glfwGetWindowTitle(glfw.glfwGetCurrentContext()) or b"").decode()
+
+
+def window_title(state) -> str:
+    """The window's title: the scene shown (``state`` an :class:`~.state.AppState`)."""
+    return f"workbench ui: {state.scene_path.stem}"

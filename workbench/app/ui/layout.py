@@ -85,7 +85,7 @@ def docking_params(state: AppState, window_height: int) -> hello_imgui.DockingPa
 
 def window_report() -> dict[str, dict]:
     """Each dockable window's state in the last frame: docked, drawn (shown, i.e. its tab in
-    front) and size."""
+    front), size and position (window pixels)."""
     from imgui_bundle.imgui import internal
     out = {}
     for w in hello_imgui.get_runner_params().docking_params.dockable_windows:
@@ -94,5 +94,6 @@ def window_report() -> dict[str, dict]:
             out[w.label] = {"exists": False}
             continue
         out[w.label] = {"exists": True, "docked": bool(win.dock_id), "drawn": bool(win.was_active and not win.hidden),
-                        "size": [float(win.size.x), float(win.size.y)]}
+                        "size": [float(win.size.x), float(win.size.y)],
+                        "pos": [float(win.pos.x), float(win.pos.y)]}
     return out

@@ -15,7 +15,7 @@ import time
 from pathlib import Path
 
 from ..args import size
-from .glfw_title import glfw_library
+from .glfw_title import glfw_library, window_title
 from .state import AppState, new_state
 
 WINDOW_SIZE = (1280, 760)
@@ -32,11 +32,6 @@ def frame_rest(last: float | None, now: float, cap: float, job_running: bool) ->
     if last is None or cap <= 0.0 or not job_running:
         return 0.0
     return max(0.0, last + 1.0 / cap - now)
-
-
-def window_title(state: AppState) -> str:
-    """The window's title: the scene shown."""
-    return f"workbench ui: {state.scene_path.stem}"
 
 
 def run(state: AppState, max_frames: int | None = None, script=None,

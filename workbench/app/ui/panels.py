@@ -7,8 +7,9 @@ from imgui_bundle import imgui
 from . import camera as cam
 from .frames import (difference_on_gpu, image_stats, panel_texture, show_image, stale, upload,
                      upload_linear)
-from .inspect import export, pixel_under_mouse, probe_tooltip, select_ray_tree
 from .colours import colour_scale, hot_table
+from .export import export
+from .inspect import pixel_under_mouse, probe_tooltip, select_ray_tree
 from .patch_view import select_patch
 from .placement import PANEL_GAP, PANEL_LINES, focus, panel_grid
 from .state import (DISPLAY_MODES, HARMONIES, MATERIAL_FIELDS, AppState, choosable_methods,
@@ -72,7 +73,7 @@ def scene_picker(state: AppState) -> None:
     check_fits(state, "export")
     if clicked:
         folder = (state.export_dir / f"{state.scene_path.stem}_{state.frame:06d}").resolve()
-        state.status["export"] = f"saved {len(export(state, folder))} files to {folder}"
+        export(state, folder)  # its message (the folder, panels skipped) in status["export"]
     if "export" in state.status:
         imgui.push_text_wrap_pos(0.0)
         imgui.text_disabled(state.status["export"])
