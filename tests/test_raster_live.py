@@ -13,7 +13,7 @@ import pytest
 import workbench
 from workbench.core.imageio import to_srgb8
 from workbench.renderers.raster import RasterSession
-from workbench.scene.model import AreaLight, DirectionalLight, PointLight
+from workbench.scene.model import AREA_LIGHT_PREFIX, AreaLight, DirectionalLight, PointLight
 
 pytestmark = pytest.mark.gl
 MODES = ("flat", "gouraud", "phong")
@@ -149,7 +149,7 @@ def test_area_light_colour_and_intensity_are_uniforms(gl_ctx, mode):
                                color=(1.0, 0.8, 0.5 + 0.1 * k))
         edited = replace(scene, lights=tuple(lights))
         assert session.update(edited)
-        assert session.live_lights and session.live_areas == {f"area light {area + 1}"}
+        assert session.live_lights and session.live_areas == {f"{AREA_LIGHT_PREFIX}{area}"}
         live = session.draw(cam)
         if compiled is None:
             compiled = session.programs.compiles

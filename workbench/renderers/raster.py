@@ -59,7 +59,7 @@ import numpy as np
 
 from ..core.errors import WorkbenchError
 from ..scene import features as ft
-from ..scene.model import AreaLight, Camera, Environment, Material, Scene
+from ..scene.model import AREA_LIGHT_PREFIX, AreaLight, Camera, Environment, Material, Scene
 from ..scene.clip_planes import auto_near_far
 from ..scene.parts import Part
 from ..scene.tessellate import (DEFAULT_LEVEL, MAX_LEVEL, NORMAL_RULES, area_light_parts, tessellate_scene,
@@ -573,7 +573,7 @@ class RasterSession:
                                                                intensity=a.intensity), a):
                     return False  # its polygon (or stand-in grid) is geometry: a new session
                 if not _same(a, b):  # radiance only: the polygon's emission, live
-                    areas[f"area light {i + 1}"] = tuple(float(x) for x in a.radiance)
+                    areas[f"{AREA_LIGHT_PREFIX}{i}"] = tuple(float(x) for x in a.radiance)
         lights = scene.point_lights()
         if [light_kind(x) for x in lights] != [light_kind(x) for x in self.lights]:
             return False
