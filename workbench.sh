@@ -2,14 +2,14 @@
 # One entry point for the README's two commands:
 #   bash workbench.sh demo   install what is missing, then run the main job on the default scene
 #   bash workbench.sh test   install what is missing, then run the test suite
-# Installing: Debian packages (Mesa EGL/llvmpipe, OSMesa, Xvfb, GLFW, POV-Ray) when missing, and
+# Installing: Debian packages (Mesa EGL/llvmpipe, OSMesa, Xvfb, xwd, GLFW, POV-Ray) when missing, and
 # a virtual environment .venv with the package and its test/bench/reference extras.  Safe to re-run.
 set -euo pipefail
 cd "$(dirname "$0")"
 what="${1:-}"
 case "$what" in demo|test) ;; *) echo "usage: bash workbench.sh demo|test" >&2; exit 2 ;; esac
 
-debs=(libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6 xvfb xauth libglfw3 povray)
+debs=(libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6 xvfb xauth x11-apps libglfw3 povray)
 missing=()
 for d in "${debs[@]}"; do dpkg -s "$d" >/dev/null 2>&1 || missing+=("$d"); done
 if [ ${#missing[@]} -gt 0 ]; then

@@ -24,6 +24,7 @@ const vec2 v_uv = vec2(0.0);
 const bool HAS_UV_ATTR = false;
 #endif
 
+#include "standins.glsl"
 #include "lighting.glsl"
 #include "texturing.glsl"
 #ifdef USER_MODEL
@@ -35,6 +36,14 @@ flat in vec3 v_specular;
 #elif defined(MODE_GOURAUD)
 in vec3 v_diffuse;
 in vec3 v_specular;
+#endif
+#include "screen_space.glsl"
+#if defined(MODE_GOURAUD) && defined(SHADOW_MAPS)
+in vec3 v_light_d[N_LIGHTS];
+in vec3 v_light_s[N_LIGHTS];
+#endif
+#if defined(MODE_GOURAUD) && defined(ENV_CUBE)
+in vec3 v_env;
 #endif
 
 uniform vec3 u_eye;
@@ -76,13 +85,29 @@ void main() {
 #else
     vec3 diffuse = v_diffuse;
     vec3 specular = v_specular;
+#if defined(MODE_GOURAUD) && defined(SHADOW_MAPS)
+    for (int k = 0; k < N_LIGHTS; ++k) {
+        float vis = shadow_visibility(k, v_world, N);
+        diffuse += vis * v_light_d[k];
+        specular += vis * v_light_s[k];
+    }
+#endif
 #endif
     vec3 color = MAT_EMISSION + C * diffuse + specular;
 #endif
-#if defined(ENV_MAP) && defined(ENV_KIND)
+#if defined(ENV_CUBE) && defined(MODE_GOURAUD)
+    color += v_env;  // stand-in environment map, per vertex
+#elif defined(ENV_CUBE)
+    color += env_terms(v_world, N, S, C);  // stand-in environment map (standins.glsl)
+#elif defined(ENV_MAP) && defined(ENV_KIND)
     color += MAT_KR * environment(2.0 * dot(N, S) * N - S);
 #endif
     frag_color = vec4(color, a);
+#ifdef TINT_PASS
+    // stand-in transparency, first of two passes: the colour behind is multiplied by kt C
+    // (blend ZERO, SRC_COLOR); the second pass adds this surface's own light (ONE, ONE)
+    frag_color = vec4(MAT_KT * C, 1.0);
+#endif
 #ifdef DEPTH_LEVELS
     gl_FragDepth = floor(gl_FragCoord.z * u_depth_levels + 0.5) / u_depth_levels;
 #endif

@@ -36,6 +36,25 @@ def gl_ctx():
     assert ctx.error == "GL_NO_ERROR", "the test left a GL error"
 
 
+class _WindowContext:
+    """A headless context standing in for the window's: its ``screen`` a 1 x 1 framebuffer."""
+
+    def __init__(self, ctx):
+        self._ctx, self.screen = ctx, ctx.simple_framebuffer((1, 1))
+
+    def __getattr__(self, name):
+        return getattr(self._ctx, name)
+
+
+@pytest.fixture
+def window_ctx(gl_ctx):
+    """The thread's context in the role of the UI window's (``AppState.ctx``) without a
+    window: UI frame functions run in-process."""
+    ctx = _WindowContext(gl_ctx)
+    yield ctx
+    ctx.screen.release()
+
+
 def _free_display() -> int:
     for n in range(90, 200):
         if not Path(f"/tmp/.X11-unix/X{n}").exists() and not Path(f"/tmp/.X{n}-lock").exists():

@@ -13,20 +13,23 @@ from workbench.scene.io import load_scene
 
 @pytest.mark.gl
 def test_raster_curves_fall_against_their_matched_reference_on_whitted(tmp_path):
-    """On Whitted's scene the raster methods miss reflection, refraction and shadows: their
-    total error stays high at every tessellation, while their error against the matched
-    reference (the same local model ray-cast without shadows) falls with the tessellation."""
+    """On Whitted's scene flat shading misses reflection, refraction and shadows: its total
+    error stays high at every tessellation, while its error against the matched reference (the
+    same local model ray-cast without shadows) falls with the tessellation.  Phong draws the
+    stand-ins for them by default (renderers/raster_standins.py): its matched reference is the
+    Whitted ray tracer at pixel centres, and its total error is far below flat's."""
     res = study(load_scene("whitted"), tmp_path, methods=["flat", "phong"], size=(64, 48), quick=True,
                 repeat=1, progress=False)
     assert res["reference"]["method"] == "raytrace"
-    for m in ("flat", "phong"):
-        pts = [p for p in res["points"] if p["method"] == m and p["status"] == "ok"]
-        total = [p["rmse"] for p in pts]
-        matched = [p["rmse_matched"] for p in pts]
-        assert len(pts) == 4 and all(p["matched_reference"].startswith("raycast") for p in pts)
-        assert matched[-1] < 0.6 * matched[0], (m, matched)
-        # the missing physics dominates: the total error hardly moves and stays far above
-        assert min(total) > 2 * matched[-1] and max(total) - min(total) < matched[0] - matched[-1] + 0.02
+    pts = {m: [p for p in res["points"] if p["method"] == m and p["status"] == "ok"] for m in ("flat", "phong")}
+    total = [p["rmse"] for p in pts["flat"]]
+    matched = [p["rmse_matched"] for p in pts["flat"]]
+    assert len(pts["flat"]) == 4 and all(p["matched_reference"].startswith("raycast") for p in pts["flat"])
+    assert matched[-1] < 0.6 * matched[0], matched
+    # the missing physics dominates: the total error hardly moves and stays far above
+    assert min(total) > 2 * matched[-1] and max(total) - min(total) < matched[0] - matched[-1] + 0.02
+    assert len(pts["phong"]) == 4 and all(p["matched_reference"].startswith("raytrace") for p in pts["phong"])
+    assert max(p["rmse"] for p in pts["phong"]) < 0.5 * min(total), [p["rmse"] for p in pts["phong"]]
     js = (tmp_path / "study.json").read_text()
     assert "rmse_matched" in (tmp_path / "study.csv").read_text().splitlines()[0] and "matched_references" in js
 

@@ -66,7 +66,7 @@ def test_a_sheet_in_a_csg_tree_is_refused_by_its_kind():
 
 def test_area_light_is_one_polygon_in_every_method():
     from workbench.renderers.radiosity.patches import patches_from_scene
-    from workbench.renderers.raster import _area_light_parts
+    from workbench.scene.tessellate import area_light_parts
     from workbench.renderers.raytrace.flatten import flatten
     from workbench.renderers.raytrace.reference import Context
     scene = _scene([{"type": "sphere", "material": "w", "radius": 0.5}])
@@ -78,7 +78,7 @@ def test_area_light_is_one_polygon_in_every_method():
     assert sd.materials[sd.mat[-1]] == mat and sd.mat_tab[sd.mat[-1], 14] == 1.0
     ctx = Context(scene)                                  # readable reference tracer
     assert np.array_equal(ctx.items[-1].obj.vertices, poly.vertices) and ctx.materials[mat.name] == mat
-    ((part, pmat),) = _area_light_parts(scene)            # raster
+    ((part, pmat),) = area_light_parts(scene)             # raster, zbuffer
     assert pmat == mat and np.allclose(np.sort(part.positions, 0)[[0, -1]],
                                        np.sort(poly.vertices, 0)[[0, -1]])
     patches, _ = patches_from_scene(scene, 10.0)          # radiosity

@@ -161,10 +161,12 @@ radius = 0.35
 """
 
 
-@pytest.mark.parametrize("name", ["cornell_spheres", "glossy"])
+@pytest.mark.parametrize("name", ["cornell_spheres", "glossy", "cornell"])
 def test_kernel_agrees_with_readable_reference(tmp_path, name):
     """At a few pixels the numba kernel and the readable twin (the ray tracer's readable
-    intersection, numpy random numbers) agree within 5 combined standard errors."""
+    intersection, numpy random numbers) agree within 5 combined standard errors.  On ``cornell``
+    every primitive is a BVH triangle once its polygons and area light are (``opts[20]``: each
+    ray goes to the BVH alone), while the twin traces the polygons themselves."""
     if name == "glossy":
         sc, w, h, opts = scene(tmp_path, _GLOSSY), 8, 6, dict(fresnel="exact")
         pixels = [(1, 1), (3, 2), (3, 5), (4, 6), (5, 3)]
@@ -172,12 +174,70 @@ def test_kernel_agrees_with_readable_reference(tmp_path, name):
         sc, w, h, opts = workbench.load_scene(name), 8, 8, dict(fresnel="schlick")
         pixels = [(1, 4), (5, 2), (5, 5), (3, 0), (7, 4)]
     ses = PathTraceSession(sc, w, h, seed=7, **opts)
+    assert (ses.opts[20] == 1.0) == (name == "cornell")
     ses.add_samples(2048)
     km = ses.image.reshape(-1, 3)[[i * w + j for i, j in pixels]]
     ks = ses.std_error.reshape(-1, 3)[[i * w + j for i, j in pixels]]
     rm, rs = reference.render_pixels(sc, w, h, pixels, 160, seed=11, **opts)
     assert (rs > 0).any(axis=1).all()  # every pixel is lit (a real check, not zeros)
     assert np.all(np.abs(km - rm) <= 5.0 * np.hypot(ks, rs) + 1e-9)
+
+
+def _light_over_plane(tmp_path, facing_up: bool):
+    """PLANE with a 1 x 1 area light of radiance (3, 2, 1) at height 1 on the line of sight of
+    the image's centre, facing up (towards the camera) or down (towards the plane)."""
+    c = 4.0 / 3.0  # the centre ray from (0, 3, 4) to the origin crosses y = 1 at z = 4/3
+    v = [[-0.5, 1.0, c - 0.5], [-0.5, 1.0, c + 0.5], [0.5, 1.0, c + 0.5], [0.5, 1.0, c - 0.5]]
+    if not facing_up:
+        v = v[::-1]
+    return scene(tmp_path, PLANE + f'[[lights]]\ntype = "area"\nvertices = {v}\ncolor = [3.0, 2.0, 1.0]\n',
+                 "light_up" if facing_up else "light_down")
+
+
+def test_area_light_traced_as_triangles_keeps_one_emitting_side(tmp_path):
+    """The session traces a convex area light as two BVH triangles (``geometry.triangulated``)
+    of its black material, emitting from the front only: the camera sees exactly its radiance on
+    the front and 0 on the back (pixel centres), and the plane it lights below has the mean
+    radiance of the light traced as the ray tracer's polygon (``triangulate=False``), within
+    5 standard errors of the difference."""
+    up = PathTraceSession(_light_over_plane(tmp_path, True), 16, 12, seed=1, pixel_filter="center")
+    down = PathTraceSession(_light_over_plane(tmp_path, False), 16, 12, seed=1, pixel_filter="center")
+    for ses in (up, down):
+        assert ses.opts[20] == 1.0 and len(ses.emitters.cdf) == 2 and (ses.emitters.mesh_tri >= 0).all()
+        ses.add_samples(4)
+    light = np.float32([3.0, 2.0, 1.0])
+    seen = (up.image == light).all(axis=2)        # the front, from above: exactly its radiance
+    assert seen[6, 8] and 4 <= seen.sum() < 16 * 12
+    assert (up.image[~seen] == 0.0).all()         # it lights nothing below it
+    assert (down.image[6, 8] == 0.0).all()         # the back: black
+    assert (down.image.max(axis=2) > 0).sum() > 100  # the plane below is lit
+    sc = _light_over_plane(tmp_path, False)
+    tri, poly = (PathTraceSession(sc, 16, 12, seed=s, triangulate=t) for s, t in ((2, True), (3, False)))
+    assert poly.opts[20] == 0.0
+    for ses in (tri, poly):
+        ses.add_samples(64)
+    se = np.sqrt((tri.std_error.astype(np.float64) ** 2).sum(axis=(0, 1))
+                 + (poly.std_error.astype(np.float64) ** 2).sum(axis=(0, 1))) / (16 * 12)
+    diff = tri.image.mean(axis=(0, 1), dtype=np.float64) - poly.image.mean(axis=(0, 1), dtype=np.float64)
+    assert (se > 0).all() and np.all(np.abs(diff) <= 5.0 * se)
+
+
+def test_area_light_at_grazing_angles_does_not_shadow_itself(tmp_path):
+    """A small area light (0.2 x 0.2, facing down, 1 above the plane, behind the camera) lights
+    the plane in view at grazing angles (|cos| 0.1 to 0.3 at the light): the path tracer matches
+    the Whitted ray tracer's stand-in, one inverse-square point light with a cosine lobe at the
+    light's centre and of its power (the small-light limit: off by (size / distance)^2 < 0.2 %).
+    The shadow feeler once ran along ``l`` from its pushed origin and met the light's own plane
+    short of its margin wherever |cos_l| < 1/2: every pixel was black (kernel and twin alike)."""
+    v = [[-0.1, 1.0, 4.9], [0.1, 1.0, 4.9], [0.1, 1.0, 5.1], [-0.1, 1.0, 5.1]]  # normal -y
+    sc = scene(tmp_path, PLANE + f'[[lights]]\ntype = "area"\nvertices = {v}\ncolor = [30.0, 20.0, 10.0]\n')
+    pt = workbench.render(sc, "pathtrace", spp=16, pixel_filter="center")
+    wh = workbench.render(sc, "raytrace", spp=1)
+    assert (wh.image.max(axis=2) > 0).sum() > 150
+    assert np.all(np.abs(pt.image - wh.image) <= 5.0 * pt.std_error + 5e-3 * wh.image + 1e-7)
+    mean, se = reference.render_pixels(sc, 16, 12, [(1, 8), (6, 3)], 8, pixel_filter="center", seed=2)
+    expect = wh.image[[1, 6], [8, 3]]
+    assert np.all(np.abs(mean - expect) <= 5.0 * se + 5e-3 * expect + 1e-7) and (mean > 0).all()
 
 
 @pytest.mark.parametrize("name", [p.stem for p in bundled()])

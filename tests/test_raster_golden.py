@@ -1,5 +1,6 @@
-"""Golden images: every bundled scene by flat, Gouraud and Phong at 96 x 72 (no MSAA), against
-PNGs in tests/golden/raster/.  llvmpipe output varies slightly across Mesa versions, so the
+"""Golden images: every bundled scene by flat, Gouraud and Phong at 96 x 72 (no MSAA), the bare
+local model (``standins="off"``: the stand-ins for global effects are tested in
+tests/test_raster_standins.py), against PNGs in tests/golden/raster/.  llvmpipe output varies slightly across Mesa versions, so the
 comparison is on 8-bit sRGB with tolerances: mean absolute difference <= 2 levels and at most
 1 % of pixels off by more than 24 levels (edges move by a pixel between rasterisers).
 
@@ -39,7 +40,7 @@ def _scene_hash(name: str) -> str:
 @pytest.mark.parametrize("method", ["flat", "gouraud", "phong"])
 def test_golden(gl_ctx, scene_name, method):
     from PIL import Image
-    r = workbench.render(workbench.load_scene(scene_name), method, width=W, height=H)
+    r = workbench.render(workbench.load_scene(scene_name), method, width=W, height=H, standins="off")
     assert r.stats["nonfinite_pixels"] == 0
     got = to_srgb8(r.image).astype(np.int16)
     path = GOLDEN / f"{scene_name}_{method}.png"

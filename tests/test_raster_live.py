@@ -13,7 +13,7 @@ import pytest
 import workbench
 from workbench.core.imageio import to_srgb8
 from workbench.renderers.raster import RasterSession
-from workbench.scene.model import AreaLight, DirectionalLight, PointLight
+from workbench.scene.model import AREA_LIGHT_PREFIX, AreaLight, DirectionalLight, PointLight
 
 pytestmark = pytest.mark.gl
 MODES = ("flat", "gouraud", "phong")
@@ -129,4 +129,35 @@ def test_structural_changes_need_a_new_session(gl_ctx):
     mats = {**scene.materials, name: replace(scene.materials[name], environment=True)}
     assert not session.update(replace(scene, materials=mats))
     assert session.scene is scene and not session.live  # nothing changed
+    session.release()
+
+
+@pytest.mark.parametrize("mode", MODES)
+def test_area_light_colour_and_intensity_are_uniforms(gl_ctx, mode):
+    """cornell's area light: its colour and intensity are values (its stand-ins' uniforms and
+    its polygon's emission), not geometry.  Before: every edit of them (the UI's intensity
+    drag) built a new session, 4-6 fps."""
+    scene = workbench.load_scene("cornell")
+    cam = scene.camera.with_resolution(SIZE, SIZE)
+    area = next(i for i, light in enumerate(scene.lights) if isinstance(light, AreaLight))
+    session = RasterSession(scene, mode)
+    before = session.draw(cam)
+    compiled = None
+    for k in (1, 2, 3):
+        lights = list(scene.lights)
+        lights[area] = replace(lights[area], intensity=lights[area].intensity * (0.4 + 0.5 * k),
+                               color=(1.0, 0.8, 0.5 + 0.1 * k))
+        edited = replace(scene, lights=tuple(lights))
+        assert session.update(edited)
+        assert session.live_lights and session.live_areas == {f"{AREA_LIGHT_PREFIX}{area}"}
+        live = session.draw(cam)
+        if compiled is None:
+            compiled = session.programs.compiles
+        assert session.programs.compiles == compiled, "an intensity edit compiled a program"
+        literal = RasterSession(edited, mode).draw(cam)
+        assert np.abs(literal - before).max() > 0.05
+        assert np.abs(live - literal).max() <= 1e-4
+    while not session.settle(budget=1):
+        session.draw(cam)
+    assert np.array_equal(session.draw(cam), literal)
     session.release()

@@ -61,7 +61,7 @@ def test_program_cache_keys_on_defines(gl_ctx):
 
 
 def test_left_out_and_features(gl_ctx):
-    r = workbench.render(workbench.load_scene("whitted"), "gouraud", width=32, height=24)
+    r = workbench.render(workbench.load_scene("whitted"), "gouraud", width=32, height=24, standins="off")
     left = " ".join(r.left_out)
     for f in ("bump: not needed", "opacity: not needed", "environment: not needed", "shadows:", "refraction:"):
         assert f in left
@@ -83,7 +83,7 @@ def test_session_draws_other_cameras_without_rebuilding(gl_ctx):
     s = RasterSession(scene, "phong")
     cam = replace(scene.camera, position=(2.0, 2.0, -5.0), width=40, height=30)
     img = s.draw(cam)
-    ref = workbench.render(scene.with_camera(cam), "phong").image
+    ref = workbench.render(scene.with_camera(cam), "phong", standins="off").image
     assert np.allclose(img, ref, atol=1e-6)
     assert not np.allclose(img, s.draw(scene.camera.with_resolution(40, 30)), atol=1e-3)
     # render() reuses its session for the same scene content

@@ -120,3 +120,68 @@ def test_4wide_traversal_equals_brute_force_closest_and_any_hit():
         if tria >= 0:
             assert ta < 0.5 and tb[tria] == pytest.approx(ta, rel=1e-9)
     assert hits > 60
+
+
+def _readable_sah(tri_v):
+    """The binned SAH tree of :func:`.bvh.build_bvh` written plainly (recursion, numpy, every
+    node's bounds rescanned): ``[(box, axis or -1, leaf triangle set or None), ...]`` in depth
+    first order, left child first."""
+    from workbench.renderers.raytrace.bvh import MAX_DEPTH, MAX_LEAF, N_BINS, TRAVERSAL_COST
+    t = tri_v.reshape(-1, 3, 3)
+    tb = np.concatenate([t.min(1), t.max(1)], 1)
+    cen = 0.5 * (tb[:, :3] + tb[:, 3:])
+
+    def area(b):
+        d = b[3:] - b[:3]
+        return 0.0 if d[0] < 0 else d[0] * d[1] + d[1] * d[2] + d[2] * d[0]
+
+    def union(rows):
+        return np.concatenate([rows[:, :3].min(0), rows[:, 3:].max(0)]) if len(rows) else np.r_[[np.inf] * 3, [-np.inf] * 3]
+
+    out = []
+
+    def node(ids, depth):
+        box = union(tb[ids])
+        cmin, ext = cen[ids].min(0), cen[ids].max(0) - cen[ids].min(0)
+        rec = [box, -1, None]
+        out.append(rec)
+        if len(ids) <= MAX_LEAF or not ext.max() > 0.0 or depth >= MAX_DEPTH:
+            rec[2] = set(ids.tolist())
+            return
+        best, best_b, axis = np.inf, -1, 0
+        for ax in range(3):
+            if not ext[ax] > 0.0:
+                continue
+            bins = ((cen[ids, ax] - cmin[ax]) * (N_BINS * (1.0 - 1e-9) / ext[ax])).astype(int)
+            for b in range(N_BINS - 1):
+                left, right = ids[bins <= b], ids[bins > b]
+                if len(left) and len(right):
+                    c = area(union(tb[left])) * len(left) + area(union(tb[right])) * len(right)
+                    if c < best:
+                        best, best_b, axis = c, b, ax
+        if best_b < 0 or (TRAVERSAL_COST + best / max(area(box), 1e-300) >= len(ids) and len(ids) <= 4 * MAX_LEAF):
+            rec[2] = set(ids.tolist())
+            return
+        rec[1] = axis
+        bins = ((cen[ids, axis] - cmin[axis]) * (N_BINS * (1.0 - 1e-9) / ext[axis])).astype(int)
+        node(ids[bins <= best_b], depth + 1)
+        node(ids[bins > best_b], depth + 1)
+
+    node(np.arange(len(tb)), 0)
+    return out
+
+
+def test_the_fast_build_makes_the_readable_builds_tree():
+    # the numba build keeps boxes and centroids in idx order, takes a node's bounds from its
+    # parent's partition and bins three axes in one pass; the tree must be the plain one
+    from workbench.renderers.raytrace.bvh import build_bvh
+    for seed, n in ((1, 700), (2, 300)):
+        tri = _soup(seed, n)
+        order, box, meta = build_bvh(tri)
+        ref = _readable_sah(tri)
+        assert len(ref) == len(box)
+        for i, (rbox, axis, leaf) in enumerate(ref):
+            assert np.array_equal(box[i], rbox)
+            assert meta[i, 2] == axis
+            if leaf is not None:
+                assert set(order[meta[i, 0]:meta[i, 0] + meta[i, 1]].tolist()) == leaf

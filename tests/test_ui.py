@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -32,11 +31,7 @@ def session(xvfb, tmp_path_factory):
                         "--test-script", "check", "--out", str(out), "--frames", "2000"],
                        cwd=ROOT, env=env, capture_output=True, text=True, timeout=400)
     summary = json.loads((out / "summary.json").read_text()) if (out / "summary.json").exists() else None
-    shot, doc = out / "ui.png", ROOT / "docs" / "images" / "ui.png"
-    if shot.exists() and (not doc.exists() or os.environ.get("WORKBENCH_UPDATE_SCREENSHOT")):
-        doc.parent.mkdir(parents=True, exist_ok=True)  # the test artefact, kept once
-        shutil.copy(shot, doc)
-    return out, summary, p
+    return out, summary, p  # (the README's screenshot comes from test_ui_screens.py)
 
 
 def _img(out: Path, phase: str, m: str) -> np.ndarray:
@@ -115,6 +110,7 @@ def test_ray_tree_of_a_pixel_matches_the_raytrace_panel(session):
 def test_export_writes_panels_and_settings(session):
     from PIL import Image
 
+    from workbench.core.display import apply_display_mode
     from workbench.core.imageio import to_srgb8
     out, summary, _ = session
     exp = out / "export"
@@ -122,10 +118,16 @@ def test_export_writes_panels_and_settings(session):
     assert settings["methods"] == list(METHODS)
     assert settings["material_overrides"] == {summary["script"]["material"]: {
         "ks": 1.0 if summary["script"]["ks_before"] < 0.5 else 0.0}}
+    shown = summary["script"]["display"]
     for m in METHODS:
         png = np.asarray(Image.open(exp / f"{m}.png"))
-        assert np.array_equal(png, to_srgb8(_img(out, "final", m)))
+        linear = _img(out, "final", m)
+        assert np.array_equal(np.load(exp / f"{m}.npy"), linear)  # the linear data too
+        if m == shown["method"]:  # as displayed (before: the display mode was ignored)
+            linear = apply_display_mode(linear, "indexed2-mediancut")
+        assert np.array_equal(png, to_srgb8(linear)), m
     assert (exp / "difference.png").exists()
+    assert settings["display"][shown["method"]] == "indexed2-mediancut"
 
 
 def test_panel_display_mode_quantises_only_what_is_shown(session):

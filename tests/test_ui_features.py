@@ -166,6 +166,14 @@ def test_error_plot_points_are_the_compare_metrics(features):
         assert np.isclose(point["rmse"], expected["rmse"], rtol=1e-6, atol=1e-9), m
         assert np.isclose(point["flip"], expected["flip"], rtol=1e-4, atol=1e-6), m
         assert point["seconds"] > 0
+        # the error split: each also against its matched reference, the same metrics against
+        # that reference (raytrace's is the full reference itself: max_depth 12 on whitted);
+        # the raster methods' below their total error (they miss reflection, refraction and
+        # shadows, which their matched reference also leaves out)
+        matched = np.load(out / f"plot_matched_{m}.npy")
+        assert np.isclose(point["rmse_matched"], metrics(_img(out, "plot", m), matched)["rmse"],
+                          rtol=1e-6, atol=1e-9), m
+        assert (m == "raytrace" and point["rmse_matched"] == point["rmse"]) or point["rmse_matched"] < point["rmse"], m
     # Phong has no reflection, refraction or shadows: further from the reference than the
     # ray tracer at max_depth 5
     assert plot["points"]["raytrace"][0]["rmse"] < plot["points"]["phong"][0]["rmse"]

@@ -90,7 +90,7 @@ def test_panels_are_copied_into_the_window_where_imgui_laid_them_out(gpu_session
 
 
 def test_difference_view_on_the_gpu_is_the_cpu_error_map(gpu_session):
-    from workbench.app.ui.panels import colour_scale
+    from workbench.app.ui.colours import colour_scale
     from workbench.compare.metrics import error_map
     out, _ = gpu_session
     flat, phong = np.load(out / "image_flat.npy"), np.load(out / "image_phong.npy")

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from workbench.app.ui.layout import PANEL_GAP, panel_grid
+from workbench.app.ui.placement import PANEL_GAP, panel_grid
 from workbench.app.ui.state import (MAX_PANELS, choosable_methods, new_state, panel_camera,
                                     set_scene, toggle_method)
 

@@ -78,11 +78,37 @@ void local_terms(vec3 P, vec3 N, vec3 S, out vec3 diffuse, out vec3 specular) {
     diffuse = MAT_KA * SCENE_AMBIENT;
     specular = vec3(0.0);
     float NdS = dot(N, S);
+#if defined(SHADOW_MAPS) && defined(MODE_PHONG)
+    // stand-in shadows (standins.glsl): light k's colour times its shadow-map visibility at P
+    int k = 0;
+#define X(POINT, INV_SQ, LOBE, pos, color, lobe_normal) \
+    add_light(POINT, INV_SQ, LOBE, pos, (color) * shadow_visibility(k++, P, N), lobe_normal, P, N, S, NdS, \
+              diffuse, specular);
+#else
 #define X(POINT, INV_SQ, LOBE, pos, color, lobe_normal) \
     add_light(POINT, INV_SQ, LOBE, pos, color, lobe_normal, P, N, S, NdS, diffuse, specular);
+#endif
     FOR_EACH_LIGHT(X)
 #undef X
 }
+
+#if defined(SHADOW_MAPS) && defined(MODE_GOURAUD)
+// Gouraud with stand-in shadows: each light's diffuse and specular terms at the vertex apart
+// (ld[k], ls[k], without the ambient term), so that the fragment can weigh each by its
+// shadow-map visibility after interpolation.
+void light_terms(vec3 P, vec3 N, vec3 S, out vec3 ld[N_LIGHTS], out vec3 ls[N_LIGHTS]) {
+    for (int i = 0; i < N_LIGHTS; ++i) {
+        ld[i] = vec3(0.0);
+        ls[i] = vec3(0.0);
+    }
+    float NdS = dot(N, S);
+    int k = 0;
+#define X(POINT, INV_SQ, LOBE, pos, color, lobe_normal) \
+    add_light(POINT, INV_SQ, LOBE, pos, color, lobe_normal, P, N, S, NdS, ld[k], ls[k]); ++k;
+    FOR_EACH_LIGHT(X)
+#undef X
+}
+#endif
 
 // The shading normal turned towards the viewer (two-sided surfaces).
 vec3 face_viewer(vec3 N, vec3 S) {

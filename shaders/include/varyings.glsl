@@ -9,3 +9,7 @@
 #if defined(MODE_PHONG) || defined(ENV_MAP)
 #define NEEDS_SURFACE
 #endif
+// stand-in shadows (standins.glsl) test the world point per fragment, in Gouraud too
+#if defined(SHADOW_MAPS) && !defined(NEEDS_SURFACE)
+#define NEEDS_SURFACE
+#endif

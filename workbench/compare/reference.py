@@ -74,7 +74,7 @@ whole sample budget on the few pixels that straddle a light's edge)."""
 _RAYCAST_LOCAL = ("raycast", {"shadows": False, "spp": 1},
                   "the same local model ray-cast on the analytic surfaces, no shadows, pixel centres")
 MATCHED: dict[str, tuple[str, dict, str]] = {
-    "flat": _RAYCAST_LOCAL, "gouraud": _RAYCAST_LOCAL, "phong": _RAYCAST_LOCAL,
+    "flat": _RAYCAST_LOCAL, "gouraud": _RAYCAST_LOCAL, "phong": _RAYCAST_LOCAL, "zbuffer": _RAYCAST_LOCAL,
     "raycast": ("raycast", {"spp": CONVERGED_SPP}, "the ray caster itself, box-filtered (its knob is spp)"),
     "raytrace": ("raytrace", {"max_depth": 12}, "the Whitted ray tracer at depth 12, pixel centres"),
     "povray": ("raytrace", {"max_depth": 12, "transmissive_shadows": True},
@@ -269,10 +269,29 @@ def _what(method: str, scene: Scene) -> str:
     return MATCHED.get(method, (None, None, "the method at its finest setting"))[2]
 
 
-def matched_spec(method: str) -> tuple[str, dict, str] | None:
+#: Gouraud and Phong draw stand-ins for global effects by default where the scene needs them
+#: (:mod:`workbench.renderers.raster_standins`): their physics is then the ray tracer's, approximated.
+_STANDIN_SHADOWS = ("raycast", {"shadows": True, "spp": 1},
+                    "the same local model ray-cast with shadow feelers (the limit of the shadow-map "
+                    "stand-in), pixel centres")
+_STANDIN_WHITTED = ("raytrace", {"max_depth": 12},
+                    "the Whitted ray tracer at pixel centres: the physics the stand-ins (environment maps, "
+                    "blending, shadow maps) approximate; their approximation error counts here")
+
+
+def matched_spec(method: str, scene: Scene | None = None) -> tuple[str, dict, str] | None:
     """``(reference method, options, what it computes)`` matching ``method``'s physics, or None
-    for outside renderers and methods without one (a user's GLSL model has no ray-cast twin)."""
+    for outside renderers and methods without one (a user's GLSL model has no ray-cast twin).
+    ``scene``: Gouraud and Phong with their default stand-ins match the Whitted ray tracer on a
+    scene that needs reflection or refraction, the ray caster with shadows on one that needs
+    shadows (else the table :data:`MATCHED`: the bare local model)."""
     spec = MATCHED.get(method)
+    if spec is not None and scene is not None and method in ("gouraud", "phong"):
+        needs = F.scene_needs(scene)
+        if F.REFLECTION in needs or F.REFRACTION in needs:
+            spec = _STANDIN_WHITTED
+        elif F.SHADOWS in needs and scene.lights:
+            spec = _STANDIN_SHADOWS
     if spec is None:
         return None
     m, opts, what = spec
@@ -302,7 +321,7 @@ class References:
 
     def matched(self, method: str) -> Reference | None:
         """``method``'s matched reference, or None (none exists, or it does not apply)."""
-        spec = matched_spec(method)
+        spec = matched_spec(method, self.scene)
         if spec is None:
             return None
         m, opts, what = spec

@@ -79,8 +79,25 @@ class RenderResult:
     std_error: np.ndarray | None = None
 
 
+UI_KINDS = ("gl", "cpu", "child", "progressive")
+"""What a renderer is to the interactive window (its ``ui_kind``), which the window asks
+instead of listing methods by name:
+
+* ``"gl"``: drawn in the window's own GL context whenever its inputs change; the renderer has
+  ``session(scene, tessellation=, ctx=)`` returning a :class:`~.raster.RasterSession`;
+* ``"cpu"``: rendered by :func:`render` in a background thread (``on_tile`` when it accepts it);
+* ``"child"``: rendered by :func:`render` in a child process (PyOpenGL's EGL platform cannot
+  share the window's process);
+* ``"progressive"``: refined pass after pass in a background thread; the renderer has
+  ``progressive_session(scene, width, height, **options)`` returning an object with
+  ``add_samples(n)``, ``image``, ``samples`` and ``noise_rmse``, and its knob (the samples per
+  pixel) is the target the panel refines towards.
+"""
+
+
 class Renderer(Protocol):
     name: str
+    ui_kind: str
     knob: Knob
     options: dict[str, Option]
     memory_options: tuple[str, ...]

@@ -148,6 +148,7 @@ class MitsubaRenderer:
     """The registered ``mitsuba`` method (see the module docstring and :mod:`.mitsuba_export`)."""
 
     name = "mitsuba"
+    ui_kind = "cpu"
     knob = Knob("spp", (4, 16, 64, 256, 1024, 4096), 64, "samples per pixel (two independent halves)")
     options = {
         "spp": Option(int, 64, "samples per pixel, >= 2 (two independent passes of spp/2: noise estimate)"),

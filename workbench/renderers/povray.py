@@ -72,6 +72,7 @@ class PovrayRenderer:
     """The registered ``povray`` method (see the module docstring)."""
 
     name = "povray"
+    ui_kind = "cpu"
     knob = Knob("max_trace_level", (1, 2, 3, 4, 5, 6, 8, 12), 5,
                 "POV-Ray's max_trace_level (primary = 1, as the ray tracer's max_depth)")
     options = {

@@ -11,6 +11,10 @@ All three use the local model of :mod:`.local_model` (GLSL mirror in
 ``shaders/include/lighting.glsl``) and the textures of :mod:`.texturing` (mirror in
 ``shaders/include/texturing.glsl``).
 
+Gouraud and Phong also draw stand-ins for the global effects the scene needs (environment
+maps, blending, shadow maps: :mod:`.raster_standins`, option ``standins``, on by default in
+:func:`render`; a :class:`RasterSession` builds them when given ``standins``).
+
 Interactive use (the UI calls this every frame)::
 
     session = RasterSession(scene, "phong", tessellation=6)   # tessellate + upload once
@@ -55,10 +59,11 @@ import numpy as np
 
 from ..core.errors import WorkbenchError
 from ..scene import features as ft
-from ..scene.model import AreaLight, Camera, Environment, Material, Scene
+from ..scene.model import AREA_LIGHT_PREFIX, AreaLight, Camera, Environment, Material, Scene
 from ..scene.clip_planes import auto_near_far
 from ..scene.parts import Part
-from ..scene.tessellate import DEFAULT_LEVEL, MAX_LEVEL, tessellate_object, tessellate_scene
+from ..scene.tessellate import (DEFAULT_LEVEL, MAX_LEVEL, NORMAL_RULES, area_light_parts, tessellate_scene,
+                                with_normal_rule)
 from .estimates import raster_bytes
 from ..scene.tessellate_topology import closed_outward, provoking_layout
 from . import gl
@@ -66,12 +71,16 @@ from . import texturing as tx
 from .base import Knob, Option, RenderResult
 from .raster_shaders import (LIVE_MATERIAL_FIELDS, ProgramCache, base_defines, light_kind,
                              light_uniforms, material_defines, material_uniforms)
+from . import raster_standins as sti
 
 DEPTH_CHOICES = (16, 24, 32)
+#: Varying interpolation: GL's perspective-correct one, or the course's screen-space scanline.
+INTERPOLATIONS = ("perspective", "screen")
 #: Object kinds tessellated as closed, outward-wound surfaces.
 CLOSED_KINDS = ("sphere", "box", "csg", "blob", "isosurface", "prism")
 #: Texture units of the image samplers.
-UNITS = {"u_tex_image": 0, "u_bump_image": 1, "u_op_image": 2, "u_env_image": 3}
+UNITS = {"u_tex_image": 0, "u_bump_image": 1, "u_op_image": 2, "u_env_image": 3, "u_env_cube": 4,
+         "u_shadow_atlas": 5, "u_env_depth": 6}
 #: Shader features and why they may be left out.
 SHADER_FEATURES = (ft.TEXTURES, ft.SOLID_TEXTURES, ft.IMAGE_TEXTURES, ft.BUMP, ft.OPACITY, ft.ENVIRONMENT)
 NOT_RASTER = {
@@ -139,6 +148,13 @@ class _Draw:
     buffers: tuple = ()
     #: vertex array of each program variant the part was drawn with (by id of the program)
     vaos: dict = field(default_factory=dict)
+    #: the object the part belongs to (its name, else the draw's id): what an environment map
+    #: of that object leaves out
+    group: object = None
+    #: the stand-ins its program compiles (raster_standins.DrawStandins, None: none) and the
+    #: multiplicative first pass of blended transparency (a _Draw on the same buffers, or None)
+    standins: object = None
+    tint: "_Draw | None" = None
     #: (live material, live lights) of ``prog``, its uniforms other than live values, and
     #: whether it reads the lights from uniforms
     variant: tuple | None = None
@@ -166,12 +182,6 @@ def _same(a, b) -> bool:
         return bool(a == b)
     except (ValueError, TypeError):
         return False
-
-
-def _area_light_parts(scene: Scene) -> list[tuple[Part, Material]]:
-    """Area lights as emissive polygons of radiance ``color * intensity``."""
-    return [(part, mat) for _, polygon, mat in scene.area_light_polygons()
-            for part in tessellate_object(polygon, 1)]
 
 
 _PARTS: OrderedDict = OrderedDict()
@@ -204,11 +214,22 @@ class RasterSession:
         outside them (:meth:`_cull_groups`; the image is the same, the triangle work halves).
     shading : a user's shading model in place of the local model (Phong only; a
         :class:`~.user_shading.ShadingProgram`, see :mod:`.user_shading`).
+    interpolation : ``"perspective"`` (GL's default, perspective-correct varyings) or
+        ``"screen"``: the course's scanline formulas, linear in screen space along edges and
+        spans (as GLSL ``noperspective``; the ``SCREEN_SPACE`` define,
+        ``shaders/include/screen_space.glsl``).
+    normals : vertex normals, ``"smooth"`` (the tessellation's) or ``"face_mean"`` (the
+        course's plain mean of the incident faces' normals,
+        :func:`~workbench.scene.tessellate.with_normal_rule`).
+    standins : the stand-ins for global effects asked for (:class:`.raster_standins.
+        StandinOptions`; None: none, the bare local model); those the scene needs and the
+        mode draws are built (:func:`.raster_standins.plan`).
     """
 
     def __init__(self, scene: Scene, mode: str, *, tessellation: int = DEFAULT_LEVEL,
                  blinn: bool = False, depth_bits: int = 24, ctx=None, backface_culling: bool = True,
-                 shading=None):
+                 shading=None, interpolation: str = "perspective", normals: str = "smooth",
+                 standins: sti.StandinOptions | None = None):
         if mode not in ("flat", "gouraud", "phong"):
             raise WorkbenchError(f"unknown raster mode {mode!r}")
         if shading is not None and mode != "phong":
@@ -216,17 +237,23 @@ class RasterSession:
         self.shading = shading
         if depth_bits not in DEPTH_CHOICES:
             raise WorkbenchError(f"depth_bits must be one of {DEPTH_CHOICES}, got {depth_bits}")
+        if interpolation not in INTERPOLATIONS:
+            raise WorkbenchError(f"interpolation must be one of {', '.join(INTERPOLATIONS)}, got {interpolation!r}")
         self.scene, self.mode, self.depth_bits, self.blinn = scene, mode, depth_bits, blinn
+        self.interpolation = interpolation
         #: materials (names) and whether the lights are drawn by live programs
         #: (:meth:`update`; :meth:`settle` compiles their values back in)
         self.live_materials: set[str] = set()
         self.live_lights = False
+        #: area lights' polygon materials ("area light N") whose radiance is live
+        self.live_areas: set[str] = set()
         self.ctx = ctx or gl.context()
         self.programs = ProgramCache(self.ctx)
         self.timings: dict[str, float] = {}
         t0 = time.perf_counter()
-        pairs = [(p, scene.materials[p.material], p.material) for p in _parts(scene, tessellation)]
-        pairs += [(p, m, None) for p, m in _area_light_parts(scene)]
+        pairs = [(with_normal_rule(p, normals), scene.materials[p.material], p.material)
+                 for p in _parts(scene, tessellation)]
+        pairs += [(p, m, None) for p, m in area_light_parts(scene)]
         self.timings["tessellate"] = time.perf_counter() - t0
         self.n_triangles = sum(p.n_triangles for p, _, _ in pairs)
         #: (K, 2, 3) world box of every part: the automatic clip planes (.scene.clip_planes)
@@ -240,6 +267,7 @@ class RasterSession:
         self._uniforms_of: dict[int, _Draw] = {}  # program -> draw whose uniforms it holds
         self._camera_of: dict[int, bytes] = {}    # program -> clip matrix it holds
         t0 = time.perf_counter()
+        self._build_standins(pairs, standins)
         self.draws = [self._upload(p, m, name) for p, m, name in pairs]
         self.cull_boxes = self._cull_groups() if backface_culling else np.zeros((0, 8, 3))
         self.background = None
@@ -250,7 +278,8 @@ class RasterSession:
         # compile time (a 1 x 1 frame)
         t0 = time.perf_counter()
         self.draw(scene.camera.with_resolution(1, 1))
-        self.timings["compile"] = self.programs.compile_seconds + time.perf_counter() - t0
+        self.timings["compile"] = (self.programs.compile_seconds + time.perf_counter() - t0
+                                   - self.timings.get("standin_maps", 0.0))
 
     @property
     def left_out(self) -> list[str]:
@@ -301,6 +330,42 @@ class RasterSession:
         self._gl_objects.append(vao)
         return _Draw(None, None, prog, vao, False, np.zeros(3), images, u)
 
+    def _build_standins(self, pairs, options: sti.StandinOptions | None) -> None:
+        """The plan of stand-ins (:func:`.raster_standins.plan`) and their maps: the shadow
+        atlas, and one environment map per object (parts grouped by object name) whose material
+        is mapped, seen from the centre of the object's bounds, the object left out."""
+        self.standin_options = options
+        self.plan = sti.plan(self._needs, options, self.mode, user_model=self.shading is not None,
+                             n_lights=len(self.lights))
+        self.shadow_layout = self.shadow_atlas = None
+        self._shadows_drawn = self._env_drawn = False
+        self.env_maps: dict = {}
+        if self.plan.shadows:
+            self.shadow_layout = sti.shadow_layout(self.lights, self.part_boxes, options.shadow_resolution,
+                                                   options.shadow_bias)
+            self.shadow_atlas = sti.ShadowAtlas(self.ctx, self.shadow_layout)
+        if self.plan.envmap:
+            keys = [p.name or id(p) for p, _, _ in pairs]
+            mapped = {k for k, (p, m, name) in zip(keys, pairs)
+                      if name is not None and sti.mapped_material(m, p.kind, self.plan)}
+            for key in mapped:
+                mine = np.array([k == key for k in keys])
+                box = self.part_boxes[mine]
+                centre = 0.5 * (box[:, 0].min(0) + box[:, 1].max(0))
+                self.env_maps[key] = sti.EnvironmentMap(self.ctx, key, centre, self.part_boxes[~mine],
+                                                        options.envmap_resolution)
+
+    def _draw_standins(self, part: Part, mat: Material, group, name: str | None):
+        """The :class:`.raster_standins.DrawStandins` of a draw (None: an area light's
+        polygon, or no stand-in in the session)."""
+        if name is None or not self.plan.any:
+            return None
+        env = self.env_maps.get(group) if sti.mapped_material(mat, part.kind, self.plan) else None
+        return sti.DrawStandins(env_res=env.resolution if env else 0,
+                                env_iterations=self.standin_options.envmap_iterations if env else 0,
+                                env_kt=env is not None and sti.refracts_through_map(mat, part.kind, self.plan),
+                                shadows=self.shadow_layout)
+
     def _upload(self, part: Part, mat: Material, name: str | None) -> _Draw:
         ctx = self.ctx
         has_uv = part.uvs is not None
@@ -335,9 +400,24 @@ class RasterSession:
             images["u_env_image"] = self._image_texture(env.path, repeat_v=False)
         op = mat.opacity
         blended = op is not None and (op.kind == "image" or (op.kind == "constant" and op.value < 1.0))
-        d = _Draw(part, mat, None, None, blended, part.positions.mean(0), images, None,
-                  name=name, has_uv=has_uv, buffers=(vbo, fmt, names, index))
+        group = part.name or id(part)
+        standins = self._draw_standins(part, mat, group, name)
+        if standins is not None and standins.env_res:
+            images["u_env_cube"] = self.env_maps[group].color
+            images["u_env_depth"] = self.env_maps[group].depth
+        if standins is not None and standins.shadows is not None:
+            images["u_shadow_atlas"] = self.shadow_atlas.depth
+        kt_blend = name is not None and sti.blended_material(mat, part.kind, self.plan)
+        d = _Draw(part, mat, None, None, blended or kt_blend, part.positions.mean(0), images, None,
+                  name=name, has_uv=has_uv, buffers=(vbo, fmt, names, index), group=group, standins=standins)
         self._bind(d)
+        if kt_blend:
+            d.tint = _Draw(part, mat, None, None, True, d.centre, {k: v for k, v in images.items()
+                                                                  if k not in ("u_env_cube", "u_env_depth",
+                                                                               "u_shadow_atlas")},
+                           None, name=name, has_uv=has_uv, buffers=d.buffers, group=group,
+                           standins=sti.DrawStandins(tint_pass=True))
+            self._bind(d.tint)
         return d
 
     def _bind(self, d: _Draw) -> None:
@@ -346,21 +426,19 @@ class RasterSession:
         on the same buffers) and its uniforms.  A live program does not depend on the values
         it reads, so a draw whose variant is unchanged keeps its program and only gets the
         new values."""
-        live_mat = d.name is not None and d.name in self.live_materials
+        live_mat = (d.name in self.live_materials if d.name is not None
+                    else d.material.name in self.live_areas)
         if d.variant != (live_mat, self.live_lights):
             defines = material_defines(self.scene, d.material, self.mode, n_lights=len(self.lights),
                                        has_uv=d.has_uv, blinn=self.blinn, depth_bits=self.depth_bits,
                                        allow_bump=self.mode == "phong", live_material=live_mat,
                                        live_lights=self.live_lights, needs=self._needs,
-                                       user_model=self.shading is not None)
+                                       user_model=self.shading is not None,
+                                       screen_space=self.interpolation == "screen", standins=d.standins)
             prog = self.programs.get("raster", defines, user=self.shading)
-            vao = d.vaos.get(id(prog))
-            if vao is None:
-                vbo, fmt, names, index = d.buffers
-                vao = d.vaos[id(prog)] = self.ctx.vertex_array(prog, [(vbo, fmt, *names)], index,
-                                                               index_element_size=4, skip_errors=True)
+            vao = self._vertex_array(d, prog)
             d.prog, d.vao, d.variant = prog, vao, (live_mat, self.live_lights)
-            d.fixed = self._static_uniforms(prog, d.part, d.material)
+            d.fixed = self._static_uniforms(prog, d)
             d.light_uniforms = "LIVE_LIGHTS" in defines
         if not live_mat and not d.light_uniforms:
             d.uniforms = d.fixed
@@ -375,11 +453,21 @@ class RasterSession:
                 u.set(k, v)
         d.uniforms = u
 
-    def _static_uniforms(self, prog, part: Part, mat: Material) -> _Uniforms:
-        """Samplers, the bump gradient's transform, the sky colours and the depth levels of one
-        draw (lights, material and map constants are compiled in, raster_shaders.
-        material_defines; the camera is set per frame)."""
+    def _static_uniforms(self, prog, d: _Draw) -> _Uniforms:
+        """Samplers, the bump gradient's transform, the sky colours, the depth levels and the
+        stand-ins' matrices of one draw (lights, material and map constants are compiled in,
+        raster_shaders.material_defines; the camera is set per frame)."""
+        part, mat = d.part, d.material
         u = _Uniforms(prog)
+        env = self.env_maps.get(d.group) if d.standins is not None and d.standins.env_res else None
+        if env is not None:
+            u.set("u_env_centre", tuple(float(x) for x in env.centre))
+            u.set("u_env_range", (float(env.near), float(env.far)))
+        if d.standins is not None and d.standins.shadows is not None and "u_shadow_clip" in prog:
+            # only directional lights' tiles are read: the compiler keeps the array up to the
+            # last one, whose length the data must match
+            n = prog["u_shadow_clip"].array_length
+            u.set("u_shadow_clip", sti.mat4_array(d.standins.shadows.clips[:n]))
         if mat.bump is not None:  # per part, not per material
             u.set("u_grad_from_object", np.linalg.inv(part.world_from_object[:3, :3]))
         env = self.scene.environment
@@ -429,23 +517,34 @@ class RasterSession:
         left = [f"{f}: not needed by the scene (not compiled)" for f in SHADER_FEATURES if f not in needs]
         if ft.BUMP in needs and self.mode != "phong":
             left.append(f"bump: {self.mode} shading has no per-fragment normal to perturb")
+        covered = self.plan.covered
         for f, why in NOT_RASTER.items():
-            if f in needs:
-                left.append(f"{f}: {why}")
-        used = sorted(f for f in needs if f not in NOT_RASTER and not (f == ft.BUMP and self.mode != "phong"))
+            if f in needs and f not in covered:
+                stand_in = f != ft.ABSORPTION
+                left.append(f"{f}: {why}" + (f" ({self.plan.off_reason})" if stand_in else ""))
+        used = sorted(f for f in needs if (f not in NOT_RASTER or f in covered)
+                      and not (f == ft.BUMP and self.mode != "phong"))
         return left, used
+
+    @property
+    def standins_used(self) -> dict[str, str]:
+        """Scene features drawn by a stand-in, and how."""
+        return dict(self.plan.covered)
 
     # ------------------------------------------------------------------ live edits
     @property
     def live(self) -> bool:
         """Some draws use live programs (values in uniforms): :meth:`settle` compiles them in."""
-        return any(d.variant != (False, False) for d in self.draws)
+        return any(d.variant != (False, False) for d in self.draws
+                   + [d.tint for d in self.draws if d.tint is not None])
 
     def update(self, scene: Scene) -> bool:
         """Take ``scene`` if it differs from the session's only in values that live programs
         read from uniforms: materials' colour, emission, ka, kd, ks, kr, shininess (and kt,
         ior, absorption, which no raster method uses), point and directional lights' position
-        or direction, colour and intensity.  The edited materials' draws (all lit draws for a
+        or direction, colour and intensity, and area lights' colour and intensity (their
+        stand-ins' uniforms and their polygon's emission; a moved polygon is geometry).  The
+        edited materials' draws (all lit draws for a
         light edit) switch to live programs (compiled once per variant, then only uniforms
         change: no recompile, no upload); :meth:`settle` compiles the values back in.
         Returns False, changing nothing, for any other difference (new objects, environment,
@@ -467,24 +566,41 @@ class RasterSession:
             if replace(o, **{k: getattr(m, k) for k in _VALUE_FIELDS}) != m:
                 return False
             edited.add(name)
-        for a, b in zip(scene.lights, old.lights):
+        areas = {}
+        for i, (a, b) in enumerate(zip(scene.lights, old.lights)):
             if isinstance(a, AreaLight) or isinstance(b, AreaLight):
-                if not _same(a, b):  # its polygon is geometry: a new session
-                    return False
+                if type(a) is not type(b) or not _same(replace(b, color=a.color,
+                                                               intensity=a.intensity), a):
+                    return False  # its polygon (or stand-in grid) is geometry: a new session
+                if not _same(a, b):  # radiance only: the polygon's emission, live
+                    areas[f"{AREA_LIGHT_PREFIX}{i}"] = tuple(float(x) for x in a.radiance)
         lights = scene.point_lights()
         if [light_kind(x) for x in lights] != [light_kind(x) for x in self.lights]:
             return False
         lights_edited = any(not _same(a, b) for a, b in zip(lights, self.lights))
+        if lights_edited and self.shadow_atlas is not None:
+            return False  # the shadow maps are the lights' views: a new session
+        if self.plan.any and any(getattr(scene.materials[n], k) != getattr(old.materials[n], k)
+                                 for n in edited for k in ("kr", "kt", "ior")):
+            return False  # which stand-ins a material gets, and their literals
         self.scene, self.lights = scene, lights
         if lights_edited:
             self._light_values = light_uniforms(lights)
         self.live_materials |= edited
+        self.live_areas |= set(areas)
         self.live_lights = self.live_lights or lights_edited
+        self._env_drawn = False  # the maps show the edited materials at the next frame
         for d in self.draws:
             if d.name is not None:
                 d.material = scene.materials[d.name]
-            if d.name in edited or lights_edited:
+            elif d.material.name in areas:
+                d.material = replace(d.material, emission=areas[d.material.name])
+            if d.name in edited or lights_edited or (d.name is None and d.material.name in areas):
                 self._bind(d)  # a live program (cached after its first use), new uniforms
+            if d.tint is not None:
+                d.tint.material = d.material
+                if d.name in edited:
+                    self._bind(d.tint)
         self._uniforms_of.clear()
         return True
 
@@ -494,9 +610,9 @@ class RasterSession:
         code at its first draw, so a caller that draws after each call spreads the work over
         frames); once no draw is live, release the literal programs no draw uses any more
         (live ones are kept for the next edit).  Returns True when no draw is live."""
-        self.live_materials, self.live_lights = set(), False
+        self.live_materials, self.live_lights, self.live_areas = set(), False, set()
         start = self.programs.compiles
-        for d in self.draws:
+        for d in self.draws + [d.tint for d in self.draws if d.tint is not None]:
             if d.variant != (False, False):
                 if budget is not None and self.programs.compiles - start >= budget:
                     break
@@ -505,8 +621,11 @@ class RasterSession:
         if self.live:
             return False
         used = [d.prog for d in self.draws] + ([self.background.prog] if self.background else [])
+        used += [d.tint.prog for d in self.draws if d.tint is not None]
+        if self.shadow_atlas is not None:
+            used.append(self.programs.get("shadow_depth", base_defines()))
         gone = {id(p) for p in self.programs.release_unused(used)}
-        for d in self.draws:
+        for d in self.draws + [d.tint for d in self.draws if d.tint is not None]:
             for k in [k for k in d.vaos if k in gone]:
                 d.vaos.pop(k).release()
         self._camera_of.clear()
@@ -515,6 +634,10 @@ class RasterSession:
     def release(self) -> None:
         """Free the session's GL objects (buffers, vertex arrays, programs, textures, FBOs)."""
         vaos = [v for d in self.draws for v in d.vaos.values()]
+        vaos += [v for d in self.draws if d.tint is not None for v in d.tint.vaos.values()]
+        for m in list(self.env_maps.values()) + ([self.shadow_atlas] if self.shadow_atlas else []):
+            m.release()
+        self.env_maps, self.shadow_atlas = {}, None
         for obj in vaos + self._gl_objects + list(self._gl_images.values()) + list(self.programs.programs.values()):
             obj.release()
         for _, free in self._fbos.values():
@@ -553,30 +676,93 @@ class RasterSession:
         return self._fbos[key][0]
 
     def draw_to(self, fbo, camera: Camera, near: float | None = None, far: float | None = None):
-        """Draw the scene seen by ``camera`` into ``fbo`` (colour attachment 0 + depth).
-        Returns the (near, far) used."""
-        import moderngl
-        ctx = self.ctx
-        n0, f0 = self.near_far(camera)
-        near, far = near or n0, far or f0
+        """Draw the scene seen by ``camera`` into ``fbo`` (colour attachment 0 + depth), after
+        the stand-ins' maps when the scene changed since they were drawn (shadow maps: at the
+        first frame, since a light or geometry edit builds a new session; environment maps: at
+        the first frame and after every edit :meth:`update` takes).  Neither depends on the
+        camera, so a camera move redraws neither.  Returns the (near, far) used."""
+        if not (near and far):  # the automatic planes only when needed (Python, per draw)
+            n0, f0 = self.near_far(camera)
+            near, far = near or n0, far or f0
         if not 0.0 < near < far:
             raise WorkbenchError(f"clip planes need 0 < near < far, got near {near:.6g} and far {far:.6g}")
+        if (self.shadow_atlas is not None and not self._shadows_drawn) or (self.env_maps and not self._env_drawn):
+            t0 = time.perf_counter()
+            if self.shadow_atlas is not None and not self._shadows_drawn:
+                self._draw_shadow_maps()
+            if self.env_maps and not self._env_drawn:
+                self.draw_environment_maps()
+            self.timings["standin_maps"] = time.perf_counter() - t0
+        self._draw_pass(fbo, (0, 0, fbo.width, fbo.height), camera, near, far)
+        return near, far
+
+    def draw_environment_maps(self, rounds: int = 2) -> None:
+        """Draw every environment map's six faces from its object's centre, the object left
+        out, with the image's programs.  Mapped objects see each other's maps as last drawn:
+        ``rounds`` passes over all maps (from maps cleared to the background) give
+        ``rounds - 1`` bounces between them (a mirror sees the glass ball refracting the
+        mirror's first-round map)."""
+        bg = tuple(float(x) for x in self.scene.background)
+        for env in self.env_maps.values():
+            env.fbo.clear(*bg, 0.0, depth=1.0)
+        for _ in range(rounds):
+            for env in self.env_maps.values():
+                for viewport, face in env.faces():
+                    self._draw_pass(env.fbo, viewport, face, env.near, env.far, skip=env.key)
+        self._env_drawn = True
+
+    def _draw_shadow_maps(self) -> None:
+        """Depth of every surface (area lights' polygons excepted: their stand-in lights sit on
+        them) seen from each tile of the shadow atlas (:class:`.raster_standins.ShadowAtlas`)."""
+        import moderngl
+        ctx, atlas = self.ctx, self.shadow_atlas
+        prog = self.programs.get("shadow_depth", base_defines())
+        atlas.fbo.use()
+        atlas.fbo.depth_mask = True
+        atlas.fbo.clear(depth=1.0)
+        ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<"
+        for viewport, clip in atlas.tiles():
+            ctx.viewport = viewport
+            prog["u_clip_from_world"].write(np.ascontiguousarray(clip.T, dtype="f4").tobytes())
+            for d in self.draws:
+                if d.name is not None:
+                    self._vertex_array(d, prog).render(moderngl.TRIANGLES)
+        self._camera_of.pop(id(prog), None)
+        self._shadows_drawn = True
+
+    def _vertex_array(self, d: _Draw, prog):
+        """The vertex array of draw ``d``'s buffers for ``prog`` (made once per program)."""
+        vao = d.vaos.get(id(prog))
+        if vao is None:
+            vbo, fmt, names, index = d.buffers
+            vao = d.vaos[id(prog)] = self.ctx.vertex_array(prog, [(vbo, fmt, *names)], index,
+                                                           index_element_size=4, skip_errors=True)
+        return vao
+
+    def _draw_pass(self, fbo, viewport: tuple, camera: Camera, near: float, far: float, skip=None) -> None:
+        """The scene seen by ``camera`` into the ``viewport`` of ``fbo`` (cleared there), all
+        draws but those of object ``skip`` (an environment map's own object)."""
+        import moderngl
+        ctx = self.ctx
         V = camera.camera_from_world()
         clip = camera.clip_from_camera(near, far) @ V
         eye = tuple(float(x) for x in camera.position)
         fbo.use()
-        ctx.viewport = (0, 0, fbo.width, fbo.height)
+        ctx.viewport = viewport
         bg = tuple(float(x) for x in self.scene.background)
-        fbo.clear(*bg, 0.0, depth=1.0, viewport=(0, 0, fbo.width, fbo.height))
+        fbo.clear(*bg, 0.0, depth=1.0, viewport=viewport)
         ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
         cam_pos = np.asarray(camera.position)
+        draws = self.draws if skip is None else [d for d in self.draws if d.group != skip]
         # opaque front to back (early depth rejection), then the environment where nothing is,
         # then blended surfaces back to front without depth writes
-        opaque = sorted((d for d in self.draws if not d.blended),
+        opaque = sorted((d for d in draws if not d.blended),
                         key=lambda d: float(np.linalg.norm(d.centre - cam_pos)))
-        blended = sorted((d for d in self.draws if d.blended),
+        blended = sorted((d for d in draws if d.blended),
                          key=lambda d: -float(np.linalg.norm(d.centre - cam_pos)))
         clip_bytes = np.ascontiguousarray(clip.T, dtype="f4").tobytes()
         ctx.provoking_vertex = moderngl.LAST_VERTEX_CONVENTION  # flat: provoking_layout
@@ -603,17 +789,22 @@ class RasterSession:
             ctx.depth_func = "<"
         if blended:
             ctx.enable(moderngl.BLEND)
-            ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
             fbo.depth_mask = False
             for d in blended:
                 # closed solids: only their front faces (the back ones would blend in twice)
                 if d.part.kind in CLOSED_KINDS:
                     ctx.enable(moderngl.CULL_FACE)
+                if d.tint is not None:
+                    # stand-in transparency: behind *= kt C, then + the surface's own light
+                    ctx.blend_func = moderngl.ZERO, moderngl.SRC_COLOR
+                    self._render_draw(d.tint, clip_bytes, eye)
+                    ctx.blend_func = moderngl.ONE, moderngl.ONE
+                else:
+                    ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
                 self._render_draw(d, clip_bytes, eye)
                 ctx.disable(moderngl.CULL_FACE)
         fbo.depth_mask = True
         ctx.disable(moderngl.BLEND)
-        return near, far
 
     def _render_draw(self, d: _Draw, clip_bytes: bytes, eye: tuple) -> None:
         """One draw; a program keeps its uniforms, so a draw's material uniforms are written
@@ -677,19 +868,22 @@ _MAX_SESSIONS = 6
 
 
 def session_for(scene: Scene, mode: str, tessellation: int, blinn: bool, depth_bits: int,
-                shading=None) -> tuple[RasterSession, bool]:
-    """A cached :class:`RasterSession` for the scene's content (camera excluded) and shading
-    model (``shading``: a user's, by its source text and parameter values); returns
-    ``(session, created)``."""
+                shading=None, interpolation: str = "perspective", normals: str = "smooth",
+                standins: sti.StandinOptions | None = None) -> tuple[RasterSession, bool]:
+    """A cached :class:`RasterSession` for the scene's content (camera excluded), shading
+    model (``shading``: a user's, by its source text and parameter values), interpolation,
+    normal rule and stand-ins; returns ``(session, created)``."""
     ctx = gl.context()
     key = (id(ctx), id(scene.objects), id(scene.materials), id(scene.lights), id(scene.environment),
-           scene.ambient, mode, tessellation, blinn, depth_bits, None if shading is None else shading.key)
+           scene.ambient, mode, tessellation, blinn, depth_bits, None if shading is None else shading.key,
+           interpolation, normals, standins)
     hit = _SESSIONS.get(key)
     if hit is not None and hit[1] is scene.objects:
         _SESSIONS.move_to_end(key)
         return hit[0], False
     session = RasterSession(scene, mode, tessellation=tessellation, blinn=blinn, depth_bits=depth_bits, ctx=ctx,
-                            shading=shading)
+                            shading=shading, interpolation=interpolation, normals=normals,
+                            standins=standins)
     _SESSIONS[key] = (session, scene.objects)
     if len(_SESSIONS) > _MAX_SESSIONS:
         _SESSIONS.popitem(last=False)[1][0].release()
@@ -711,6 +905,7 @@ class _RasterRenderer:
 
     name = ""
     mode = ""
+    ui_kind = "gl"
     knob = Knob("tessellation", (1, 2, 3, 4, 6, 8, 12, 16, 24, 32), DEFAULT_LEVEL,
                 "tessellation level of analytic primitives (sphere: 4L x 8L, see tessellate)")
     options = {
@@ -721,28 +916,71 @@ class _RasterRenderer:
         "view": Option(str, "color", "color image or depth view (white near, black far)", ("color", "depth")),
         "near": Option(float, 0.0, "near clip plane (0: the camera's, or from the scene bounds)"),
         "far": Option(float, 0.0, "far clip plane (0: the camera's, or from the scene bounds)"),
+        "interpolation": Option(str, "perspective", "varyings perspective-correct (GL) or linear in "
+                                "screen space (the course's scanline formulas, GLSL noperspective)",
+                                INTERPOLATIONS),
+        "normals": Option(str, "smooth", "vertex normals: the tessellation's (analytic, area-weighted) "
+                          "or face_mean (the course's plain mean of the incident faces' normals)",
+                          NORMAL_RULES),
+        "standins": Option(sti.parse_standins, "on",
+                           "stand-ins for global effects where the scene needs them (gouraud, phong): on, off "
+                           "(the bare local model) or a subset of envmap,blend,shadows"),
+        "envmap_resolution": Option(int, sti.DEFAULT_ENV_RESOLUTION,
+                                    "texels per side of each face of a dynamic environment map"),
+        "shadow_resolution": Option(int, sti.DEFAULT_SHADOW_RESOLUTION, "texels per side of each shadow map"),
+        "shadow_bias": Option(float, sti.DEFAULT_SHADOW_BIAS,
+                              "shadow-map bias, a fraction of the scene's extent (small: acne)"),
+        "envmap_iterations": Option(int, sti.DEFAULT_ENV_ITERATIONS,
+                                    "parallax-correction steps of environment-map lookups (0: seen from the "
+                                    "object's centre)"),
     }
 
-    memory_options = ("tessellation",)
+    memory_options = ("tessellation", "envmap_resolution", "shadow_resolution")
+
+    def session(self, scene: Scene, *, tessellation: int = DEFAULT_LEVEL, ctx=None) -> RasterSession:
+        """A :class:`RasterSession` drawing this method (the interactive window's GL panels,
+        ``ui_kind`` ``"gl"``) in ``ctx`` (default: the thread's context)."""
+        return RasterSession(scene, self.mode or self.name, tessellation=tessellation, ctx=ctx)
 
     def estimate_bytes(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
-                       **_) -> int:
-        """Triangles (:func:`.estimates.triangle_bound` at ``tessellation``) and pixels."""
+                       standins: str = "on", envmap_resolution: int = sti.DEFAULT_ENV_RESOLUTION,
+                       shadow_resolution: int = sti.DEFAULT_SHADOW_RESOLUTION,
+                       shadow_bias: float = sti.DEFAULT_SHADOW_BIAS,
+                       envmap_iterations: int = sti.DEFAULT_ENV_ITERATIONS, shading=None, **_) -> int:
+        """Triangles (:func:`.estimates.triangle_bound` at ``tessellation``), pixels and the
+        stand-ins' maps (:func:`.raster_standins.standin_bytes`)."""
         if not 1 <= tessellation <= MAX_LEVEL:
             raise WorkbenchError(f"method {self.name!r}: tessellation must be within 1..{MAX_LEVEL}, "
                                  f"got {tessellation}")
+        opts = self._standins(standins, envmap_resolution, shadow_resolution, shadow_bias, envmap_iterations)
         return raster_bytes(scene, width, height, tessellation, _BYTES_PER_TRIANGLE, _BYTES_PER_PIXEL,
-                            _FIXED_BYTES)
+                            _FIXED_BYTES) + sti.standin_bytes(scene, opts, self.mode or self.name,
+                                                              user_model=shading is not None)
+
+    def _standins(self, standins, envmap_resolution, shadow_resolution, shadow_bias,
+                  envmap_iterations) -> sti.StandinOptions:
+        try:
+            return sti.StandinOptions.parse(standins, envmap_resolution, shadow_resolution, shadow_bias,
+                                            envmap_iterations)
+        except WorkbenchError as e:
+            raise WorkbenchError(f"method {self.name!r}: {e}") from None
 
     def render(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
                blinn: bool = False, depth_bits: int = 24, view: str = "color", near: float = 0.0,
-               far: float = 0.0, shading=None) -> RenderResult:
+               far: float = 0.0, shading=None, interpolation: str = "perspective",
+               normals: str = "smooth", standins: str = "on",
+               envmap_resolution: int = sti.DEFAULT_ENV_RESOLUTION,
+               shadow_resolution: int = sti.DEFAULT_SHADOW_RESOLUTION,
+               shadow_bias: float = sti.DEFAULT_SHADOW_BIAS,
+               envmap_iterations: int = sti.DEFAULT_ENV_ITERATIONS) -> RenderResult:
         if not 1 <= tessellation <= MAX_LEVEL:
             raise WorkbenchError(f"method {self.name!r}: tessellation must be within 1..{MAX_LEVEL}, "
                                  f"got {tessellation}")
         if near < 0 or far < 0 or (near and far and far <= near):
             raise WorkbenchError(f"method {self.name!r}: need 0 < near < far, got near={near}, far={far}")
-        session, created = session_for(scene, self.mode or self.name, tessellation, blinn, depth_bits, shading)
+        opts = self._standins(standins, envmap_resolution, shadow_resolution, shadow_bias, envmap_iterations)
+        session, created = session_for(scene, self.mode or self.name, tessellation, blinn, depth_bits, shading,
+                                       interpolation, normals, opts)
         t0 = time.perf_counter()
         image, depth, (n, f) = session.draw(scene.camera.with_resolution(width, height),
                                             near=near or None, far=far or None, with_depth=True)
@@ -755,7 +993,8 @@ class _RasterRenderer:
             image = depth_view(depth, n, f)
         stats = {"gl_renderer": gl.renderer_name(session.ctx), "triangles": session.n_triangles,
                  "near": n, "far": f, "depth_bits": depth_bits, "programs": len(session.programs.programs),
-                 "draw_calls": len(session.draws), "session_reused": not created}
+                 "draw_calls": len(session.draws), "session_reused": not created,
+                 "interpolation": interpolation, "normals": normals, "standins": session.standins_used}
         return RenderResult(self.name, image, timings, stats, list(session.features_used),
                             list(session.left_out), depth=depth)
 

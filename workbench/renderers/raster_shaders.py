@@ -182,7 +182,8 @@ def light_uniforms(lights) -> dict[str, np.ndarray]:
 def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: int,
                      has_uv: bool, blinn: bool, depth_bits: int, allow_bump: bool,
                      live_material: bool = False, live_lights: bool = False,
-                     needs: frozenset[str] | None = None, user_model: bool = False) -> dict[str, object]:
+                     needs: frozenset[str] | None = None, user_model: bool = False,
+                     screen_space: bool = False, standins=None) -> dict[str, object]:
     """The ``#define``s of one draw: what the scene needs and this material uses, nothing else.
 
     ``MODE_*`` (flat, gouraud, phong); the scene's ambient and the material's constants as
@@ -206,6 +207,12 @@ def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: i
     ``needs``: ``ft.scene_needs(scene)`` when the caller has it.  ``user_model``: a user's shading
     model replaces the local model (``USER_MODEL``, ``shaders/include/user_model.glsl``; the
     lights are compiled in whatever kd and ks are, since the user's model may use neither).
+    ``screen_space``: ``SCREEN_SPACE``, every smooth varying linear in screen space (the
+    course's scanline interpolation, GLSL's ``noperspective`` made robust to near-plane
+    clipping: ``shaders/include/screen_space.glsl``).
+    ``standins``: the global-effect stand-ins this draw compiles (a
+    :class:`~.raster_standins.DrawStandins`, or None: the bare local model), see
+    :func:`standin_defines`.
     """
     needs = ft.scene_needs(scene) if needs is None else needs
     d = base_defines()
@@ -245,6 +252,38 @@ def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: i
         d["ENV_KIND"] = ENV_KIND[scene.environment.kind if scene.environment else "sky"]
     if depth_bits == 16:
         d["DEPTH_LEVELS"] = ""
+    if screen_space:
+        d["SCREEN_SPACE"] = ""
+    if standins is not None:
+        d.update(standin_defines(material, standins, lit=bool(d.get("FOR_EACH_LIGHT(X)"))))
+    return d
+
+
+def standin_defines(material: Material, s, *, lit: bool) -> dict[str, object]:
+    """The ``#define``s of the stand-ins one draw compiles (``shaders/include/standins.glsl``;
+    ``s`` a :class:`~.raster_standins.DrawStandins`): ``ENV_CUBE`` + ``ENV_RES`` + ``ENV_ITERATIONS``
+    (the object's dynamic environment map: kr reflection), ``ENV_KT`` + ``MAT_KT`` + ``MAT_IOR`` (kt
+    refraction through the same map), ``TINT_PASS`` + ``MAT_KT`` (the multiplicative pass of
+    blended transparency), and for a lit material ``SHADOW_MAPS`` with the shadow atlas's
+    layout (``SHADOW_RES``, ``SHADOW_COLS``, ``SHADOW_TILES``, the per-light lists
+    ``SHADOW_BASE_LIST``, ``SHADOW_CUBE_LIST``, ``SHADOW_POS_LIST``, ``SHADOW_RANGE_LIST`` and the world-space
+    ``SHADOW_BIAS``)."""
+    d: dict[str, object] = {}
+    if s.env_res > 0:
+        d["ENV_CUBE"], d["ENV_RES"], d["ENV_ITERATIONS"] = "", int(s.env_res), int(s.env_iterations)
+        if s.env_kt:
+            d["ENV_KT"], d["MAT_KT"], d["MAT_IOR"] = "", _float(material.kt), _float(material.ior)
+    if s.tint_pass:
+        d["TINT_PASS"], d["MAT_KT"] = "", _float(material.kt)
+    L = s.shadows
+    if L is not None and lit:
+        d["SHADOW_MAPS"] = ""
+        d["SHADOW_RES"], d["SHADOW_COLS"], d["SHADOW_TILES"] = int(L.resolution), int(L.cols), int(L.tiles)
+        d["SHADOW_BASE_LIST"] = "int[](" + ", ".join(str(int(b)) for b in L.base) + ")"
+        d["SHADOW_CUBE_LIST"] = "bool[](" + ", ".join("true" if c else "false" for c in L.cube) + ")"
+        d["SHADOW_POS_LIST"] = "vec3[](" + ", ".join(_vec3(p) for p in L.pos) + ")"
+        d["SHADOW_RANGE_LIST"] = "vec2[](" + ", ".join(f"vec2({_float(n)}, {_float(f)})" for n, f in L.ranges) + ")"
+        d["SHADOW_BIAS"] = _float(L.bias_world)
     return d
 
 

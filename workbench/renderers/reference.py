@@ -336,6 +336,7 @@ class PyrenderRenderer:
     """The registered ``pyrender`` method (see the module docstring for the mapping)."""
 
     name = "pyrender"
+    ui_kind = "child"
     knob = Knob("tessellation", (1, 2, 3, 4, 6, 8, 12, 16), DEFAULT_LEVEL,
                 "tessellation level of analytic primitives (as the raster methods)")
     options = {

@@ -13,6 +13,7 @@ BUILTIN: dict[str, str] = {
     "flat": "workbench.renderers.raster:FlatRenderer",
     "gouraud": "workbench.renderers.raster:GouraudRenderer",
     "phong": "workbench.renderers.raster:PhongRenderer",
+    "zbuffer": "workbench.renderers.zbuffer:ZBufferRenderer",
     "pyrender": "workbench.renderers.reference:PyrenderRenderer",
     "povray": "workbench.renderers.povray:PovrayRenderer",
     "raycast": "workbench.renderers.raytrace.whitted:RaycastRenderer",

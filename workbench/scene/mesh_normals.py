@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.tol import tol
 from ..core.transform import normalize
 
 DEFAULT_CREASE_ANGLE = 30.0
@@ -81,3 +82,31 @@ def _crease_vertices(F: np.ndarray, fu: np.ndarray, cos_max: float, n_vertices: 
     out[lo[e0[crease]]] = True
     out[hi[e0[crease]]] = True
     return out
+
+
+def mean_face_normals(V: np.ndarray, F: np.ndarray, fallback: np.ndarray) -> np.ndarray:
+    """Vertex normals as the course defines them for Gouraud and Phong smoothing: "moyenne des
+    normales aux faces incidentes", the plain mean of the unit normals of the triangles around
+    each vertex (each triangle counts once, whatever its area or its angle at the vertex;
+    compare :func:`crease_normals`' area weights and the analytic normals of spheres).
+
+    Parameters
+    ----------
+    V : (N, 3) vertices; F : (T, 3) int triangles (a vertex shared by triangles is one index).
+    fallback : (N, 3) unit normals kept where the mean cancels (``< tol.normal_cancel``) or
+        no triangle uses the vertex.
+
+    Returns
+    -------
+    (N, 3) unit normals.
+    """
+    V = np.asarray(V, dtype=np.float64)
+    F = np.asarray(F, dtype=np.int64)
+    fu = normalize(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]))
+    vert = F.reshape(-1)
+    face = np.repeat(np.arange(len(F)), 3)
+    total = np.stack([np.bincount(vert, fu[face, c], minlength=len(V)) for c in range(3)], -1)
+    count = np.bincount(vert, minlength=len(V))
+    mean = total / np.maximum(count, 1)[:, None]
+    ok = np.linalg.norm(mean, axis=-1) >= tol.normal_cancel
+    return np.where(ok[:, None], normalize(mean), np.asarray(fallback, dtype=np.float64))

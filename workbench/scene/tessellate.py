@@ -43,11 +43,14 @@ polygon as the course draws it.
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..core.errors import WorkbenchError
 from . import model as m
 from .kinds import kind_of
+from .mesh_normals import mean_face_normals
 from .parts import Part
 
 DEFAULT_LEVEL = 6
@@ -85,3 +88,27 @@ def tessellate_scene(scene: m.Scene, level: int = DEFAULT_LEVEL) -> list[Part]:
     for obj in scene.objects:
         parts.extend(tessellate_object(obj, level))
     return parts
+
+
+def area_light_parts(scene: m.Scene) -> list[tuple[Part, m.Material]]:
+    """Area lights as emissive polygons of radiance ``color * intensity`` (what the raster
+    methods draw of them), each with its own material."""
+    return [(part, mat) for _, polygon, mat in scene.area_light_polygons()
+            for part in tessellate_object(polygon, 1)]
+
+
+#: Vertex-normal rules of the raster methods' ``normals`` option: ``"smooth"`` keeps the
+#: tessellation's (analytic for spheres and quadrics, area-weighted for meshes), ``"face_mean"``
+#: is the course's plain mean of the incident triangles' normals.
+NORMAL_RULES = ("smooth", "face_mean")
+
+
+def with_normal_rule(part: Part, rule: str) -> Part:
+    """``part`` with its vertex normals by ``rule`` (:data:`NORMAL_RULES`; ``"face_mean"``:
+    :func:`.mesh_normals.mean_face_normals`, the course's "moyenne des normales aux faces
+    incidentes", over the part's triangles)."""
+    if rule == "smooth":
+        return part
+    if rule != "face_mean":
+        raise WorkbenchError(f"normals must be one of {', '.join(NORMAL_RULES)}, got {rule!r}")
+    return replace(part, normals=mean_face_normals(part.positions, part.faces, part.normals))

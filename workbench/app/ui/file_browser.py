@@ -1,35 +1,23 @@
-"""An in-window file browser for scene files (``*.toml``).
+"""In-window file browsers: scene files (``*.toml``) and users' shading models (``*.glsl``).
 
 imgui-bundle's ``portable_file_dialogs`` opens zenity or kdialog, which a bare (or headless)
-machine does not have; this browser lists a folder inside the window instead: its sub-folders,
-its scene files, a parent button and a folder field.  Opening a file that does not load leaves
-the current scene as it was and shows the loader's message (:class:`~workbench.scene.io.SceneError`
-names the file, the key and what was expected) in the window.
+machine does not have; a browser lists a folder inside the window instead: its sub-folders,
+its files of the browser's pattern, a parent button and a folder field.  Opening a scene file
+that does not load leaves the current scene as it was and shows the loader's message
+(:class:`~workbench.scene.io.SceneError` names the file, the key and what was expected) in the
+window; a shading model that cannot be used or does not compile shows its one-line message
+(the user's file and line) the same way.
 """
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 
 from ...core.errors import WorkbenchError
-from .state import AppState, set_scene
+from .state import AppState, Browser, add_shading_model, set_scene
 
-PATTERN = "*.toml"
 RELIST_SECONDS = 1.0
 """A shown folder is listed again after this long (files saved meanwhile appear), not every frame."""
-
-
-@dataclass
-class Browser:
-    """The browser's folder, the file selected in it and the last outcome (error or opened)."""
-
-    folder: Path
-    selected: Path | None = None
-    message: str = ""
-    failed: bool = False
-    listed: tuple[list[Path], list[Path]] | None = field(default=None, repr=False)
-    listed_at: float = 0.0
 
 
 def cached_listing(browser: Browser, now: float | None = None) -> tuple[list[Path], list[Path]]:
@@ -38,19 +26,20 @@ def cached_listing(browser: Browser, now: float | None = None) -> tuple[list[Pat
     now = time.monotonic() if now is None else now
     if browser.listed is None or now - browser.listed_at >= RELIST_SECONDS:
         browser.listed, browser.listed_at = None, now
-        browser.listed = listing(browser.folder)
+        browser.listed = listing(browser.folder, browser.pattern)
     return browser.listed
 
 
-def listing(folder: Path) -> tuple[list[Path], list[Path]]:
-    """(sub-folders, scene files) of ``folder``, each sorted by name; hidden entries left out."""
+def listing(folder: Path, pattern: str = "*.toml") -> tuple[list[Path], list[Path]]:
+    """(sub-folders, files matching ``pattern``) of ``folder``, each sorted by name; hidden
+    entries left out."""
     folder = Path(folder)
     try:
         entries = [p for p in folder.iterdir() if not p.name.startswith(".")]
     except OSError as e:
         raise WorkbenchError(f"{folder}: cannot list this folder ({e.strerror or e})") from None
     dirs = sorted((p for p in entries if p.is_dir()), key=lambda p: p.name.lower())
-    files = sorted((p for p in entries if p.is_file() and p.match(PATTERN)),
+    files = sorted((p for p in entries if p.is_file() and p.match(pattern)),
                    key=lambda p: p.name.lower())
     return dirs, files
 
@@ -80,11 +69,47 @@ def open_scene(state: AppState, path: Path) -> bool:
     return True
 
 
+def add_model(state: AppState, path: Path) -> bool:
+    """Add the shading model in ``path`` as a method panel (:func:`~.state.add_shading_model`);
+    a file that cannot be used keeps everything as it was and its message is kept."""
+    b = state.shading_browser
+    try:
+        m = add_shading_model(state, path)
+    except WorkbenchError as e:
+        b.message, b.failed = str(e), True
+        return False
+    except OSError as e:
+        b.message, b.failed = f"{path}: cannot be read ({e.strerror or e})", True
+        return False
+    b.message, b.failed = state.status.get("methods") or f"added {m}", "methods" in state.status
+    return True
+
+
 def file_browser(state: AppState) -> None:
-    """The browser: folder field, parent button, folders and scene files, open button, outcome."""
+    """The scene file browser (:func:`browse`), under its title."""
     from imgui_bundle import imgui
-    b = state.browser
     imgui.separator_text("scene file")
+    browse(state.browser, "open", lambda path: open_scene(state, path))
+
+
+def shading_picker(state: AppState) -> None:
+    """The picker of users' shading models: a ``*.glsl`` file becomes a method panel
+    (``glsl:FILE``); under it, the one-line compile error of each added model that failed."""
+    from imgui_bundle import imgui
+    imgui.separator_text("your shading model (GLSL)")
+    browse(state.shading_browser, "add", lambda path: add_model(state, path))
+    imgui.push_text_wrap_pos(0.0)
+    for m in state.user_methods:
+        if m in state.panel_errors:
+            imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), state.panel_errors[m][1])
+    imgui.pop_text_wrap_pos()
+
+
+def browse(b: Browser, action: str, chosen) -> None:
+    """A browser's widgets: folder field, parent button, its folders and files, the ``action``
+    button; ``chosen(path)`` on a double click or the button; the last outcome under them."""
+    from imgui_bundle import imgui
+    imgui.push_id(action)
     if imgui.button("parent"):
         go_to(b, b.folder.parent)
     imgui.same_line()
@@ -109,16 +134,17 @@ def file_browser(state: AppState) -> None:
         if clicked:
             b.selected = f
             if imgui.is_mouse_double_clicked(imgui.MouseButton_.left):
-                open_scene(state, f)
+                chosen(f)
     if not dirs and not files:
-        imgui.text_disabled(f"no folder and no {PATTERN} file here")
+        imgui.text_disabled(f"no folder and no {b.pattern} file here")
     imgui.end_child()
     imgui.begin_disabled(b.selected is None)
-    if imgui.button("open"):
-        open_scene(state, b.selected)
+    if imgui.button(action):
+        chosen(b.selected)
     imgui.end_disabled()
     if b.message:
         colour = imgui.ImVec4(1.0, 0.35, 0.3, 1.0) if b.failed else imgui.ImVec4(0.5, 0.9, 0.5, 1.0)
         imgui.push_text_wrap_pos(0.0)
         imgui.text_colored(colour, b.message)
         imgui.pop_text_wrap_pos()
+    imgui.pop_id()

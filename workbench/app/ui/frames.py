@@ -1,6 +1,6 @@
 """Each panel's picture, kept on the GPU and redrawn only when what it shows changes.
 
-* Raster methods (flat, Gouraud, Phong) draw through a cached
+* GL methods (``ui_kind`` ``"gl"``: flat, Gouraud, Phong, a user's shading model) draw through a cached
   :class:`~workbench.renderers.raster.RasterSession` (one per scene, method and
   tessellation; replaced sessions are released) into the session's float framebuffer, in the
   window's own moderngl context, and only when the panel's inputs change: the scene version
@@ -20,7 +20,7 @@
 * Pixels come back to the CPU only when asked for: ``state.images[m]`` of a raster panel is a
   pending read (:class:`~.images.PanelImages`), resolved once per draw by the probe, the
   difference view, the export or a script.
-* CPU methods are requested from the :class:`~.jobs.JobBoard`; their texture is refreshed when
+* CPU and progressive methods are requested from the :class:`~.jobs.JobBoard`; their texture is refreshed when
   the job reports new tiles (``Job.version``).
 """
 from __future__ import annotations
@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .state import CHILD, RASTER, AppState, shown_image
+from .state import AppState, method_kind
 
 LIVE_REST_SECONDS = 0.5
 """How long edited material or light values must stay unchanged before a GL panel compiles
@@ -265,12 +265,20 @@ class PanelGPU:
     """GL programs compiled by raster sessions since released (tests count compiles)."""
     settle_frame: int = -1
     """The frame of the last ``RasterSession.settle`` step (one per frame)."""
+    near_far: dict = field(default_factory=dict)
+    """{"camera": the camera, boxes bytes: (near, far)}: :func:`shared_near_far`."""
+    backdrops: dict[str, tuple] = field(default_factory=dict)
+    """CPU panel -> (id of its current job, the image shown before that job): :func:`over_stale`."""
+    modes: object = None
+    """:class:`.display_modes.ModeDisplay`: panels shown through another mode than direct24."""
 
 
 def gpu(state: AppState) -> PanelGPU:
     """``state.gpu``, created on first use in the window's context."""
     if state.gpu is None:
-        state.gpu = PanelGPU(DisplayPasses(state.ctx), ScreenBlits(state.ctx))
+        from .display_modes import ModeDisplay
+        state.gpu = PanelGPU(DisplayPasses(state.ctx), ScreenBlits(state.ctx),
+                             modes=ModeDisplay(state.ctx, getattr(state.jobs, "notify", None)))
     return state.gpu
 
 
@@ -329,6 +337,8 @@ def linear_source(state: AppState, method: str) -> tuple[object, bool]:
 
 def refresh_raster(state: AppState, method: str) -> bool:
     """Redraw ``method``'s panel if its inputs changed; returns whether it drew."""
+    from ...core.errors import WorkbenchError
+    from ...renderers.base import get_renderer
     from ...renderers.raster import RasterSession
     g = gpu(state)
     tess = int(state.options[method]["tessellation"])
@@ -339,11 +349,24 @@ def refresh_raster(state: AppState, method: str) -> bool:
         # only material or light values changed: same session, live programs
         panel.session_key, panel.drawn, panel.edited = key, None, time.perf_counter()
     elif panel is None or panel.session_key != key:
+        if state.panel_errors.get(method, (None,))[0] == key:
+            return False  # did not build for these inputs: its message stays shown
         if panel is not None:
             g.compiled += panel.session.programs.compiles
             panel.session.release()
-        panel = g.raster[method] = RasterPanel(
-            RasterSession(state.scene, method, tessellation=tess, ctx=state.ctx), key)
+            del g.raster[method]
+            g.linear.pop(method, None)
+        try:
+            session = get_renderer(method).session(state.scene, tessellation=tess, ctx=state.ctx)
+        except WorkbenchError as e:  # a user's model that does not compile: one line, no image
+            state.panel_errors[method] = (key, str(e))
+            state.status[method] = str(e)
+            if method in state.images:  # del, not pop: a pending read of a released session
+                del state.images[method]
+            state.ctx.screen.use()
+            return False
+        state.panel_errors.pop(method, None)
+        panel = g.raster[method] = RasterPanel(session, key)
         state.status[method] = f"{panel.session.n_triangles} triangles"
     if (panel.session.live and time.perf_counter() - panel.edited > LIVE_REST_SECONDS
             and g.settle_frame != state.frame):
@@ -357,7 +380,7 @@ def refresh_raster(state: AppState, method: str) -> bool:
         return False
     t0 = time.perf_counter()
     fbo = panel.session.framebuffer(cam.width, cam.height)
-    panel.session.draw_to(fbo, cam)
+    panel.session.draw_to(fbo, cam, *shared_near_far(g, panel.session, cam))
     state.ctx.finish()  # the time shown is the draw's, not just its submission
     state.ctx.screen.use()  # back to the window's framebuffer for imgui
     state.timings[method] = time.perf_counter() - t0
@@ -367,6 +390,18 @@ def refresh_raster(state: AppState, method: str) -> bool:
     g.linear[method] = (fbo.color_attachments[0], True, state.images.version(method))
     panel.drawn, panel.draws = cam, panel.draws + 1
     return True
+
+
+def shared_near_far(g: PanelGPU, session, cam) -> tuple[float, float]:
+    """The automatic clip planes of ``session`` for ``cam``, computed once per camera for
+    sessions with the same parts' boxes (the GL panels of one scene and tessellation share
+    them: 3-10 ms of Python each on a loaded machine, every frame of a drag)."""
+    key = session.part_boxes.tobytes()
+    if g.near_far.get("camera") != cam:
+        g.near_far = {"camera": cam}
+    if key not in g.near_far:
+        g.near_far[key] = session.near_far(cam)
+    return g.near_far[key]
 
 
 def read_pixel(fbo, i: int, j: int, shape: tuple[int, int]) -> np.ndarray | None:
@@ -392,7 +427,8 @@ def refresh_cpu(state: AppState, method: str) -> None:
         state.status[method] = (f"done: {job.spp} spp, noise {job.noise:.3g}"
                                 if job.progressive and job.noise is not None else "done")
     elif job.progressive:
-        target = state.options[method]["spp"]
+        from ...renderers.base import get_renderer
+        target = state.options[method][get_renderer(method).knob.name]
         state.status[method] = (f"refining: {job.spp}/{target} spp" +
                                 ("" if job.noise is None else f", noise {job.noise:.3g}"))
     else:
@@ -403,17 +439,41 @@ def refresh_cpu(state: AppState, method: str) -> None:
         image = job.snapshot()
         # the previous job's image is kept while its successor waits, unless it has another
         # size (a scene switch changed the panels' aspect): then black until the new one comes
-        state.images[method] = image if image.shape == shape else np.zeros(shape, np.float32)
+        state.images[method] = (over_stale(state, method, job, image)
+                                if image.shape == shape else np.zeros(shape, np.float32))
+
+
+def over_stale(state: AppState, method: str, job, image: np.ndarray) -> np.ndarray:
+    """What a CPU panel shows of ``job``'s ``image`` (H, W, 3): the image once done; before,
+    its rendered bands (rows ``0 .. job.rows_done``; a progressive job's image once it has a
+    sample) over the panel's previous image (its *backdrop*, taken when the job first shows),
+    so a restarted render never blanks the panel (it used to show black until its bands came)."""
+    g = gpu(state)
+    held = g.backdrops.get(method)
+    if held is None or held[0] != id(job):
+        prev = state.images[method] if method in state.images else None
+        held = g.backdrops[method] = (id(job), prev)
+    back = held[1]
+    if job.done or back is None or back.shape != image.shape:
+        return image
+    if job.progressive:
+        return image if job.spp > 0 else back
+    out = back.copy()
+    out[:job.rows_done] = image[:job.rows_done]
+    return out
 
 
 def update_images(state: AppState) -> None:
     """Bring every selected panel up to date (called once per frame, before the widgets)."""
     from .pyrender_proc import refresh_pyrender
     state.jobs.keep_only(state.methods)
+    if state.gpu is not None:  # a removed panel's approximation keeps nothing awake
+        state.gpu.modes.approximate &= set(state.methods)
     for m in state.methods:
-        if m in RASTER:
+        kind = method_kind(state, m)
+        if kind == "gl":
             refresh_raster(state, m)
-        elif m in CHILD:
+        elif kind == "child":
             refresh_pyrender(state)
         else:
             refresh_cpu(state, m)
@@ -425,21 +485,33 @@ def in_progress(state: AppState) -> bool:
     values still to compile back in.  The loop then runs at full rate (capped while a job runs,
     :func:`.main.frame_rest`); otherwise it idles."""
     proc = state.pyrender
+    g = state.gpu
     return (state.jobs.busy() or (proc is not None and proc.busy) or state.errors.busy(state.frame)
-            or (state.gpu is not None and any(p.session.live for p in state.gpu.raster.values())))
+            or (g is not None and (any(p.session.live for p in g.raster.values())
+                                   or g.modes.busy())))
 
 
 def panel_texture(state: AppState, method: str):
     """The RGBA8 texture showing ``method``'s panel through its display mode; rebuilt only
-    when the image or the mode changed."""
+    when the image or the mode changed (another mode than direct24:
+    :meth:`.display_modes.ModeDisplay.step`, cheap while the image changes)."""
     mode = state.display.get(method, "direct24")
+    if mode != "direct24":
+        g = gpu(state)
+        g.shown.pop(method, None)
+        todo = g.modes.step(method, state.images.version(method), mode,
+                            lambda: state.images[method], method in state.textures)
+        if todo is not None and todo[0] == "pass":
+            source, flip = linear_source(state, method)
+            g.modes.run(source, flip, display_texture(state, method, source.size), *todo[1:])
+        elif todo is not None:
+            upload_linear(state, method, todo[1])
+        return state.textures[method]
+    gpu(state).modes.forget(method)
     key = (state.images.version(method), mode)
     if stale(state, method, key) or method not in state.textures:
-        if mode == "direct24":
-            source, flip = linear_source(state, method)
-            gpu(state).passes.encode(source, display_texture(state, method, source.size), flip)
-        else:
-            upload_linear(state, method, shown_image(state, method))
+        source, flip = linear_source(state, method)
+        gpu(state).passes.encode(source, display_texture(state, method, source.size), flip)
     return state.textures[method]
 
 
@@ -521,6 +593,7 @@ def release_gl(state: AppState) -> None:
             tex.release()
         state.gpu.passes.release()
         state.gpu.blits.release()
+        state.gpu.modes.release()
         state.gpu = None
     for tex in state.textures.values():
         tex.release()

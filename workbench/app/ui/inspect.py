@@ -1,10 +1,8 @@
-"""Looking closely: the pixel probe, the ray tree of a clicked pixel and the export of the
-comparison (panels, difference view and settings)."""
+"""Looking closely: the pixel probe and the ray tree of a clicked pixel (the export is in
+:mod:`.export`)."""
 from __future__ import annotations
 
-import json
-from dataclasses import asdict, replace
-from pathlib import Path
+from dataclasses import replace
 
 import numpy as np
 from imgui_bundle import imgui
@@ -75,31 +73,3 @@ def ray_tree_view(state: AppState) -> None:
         i, j = state.ray_tree["pixel"]
         imgui.set_next_item_open(True, imgui.Cond_.once)
         _show_node(f"pixel ({i}, {j})", state.ray_tree["tree"])
-
-
-def settings(state: AppState) -> dict:
-    """The comparison's settings (scene, camera, methods and their options, material overrides,
-    difference view)."""
-    return {"scene": str(state.scene_path), "camera": asdict(state.camera),
-            "methods": list(state.methods),
-            "options": {m: state.options[m] for m in state.methods},
-            "material_overrides": state.overrides,
-            "light_overrides": {str(k): v for k, v in state.light_overrides.items()},
-            "difference": {"a": state.diff_pair[0], "b": state.diff_pair[1],
-                           "kind": state.diff_kind}}
-
-
-def export(state: AppState, folder: Path) -> list[Path]:
-    """Write every panel (sRGB PNG), the difference view (colour scale PNG) and
-    ``settings.json`` into ``folder``; returns the files written."""
-    from ...core.imageio import save_png, save_png8
-    from .panels import colour_scale
-    folder = Path(folder)
-    written = [save_png(folder / f"{m}.png", state.images[m])
-               for m in state.methods if m in state.images]
-    err = state.images.get("difference")
-    if err is not None:
-        written.append(save_png8(folder / "difference.png", colour_scale(err, float(err.max()))))
-    path = folder / "settings.json"
-    path.write_text(json.dumps(settings(state), indent=1, default=str))
-    return [*written, path]

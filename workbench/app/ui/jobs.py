@@ -1,4 +1,5 @@
-"""CPU methods (ray casting, ray tracing, radiosity, hybrid) in background threads.
+"""Methods that render on the CPU (``ui_kind`` ``"cpu"`` or ``"progressive"``,
+:data:`workbench.renderers.base.UI_KINDS`) in background threads.
 
 A :class:`Job` renders one (scene, camera, method, options) request with
 :func:`workbench.renderers.base.render`; methods that accept ``on_tile`` fill ``partial`` band
@@ -31,11 +32,8 @@ from dataclasses import replace
 
 import numpy as np
 
-PROGRESSIVE = {"pathtrace": "workbench.renderers.pathtrace.session:PathTraceSession"}
-"""Methods whose job refines one image pass after pass (a session with ``add_samples(n)``,
-``image``, ``samples`` and ``noise_rmse``, as :class:`~workbench.renderers.pathtrace.session.
-PathTraceSession`): the panel shows the running image, its samples per pixel and noise, and
-the job ends at the method's ``spp`` option."""
+from ...renderers.base import check_memory, convert_options, get_renderer
+
 PASS_SAMPLES = 1 << 16
 """Samples (over the whole image) per pass of a progressive job: a 256 x 192 panel gets one
 sample per pixel per pass, so its image and noise refresh several times a second at first."""
@@ -82,7 +80,10 @@ class Job:
         self.error = None
         self.rows_done = 0
         self.version = 0
-        self.progressive = method in PROGRESSIVE
+        # a progressive method's job refines one image pass after pass (a session with
+        # add_samples(n), image, samples and noise_rmse): the panel shows the running image, its
+        # samples per pixel and noise, and the job ends at the method's spp option
+        self.progressive = get_renderer(method).ui_kind == "progressive"
         self.spp, self.noise = 0, None
         self.cancelled = threading.Event()
         self.lock = threading.Lock()
@@ -138,18 +139,15 @@ class Job:
         self._notify()
 
     def _refine(self, scene, method: str, opts: dict) -> np.ndarray:
-        """A progressive render: passes of :data:`PASS_SAMPLES` samples until ``opts["spp"]``
-        samples per pixel, each pass's running image in ``partial`` (cancelled between
+        """A progressive render: passes of :data:`PASS_SAMPLES` samples until the knob's
+        value (``opts["spp"]``) of samples per pixel, each pass's running image in ``partial`` (cancelled between
         passes); returns the final image."""
-        import importlib
-
-        from ...renderers.base import check_memory, get_renderer
-        mod, attr = PROGRESSIVE[method].split(":")
+        r = get_renderer(method)
         w, h = scene.camera.width, scene.camera.height
-        check_memory(get_renderer(method), scene, w, h, opts)  # as render() does first
-        opts = dict(opts)
-        target = int(opts.pop("spp"))
-        session = getattr(importlib.import_module(mod), attr)(scene, w, h, **opts)
+        opts = convert_options(r, opts)
+        check_memory(r, scene, w, h, opts)  # as render() does first
+        target = int(opts[r.knob.name])
+        session = r.progressive_session(scene, w, h, **opts)
         per_pass = max(1, PASS_SAMPLES // (w * h))
         while session.samples < target:
             if self.cancelled.is_set():

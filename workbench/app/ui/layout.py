@@ -34,30 +34,6 @@ STATUS_BAR = 30
 """Pixels of the window's height taken by the status bar."""
 
 
-PANEL_GAP = 8
-"""Pixels between two image panels (imgui's item spacing and a margin)."""
-PANEL_LINES = 3
-"""Text lines of each panel besides its image: title, status, display-mode combo."""
-
-
-def panel_grid(n: int, avail_w: float, avail_h: float, aspect: float,
-               chrome_h: float) -> tuple[int, float, float]:
-    """Lay out ``n`` panels of aspect ``aspect`` (width / height) in rows that fit a region of
-    ``avail_w`` x ``avail_h`` pixels, each panel taking ``chrome_h`` pixels of text besides its
-    image: (columns, image width, image height) of the largest images for which the rows fit
-    both ways (never below 32 pixels wide: the window then scrolls)."""
-    best = (1, 0.0)
-    for cols in range(1, max(1, n) + 1):
-        rows = -(-n // cols)
-        w = min((avail_w - (cols - 1) * PANEL_GAP) / cols,
-                ((avail_h - (rows - 1) * PANEL_GAP) / rows - chrome_h) * aspect)
-        if w > best[1]:
-            best = (cols, w)
-    cols, w = best
-    w = max(32.0, float(int(w)))
-    return cols, w, float(int(w / aspect))
-
-
 def splits(window_height: int, panel_height: int) -> list[tuple[str, str, object, float]]:
     """(dock space split, new dock space, side, fraction of the split one) in order: the
     control row takes what one row of panels leaves of the window's height (between 20 % and
@@ -73,7 +49,7 @@ def splits(window_height: int, panel_height: int) -> list[tuple[str, str, object
 
 def windows(state: AppState) -> list[tuple[str, str, object]]:
     """(label, dock space, gui function of no argument) of every dockable window."""
-    from .file_browser import file_browser
+    from .file_browser import file_browser, shading_picker
     from .inspect import ray_tree_view
     from .lights import light_controls
     from .panels import (colour_wheel, difference_panel, image_panels, method_list, parameters,
@@ -81,7 +57,7 @@ def windows(state: AppState) -> list[tuple[str, str, object]]:
     from .patch_view import patch_view
     from .plot import error_plot
     return [("Scene", "ControlSpace", lambda: (scene_picker(state), file_browser(state))),
-            ("Methods", "MethodSpace", lambda: method_list(state)),
+            ("Methods", "MethodSpace", lambda: (method_list(state), shading_picker(state))),
             ("Parameters", "ParamSpace", lambda: parameters(state)),
             ("Lights", "ParamSpace", lambda: light_controls(state)),
             ("Colour wheel", "ParamSpace", lambda: colour_wheel(state)),
@@ -107,14 +83,9 @@ def docking_params(state: AppState, window_height: int) -> hello_imgui.DockingPa
     return params
 
 
-def focus(label: str) -> None:
-    """Bring a dockable window's tab to the front (e.g. the ray tree after a Ctrl+click)."""
-    hello_imgui.get_runner_params().docking_params.focus_dockable_window(label)
-
-
 def window_report() -> dict[str, dict]:
     """Each dockable window's state in the last frame: docked, drawn (shown, i.e. its tab in
-    front) and size."""
+    front), size and position (window pixels)."""
     from imgui_bundle.imgui import internal
     out = {}
     for w in hello_imgui.get_runner_params().docking_params.dockable_windows:
@@ -123,5 +94,6 @@ def window_report() -> dict[str, dict]:
             out[w.label] = {"exists": False}
             continue
         out[w.label] = {"exists": True, "docked": bool(win.dock_id), "drawn": bool(win.was_active and not win.hidden),
-                        "size": [float(win.size.x), float(win.size.y)]}
+                        "size": [float(win.size.x), float(win.size.y)],
+                        "pos": [float(win.pos.x), float(win.pos.y)]}
     return out

@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 from ..args import size
+from .glfw_title import glfw_library, window_title
 from .state import AppState, new_state
 
 WINDOW_SIZE = (1280, 760)
@@ -31,30 +32,6 @@ def frame_rest(last: float | None, now: float, cap: float, job_running: bool) ->
     if last is None or cap <= 0.0 or not job_running:
         return 0.0
     return max(0.0, last + 1.0 / cap - now)
-
-
-def window_title(state: AppState) -> str:
-    """The window's title: the scene shown."""
-    return f"workbench ui: {state.scene_path.stem}"
-
-
-def _glfw():
-    """The window's GLFW library (imgui-bundle's), with the title functions typed."""
-    import ctypes
-
-    import imgui_bundle
-    glfw = ctypes.CDLL(str(Path(imgui_bundle.__file__).parent / "libglfw.so.3"))
-    glfw.glfwGetCurrentContext.restype = ctypes.c_void_p
-    glfw.glfwSetWindowTitle.argtypes = [ctypes.c_void_p, ctypes.c_char_p]
-    glfw.glfwGetWindowTitle.argtypes = [ctypes.c_void_p]
-    glfw.glfwGetWindowTitle.restype = ctypes.c_char_p
-    return glfw
-
-
-def shown_title() -> str:
-    """The title the window has now (GLFW's), for scripts and tests."""
-    glfw = _glfw()
-    return (glfw.glfwGetWindowTitle(glfw.glfwGetCurrentContext()) or b"").decode()
 
 
 def run(state: AppState, max_frames: int | None = None, script=None,
@@ -92,7 +69,7 @@ def run(state: AppState, max_frames: int | None = None, script=None,
         track(state)
         if window_title(state) != clock["title"]:  # the scene changed: so does the title
             clock["title"] = window_title(state)
-            glfw = _glfw()
+            glfw = glfw_library()
             glfw.glfwSetWindowTitle(glfw.glfwGetCurrentContext(), clock["title"].encode())
         if script is not None:
             script(state)

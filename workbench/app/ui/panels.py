@@ -7,11 +7,14 @@ from imgui_bundle import imgui
 from . import camera as cam
 from .frames import (difference_on_gpu, image_stats, panel_texture, show_image, stale, upload,
                      upload_linear)
-from .inspect import export, pixel_under_mouse, probe_tooltip, select_ray_tree
-from .layout import focus
+from .colours import colour_scale, hot_table
+from .export import export
+from .inspect import pixel_under_mouse, probe_tooltip, select_ray_tree
 from .patch_view import select_patch
+from .placement import PANEL_GAP, PANEL_LINES, focus, panel_grid
 from .state import (DISPLAY_MODES, HARMONIES, MATERIAL_FIELDS, AppState, choosable_methods,
-                    set_display, set_material_value, set_option, set_scene, toggle_method)
+                    set_display, set_material_value, set_option, set_scene, short_name,
+                    toggle_method)
 
 ORBIT_SPEED = 0.01
 """Radians of orbit per pixel of mouse drag."""
@@ -20,25 +23,6 @@ ZOOM_STEP = 0.9
 MATERIAL_RANGES = {"ka": (0.0, 1.0), "kd": (0.0, 1.0), "ks": (0.0, 1.0),
                    "shininess": (1.0, 500.0), "kr": (0.0, 1.0), "kt": (0.0, 1.0),
                    "ior": (1.0, 2.5)}
-HOT = np.array([[0, 0, 0], [0.5, 0, 0], [1, 0.3, 0], [1, 0.9, 0], [1, 1, 1]], np.float32)
-"""Colour scale of the difference panel, from 0 (black) to the maximum (white)."""
-
-
-def hot_table(n: int = 256) -> np.ndarray:
-    """(n, 3) uint8 colours of :data:`HOT`, piecewise linear from 0 to 1."""
-    t = np.linspace(0.0, 1.0, n) * (len(HOT) - 1)
-    i = np.minimum(t.astype(int), len(HOT) - 2)
-    f = (t - i)[:, None]
-    return ((HOT[i] * (1 - f) + HOT[i + 1] * f) * 255 + 0.5).astype(np.uint8)
-
-
-def colour_scale(values: np.ndarray, vmax: float) -> np.ndarray:
-    """(H, W) values in [0, vmax] -> (H, W, 3) uint8 colours of :data:`HOT` (display space)."""
-    table = hot_table()
-    idx = (np.clip(values * (1.0 / vmax if vmax > 0 else 0.0), 0.0, 1.0) * (len(table) - 1))
-    return table[idx.astype(np.intp)]
-
-
 def check_fits(state: AppState, name: str) -> None:
     """Note in ``state.cut`` whether the last item (its frame and label) ends past the right
     edge of its window's content: nothing should (scripts and tests read it)."""
@@ -89,7 +73,7 @@ def scene_picker(state: AppState) -> None:
     check_fits(state, "export")
     if clicked:
         folder = (state.export_dir / f"{state.scene_path.stem}_{state.frame:06d}").resolve()
-        state.status["export"] = f"saved {len(export(state, folder))} files to {folder}"
+        export(state, folder)  # its message (the folder, panels skipped) in status["export"]
     if "export" in state.status:
         imgui.push_text_wrap_pos(0.0)
         imgui.text_disabled(state.status["export"])
@@ -99,15 +83,17 @@ def scene_picker(state: AppState) -> None:
 def method_list(state: AppState) -> None:
     """Checkboxes over the methods (1 to 6 selected), in as many columns as their labels
     fit (two at most); a refused change says why."""
-    methods = choosable_methods()
+    methods = [*choosable_methods(), *state.user_methods]
     style = imgui.get_style()
-    column = imgui.get_frame_height() + label_room(*methods) + style.item_spacing.x
+    column = imgui.get_frame_height() + label_room(*map(short_name, methods)) + style.item_spacing.x
     cols = 2 if 2 * column <= imgui.get_content_region_avail().x else 1
     x0 = imgui.get_cursor_pos_x()
     for k, m in enumerate(methods):
         if k % cols:
             imgui.same_line(x0 + column)
-        changed, on = imgui.checkbox(m, m in state.methods)
+        changed, on = imgui.checkbox(f"{short_name(m)}##{m}", m in state.methods)
+        if short_name(m) != m and imgui.is_item_hovered():
+            imgui.set_tooltip(m)
         check_fits(state, f"method {m}")
         if changed:
             toggle_method(state, m, on)
@@ -203,9 +189,8 @@ def text_in_width(text: str, width: float, disabled: bool = False) -> None:
 
 def image_panels(state: AppState) -> None:
     """One image per selected method at the scene camera's aspect, as large as the window
-    allows, in as many rows as fit best (:func:`~.layout.panel_grid`); each image is shown
+    allows, in as many rows as fit best (:func:`~.placement.panel_grid`); each image is shown
     scaled from the panels' render resolution."""
-    from .layout import PANEL_GAP, PANEL_LINES, panel_grid
     avail = imgui.get_content_region_avail()
     chrome = PANEL_LINES * imgui.get_frame_height_with_spacing()
     cols, w, h = panel_grid(len(state.methods), avail.x, avail.y,
@@ -216,7 +201,7 @@ def image_panels(state: AppState) -> None:
         imgui.begin_group()
         t = state.timings.get(m)
         imgui.align_text_to_frame_padding()  # every panel's title on the same baseline
-        text_in_width(f"{m}  {'' if t is None else f'{t * 1e3:.1f} ms'}", w)
+        text_in_width(f"{short_name(m)}  {'' if t is None else f'{t * 1e3:.1f} ms'}", w)
         if m in state.images:
             tex = panel_texture(state, m)
             show_image(state, m, tex, imgui.ImVec2(w, h), *cam.view_window(state.view))

@@ -152,7 +152,7 @@ def row_image(state: AppState, pick: PatchPick) -> np.ndarray:
     """(VIEW_SIZE, VIEW_SIZE, 3) uint8: each patch coloured by F_ij (the difference panel's
     colour scale, 0 to the row's maximum), the picked patch in :data:`SELECTED`."""
     from ...renderers.radiosity.display import draw
-    from .panels import colour_scale
+    from .colours import colour_scale
     vmax = float(pick.row.max())
     colours = colour_scale(pick.row[None], vmax)[0].astype(np.float64) / 255.0
     colours[pick.patch] = SELECTED

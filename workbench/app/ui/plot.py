@@ -12,6 +12,14 @@ setting: its run time and :func:`workbench.compare.metrics.metrics` against the 
 evaluation, ~0.2 s, stalled the UI thread for as long when it ran in a thread).  The UI thread
 only copies images and reads finished results; a change of scene or camera starts a new set of
 points.
+
+The error split (:mod:`workbench.compare.reference`, README "Ground truth and the error split"):
+each method's *matched* reference (the same physics as the method, at its limit:
+:func:`~workbench.compare.reference.matched_spec`; a path-traced one at the path tracer's finest
+knob here) renders as a job of its own, on a board per (reference method, options), and each
+point also gets its error against it (the discretisation error) when it arrives, drawn as a
+dashed "vs matched" line beside the method's total error.  The total point never waits for it;
+while a matched reference renders, the plot says which and how far it is.
 """
 from __future__ import annotations
 
@@ -19,12 +27,11 @@ import multiprocessing as mp
 import time
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from .jobs import job_key
-from .state import CHILD, RASTER, AppState
+from .state import AppState, ErrorPlot, choosable_methods, method_kind, short_name
 
 SETTLE_SECONDS = 0.3
 """The camera and scene must stay unchanged this long before the reference render starts."""
@@ -38,52 +45,14 @@ background instead of painting its frame, plot area and legend, which on llvmpip
 ~2.4 ms of CPU per frame (9.0-9.4 against 11.5-11.8 ms for a whole 1600 x 860 frame)."""
 
 
-@dataclass
-class ErrorPlot:
-    """Points of error against run time for one (scene version, camera).
-
-    ``points[method][option values]`` is ``{"seconds", "rmse", "psnr", "flip", "label"}``.
-    """
-
-    key: tuple | None = None
-    since: float = 0.0
-    candidates: list = field(default_factory=list)
-    reference: str | None = None
-    ref_options: dict = field(default_factory=dict)
-    ref_image: np.ndarray | None = None
-    message: str = ""
-    points: dict = field(default_factory=dict)
-    pending: dict = field(default_factory=dict)
-    failed: dict = field(default_factory=dict)
-    metric: str = "rmse"
-    shown: int = -2
-    gave_up: bool = False
-    board: object = None
-    pool: ProcessPoolExecutor | None = None
-
-    def busy(self, frame: int) -> bool:
-        """Something will arrive without any input: evaluations in the worker, or, while the
-        plot is shown (drawn in frame ``frame`` or the one before), its reference."""
-        if self.pending:
-            return True
-        return self.shown >= frame - 1 and self.ref_image is None and not self.gave_up
-
-    def shutdown(self) -> None:
-        """Cancel the reference render and end the worker process (joined)."""
-        if self.board is not None:
-            self.board.join_all()
-        if self.pool is not None:
-            self.pool.shutdown(wait=True, cancel_futures=True)
-            self.pool = None
-
-
 def _final_image(state: AppState, method: str) -> tuple[np.ndarray, float] | None:
     """(image, run time) of a panel whose image is final for the current request, else None."""
-    if method in RASTER:
+    kind = method_kind(state, method)
+    if kind == "gl":
         if method not in state.images or method not in state.timings:
             return None
         return np.array(state.images[method], np.float32), state.timings[method]
-    if method in CHILD:
+    if kind == "child":
         proc = state.pyrender
         current = (state.scene_version, state.camera, tuple(sorted(state.options[method].items())))
         if proc is None or proc.image_key != current:
@@ -143,22 +112,48 @@ MARKERS = ("circle", "square", "diamond", "up", "down", "left", "right", "cross"
 
 def marker_of(method: str) -> str:
     """The name of ``method``'s marker in :data:`MARKERS` (stable: by registry order)."""
-    from .state import choosable_methods
     allowed = choosable_methods()
     k = allowed.index(method) if method in allowed else len(allowed)
     return MARKERS[k % len(MARKERS)]
 
 
+MATCHED_SUFFIX = " vs matched"
+"""Label suffix of a method's line of errors against its matched reference."""
+
+
 def plotted_lines(plot: ErrorPlot, methods, metric: str) -> dict:
-    """{method: (run times in ms, errors)} of the methods on screen (a removed panel's line
-    leaves the legend), each sorted by run time, errors at least :data:`FLOOR`."""
+    """{label: (run times in ms, errors)} of the methods on screen (a removed panel's line
+    leaves the legend), each sorted by run time, errors at least :data:`FLOOR`: the method's
+    total errors under its name, its errors against its matched reference (where evaluated)
+    under ``name + MATCHED_SUFFIX``, right after it."""
     lines = {}
     for m in methods:
-        rows = sorted(plot.points.get(m, {}).values(), key=lambda p: p["seconds"])
-        if rows:
-            lines[m] = (np.array([p["seconds"] * 1e3 for p in rows]),
-                        np.maximum(np.array([p[metric] for p in rows]), FLOOR))
+        for label, points in ((m, plot.points), (m + MATCHED_SUFFIX, plot.matched_points)):
+            rows = sorted(points.get(m, {}).values(), key=lambda p: p["seconds"])
+            if rows:
+                lines[label] = (np.array([p["seconds"] * 1e3 for p in rows]),
+                                np.maximum(np.array([p[metric] for p in rows]), FLOOR))
     return lines
+
+
+def dashed(xs: np.ndarray, ys: np.ndarray, dashes: int = 6) -> tuple[np.ndarray, np.ndarray]:
+    """A dashed polyline through the (n,) points (``xs``, ``ys``) on log-log axes, for
+    implot's ``plot_line`` (a NaN breaks its line): each segment cut into ``2 * dashes`` equal
+    pieces in log coordinates, every other one left out.  Returns (m,) arrays with NaN
+    between the dashes (empty for fewer than two points)."""
+    if len(xs) < 2:
+        return np.zeros(0), np.zeros(0)
+    lx, ly = np.log10(xs), np.log10(ys)
+    t = np.arange(2 * dashes + 1) / (2 * dashes)
+    starts, ends = t[:-1:2], t[1::2]
+    out = []
+    for k in range(len(xs) - 1):
+        for a, b in zip(starts, ends):
+            out += [(lx[k] + a * (lx[k + 1] - lx[k]), ly[k] + a * (ly[k + 1] - ly[k])),
+                    (lx[k] + b * (lx[k + 1] - lx[k]), ly[k] + b * (ly[k + 1] - ly[k])),
+                    (np.nan, np.nan)]
+    pts = np.array(out)
+    return 10.0 ** pts[:, 0], 10.0 ** pts[:, 1]
 
 
 def _evaluate(image: np.ndarray, reference: np.ndarray) -> dict:
@@ -166,48 +161,115 @@ def _evaluate(image: np.ndarray, reference: np.ndarray) -> dict:
     return metrics(image, reference)
 
 
+def _matched(state: AppState, plot: ErrorPlot, method: str):
+    """``method``'s matched reference for the current key: ``(image, "")`` once rendered,
+    ``(None, progress)`` while it renders, ``(False, "")`` when the method has none (outside
+    renderers, a user's shading model) or it does not apply to the scene."""
+    if method in plot.matched:
+        return plot.matched[method], ""
+    from ...compare.reference import finest_options, matched_spec
+    from .frames import tiled
+    from .jobs import JobBoard
+    spec = matched_spec(method)
+    if spec is None:
+        plot.matched[method] = False
+        return False, ""
+    ref_m, opts, _ = spec
+    if ref_m == "pathtrace" and "spp" not in opts:  # 'converged': its finest knob here
+        opts = {**opts, **finest_options(ref_m)}
+    if ref_m == plot.reference and opts == plot.ref_options:  # the full reference itself
+        plot.matched[method] = plot.ref_image
+        return plot.ref_image, ""
+    board = plot.matched_boards.get((ref_m, tuple(sorted(opts.items()))))
+    if board is None:
+        board = plot.matched_boards[(ref_m, tuple(sorted(opts.items())))] = JobBoard()
+    job = board.request(state.scene, state.camera, ref_m, opts, tiled=tiled(ref_m))
+    what = f"{ref_m} ({options_text(opts)})"
+    if job.cancelled.is_set():  # the previous key's job, still ending
+        return None, f"{what} waits for the previous one to end"
+    if job.error is not None:
+        plot.matched[method] = False
+        return False, ""
+    if job.image is None:
+        done = (f"{job.spp} spp" if job.progressive else
+                f"{job.rows_done}/{state.camera.height} rows" if tiled(ref_m) else "started")
+        return None, f"{what}: {done}"
+    plot.matched[method] = job.image
+    return job.image, ""
+
+
+def _collect(plot: ErrorPlot, pending: dict, points: dict, what: str) -> None:
+    """Move finished evaluations of ``pending`` into ``points`` (a failed one is kept in
+    ``plot.failed``: not submitted again for this key)."""
+    for (m, opts), fut in list(pending.items()):
+        if fut.done():
+            del pending[(m, opts)]
+            if fut.exception() is None:
+                points.setdefault(m, {})[opts] = fut.result()
+            else:
+                plot.failed[(m, opts, what)] = f"{m}: {what} evaluation failed ({fut.exception()})"
+                plot.message = plot.failed[(m, opts, what)]
+
+
+def _submit(plot: ErrorPlot, pending: dict, m: str, opts: tuple, what: str, *args) -> None:
+    """Queue ``_point(*args)`` for the worker process under ``pending[(m, opts)]``."""
+    if plot.pool is None:
+        plot.pool = ProcessPoolExecutor(1, mp_context=mp.get_context("spawn"))
+    try:
+        pending[(m, opts)] = plot.pool.submit(_point, *args)
+    except BrokenProcessPool:  # the worker died (e.g. out of memory): a new one next time
+        plot.pool.shutdown(wait=False, cancel_futures=True)
+        plot.pool = None
+        plot.failed[(m, opts, what)] = plot.message = f"{m}: the error-evaluation process died"
+
+
 def track(state: AppState) -> None:
-    """Per frame: follow scene and camera, request the reference, queue the new final images
-    for evaluation and collect finished evaluations.  Never waits."""
+    """Per frame: follow scene and camera, request the reference and the matched references,
+    queue the new final images for evaluation against each and collect finished evaluations.
+    Never waits: a total point is queued as soon as the full reference is there, its error
+    against the matched reference when that one is."""
     plot = state.errors
     key = (state.scene_version, state.camera)
     if key != plot.key:
-        if plot.board is not None:
-            for job in plot.board.current.values():
+        for board in plot.boards():
+            for job in board.current.values():
                 job.cancelled.set()
         plot.key, plot.since, plot.ref_image, plot.candidates = key, time.perf_counter(), None, []
         plot.gave_up = False
         plot.points, plot.pending, plot.failed = {}, {}, {}
-    for (m, opts), fut in list(plot.pending.items()):
-        if fut.done():
-            del plot.pending[(m, opts)]
-            if fut.exception() is None:
-                plot.points.setdefault(m, {})[opts] = fut.result()
-            else:  # kept as failed: not submitted again for this key
-                plot.failed[(m, opts)] = f"{m}: error evaluation failed ({fut.exception()})"
-                plot.message = plot.failed[(m, opts)]
+        plot.matched, plot.matched_points, plot.matched_pending = {}, {}, {}
+        plot.matched_message = ""
+    _collect(plot, plot.pending, plot.points, "error")
+    _collect(plot, plot.matched_pending, plot.matched_points, "matched error")
     if plot.shown < state.frame - 1:  # the plot's window is hidden: no reference render
         return
     ref = _reference(state, plot)
     if ref is None:
         return
+    rendering = []
     for m in state.methods:
         opts = tuple(sorted(state.options[m].items()))
-        if opts in plot.points.get(m, {}) or (m, opts) in plot.pending or (m, opts) in plot.failed:
+        total = not (opts in plot.points.get(m, {}) or (m, opts) in plot.pending
+                     or (m, opts, "error") in plot.failed)
+        split = not (opts in plot.matched_points.get(m, {}) or (m, opts) in plot.matched_pending
+                     or (m, opts, "matched error") in plot.failed)
+        if not (total or split):
             continue
         final = _final_image(state, m)
         if final is None or final[0].shape != ref.shape:
             continue
         image, seconds = final
-        if plot.pool is None:
-            plot.pool = ProcessPoolExecutor(1, mp_context=mp.get_context("spawn"))
         label = ", ".join(f"{k} {v}" for k, v in opts)
-        try:
-            plot.pending[(m, opts)] = plot.pool.submit(_point, image, ref, seconds, label)
-        except BrokenProcessPool:  # the worker died (e.g. out of memory): a new one next time
-            plot.pool.shutdown(wait=False, cancel_futures=True)
-            plot.pool = None
-            plot.failed[(m, opts)] = plot.message = f"{m}: the error-evaluation process died"
+        if total:
+            _submit(plot, plot.pending, m, opts, "error", image, ref, seconds, label)
+        if split:
+            matched, progress = _matched(state, plot, m)
+            if matched is None:
+                rendering.append(f"{m}'s {progress}")
+            elif matched is not False and matched.shape == ref.shape:
+                _submit(plot, plot.matched_pending, m, opts, "matched error", image, matched, seconds, label)
+    plot.matched_message = ("rendering the matched reference of " + "; ".join(rendering) + "..."
+                            if rendering else "")
 
 
 def _point(image: np.ndarray, reference: np.ndarray, seconds: float, label: str) -> dict:
@@ -225,7 +287,8 @@ def log_limits(values: np.ndarray) -> tuple[float, float]:
 
 
 def error_plot(state: AppState) -> None:
-    """Log-log plot: one line per method through its knob settings, run time on x."""
+    """Log-log plot: one line per method through its knob settings, run time on x (a dashed
+    one of the same colour: its error against its matched reference)."""
     from imgui_bundle import imgui, implot
     plot = state.errors
     plot.shown = state.frame
@@ -236,6 +299,13 @@ def error_plot(state: AppState) -> None:
     imgui.same_line()
     imgui.push_text_wrap_pos(0.0)
     imgui.text_disabled(plot.message)
+    if plot.matched_message:
+        imgui.text_disabled(plot.matched_message)
+    elif plot.matched_pending:
+        imgui.text_disabled(f"evaluating {len(plot.matched_pending)} error(s) against matched references...")
+    none = [m for m in state.methods if plot.matched.get(m) is False]
+    if none:
+        imgui.text_disabled(f"no matched reference: {', '.join(map(short_name, none))} (total error only)")
     imgui.pop_text_wrap_pos()
     lines = plotted_lines(plot, state.methods, plot.metric)
     for name in CLEAR_FILLS:
@@ -250,8 +320,17 @@ def error_plot(state: AppState) -> None:
             implot.setup_axes_limits(*log_limits(xs), *log_limits(ys), implot.Cond_.always)
         else:  # 1 ms to 1 s, errors 1e-3 to 1
             implot.setup_axes_limits(1.0, 1e3, 1e-3, 1.0, implot.Cond_.always)
-        for m, (xs, ys) in lines.items():
-            spec = implot.Spec(marker=getattr(implot.Marker_, marker_of(m)), marker_size=5)
-            implot.plot_line(m, xs, ys, spec)
+        colours = {}
+        for label, (xs, ys) in lines.items():
+            m = label.removesuffix(MATCHED_SUFFIX)
+            colour = colours.setdefault(m, implot.get_colormap_color(len(colours)))
+            marker = getattr(implot.Marker_, marker_of(m))
+            shown = short_name(m) + label[len(m):]  # a user's model by its file's name
+            if label == m:
+                implot.plot_line(shown, xs, ys, implot.Spec(line_color=colour, marker=marker, marker_size=5))
+            else:  # dashes of the same colour, smaller markers (one legend entry: same label)
+                implot.plot_line(shown, *dashed(xs, ys), implot.Spec(line_color=colour))
+                implot.plot_scatter(shown, xs, ys, implot.Spec(line_color=colour, marker=marker,
+                                                               marker_size=3))
         implot.end_plot()
     implot.pop_style_color(len(CLEAR_FILLS))

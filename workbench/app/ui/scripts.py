@@ -9,10 +9,11 @@ from pathlib import Path
 import numpy as np
 
 from . import camera as cam
-from .inspect import export, select_ray_tree
+from .export import export
+from .inspect import select_ray_tree
 from .layout import window_report
 from .panels import status_text
-from .state import RASTER, AppState, set_display, set_material_value, set_option, shown_image
+from .state import AppState, method_kind, set_display, set_material_value, set_option, shown_image
 
 CPU_WAIT_SECONDS = 120.0
 """How long the check script waits for background jobs before giving up."""
@@ -21,8 +22,10 @@ PLOT_WAIT_SECONDS = 10.0
 
 
 def _record(state: AppState, out: Path, phase: str) -> None:
+    """Each panel's image as ``{phase}_{file stem}.npy`` (a user's model: ``glsl_<name>``)."""
+    from ...renderers.base import file_stem
     for m in state.methods:
-        np.save(out / f"{phase}_{m}.npy", np.asarray(state.images[m], np.float32))
+        np.save(out / f"{phase}_{file_stem(m)}.npy", np.asarray(state.images[m], np.float32))
 
 
 def _spec_material(state: AppState) -> str:
@@ -135,6 +138,9 @@ class Features:
             _record(state, out, "plot")
             plot = state.errors
             np.save(out / "plot_reference.npy", plot.ref_image)
+            for m, image in plot.matched.items():
+                if image is not False:
+                    np.save(out / f"plot_matched_{m}.npy", image)
             self.log["plot"] = {"reference": plot.reference, "ref_options": plot.ref_options,
                                 "points": self._points(state)}
             self.flat_tess = state.options["flat"]["tessellation"]
@@ -147,15 +153,28 @@ class Features:
         self.step += 1
 
     def _plotted(self, state: AppState, counts: dict) -> bool:
-        """The error plot holds ``counts[m]`` points of each method (or the wait timed out)."""
-        have = state.errors.points
-        return (all(len(have.get(m, {})) >= n for m, n in counts.items())
+        """The error plot holds ``counts[m]`` points of each method, each also against the
+        method's matched reference where it has one (or the wait timed out)."""
+        plot = state.errors
+        return (all(len(plot.points.get(m, {})) >= n and
+                    (plot.matched.get(m) is False or len(plot.matched_points.get(m, {})) >= n)
+                    for m, n in counts.items())
                 or time.perf_counter() - self.t_wait > CPU_WAIT_SECONDS)
 
     @staticmethod
     def _points(state: AppState) -> dict:
-        return {m: [{**p, "options": dict(o)} for o, p in pts.items()]
-                for m, pts in state.errors.points.items()}
+        """{method: [point]}: each point's total error, its options and, where evaluated, its
+        errors against the matched reference (``rmse_matched``, ``flip_matched``)."""
+        plot = state.errors
+        out = {}
+        for m, pts in plot.points.items():
+            out[m] = []
+            for o, p in pts.items():
+                split = plot.matched_points.get(m, {}).get(o)
+                out[m].append({**p, "options": dict(o),
+                               **({} if split is None else {"rmse_matched": split["rmse"],
+                                                            "flip_matched": split["flip"]})})
+        return out
 
 
 class Layout:
@@ -191,7 +210,7 @@ class Radiosity:
         self.out, self.log, self.t_wait = out, {}, time.perf_counter()
 
     def __call__(self, state: AppState) -> None:
-        from .layout import focus
+        from .placement import focus
         from .patch_view import select_patch
         f = state.frame
         if f == 0:  # the patch view in front of the error plot: no reference render
@@ -249,21 +268,28 @@ class Fps:
     ``step`` 0 leaves the camera alone).  ``raytrace_spp`` sets the ray tracer's samples per
     pixel (a longer background job).  With ``wait_cpu`` the count also ends when no background
     job runs any more (the rate is the one *while* a job runs), then the session stays open
-    until the jobs end and logs the ray trace's run time with the window open."""
+    until the jobs end and logs the ray trace's run time with the window open.  ``display``
+    sets every panel's display mode first (e.g. an indexed CLUT)."""
 
     def __init__(self, out: Path, seconds: float = 10.0, warmup: int = 10, step: float = 0.002,
-                 raytrace_spp: int | None = None, wait_cpu: bool = False):
+                 raytrace_spp: int | None = None, wait_cpu: bool = False,
+                 display: str | None = None):
         self.out, self.seconds, self.warmup, self.step, self.log = out, seconds, warmup, step, {}
-        self.spp, self.wait_cpu, self.t0 = raytrace_spp, wait_cpu, None
+        self.spp, self.wait_cpu, self.t0, self.display = raytrace_spp, wait_cpu, None, display
 
     def __call__(self, state: AppState) -> None:
         if state.frame == 0 and self.spp is not None:
             set_option(state, "raytrace", "spp", self.spp)
+        if state.frame == 0 and self.display is not None:
+            for m in state.methods:
+                set_display(state, m, self.display)
+            self.log["display"] = self.display
         if self.step:
             state.camera = cam.orbit(state.camera, self.step, 0.0)
         if state.frame == self.warmup:
             self.t0, self.busy_frames, self.gui, self.frame_ms = time.perf_counter(), 0, 0.0, []
             self.counts, self.starts = _gpu_counts(state), state.jobs.count
+            self.cpu0 = process_cpu_seconds()
         elif self.t0 is not None and "fps" not in self.log:
             busy = state.jobs.busy()
             self.busy_frames += busy
@@ -275,13 +301,14 @@ class Fps:
                 (d0, r0), (d1, r1) = self.counts, _gpu_counts(state)
                 q = np.percentile(self.frame_ms, [10, 50, 90, 99]).round(1).tolist()
                 self.log.update(frames=n, seconds=dt, fps=n / dt, gui_ms_mean=self.gui / n * 1e3,
+                                cpu_ms_per_frame=(process_cpu_seconds() - self.cpu0) / n * 1e3,
                                 frame_ms_p10_50_90_99=q,
                                 frames_with_cpu_job_running=self.busy_frames,
                                 gl_panel_draws=d1 - d0, read_backs=r1 - r0,
                                 cpu_jobs_started=state.jobs.count - self.starts,
                                 panels_window=window_report()["Panels"].get("size"),
                                 raster_ms={m: state.timings.get(m, 0) * 1e3
-                                           for m in state.methods if m in RASTER})
+                                           for m in state.methods if method_kind(state, m) == "gl"})
                 self.t_wait = time.perf_counter()
                 state.quit = not self.wait_cpu
         elif "fps" in self.log and (not state.jobs.busy()
@@ -290,6 +317,159 @@ class Fps:
             self.log.update(raytrace_seconds=None if job is None else job.seconds,
                             raytrace_options=state.options["raytrace"])
             state.quit = True
+
+
+class DragCheck:
+    """A camera drag with display modes and a ray-traced panel: once the ray trace is done,
+    ``mode`` is set on every GL panel and the script waits for their exact images; then
+    ``frames`` frames each orbit the camera, logging per frame what each GL panel shows
+    (``display_modes`` kind: "fast" or "exact"), its distinct colours, the exact computations
+    started, whether the ray-traced panel still holds its image and what the probe reads at
+    three pixels (one-pixel reads); then the camera rests until the GL panels are exact again
+    and the ray trace has restarted and ended, logging rows of the ray-traced panel that went
+    black meanwhile, and each GL panel's display texture against the CLI's mode
+    (``shown_M.npy``, ``cli_M.npy``)."""
+
+    def __init__(self, out: Path, mode: str = "indexed16-mediancut", frames: int = 8):
+        self.out, self.mode, self.frames, self.log = out, mode, frames, {"drag": []}
+        self.step, self.k, self.t0 = 0, 0, time.perf_counter()
+
+    def _gl(self, state: AppState) -> list[str]:
+        return [m for m in state.methods if method_kind(state, m) == "gl"]
+
+    def _exact(self, state: AppState) -> bool:
+        md = state.gpu.modes
+        return all(md.shown.get(m, (None, None, ""))[:3] == (state.images.version(m), self.mode,
+                                                              "exact") for m in self._gl(state))
+
+    def _texture(self, state: AppState, m: str) -> np.ndarray:
+        h, w = state.camera.height, state.camera.width
+        return np.frombuffer(state.textures[m].read(), np.uint8).reshape(h, w, -1)[..., :3]
+
+    def __call__(self, state: AppState) -> None:
+        from ...core.display import apply_display_mode
+        from ...core.imageio import to_srgb8
+        now, md = time.perf_counter(), state.gpu.modes if state.gpu is not None else None
+        timeout = now - self.t0 > CPU_WAIT_SECONDS
+        h, w = state.camera.height, state.camera.width
+        if self.step == 0 and state.frame >= 2 and (not state.jobs.busy() or timeout):
+            for m in self._gl(state):
+                set_display(state, m, self.mode)
+            self.step, self.t0 = 1, now
+        elif self.step == 1 and (self._exact(state) or timeout):
+            self.log["exact_before_drag"] = self._exact(state)
+            self.before = state.images["raytrace"].copy()
+            self.started0 = md.started
+            self.step = 2
+        elif self.step == 2:
+            if self.k:  # what the previous frame's orbit shows now
+                pixels = [(h // 2, w // 2), (h // 3, w // 4), (h - 1, w - 1)]
+                probe = {m: [state.images.pixel(m, i, j, (h, w)).tolist() for i, j in pixels]
+                         for m in state.methods}
+                shown = state.images["raytrace"]
+                self.log["drag"].append({
+                    "kinds": {m: md.shown[m][2] for m in self._gl(state)},
+                    "colours": {m: int(len(np.unique(self._texture(state, m).reshape(-1, 3), axis=0)))
+                                for m in self._gl(state)},
+                    "exact_started": md.started - self.started0,
+                    "raytrace_kept": bool(np.array_equal(shown, self.before)),
+                    "probe": probe,
+                    "probe_full": {m: [state.images[m][i, j].tolist() for i, j in pixels]
+                                   for m in state.methods}})
+            if self.k < self.frames:
+                state.camera = cam.orbit(state.camera, 0.05, 0.0)
+                self.k += 1
+            else:
+                self.step, self.t0, self.black_rows = 3, now, 0
+        elif self.step == 3:
+            image = state.images["raytrace"]
+            black = (np.abs(image).max(-1).max(-1) == 0) & (np.abs(self.before).max(-1).max(-1) > 0)
+            self.black_rows = max(self.black_rows, int(black.sum()))
+            job = state.jobs.current.get("raytrace")
+            if (self._exact(state) and job is not None and job.image is not None
+                    and job.key[1] == state.camera) or timeout:
+                self.log.update(exact_after_rest=self._exact(state), raytrace_black_rows=self.black_rows,
+                                rest_seconds=now - self.t0, exact_started=md.started - self.started0)
+                for m in self._gl(state):
+                    np.save(self.out / f"shown_{m}.npy", self._texture(state, m))
+                    np.save(self.out / f"cli_{m}.npy",
+                            to_srgb8(apply_display_mode(state.images[m], self.mode)))
+                state.quit = True
+
+
+class ExportCheck:
+    """Frame 2: orbit the camera, override a material (the first sphere's ``ks``) and light
+    0 (intensity, and where it is), set the first panel's display mode to ``mode`` and the
+    knobs; then wait for the background jobs and export into ``out/export`` (logging the
+    status line), and quit."""
+
+    def __init__(self, out: Path, mode: str = "indexed16-mediancut"):
+        self.out, self.mode, self.log, self.t0 = out, mode, {}, time.perf_counter()
+
+    def __call__(self, state: AppState) -> None:
+        from .state import light_fields, light_value, set_light_value
+        if state.frame == 2:
+            state.camera = cam.orbit(state.camera, 0.3, 0.1)
+            mat = _spec_material(state)
+            set_material_value(state, mat, "ks", 0.9)
+            light = state.base_scene.lights[0]
+            where = light_fields(light)[0]
+            p = np.asarray(light_value(light, where), float)
+            set_light_value(state, 0, where, tuple(p + np.array([0.5, 0.3, -0.2])))
+            set_light_value(state, 0, "intensity", float(light.intensity) * 0.7)
+            set_display(state, state.methods[0], self.mode)
+            if "phong" in state.methods:
+                set_option(state, "phong", "tessellation", 2)
+            if "raytrace" in state.methods:
+                set_option(state, "raytrace", "max_depth", 3)
+            self.t0 = time.perf_counter()
+        elif state.frame > 4 and (not state.jobs.busy()
+                                  or time.perf_counter() - self.t0 > CPU_WAIT_SECONDS):
+            self.log["exported"] = [p.name for p in export(state, self.out / "export")]
+            self.log["status"] = state.status["export"]
+            state.quit = True
+
+
+class Screens:
+    """What a user sees of the default view: once nothing is in progress (the jobs, the error
+    plot's reference and points; at most :data:`CPU_WAIT_SECONDS`) and a few frames later,
+    the window as the X server shows it (``xwd``, :mod:`.screenshot`) is saved as
+    ``screen.png`` with, logged, the widgets cut at a window's right edge over those frames,
+    the window report, the blit rectangles, the panels' size, the plot's points, and each
+    panel's display texture (``shown_M.npy``) to find it on screen."""
+
+    def __init__(self, out: Path, frames: int = 4):
+        self.out, self.frames, self.log = out, frames, {"cut": []}
+        self.t0, self.rested = time.perf_counter(), None
+
+    def __call__(self, state: AppState) -> None:
+        from . import screenshot
+        from .frames import in_progress
+        from .glfw_title import window_title
+        busy = in_progress(state) and time.perf_counter() - self.t0 < CPU_WAIT_SECONDS
+        if state.frame < 2 or busy:
+            self.rested = None
+            return
+        if self.rested is None:
+            self.rested = state.frame
+        if state.frame > self.rested:  # widgets drawn in a rested frame
+            self.log["cut"] = sorted(set(self.log["cut"]) | state.cut)
+        if state.frame < self.rested + self.frames:
+            return
+        h, w = state.camera.height, state.camera.width
+        for m in [*state.methods, "difference"]:
+            if m in state.textures:
+                tex = state.textures[m]
+                tw, th = tex.size
+                np.save(self.out / f"shown_{m}.npy", np.frombuffer(
+                    tex.read(), np.uint8).reshape(th, tw, -1)[..., :3])
+        shot = screenshot.save(window_title(state), self.out / "screen.png")
+        self.log.update(screen=list(shot.shape), windows=window_report(),
+                        blits=[[m, list(r)] for m, r in state.gpu.blits.last],
+                        camera=[w, h], methods=list(state.methods), timed_out=not
+                        (time.perf_counter() - self.t0 < CPU_WAIT_SECONDS),
+                        plot_points={m: len(p) for m, p in state.errors.points.items()})
+        state.quit = True
 
 
 def _compiles(state: AppState) -> int:
@@ -470,13 +650,13 @@ class Idle:
                     "shown_is_job_image": bool(job is not None and job.image is not None
                                                and np.array_equal(shown, job.image)),
                     "frames": state.frame - self.frame0, "seconds": now - self.t0}
-                from .main import shown_title
+                from .glfw_title import shown_title
                 from .state import set_scene
                 self.log["title_before"] = shown_title()
                 set_scene(state, "csg")
                 self.step = 3
         elif self.step == 3:
-            from .main import shown_title
+            from .glfw_title import shown_title
             self.log["title_after"] = shown_title()
             state.quit = True
 
@@ -484,14 +664,16 @@ class Idle:
 class Soak:
     """A long session in a loop: ``rounds`` rounds of a scene switch (through ``scenes``),
     a method added or removed, a knob change, camera orbits and a difference pair change,
-    waiting between rounds until the background jobs have ended.  Logs, every round, the
+    waiting between rounds until the background jobs have ended (``rounds`` rounds, or rounds
+    until ``seconds`` have passed).  Logs, every round, its time since the start, the
     process RSS, the jobs the board keeps, and the GL textures, framebuffers, buffers and
     programs alive in the window's context (:func:`gl_object_counts`)."""
 
-    def __init__(self, out: Path, rounds: int = 24,
-                 scenes=("whitted", "csg", "cornell", "quadrics")):
+    def __init__(self, out: Path, rounds: int | None = 24,
+                 scenes=("whitted", "csg", "cornell", "quadrics"), seconds: float | None = None):
         self.out, self.rounds, self.scenes, self.log = out, rounds, scenes, {"rounds": []}
         self.round, self.t_wait, self.phase = 0, time.perf_counter(), 0
+        self.seconds, self.t_start = seconds, time.perf_counter()
 
     def __call__(self, state: AppState) -> None:
         from .state import set_scene
@@ -508,7 +690,9 @@ class Soak:
                                    "jobs_kept": len(state.jobs.started),
                                    "scene": state.scene_path.stem, "methods": list(state.methods),
                                    **counts})
-        if self.round >= self.rounds:
+        self.log["rounds"][-1]["seconds"] = time.perf_counter() - self.t_start
+        if ((self.rounds is not None and self.round >= self.rounds) or (
+                self.seconds is not None and time.perf_counter() - self.t_start >= self.seconds)):
             state.quit = True
             return
         k = self.round
@@ -549,9 +733,12 @@ def gl_object_counts(state: AppState, names: int = 4096) -> dict:
 
 SCRIPTS = {"check": Check, "features": Features, "radiosity": Radiosity, "pyrender": Pyrender,
            "fps": Fps,
+           "fps_indexed": lambda out: Fps(out, display="indexed16-kmeans-fs"),
+           "drag_check": DragCheck, "export_check": ExportCheck, "screens": Screens,
            "fps_static": lambda out: Fps(out, step=0.0, raytrace_spp=16, wait_cpu=True),
            "gpu_panels": GpuPanels, "slider_frames": SliderFrames,
            "fps_material_drag": lambda out: SliderFps(out, "material"),
            "fps_slider_drag": lambda out: SliderFps(out, "material+light"),
            "layout": Layout, "idle": Idle, "idle_quick": lambda out: Idle(out, seconds=3.0),
-           "soak": Soak, "soak_quick": lambda out: Soak(out, rounds=10)}
+           "soak": Soak, "soak_quick": lambda out: Soak(out, rounds=10),
+           "soak_10min": lambda out: Soak(out, rounds=None, seconds=600.0)}

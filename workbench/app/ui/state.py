@@ -1,22 +1,25 @@
-"""The one state object of the UI: every gui function takes it, nothing lives in module globals."""
+"""The one state object of the UI: every gui function takes it, nothing lives in module globals.
+
+Plain data and the functions that edit it: the views (panels, plot, browser, ...) import this
+module, never the other way round.  What a method is to the window (a GL panel, a CPU job, a
+child process, a progressive job) is asked of its renderer (``ui_kind``,
+:data:`workbench.renderers.base.UI_KINDS`; :func:`method_kind`), so a newly registered method
+appears in the window without any edit here.
+"""
 from __future__ import annotations
 
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
+from ...renderers.base import USER_PREFIX, available, check_methods, get_renderer
 from ...scene.model import Camera, Scene
 from .images import PanelImages
 from ...scene.features import scene_needs
+from .jobs import RESTART_SETTLE_SECONDS, JobBoard
 
-RASTER = ("flat", "gouraud", "phong")
-"""Methods drawn every frame in the window's own GL context."""
-CPU = ("raycast", "raytrace", "radiosity", "hybrid")
-"""Methods run in background threads."""
-CHILD = ("pyrender",)
-"""Methods rendered in a child process (PyOpenGL's EGL platform cannot share the window's
-process): :mod:`.pyrender_proc`."""
 MAX_PANELS = 6
 FIRST_VIEW = ("phong", "raytrace")
 """The methods of the first view of any scene: a raster method beside the ray tracer (their
@@ -34,6 +37,79 @@ DISPLAY_MODES = ("direct24", "direct16-555", "direct16-565", "direct16-565-fs",
 """Display modes offered per panel (the colour chapter's 24/16-bit direct and indexed CLUTs);
 ``workbench.core.display`` accepts more from the CLI."""
 HARMONIES = ("complementary", "triad", "square", "hexagon")
+
+
+@dataclass
+class Browser:
+    """The file browser's folder, the file selected in it and the last outcome (error or
+    opened); the view is :mod:`.file_browser`."""
+
+    folder: Path
+    selected: Path | None = None
+    message: str = ""
+    failed: bool = False
+    listed: tuple[list[Path], list[Path]] | None = field(default=None, repr=False)
+    listed_at: float = 0.0
+    pattern: str = "*.toml"
+    """The files listed (``fnmatch`` pattern): scene files, or a shading model's ``*.glsl``."""
+
+
+@dataclass
+class ErrorPlot:
+    """Points of error against run time for one (scene version, camera); the view is
+    :mod:`.plot`.
+
+    ``points[method][option values]`` is ``{"seconds", "rmse", "psnr", "flip", "label"}``
+    against the full reference (the total error); ``matched_points`` holds the same against
+    the method's matched reference (its discretisation error, the error split of
+    :mod:`workbench.compare.reference`), evaluated on its own when that reference arrives.
+    ``matched[method]`` is that reference's image once rendered, or False (the method has
+    none); ``matched_boards`` render them, one :class:`~.jobs.JobBoard` per (reference method,
+    options) (a board runs one job per method); ``matched_message`` says which are still
+    rendering.
+    """
+
+    key: tuple | None = None
+    since: float = 0.0
+    candidates: list = field(default_factory=list)
+    reference: str | None = None
+    ref_options: dict = field(default_factory=dict)
+    ref_image: np.ndarray | None = None
+    message: str = ""
+    points: dict = field(default_factory=dict)
+    pending: dict = field(default_factory=dict)
+    failed: dict = field(default_factory=dict)
+    matched: dict = field(default_factory=dict)
+    matched_points: dict = field(default_factory=dict)
+    matched_pending: dict = field(default_factory=dict)
+    matched_boards: dict = field(default_factory=dict)
+    matched_message: str = ""
+    metric: str = "rmse"
+    shown: int = -2
+    gave_up: bool = False
+    board: object = None
+    pool: ProcessPoolExecutor | None = None
+
+    def busy(self, frame: int) -> bool:
+        """Something will arrive without any input: evaluations in the worker, or, while the
+        plot is shown (drawn in frame ``frame`` or the one before), its reference or a matched
+        reference still rendering."""
+        if self.pending or self.matched_pending:
+            return True
+        return self.shown >= frame - 1 and ((self.ref_image is None and not self.gave_up)
+                                            or bool(self.matched_message))
+
+    def boards(self) -> list:
+        """The boards rendering references: the full one's and the matched ones'."""
+        return [b for b in (self.board, *self.matched_boards.values()) if b is not None]
+
+    def shutdown(self) -> None:
+        """Cancel the reference renders and end the worker process (joined)."""
+        for board in self.boards():
+            board.join_all()
+        if self.pool is not None:
+            self.pool.shutdown(wait=True, cancel_futures=True)
+            self.pool = None
 
 
 @dataclass
@@ -85,6 +161,17 @@ class AppState:
     errors: object = None
     patch_pick: object = None
     pyrender: object = None
+    user_methods: list[str] = field(default_factory=list)
+    """Users' shading models (``glsl:PATH``, :func:`add_shading_model`), listed in the Methods
+    window after the registered methods."""
+    shading_browser: Browser | None = None
+    """The file picker of users' shading models (``*.glsl``)."""
+    panel_errors: dict[str, tuple] = field(default_factory=dict)
+    """method -> (what its GL session was to be built from, one-line message) of a GL panel
+    whose session could not be built (a user's model that does not compile): the message is
+    shown, and the build is not tried again until what it is built from changes."""
+    kinds: dict[str, str] = field(default_factory=dict)
+    """method -> its renderer's ``ui_kind`` (:func:`method_kind`)."""
     cut: set = field(default_factory=set)
     """Widgets that ran past their window's right edge in the last frame (``panels.check_fits``)."""
     quit: bool = False
@@ -92,17 +179,31 @@ class AppState:
 
 def choosable_methods() -> list[str]:
     """Registered methods the UI can show (all of them)."""
-    from ...renderers.base import available
     return list(available())
 
 
+def short_name(method: str) -> str:
+    """What the window calls a method: its name, or ``glsl:`` and the file's name for a
+    user's shading model ``glsl:PATH`` (the whole path is a tooltip)."""
+    if method.startswith(USER_PREFIX):
+        return USER_PREFIX + Path(method[len(USER_PREFIX):]).name
+    return method
+
+
+def method_kind(state: AppState, method: str) -> str:
+    """What ``method`` is to the window: its renderer's ``ui_kind`` (``"gl"``, ``"cpu"``,
+    ``"child"`` or ``"progressive"``, :data:`workbench.renderers.base.UI_KINDS`), asked once."""
+    kind = state.kinds.get(method)
+    if kind is None:
+        kind = state.kinds[method] = get_renderer(method).ui_kind
+    return kind
+
+
 def default_options(method: str) -> dict:
-    """The method's quality knob at its default value; a progressive method's
-    (:data:`~.jobs.PROGRESSIVE`) at its most accurate, which it refines towards pass by pass."""
-    from ...renderers.base import get_renderer
-    from .jobs import PROGRESSIVE
-    knob = get_renderer(method).knob
-    return {knob.name: knob.values[-1] if method in PROGRESSIVE else knob.default}
+    """The method's quality knob at its default value; a progressive method's (``ui_kind``
+    ``"progressive"``) at its most accurate, which it refines towards pass by pass."""
+    r = get_renderer(method)
+    return {r.knob.name: r.knob.values[-1] if r.ui_kind == "progressive" else r.knob.default}
 
 
 def first_view(scene: Scene, allowed) -> list[str]:
@@ -129,23 +230,45 @@ def new_state(scene_name: str, methods: list[str] | None = None,
     from ...core.errors import WorkbenchError
     from ...scene.io import load_scene
     from ...scene.library import resolve
-    from .file_browser import Browser
-    from .jobs import RESTART_SETTLE_SECONDS, JobBoard
-    from .plot import ErrorPlot
     path = resolve(scene_name)
     scene = load_scene(path)
     allowed = choosable_methods()
     methods = list(methods) if methods else first_view(scene, allowed)
-    bad = [m for m in methods if m not in allowed]
+    user = [m for m in methods if m.startswith(USER_PREFIX)]
+    bad = [m for m in methods if m not in allowed and m not in user]
     if bad or not 1 <= len(methods) <= MAX_PANELS:
-        raise WorkbenchError(f"methods must be 1 to {MAX_PANELS} of {', '.join(allowed)} "
-                             f"(got {', '.join(methods)})")
+        raise WorkbenchError(f"methods must be 1 to {MAX_PANELS} of {', '.join(allowed)} or "
+                             f"{USER_PREFIX}FILE (got {', '.join(methods)})")
+    check_methods(user)  # a user's shading model file that cannot be used: one line
+    examples = Path.cwd() / "examples" / "shading"
     return AppState(scene=scene, scene_path=path, base_scene=scene,
                     camera=panel_camera(scene.camera, panel_size), methods=methods,
-                    options={m: default_options(m) for m in allowed},
+                    options={m: default_options(m) for m in [*allowed, *user]},
                     material=next(iter(scene.materials)), panel_size=panel_size,
                     diff_pair=(methods[0], methods[min(1, len(methods) - 1)]), jobs=JobBoard(RESTART_SETTLE_SECONDS),
-                    browser=Browser(path.parent), errors=ErrorPlot())
+                    browser=Browser(path.parent), errors=ErrorPlot(), user_methods=user,
+                    shading_browser=Browser(examples if examples.is_dir() else Path.cwd(),
+                                            pattern="*.glsl"))
+
+
+def add_shading_model(state: AppState, path) -> str:
+    """Add the user's shading model in the GLSL file ``path``
+    (:mod:`workbench.renderers.user_shading`) as the method ``glsl:PATH`` and show its panel
+    (a seventh panel is refused as by :func:`toggle_method`); returns the method's name.  A
+    file that cannot be used, or whose name would clash with another model's output files,
+    raises :class:`~workbench.core.errors.WorkbenchError` (one line) and changes nothing; a
+    model that does not compile shows its one-line message (the user's file and line) in its
+    panel; adding the file again (once fixed) compiles it again."""
+    from ...renderers.user_shading import method_name
+    m = method_name(path)
+    user = [*state.user_methods, *([] if m in state.user_methods else [m])]
+    check_methods(user)
+    state.user_methods[:] = user
+    state.options.setdefault(m, default_options(m))
+    state.kinds.pop(m, None)
+    state.panel_errors.pop(m, None)
+    toggle_method(state, m, True)
+    return m
 
 
 def set_scene(state: AppState, scene_name: str) -> None:

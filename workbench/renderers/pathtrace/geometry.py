@@ -7,7 +7,11 @@ Cornell box's 15 quadrilaterals cost a BVH descent instead of 15 polygon tests p
 Only what a triangle mesh describes identically is converted: convex polygons and rectangles
 (fan triangles in vertex order: the same front face) whose material has no texture, bump or
 opacity map (those read the polygon's own object-space mapping) and no transmission (a mesh is
-a solid, a polygon a thin sheet).  Area lights stay polygons (front-face emitters).
+a solid, a polygon a thin sheet).  Convex area lights become triangle meshes too, of the black
+emissive material the ray tracer gives them (named ``__area_light_<k>_tris``, after
+``flatten``'s ``__area_light_<k>``), whose emission the path tracer keeps to the front face
+(:data:`FRONT_ONLY` names them for the session, which sets the ``front_only_emitter`` column): a
+scene of polygons is then all triangles, and every ray a BVH traversal alone.
 """
 from __future__ import annotations
 
@@ -29,8 +33,13 @@ def _as_mesh(o, vertices):
                   tessellation=o.tessellation, vertices=V, faces=F, source=f"pathtrace: {o.kind} as triangles")
 
 
+FRONT_ONLY = "__area_light_"
+"""Name prefix of the area lights' materials (``raytrace.flatten``): they emit from the front only."""
+
+
 def triangulated(scene: m.Scene) -> m.Scene:
-    """``scene`` with its plain opaque convex polygons and rectangles as triangle meshes."""
+    """``scene`` with its plain opaque convex polygons and rectangles, and its convex area
+    lights, as triangle meshes."""
     out = []
     for o in scene.objects:
         mat = scene.materials.get(o.material) if not isinstance(o, m.CSG) else None
@@ -41,4 +50,16 @@ def triangulated(scene: m.Scene) -> m.Scene:
         elif plain and isinstance(o, m.Plane):
             o = _as_mesh(o, o.corners())
         out.append(o)
-    return replace(scene, objects=tuple(out))
+    materials, lights = dict(scene.materials), []
+    for k, lt in enumerate(scene.lights):
+        if isinstance(lt, m.AreaLight):
+            name = f"{FRONT_ONLY}{k}_tris"
+            mesh = _as_mesh(m.Polygon(name, vertices=np.asarray(lt.vertices, dtype=np.float64), name=name),
+                            lt.vertices)
+            if isinstance(mesh, m.Mesh) and name not in materials:
+                materials[name] = m.Material(name, color=(0.0, 0.0, 0.0), ka=0.0, kd=0.0, ks=0.0,
+                                             emission=tuple(float(x) for x in lt.radiance))
+                out.append(mesh)
+                continue
+        lights.append(lt)
+    return replace(scene, objects=tuple(out), materials=materials, lights=tuple(lights))

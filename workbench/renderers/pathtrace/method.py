@@ -38,6 +38,7 @@ class PathTraceRenderer:
     """Unbiased path tracing with next-event estimation and MIS (Kajiya 1986; Veach 1997)."""
 
     name = "pathtrace"
+    ui_kind = "progressive"
     knob = Knob("spp", (2, 4, 16, 64, 256), 16, "samples per pixel")
     options = {
         "spp": Option(int, 16, "samples per pixel (uniform jitter: the box-filtered pixel; >= 2 for a noise estimate)"),
@@ -63,13 +64,19 @@ class PathTraceRenderer:
         """Upper bound of the bytes a render allocates (:func:`.session.estimate_bytes`)."""
         return estimate_bytes(scene, width, height)
 
+    def progressive_session(self, scene: Scene, width: int, height: int, **o) -> PathTraceSession:
+        """A session the interactive window refines pass by pass (``ui_kind``
+        ``"progressive"``), with the converted options ``o`` but ``spp`` (the target), ``progress``
+        and ``on_pass``."""
+        return PathTraceSession(scene, width, height, seed=o["seed"], fresnel=o["fresnel"],
+                                rr_start=o["rr_start"], max_bounces=o["max_bounces"], mis=o["mis"],
+                                transport=o["transport"], pixel_filter=o["pixel_filter"])
+
     def render(self, scene: Scene, width: int, height: int, **o) -> RenderResult:
         if not 1 <= o["spp"] <= MAX_SPP:
             raise WorkbenchError(f"method 'pathtrace': option 'spp' must be within 1..{MAX_SPP}, got {o['spp']}")
         t0 = time.perf_counter()
-        ses = PathTraceSession(scene, width, height, seed=o["seed"], fresnel=o["fresnel"],
-                               rr_start=o["rr_start"], max_bounces=o["max_bounces"], mis=o["mis"],
-                               transport=o["transport"], pixel_filter=o["pixel_filter"])
+        ses = self.progressive_session(scene, width, height, **o)
         per_pass = max(1, _SAMPLES_PER_PASS // (width * height))
         bar = None
         if o["progress"]:

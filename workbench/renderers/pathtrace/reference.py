@@ -221,7 +221,7 @@ class Tracer:
             if Le.max() > 0 and cos_s > 0 and cos_l != 0 and Nf @ l > 0:
                 f, p_b = f_and_pdf(l)
                 p_l = em.lpdf_prim[em.prim[e]] * dist * dist / abs(cos_l)
-                if p_l > 0 and self.visible(P, hit.Ng, l, dist):
+                if p_l > 0 and self.visible(P, hit.Ng, l, dist, Q):
                     out += f * Le * cos_s * self.mis(p_l, p_b) / p_l
         for light in self.lights:
             lvec, I, dist = local_model.light_incidence(light, P[None])
@@ -234,14 +234,22 @@ class Tracer:
                 out += f * np.pi * I[0] * cos_s   # irradiance pi I S cos (the kernel's convention)
         return out
 
-    def visible(self, P, Ng, l, dist) -> bool:
-        """Nothing (area lights included) between ``P`` and the point at ``dist`` along ``l``."""
+    def visible(self, P, Ng, l, dist, target=None) -> bool:
+        """Nothing (area lights included) between ``P`` and the point at ``dist`` along ``l``; for
+        a point ``target`` of an area light, the feeler aims from its pushed origin at it (along
+        ``l`` it would meet a light seen at a grazing angle before its 2 ``off`` margin)."""
         off = self.ctx.offset(P)
         side = 1.0 if Ng @ l >= 0 else -1.0
-        Q = P + side * off * Ng
+        S = P + side * off * Ng
+        if target is not None:
+            w = target - S
+            dist = float(np.linalg.norm(w))
+            if dist <= 2 * off:
+                return True
+            l = w / dist
         tmax = dist - 2 * off if np.isfinite(dist) else np.inf
         tmin = tol.t_min * max(float(np.abs(P).max()), self.ctx.extent)
-        return rt.closest(self.ctx, Q, l, tmin, tmax) is None
+        return rt.closest(self.ctx, S, l, tmin, tmax) is None
 
 
 def _around(n, cos_t, phi):

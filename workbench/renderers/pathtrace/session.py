@@ -22,7 +22,7 @@ from ...scene import model as m
 from ..raytrace.flatten import flatten, light_rows
 from ..raytrace.whitted import TEX_COLS, camera_frame, fused_textures
 from .emitters import build_emitters
-from .geometry import triangulated
+from .geometry import FRONT_ONLY, triangulated
 
 FRESNEL = {"none": 0, "schlick": 1, "exact": 2}
 MIS = {"balance": 1.0, "power": 2.0}
@@ -62,8 +62,9 @@ class PathTraceSession:
     seed : int, >= 0.  fresnel : ``none`` | ``schlick`` | ``exact`` (split of kr, kt as the ray
     tracer's option).  rr_start : bounce from which Russian roulette plays (>= 1).
     max_bounces : hard stop of a path (>= 1).  mis : ``power`` (exponent 2) or ``balance``.
-    triangulate : trace plain opaque polygons and rectangles as triangles through the BVH
-    (:mod:`.geometry`; the same surfaces, faster), else as the ray tracer's polygons.
+    triangulate : trace plain opaque polygons and rectangles, and convex area lights, as
+    triangles through the BVH (:mod:`.geometry`; the same surfaces, faster: a scene of triangles
+    only casts every ray straight into the BVH, ``opts[20]``), else as the ray tracer's polygons.
     transport : ``full`` | ``diffuse`` | ``eye_specular`` (:data:`TRANSPORT`; the latter two
     ignore point and directional lights, textures and vertex emission).
     pixel_filter : ``box`` | ``center`` (:data:`PIXEL_FILTER`).
@@ -93,6 +94,9 @@ class PathTraceSession:
         self.scene = scene.with_camera(scene.camera.with_resolution(width, height))
         self.width, self.height, self.seed = int(width), int(height), int(seed)
         sd = flatten(triangulated(self.scene) if triangulate else self.scene)
+        for i, mt in enumerate(sd.materials):  # area lights as triangles: still front-face emitters
+            if mt.name.startswith(FRONT_ONLY):
+                sd.mat_tab[i, 16] = 1.0
         self.sd = sd
         self.emitters = build_emitters(sd)
         full = transport == "full"
@@ -119,7 +123,8 @@ class PathTraceSession:
         self.opts = np.array([FRESNEL[fresnel], tol.ray_offset, tol.t_min, tol.zero, sd.extent,
                               tol.normal_cancel, rr_start, max_bounces, float(self.textured), MIS[mis],
                               *background, len(media), *(media + [0] * (4 - len(media))),
-                              TRANSPORT[transport], PIXEL_FILTER[pixel_filter]])
+                              TRANSPORT[transport], PIXEL_FILTER[pixel_filter],
+                              float(len(sd.tri_v) > 0 and not sd.top.any())])
         self.shading = (sd.mat, sd.mat_tab, np.ascontiguousarray(tex), lights)
         self.geo = sd.kernel_args()
         self.cam = camera_frame(self.scene.camera, self.width, self.height)

@@ -65,6 +65,7 @@ class HybridRenderer:
     """Radiosity (diffuse) + ray tracing from the eye (specular), two passes."""
 
     name = "hybrid"
+    ui_kind = "cpu"
     knob = Knob("patch_size", (0.2, 0.1, 0.05, 0.035, 0.025), 0.05,
                 "largest patch edge / scene diagonal")
     options = {**common_options(),

@@ -226,6 +226,7 @@ class RadiosityRenderer:
     """Radiosity with hemicube (or ray-cast) form factors, shown with Gouraud shading."""
 
     name = "radiosity"
+    ui_kind = "cpu"
     knob = Knob("patch_size", (0.2, 0.1, 0.05, 0.035, 0.025), 0.05,
                 "largest patch edge / scene diagonal")
     options = common_options()

@@ -43,7 +43,23 @@ def _area(b0, b1, b2, b3, b4, b5):
 
 
 @nb.njit(cache=True)
+def _grow(acc, o, tb, k, cen):
+    """Grow the box ``acc[o:o + 6]`` by row ``k`` of ``tb`` and the centroid bounds
+    ``acc[o + 6:o + 12]`` by row ``k`` of ``cen``."""
+    for a in range(3):
+        acc[o + a] = min(acc[o + a], tb[k, a])
+        acc[o + 3 + a] = max(acc[o + 3 + a], tb[k, 3 + a])
+        acc[o + 6 + a] = min(acc[o + 6 + a], cen[k, a])
+        acc[o + 9 + a] = max(acc[o + 9 + a], cen[k, a])
+
+
+@nb.njit(cache=True)
 def _build(tri_v):
+    """The binned SAH build (module docstring).  The triangles' boxes and centroids are kept
+    in the order of ``idx`` (swapped with it), so that every pass over a node's range reads
+    memory in sequence; a node's box and centroid bounds come from its parent's partition,
+    and one pass bins the centroids along the three axes at once.  The tree is the same as a
+    build that rescans each node's triangles (same splits, same partition swaps)."""
     T = tri_v.shape[0]
     tb = np.empty((T, 6))
     cen = np.empty((T, 3))
@@ -58,14 +74,24 @@ def _build(tri_v):
     box = np.empty((cap, 6))
     meta = np.zeros((cap, 3), dtype=np.int64)
     stack = np.empty((MAX_DEPTH + 2, 5), dtype=np.int64)  # start, end, parent, is_right, depth
+    bounds = np.empty((MAX_DEPTH + 2, 12))  # each pending node's box and centroid bounds
+    acc = np.empty(24)  # two running boxes and centroid bounds (left at 0, right at 12)
+    for a in range(3):
+        acc[a], acc[3 + a], acc[6 + a], acc[9 + a] = np.inf, -np.inf, np.inf, -np.inf
+    for k in range(T):
+        _grow(acc, 0, tb, k, cen)
+    bounds[0, :] = acc[:12]
     stack[0, 0], stack[0, 1], stack[0, 2], stack[0, 3], stack[0, 4] = 0, T, -1, 0, 0
     sp = 1
     n_nodes = 0
-    bin_box = np.empty((N_BINS, 6))
-    bin_cnt = np.zeros(N_BINS, dtype=np.int64)
+    bin_box = np.empty((3, N_BINS, 6))
+    bin_cnt = np.zeros((3, N_BINS), dtype=np.int64)
     right_area = np.empty(N_BINS)
     right_cnt = np.empty(N_BINS, dtype=np.int64)
-    acc = np.empty(6)  # running box of the sweeps
+    sweep = np.empty(6)  # running box of the sweeps
+    cmin = np.empty(3)
+    ext = np.empty(3)
+    scale = np.zeros(3)
     while sp > 0:
         sp -= 1
         s, e, parent, is_right, depth = stack[sp, 0], stack[sp, 1], stack[sp, 2], stack[sp, 3], stack[sp, 4]
@@ -73,61 +99,62 @@ def _build(tri_v):
         n_nodes += 1
         if is_right == 1:
             meta[parent, 0] = node
-        # node bounds and centroid bounds
+        for a in range(6):
+            box[node, a] = bounds[sp, a]
         for a in range(3):
-            box[node, a], box[node, 3 + a] = np.inf, -np.inf
-        cmin = np.full(3, np.inf)
-        cmax = np.full(3, -np.inf)
-        for k in range(s, e):
-            i = idx[k]
-            for a in range(3):
-                box[node, a] = min(box[node, a], tb[i, a])
-                box[node, 3 + a] = max(box[node, 3 + a], tb[i, 3 + a])
-                cmin[a] = min(cmin[a], cen[i, a])
-                cmax[a] = max(cmax[a], cen[i, a])
+            cmin[a] = bounds[sp, 6 + a]
+            ext[a] = bounds[sp, 9 + a] - cmin[a]
         n = e - s
-        ext = cmax - cmin
         if n <= MAX_LEAF or not max(ext[0], ext[1], ext[2]) > 0.0 or depth >= MAX_DEPTH:
             meta[node, 0], meta[node, 1], meta[node, 2] = s, n, -1
             continue
-        # bin the centroids along each axis, sweep from the right, then from the left
+        # bin the centroids along the three axes in one pass
+        for ax in range(3):
+            scale[ax] = N_BINS * (1.0 - 1e-9) / ext[ax] if ext[ax] > 0.0 else 0.0
+            for b in range(N_BINS):
+                bin_cnt[ax, b] = 0
+                for a in range(3):
+                    bin_box[ax, b, a], bin_box[ax, b, 3 + a] = np.inf, -np.inf
+        for k in range(s, e):
+            for ax in range(3):
+                if scale[ax] == 0.0:
+                    continue
+                b = int((cen[k, ax] - cmin[ax]) * scale[ax])
+                bin_cnt[ax, b] += 1
+                for a in range(3):
+                    bin_box[ax, b, a] = min(bin_box[ax, b, a], tb[k, a])
+                    bin_box[ax, b, 3 + a] = max(bin_box[ax, b, 3 + a], tb[k, 3 + a])
+        # sweep each axis from the right, then from the left
         best, best_b, axis = np.inf, -1, 0
         for ax in range(3):
             if not ext[ax] > 0.0:
                 continue
-            scale = N_BINS * (1.0 - 1e-9) / ext[ax]
-            for b in range(N_BINS):
-                bin_cnt[b] = 0
-                for a in range(3):
-                    bin_box[b, a], bin_box[b, 3 + a] = np.inf, -np.inf
-            for k in range(s, e):
-                i = idx[k]
-                b = int((cen[i, ax] - cmin[ax]) * scale)
-                bin_cnt[b] += 1
-                for a in range(3):
-                    bin_box[b, a] = min(bin_box[b, a], tb[i, a])
-                    bin_box[b, 3 + a] = max(bin_box[b, 3 + a], tb[i, 3 + a])
             for a in range(3):
-                acc[a], acc[3 + a] = np.inf, -np.inf
+                sweep[a], sweep[3 + a] = np.inf, -np.inf
             cnt = 0
             for b in range(N_BINS - 1, 0, -1):
+                if bin_cnt[ax, b] == 0 and b < N_BINS - 1:  # an empty bin changes nothing
+                    right_area[b], right_cnt[b] = right_area[b + 1], cnt
+                    continue
                 for a in range(3):
-                    acc[a] = min(acc[a], bin_box[b, a])
-                    acc[3 + a] = max(acc[3 + a], bin_box[b, 3 + a])
-                cnt += bin_cnt[b]
-                right_area[b] = _area(acc[0], acc[1], acc[2], acc[3], acc[4], acc[5])
+                    sweep[a] = min(sweep[a], bin_box[ax, b, a])
+                    sweep[3 + a] = max(sweep[3 + a], bin_box[ax, b, 3 + a])
+                cnt += bin_cnt[ax, b]
+                right_area[b] = _area(sweep[0], sweep[1], sweep[2], sweep[3], sweep[4], sweep[5])
                 right_cnt[b] = cnt
             for a in range(3):
-                acc[a], acc[3 + a] = np.inf, -np.inf
+                sweep[a], sweep[3 + a] = np.inf, -np.inf
             cnt = 0
             for b in range(N_BINS - 1):
+                if bin_cnt[ax, b] == 0:  # the split of the bin before, at the same cost: not a new one
+                    continue
                 for a in range(3):
-                    acc[a] = min(acc[a], bin_box[b, a])
-                    acc[3 + a] = max(acc[3 + a], bin_box[b, 3 + a])
-                cnt += bin_cnt[b]
+                    sweep[a] = min(sweep[a], bin_box[ax, b, a])
+                    sweep[3 + a] = max(sweep[3 + a], bin_box[ax, b, 3 + a])
+                cnt += bin_cnt[ax, b]
                 if cnt == 0 or right_cnt[b + 1] == 0:
                     continue
-                c = _area(acc[0], acc[1], acc[2], acc[3], acc[4], acc[5]) * cnt + right_area[b + 1] * right_cnt[b + 1]
+                c = _area(sweep[0], sweep[1], sweep[2], sweep[3], sweep[4], sweep[5]) * cnt + right_area[b + 1] * right_cnt[b + 1]
                 if c < best:
                     best, best_b, axis = c, b, ax
         parent_area = _area(box[node, 0], box[node, 1], box[node, 2], box[node, 3], box[node, 4], box[node, 5])
@@ -136,22 +163,34 @@ def _build(tri_v):
         if best_b < 0 or (split_cost >= leaf_cost and n <= 4 * MAX_LEAF):
             meta[node, 0], meta[node, 1], meta[node, 2] = s, n, -1
             continue
-        # partition idx[s:e] by bin
-        scale = N_BINS * (1.0 - 1e-9) / ext[axis]
+        # partition [s, e) by bin (idx, boxes and centroids swapped together), growing each
+        # side's box and centroid bounds as its triangles are placed
+        sc, cm = scale[axis], cmin[axis]
+        for a in range(3):
+            for o in (0, 12):
+                acc[o + a], acc[o + 3 + a], acc[o + 6 + a], acc[o + 9 + a] = np.inf, -np.inf, np.inf, -np.inf
         lo, hi = s, e - 1
         while lo <= hi:
-            if int((cen[idx[lo], axis] - cmin[axis]) * scale) <= best_b:
+            if int((cen[lo, axis] - cm) * sc) <= best_b:
+                _grow(acc, 0, tb, lo, cen)
                 lo += 1
             else:
                 idx[lo], idx[hi] = idx[hi], idx[lo]
+                for a in range(6):
+                    tb[lo, a], tb[hi, a] = tb[hi, a], tb[lo, a]
+                for a in range(3):
+                    cen[lo, a], cen[hi, a] = cen[hi, a], cen[lo, a]
+                _grow(acc, 12, tb, hi, cen)
                 hi -= 1
         mid = lo
         meta[node, 1], meta[node, 2] = 0, axis
         # push right then left: the left child is popped next and gets index node + 1 (at most
         # one pending right child per level: the stack holds MAX_DEPTH + 2)
         stack[sp, 0], stack[sp, 1], stack[sp, 2], stack[sp, 3], stack[sp, 4] = mid, e, node, 1, depth + 1
+        bounds[sp, :] = acc[12:]
         sp += 1
         stack[sp, 0], stack[sp, 1], stack[sp, 2], stack[sp, 3], stack[sp, 4] = s, mid, node, 0, depth + 1
+        bounds[sp, :] = acc[:12]
         sp += 1
     return idx, box[:n_nodes].copy(), meta[:n_nodes].copy()
 

@@ -64,7 +64,7 @@ class SceneData:
     has_uv: np.ndarray          # (P,) bool: a mesh with uvs (else texturing's own mapping)
     poly_v: np.ndarray          # (K, 3) polygon vertices, object space
     csg_prog: np.ndarray        # postfix program: leaf primitive >= 0 or a CSG_* op
-    tri_v: np.ndarray           # (T, 9) world-space vertices, BVH order
+    tri_v: np.ndarray           # (T, 9) world-space vertices, BVH order (octree: one row per reference)
     tri_n: np.ndarray           # (T, 9) world-space vertex normals
     tri_uv: np.ndarray          # (T, 6)
     tri_e: np.ndarray           # (T, 9) vertex emission (radiance)
@@ -194,8 +194,9 @@ def _triangles(meshes):
             np.concatenate(tp))
 
 
-def flatten(scene: m.Scene) -> SceneData:
-    """Build the kernel arrays for ``scene`` (area lights become emissive polygons)."""
+def flatten(scene: m.Scene, accel: str = "bvh") -> SceneData:
+    """Build the kernel arrays for ``scene`` (area lights become emissive polygons), the
+    triangles' acceleration structure ``accel`` (:data:`.accel.ACCELS`) over the triangles."""
     import time
     b = _Builder(scene)
     for i, o in enumerate(scene.objects):
@@ -208,10 +209,11 @@ def flatten(scene: m.Scene) -> SceneData:
         return np.ascontiguousarray(np.array([r[key] for r in rows], dtype=dtype))
 
     tri_v, tri_n, tri_uv, tri_e, tri_p = _triangles(b.meshes)
-    from .bvh import build_bvh4, empty_bvh4
+    from .accel import build_accel
+    from .bvh import empty_bvh4
     t0 = time.perf_counter()
     if len(tri_v):
-        order, bvh = build_bvh4(tri_v)
+        order, bvh = build_accel(tri_v, accel)
         tri_v, tri_n, tri_uv, tri_e, tri_p = (np.ascontiguousarray(a[order]) for a in
                                               (tri_v, tri_n, tri_uv, tri_e, tri_p))
     else:

@@ -23,7 +23,9 @@ number of ray generations in a path, primary = 1, as the course's ``recurs_max``
 ``max_trace_level``), ``threshold`` (the course's perceptual threshold on the accumulated
 weight), ``spp`` (samples per pixel, stratified jitter, seeded by ``seed``), ``fresnel``
 (``none``: constant k_r, k_t; ``schlick``; ``exact`` dielectric), ``transmissive_shadows``,
-``blinn``, ``progress`` (tqdm bar) and ``on_tile``.
+``blinn``, ``progress`` (tqdm bar), ``on_tile``, ``accel`` (the triangles' acceleration
+structure: ``bvh``, ``octree`` or ``none``, :mod:`.accel`) and ``traversal_stats`` (nodes visited
+and primitives tested per camera ray, :mod:`.traversal_stats`).
 
 ``on_tile(y0, y1, x0, x1, tile)`` is called from the rendering thread after each band with
 ``tile`` the (y1 - y0, x1 - x0, 3) float32 linear image of rows ``y0:y1`` and columns ``x0:x1``.
@@ -37,8 +39,9 @@ import numpy as np
 from ...core.errors import WorkbenchError
 from ...core.tol import tol
 from ...scene import features as F
-from ...scene.model import Scene
+from ...scene.model import Mesh, Scene
 from ..base import Knob, Option, RenderResult
+from .accel import ACCELS, accel_extra_bytes
 from .flatten import MAX_CUTOUTS, OPACITY_CUT, SHADOW_CROSSINGS, SceneData, flatten
 
 _RAYS_PER_BAND = 1 << 16
@@ -119,6 +122,7 @@ def estimate_trace_bytes(scene: Scene, width: int, height: int, opts: dict, recu
     spp = int(opts["spp"])
     tris = extra_triangles + sum(len(o.faces) for o in scene.objects if isinstance(o, m.Mesh))
     total = _FIXED_BYTES + tris * _BYTES_PER_TRIANGLE + width * height * _BYTES_PER_PIXEL
+    total += accel_extra_bytes(tris, opts.get("accel", "bvh"))
     total += width * height * spp * _BYTES_PER_PRIMARY_RAY
     G = generation_bound(scene, int(opts.get("max_depth", 1)), float(opts.get("threshold", 0.0)), recursive)
     if fusable(scene, scene.materials.values()):  # MAX_TASKS stacks of 2 G + 2 pending rays
@@ -538,7 +542,7 @@ class _WhittedBase:
             raise WorkbenchError(f"method {self.name!r}: option 'spp' must be within 1..4096, got {o['spp']}")
         timings = {}
         t0 = time.perf_counter()
-        sd = flatten(scene)
+        sd = flatten(scene, o["accel"])
         timings["build"] = time.perf_counter() - t0
         timings["bvh_build"] = sd.bvh_build_time
         opts = dict(o)
@@ -584,7 +588,14 @@ class _WhittedBase:
         st["total_rays"] = total
         st["mrays_per_s"] = total / max(timings["trace"], 1e-9) / 1e6
         st["primitives"] = int(sd.top.sum())
-        st["triangles"] = int(len(sd.tri_v))
+        st["triangles"] = int(sum(len(ob.faces) for ob in scene.objects if isinstance(ob, Mesh)))
+        st["accel"] = opts["accel"]
+        st["triangle_references"] = int(len(sd.tri_v))
+        if opts["traversal_stats"]:
+            from .traversal_stats import primary_ray_counts
+            t2 = time.perf_counter()
+            st.update(primary_ray_counts(sd, *camera_rays(cam, width, height, 1, 0)[:2]))
+            timings["traversal_stats"] = time.perf_counter() - t2
         st["scene_extent"] = sd.extent
         used, left = self._features(scene, tr)
         return RenderResult(self.name, image.reshape(height, width, 3), timings, st, used, left,
@@ -627,6 +638,10 @@ _COMMON = {
     "fresnel": Option(str, "none", "reflection/transmission split: none (constant kr, kt), schlick or exact dielectric", ("none", "schlick", "exact")),
     "progress": Option(bool, False, "show a tqdm progress bar (CLI)"),
     "on_tile": Option(_callback, None, "callback on_tile(y0, y1, x0, x1, tile) after each band of rows"),
+    "accel": Option(str, "bvh", "acceleration structure over the triangles: bvh (4-wide binned SAH), octree "
+                    "(the course's arbre octal) or none (every triangle tested); same images", ACCELS),
+    "traversal_stats": Option(bool, False, "count nodes visited and primitives tested per pixel-centre "
+                              "camera ray (stats accel_*; a pass of its own, timed apart)"),
 }
 
 
@@ -634,6 +649,7 @@ class RaycastRenderer(_WhittedBase):
     """Eye rays and shadow feelers with the shared local model (no secondary rays)."""
 
     name = "raycast"
+    ui_kind = "cpu"
     recursive = False
     knob = Knob("spp", (1, 2, 4, 8, 16), 1, "samples per pixel")
     options = dict(_COMMON)
@@ -644,6 +660,7 @@ class RaytraceRenderer(_WhittedBase):
     """Whitted ray tracer: raycast plus recursive reflection and refraction."""
 
     name = "raytrace"
+    ui_kind = "cpu"
     knob = Knob("max_depth", (1, 2, 3, 4, 5, 6, 8, 12), 5,
                 "maximum number of ray generations in a path (primary = 1)")
     options = {**_COMMON,

@@ -1,0 +1,188 @@
+"""Acceleration structures of the ray tracer (``accel=bvh|octree|none``) on two triangle
+scenes, and the BVH build time before and after the build rewrite.
+
+Scenes: the bundled ``mesh`` (one 81,920-triangle blob on an analytic floor: dense, compact)
+and ``many`` (a 20 x 20 grid of 80-triangle icospheres over a floor, 32,000 triangles in 400
+objects with empty space between them: where a uniform subdivision and a SAH tree differ).
+For each structure: build time (``timings["bvh_build"]`` of the render: the structure and the
+reordering of the triangle arrays; best of the runs), trace time of a ``raycast`` render
+(``timings["trace"]``, best of ``--repeat`` warm runs), nodes visited and triangle tests per
+camera ray (option ``traversal_stats``: its pass's time ``stats_pass_s`` beside the trace time of the same
+render, ``stats_render_trace_s``; the rendering kernels themselves carry no counters), triangle rows held (the octree repeats triangles) and
+the memory estimate.  The images of the three structures are compared (equal: ``same_image``).
+
+BVH build before / after: ``build_bvh4`` on the mesh scene's triangles in one child process
+that loads both versions of ``bvh.py`` (``--before``: a git revision, default ``f2e4b0a``, the
+last one before the rewrite, exported with ``git archive`` to a temporary folder; after: this
+checkout) and alternates them, best and median of 15 builds each, wall and CPU seconds; the two trees' arrays are compared (the
+rewrite makes the same tree, so the BVH's quality (nodes visited, trace time) is unchanged).
+
+Writes ``bench/results/accel.json`` and ``accel.md``.  Run:
+``.venv/bin/python bench/accel.py [--size 160x120] [--repeat 3] [--before f2e4b0a]``.
+The machine is shared: its load average is recorded at the start and the end.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+RESULTS = ROOT / "bench" / "results"
+ACCELS = ("bvh", "octree", "none")
+
+BUILD_CHILD = r"""
+import hashlib, importlib.util, json, sys, time
+import numpy as np
+from workbench.renderers.raytrace import bvh as after
+spec = importlib.util.spec_from_file_location("bvh_before", sys.argv[2])
+before = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(before)
+tri = np.load(sys.argv[1])
+codes = {"before": before.build_bvh4, "after": after.build_bvh4}
+for f in codes.values():
+    f(tri[:64])  # JIT or cache load, outside the measurement
+wall = {k: [] for k in codes}
+cpu = {k: [] for k in codes}
+for _ in range(15):  # alternating, so that both see the same load
+    for k, f in codes.items():
+        t0, c0 = time.perf_counter(), time.process_time()
+        f(tri)
+        wall[k].append(time.perf_counter() - t0)
+        cpu[k].append(time.process_time() - c0)
+out = {}
+for k, f in codes.items():
+    order, bvh = f(tri)
+    h = hashlib.sha256(order.tobytes())
+    for a in bvh:
+        h.update(np.ascontiguousarray(a).tobytes())
+    out[k] = dict(wall_best_s=min(wall[k]), wall_median_s=float(np.median(wall[k])), cpu_best_s=min(cpu[k]),
+                  cpu_median_s=float(np.median(cpu[k])), nodes_4wide=int(len(bvh.node)), leaves=int(len(bvh.leaf)),
+                  tree_sha256=h.hexdigest())
+print(json.dumps(out))
+"""
+
+
+def many_scene():
+    from workbench.scene.io import scene_from_dict
+    objs = [{"type": "mesh", "material": "m", "generate": {"kind": "icosphere", "subdivisions": 1},
+             "transform": {"translate": [-4.75 + 0.5 * i, 0.2, -4.75 + 0.5 * j], "scale": 0.18}}
+            for i in range(20) for j in range(20)]
+    objs.append({"type": "plane", "material": "floor", "point": [0, 0, 0], "normal": [0, 1, 0], "size": [12, 12]})
+    return scene_from_dict({
+        "scene": {"name": "many", "background": [0.08, 0.08, 0.1], "ambient": [0.12, 0.12, 0.12]},
+        "camera": {"position": [0.0, 4.0, 7.5], "look_at": [0.0, 0.0, 0.0], "fov_y": 45.0, "resolution": [320, 240]},
+        "lights": [{"type": "point", "position": [3.0, 6.0, 3.0], "intensity": 0.9}],
+        "materials": {"m": {"color": [0.7, 0.5, 0.3], "ks": 0.3}, "floor": {"color": [0.6, 0.6, 0.6]}},
+        "objects": objs})
+
+
+def structures(scene, w, h, repeat):
+    import workbench
+    from workbench.renderers.base import check_memory, convert_options, get_renderer
+    r = get_renderer("raycast")
+    out, images = {}, {}
+    for a in ACCELS:
+        runs = [workbench.render(scene, "raycast", width=w, height=h, accel=a) for _ in range(repeat)]
+        counted = workbench.render(scene, "raycast", width=w, height=h, accel=a, traversal_stats=True)
+        st = counted.stats
+        images[a] = runs[-1].image
+        out[a] = dict(build_s=min(x.timings["bvh_build"] for x in runs),
+                      trace_s=min(x.timings["trace"] for x in runs),
+                      stats_pass_s=counted.timings["traversal_stats"], stats_render_trace_s=counted.timings["trace"],
+                      nodes_per_ray=st["accel_nodes_per_ray"],
+                      triangle_tests_per_ray=st["accel_triangle_tests_per_ray"],
+                      primitive_tests_per_ray=st["accel_primitive_tests_per_ray"],
+                      triangles=st["triangles"], triangle_rows=st["triangle_references"],
+                      memory_estimate_mb=check_memory(r, scene, w, h, convert_options(r, {"accel": a})) / 2 ** 20)
+    for a in ACCELS:
+        out[a]["same_image_as_bvh"] = bool(np.array_equal(images[a], images["bvh"]))
+    return out
+
+
+def build_before_after(before: str):
+    import workbench
+    from workbench.renderers.raytrace.flatten import _Builder, _triangles
+    scene = workbench.load_scene("mesh")
+    b = _Builder(scene)
+    for i, o in enumerate(scene.objects):
+        b.object(o, i)
+    tri = np.ascontiguousarray(_triangles(b.meshes)[0])
+    res = {"triangles": int(len(tri)), "before_revision": before}
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "tri.npy"
+        np.save(path, tri)
+        old = Path(tmp) / "before"
+        old.mkdir()
+        arch = subprocess.run(["git", "archive", before, "workbench"], cwd=ROOT, capture_output=True, check=True)
+        subprocess.run(["tar", "-x", "-C", str(old)], input=arch.stdout, check=True)
+        env = dict(os.environ, PYTHONPATH=str(ROOT), NUMBA_CACHE_DIR=str(Path(tmp) / "cache"))
+        p = subprocess.run([sys.executable, "-c", BUILD_CHILD, str(path),
+                            str(old / "workbench" / "renderers" / "raytrace" / "bvh.py")],
+                           capture_output=True, text=True, cwd=tmp, env=env)
+        if p.returncode != 0:
+            raise RuntimeError(p.stderr[-3000:])
+        res.update(json.loads(p.stdout.strip().splitlines()[-1]))
+    res["same_tree"] = res["before"]["tree_sha256"] == res["after"]["tree_sha256"]
+    return res
+
+
+def markdown(res) -> str:
+    lines = [f"# Acceleration structures ({res['size']}, raycast; load average {res['load_average_start'][0]:.1f} "
+             f"at the start, {res['load_average_end'][0]:.1f} at the end, {res['machine']})", ""]
+    for name, rows in res["scenes"].items():
+        lines += [f"## {name} ({rows['bvh']['triangles']} triangles)", "",
+                  "| accel | build (ms) | trace (ms) | nodes / ray | triangle tests / ray | triangle rows | "
+                  "memory estimate (MiB) | same image | statistics pass (ms) |", "|---|---|---|---|---|---|---|---|---|"]
+        for a in ACCELS:
+            r = rows[a]
+            lines.append(f"| {a} | {1e3 * r['build_s']:.1f} | {1e3 * r['trace_s']:.1f} | {r['nodes_per_ray']:.2f} | "
+                         f"{r['triangle_tests_per_ray']:.1f} | {r['triangle_rows']} | {r['memory_estimate_mb']:.0f} | "
+                         f"{'yes' if r['same_image_as_bvh'] else 'NO'} | {1e3 * r['stats_pass_s']:.1f} |")
+        lines.append("")
+    b = res["bvh_build"]
+    lines += [f"## BVH build, {b['triangles']} triangles (mesh scene), best / median of 15", "",
+              "| code | wall (ms) | CPU (ms) | 4-wide nodes | leaves |", "|---|---|---|---|---|"]
+    for k in ("before", "after"):
+        r = b[k]
+        lines.append(f"| {k}{' (' + b['before_revision'] + ')' if k == 'before' else ''} | "
+                     f"{1e3 * r['wall_best_s']:.1f} / {1e3 * r['wall_median_s']:.1f} | "
+                     f"{1e3 * r['cpu_best_s']:.1f} / {1e3 * r['cpu_median_s']:.1f} | {r['nodes_4wide']} | {r['leaves']} |")
+    lines += ["", f"Same tree before and after: {'yes' if b['same_tree'] else 'NO'}.", ""]
+    return "\n".join(lines)
+
+
+def main(argv=None) -> dict:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--size", default="160x120")
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--before", default="f2e4b0a")
+    args = ap.parse_args(argv)
+    w, h = (int(x) for x in args.size.lower().split("x"))
+    import workbench
+    res = {"machine": f"{os.cpu_count()} CPUs (shared)", "load_average_start": os.getloadavg(), "size": f"{w}x{h}",
+           "command": "python bench/accel.py " + " ".join(argv if argv is not None else sys.argv[1:])}
+    t0 = time.perf_counter()
+    for a in ACCELS:  # JIT or cache load of the kernels and the counting pass, outside the measurements
+        workbench.render(many_scene(), "raycast", width=8, height=6, accel=a, traversal_stats=True)
+    res["scenes"] = {"mesh": structures(workbench.load_scene("mesh"), w, h, args.repeat),
+                     "many": structures(many_scene(), w, h, args.repeat)}
+    res["bvh_build"] = build_before_after(args.before)
+    res["load_average_end"] = os.getloadavg()
+    res["bench_s"] = time.perf_counter() - t0
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    (RESULTS / "accel.json").write_text(json.dumps(res, indent=2))
+    (RESULTS / "accel.md").write_text(markdown(res))
+    print(markdown(res))
+    return res
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,186 @@
+"""Export of the comparison on screen, in a form the CLI replays.
+
+Into one folder (written whole or not at all: a temporary sibling renamed at the end):
+
+* ``M.png`` per panel **as displayed** (its display mode applied) and ``M.npy``, the linear
+  float32 image (the data the error plot and the probe use);
+* ``difference.png`` (its colour scale) and ``difference.npy`` when the difference view has
+  a map;
+* ``scene.toml``: the scene as shown: the scene file with the material and light overrides
+  written in and the camera as moved (its resolution the panels'), file paths made absolute;
+* ``settings.json``: scene, camera, methods with their options and display modes, the
+  overrides, the panels skipped and why (a panel whose method does not apply to the scene, or
+  whose render failed, has no image to write), and ``replay``: one ``workbench render``
+  command per panel that renders ``scene.toml`` with the panel's options and display mode into
+  the same PNG and NPY (``tests/test_ui_export.py`` runs them).
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import tomllib
+from dataclasses import asdict
+from pathlib import Path
+
+import numpy as np
+
+from .state import AppState, shown_image
+
+
+def toml_value(v) -> str:
+    """One TOML value: numbers, booleans, strings, arrays and inline tables."""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    if isinstance(v, (float, np.floating)):
+        x = float(v)
+        if not math.isfinite(x):
+            raise ValueError(f"not a finite number: {x}")
+        return repr(x)
+    if isinstance(v, str):
+        return json.dumps(v)  # a TOML basic string: JSON's escapes are TOML's
+    if isinstance(v, (list, tuple, np.ndarray)):
+        return "[" + ", ".join(toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{json.dumps(str(k))} = {toml_value(x)}" for k, x in v.items()) + "}"
+    raise ValueError(f"no TOML value for {type(v).__name__}")
+
+
+def toml_text(data: dict) -> str:
+    """A TOML document of ``data``: top-level scalars first, then a ``[table]`` per dict and
+    a ``[[table]]`` per list of dicts (their entries as ``key = value``, nested values inline)."""
+    lines, tables = [], []
+    for k, v in data.items():
+        if isinstance(v, dict) or (isinstance(v, list) and v and all(isinstance(x, dict) for x in v)):
+            tables.append((k, v))
+        else:
+            lines.append(f"{json.dumps(str(k))} = {toml_value(v)}")
+    for k, v in tables:
+        if isinstance(v, dict):
+            scalars = {a: b for a, b in v.items() if not isinstance(b, dict)}
+            subs = {a: b for a, b in v.items() if isinstance(b, dict)}
+            lines += ["", f"[{json.dumps(str(k))}]"] + [f"{json.dumps(str(a))} = {toml_value(b)}"
+                                                        for a, b in scalars.items()]
+            for a, b in subs.items():  # [materials.NAME]
+                lines += ["", f"[{json.dumps(str(k))}.{json.dumps(str(a))}]"]
+                lines += [f"{json.dumps(str(c))} = {toml_value(d)}" for c, d in b.items()]
+        else:
+            for entry in v:
+                lines += ["", f"[[{json.dumps(str(k))}]]"]
+                lines += [f"{json.dumps(str(a))} = {toml_value(b)}" for a, b in entry.items()]
+    return "\n".join(lines) + "\n"
+
+
+def _absolute_paths(node, base: Path):
+    """``node`` with every string naming an existing file relative to ``base`` made absolute
+    (textures, meshes, environment maps of a scene written elsewhere)."""
+    if isinstance(node, dict):
+        return {k: _absolute_paths(v, base) for k, v in node.items()}
+    if isinstance(node, list):
+        return [_absolute_paths(v, base) for v in node]
+    if isinstance(node, str) and not Path(node).is_absolute() and (base / node).is_file():
+        return str((base / node).resolve())
+    return node
+
+
+def scene_document(state: AppState) -> dict:
+    """The scene file of ``state`` as a dict with the overrides and the camera written in."""
+    data = tomllib.loads(state.scene_path.read_text(encoding="utf-8"))
+    data = _absolute_paths(data, state.scene_path.parent)
+    cam = state.camera
+    data["camera"] = {**data["camera"], "position": list(cam.position),
+                      "look_at": list(cam.look_at), "up": list(cam.up), "fov_y": float(cam.fov_y),
+                      "resolution": [cam.width, cam.height]}
+    for name, fields in state.overrides.items():
+        data.setdefault("materials", {}).setdefault(name, {}).update(
+            {k: float(v) for k, v in fields.items()})
+    lights = data.get("lights", [])
+    for k, fields in state.light_overrides.items():
+        light = state.scene.lights[k]  # the overrides applied (an area light's moved vertices)
+        for name in fields:
+            if name == "centre":
+                lights[k]["vertices"] = np.asarray(light.vertices, float).tolist()
+            else:
+                value = getattr(light, name)
+                lights[k][name] = float(value) if name == "intensity" else [float(x) for x in value]
+    return data
+
+
+def skipped_panels(state: AppState) -> dict[str, str]:
+    """Panels with no image to write, and why (the method does not apply to the scene, its
+    render failed, or nothing has come yet)."""
+    out = {}
+    for m in state.methods:
+        job = state.jobs.current.get(m) if state.jobs is not None else None
+        error = getattr(job, "error", None)
+        proc = state.pyrender if m == "pyrender" else None
+        error = error or getattr(proc, "error", None)
+        if error:
+            out[m] = error
+        elif m not in state.images:
+            out[m] = "no image yet"
+    return out
+
+
+def replay_command(state: AppState, method: str, folder: Path) -> list[str]:
+    """The ``workbench render`` command that renders ``method``'s panel from ``scene.toml``."""
+    cmd = ["workbench", "render", str(folder / "scene.toml"), "--method", method,
+           "--size", f"{state.camera.width}x{state.camera.height}"]
+    for k, v in state.options.get(method, {}).items():
+        cmd += ["--set", f"{k}={v}"]
+    cmd += ["--display", state.display.get(method, "direct24"),
+            "-o", str(folder / f"{method}.png"), "--npy", str(folder / f"{method}.npy")]
+    return cmd
+
+
+def settings(state: AppState, folder: Path, skipped: dict[str, str]) -> dict:
+    """The export's ``settings.json``."""
+    shown = [m for m in state.methods if m not in skipped]
+    return {"scene": str(state.scene_path), "scene_file": str(folder / "scene.toml"),
+            "camera": asdict(state.camera), "methods": list(state.methods),
+            "options": {m: state.options[m] for m in state.methods},
+            "display": {m: state.display.get(m, "direct24") for m in state.methods},
+            "material_overrides": state.overrides,
+            "light_overrides": {str(k): v for k, v in state.light_overrides.items()},
+            "difference": {"a": state.diff_pair[0], "b": state.diff_pair[1],
+                           "kind": state.diff_kind},
+            "skipped": skipped,
+            "replay": [replay_command(state, m, folder) for m in shown]}
+
+
+def export(state: AppState, folder: Path) -> list[Path]:
+    """Write the comparison into ``folder`` (see the module docstring; an existing folder is
+    replaced); returns the files written.  ``state.status["export"]`` says where, and which
+    panels were skipped."""
+    from ...core.imageio import save_png, save_png8
+    from .colours import colour_scale
+    folder = Path(folder).resolve()
+    tmp = folder.with_name(folder.name + ".partial")
+    shutil.rmtree(tmp, ignore_errors=True)
+    tmp.mkdir(parents=True)
+    skipped = skipped_panels(state)
+    names = []
+    for m in state.methods:
+        if m in skipped:
+            continue
+        save_png(tmp / f"{m}.png", shown_image(state, m))
+        np.save(tmp / f"{m}.npy", np.asarray(state.images[m], np.float32))
+        names += [f"{m}.png", f"{m}.npy"]
+    err = state.images.get("difference")
+    if err is not None and not set(state.diff_pair) & set(skipped):
+        save_png8(tmp / "difference.png", colour_scale(err, float(err.max())))
+        np.save(tmp / "difference.npy", np.asarray(err, np.float32))
+        names += ["difference.png", "difference.npy"]
+    (tmp / "scene.toml").write_text(toml_text(scene_document(state)), encoding="utf-8")
+    (tmp / "settings.json").write_text(json.dumps(settings(state, folder, skipped), indent=1,
+                                                  default=str))
+    names += ["scene.toml", "settings.json"]
+    if folder.exists():
+        shutil.rmtree(folder)
+    os.replace(tmp, folder)
+    note = "" if not skipped else "; skipped: " + "; ".join(f"{m} ({why})" for m, why in skipped.items())
+    state.status["export"] = f"saved {len(names)} files to {folder}{note}"
+    return [folder / n for n in names]

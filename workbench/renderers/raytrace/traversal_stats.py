@@ -1,0 +1,153 @@
+"""Traversal statistics of the triangles' acceleration structure (option ``traversal_stats``):
+nodes visited and primitives tested per camera ray, counted in a pass of their own so that
+the rendering kernels carry no counters (their speed is untouched; the pass costs about one
+more trace of the pixel centres and is timed apart, ``timings["traversal_stats"]``).
+
+:func:`count_hit` is :func:`.kernels.bvh_hit` (closest hit) step for step with two counters:
+the same box and triangle tests in the same order, so it returns the same hit (tested) and
+its counts are the real traversal's.  Counting rules, per ray:
+
+* nodes: 1 for the structure's root box (:func:`.kernels.closest`'s bounds test), plus one
+  per further 4-wide node whose children's boxes the ray tests (the root's own visit is the
+  bounds test's: a ray that misses the root box visits 1 node, one that enters it visits the
+  root and the nodes it goes on to).  Rays that meet no triangle box are counted too.
+* triangle tests: four per leaf group tested (a group's lanes are tested side by side; a
+  group of fewer than four triangles repeats its last one).
+* primitive tests: the triangle tests plus one per top-level analytic primitive (every ray
+  tests each of them, whatever the structure).
+"""
+from __future__ import annotations
+
+import numba as nb
+import numpy as np
+from numba import prange
+
+from ...core.tol import tol
+from .kernels import (CHUNK, NO_REFCOUNT, _bounds_hit, _tasks, _visit_child, box_lane, closest, scratch,
+                      tri_lane)
+
+
+@nb.njit(**NO_REFCOUNT)
+def count_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, stack, cnt):
+    """:func:`.kernels.bvh_hit`'s closest-hit traversal, adding the 4-wide nodes visited to
+    ``cnt[0]`` and the triangle tests to ``cnt[1]``.  Returns ``(t, tri)``."""
+    node, child, leaf, first, tv4 = bvh
+    ix, iy, iz = 1.0 / dx, 1.0 / dy, 1.0 / dz
+    cx = 0 if ix >= 0.0 else 3
+    cy = 1 if iy >= 0.0 else 4
+    cz = 2 if iz >= 0.0 else 5
+    pl = (np.uint64(cx), np.uint64(cy), np.uint64(cz), np.uint64(3 - cx), np.uint64(5 - cy), np.uint64(7 - cz))
+    ax0, ax1, ax2 = abs(dx), abs(dy), abs(dz)
+    kz = 0
+    if ax1 > ax0 and ax1 >= ax2:
+        kz = 1
+    elif ax2 > ax0 and ax2 > ax1:
+        kz = 2
+    kx = (kz + 1) % 3
+    ky = (kx + 1) % 3
+    d = (dx, dy, dz)
+    if d[kz] < 0.0:
+        kx, ky = ky, kx
+    sx, sy, sz = d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]
+    o = (ox, oy, oz)
+    okx, oky, okz = o[kx], o[ky], o[kz]
+    pk = (np.uint64(kx), np.uint64(ky), np.uint64(kz), np.uint64(3 + kx), np.uint64(3 + ky),
+          np.uint64(3 + kz), np.uint64(6 + kx), np.uint64(6 + ky), np.uint64(6 + kz))
+    best, bg, bl = tmax, -1, 0
+    top = stack.shape[0] - 1
+    code, sp = 0, 0
+    while True:
+        while code >= 0:
+            cnt[0] += 1
+            nd = np.uint64(code)
+            t0 = box_lane(node, nd, 0, pl, ox, oy, oz, ix, iy, iz, tmin, best)
+            t1 = box_lane(node, nd, 1, pl, ox, oy, oz, ix, iy, iz, tmin, best)
+            t2 = box_lane(node, nd, 2, pl, ox, oy, oz, ix, iy, iz, tmin, best)
+            t3 = box_lane(node, nd, 3, pl, ox, oy, oz, ix, iy, iz, tmin, best)
+            base, code, tn = sp, -1, np.inf
+            if t0 < np.inf:
+                code, tn = child[nd, 0], t0
+            if t1 < np.inf:
+                sp, code, tn = _visit_child(stack, base, sp, top, t1, child[nd, 1], code, tn)
+            if t2 < np.inf:
+                sp, code, tn = _visit_child(stack, base, sp, top, t2, child[nd, 2], code, tn)
+            if t3 < np.inf:
+                sp, code, tn = _visit_child(stack, base, sp, top, t3, child[nd, 3], code, tn)
+        if code < -1:
+            lf = -2 - code
+            for g in range(leaf[lf, 0], leaf[lf, 0] + leaf[lf, 1]):
+                cnt[1] += 4
+                u0 = tri_lane(tv4, g, 0, pk, okx, oky, okz, sx, sy, sz, tmin, best)
+                u1 = tri_lane(tv4, g, 1, pk, okx, oky, okz, sx, sy, sz, tmin, best)
+                u2 = tri_lane(tv4, g, 2, pk, okx, oky, okz, sx, sy, sz, tmin, best)
+                u3 = tri_lane(tv4, g, 3, pk, okx, oky, okz, sx, sy, sz, tmin, best)
+                m = min(min(u0, u1), min(u2, u3))
+                if m < best:
+                    best, bg = m, g
+                    bl = 0 if u0 == m else (1 if u1 == m else (2 if u2 == m else 3))
+        code = -1
+        while sp > 0:
+            sp -= 1
+            if stack[sp, 0] <= best:
+                code = int(stack[sp, 1])
+                break
+        if code == -1:
+            break
+    if bg < 0:
+        return np.inf, -1
+    return best, first[bg] + bl
+
+
+@nb.njit(**NO_REFCOUNT)
+def _count_chunk(geo_analytic, bvh, bounds, has_tri, O, D, zero, rel_eps, extent, counts, i0, i1, scr):
+    stack, st, sp_, sf, sn = scr
+    for i in range(i0, i1):
+        ox, oy, oz, dx, dy, dz = O[i, 0], O[i, 1], O[i, 2], D[i, 0], D[i, 1], D[i, 2]
+        eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
+        # the analytic primitives' nearest hit: the far end of the triangles' search
+        best = closest(geo_analytic, ox, oy, oz, dx, dy, dz, 0.0, np.inf, False, False, zero, eps,
+                       stack, st, sp_, sf, sn)[0]
+        counts[i, 0], counts[i, 1] = 1, 0
+        if has_tri and _bounds_hit(bounds, ox, oy, oz, dx, dy, dz, 0.0, best):
+            counts[i, 0] = 0
+            count_hit(bvh, ox, oy, oz, dx, dy, dz, 0.0, best, stack, counts[i])
+
+
+@nb.njit(cache=True, error_model="numpy", parallel=True)
+def count_rays(geo_analytic, bvh, bounds, has_tri, O, D, zero, rel_eps, extent, counts):
+    """Per ray ``counts[i] = (nodes visited, triangle tests)`` of the closest-hit search from
+    ``t = 0`` (see the module docstring); ``geo_analytic`` is the kernels' geometry tuple
+    without its triangles."""
+    n = O.shape[0]
+    nchunks = (n + CHUNK - 1) // CHUNK
+    nit = _tasks(nchunks)
+    for c in prange(nit):
+        scr = scratch()
+        for q in range(c, nchunks, nit):
+            _count_chunk(geo_analytic, bvh, bounds, has_tri, O, D, zero, rel_eps, extent, counts,
+                         q * CHUNK, min(n, (q + 1) * CHUNK), scr)
+
+
+def ray_counts(sd, O: np.ndarray, D: np.ndarray) -> np.ndarray:
+    """(N, 2) int64 nodes visited and triangle tests of each ray ``O + t D``, t >= 0, of the
+    flattened scene ``sd`` (:class:`.flatten.SceneData`)."""
+    geo = list(sd.kernel_args())
+    geo[9] = np.zeros((0, 9))  # tri_v: no triangles, the analytic primitives only
+    b = sd.bvh
+    counts = np.zeros((len(O), 2), dtype=np.int64)
+    count_rays(tuple(geo), (b.node, b.child, b.leaf, b.first, b.tv4), b.bounds, len(sd.tri_v) > 0,
+               np.ascontiguousarray(O, dtype=np.float64), np.ascontiguousarray(D, dtype=np.float64),
+               tol.zero, tol.ray_offset, sd.extent, counts)
+    return counts
+
+
+def primary_ray_counts(sd, O: np.ndarray, D: np.ndarray) -> dict:
+    """The render's ``stats`` entries from its camera rays ``O, D`` (N, 3): the means over the
+    rays of nodes visited (``accel_nodes_per_ray``), triangle tests
+    (``accel_triangle_tests_per_ray``) and primitive tests (``accel_primitive_tests_per_ray``:
+    triangle tests plus the top-level analytic primitives, each tested by every ray)."""
+    c = ray_counts(sd, O, D)
+    n_analytic = int(np.count_nonzero(sd.top))
+    return {"accel_nodes_per_ray": float(c[:, 0].mean()),
+            "accel_triangle_tests_per_ray": float(c[:, 1].mean()),
+            "accel_primitive_tests_per_ray": float(c[:, 1].mean() + n_analytic)}
