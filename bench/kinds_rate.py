@@ -21,7 +21,8 @@ from pathlib import Path
 import numba as nb
 import numpy as np
 
-from workbench.scene.kinds import blob, isosurface, lathe, prism
+from workbench.scene.kinds import (blob, blob_kernels, isosurface, isosurface_kernels, lathe, lathe_kernels, prism,
+                                   prism_kernels)
 from workbench.scene.kinds.expression import MAX_STACK
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -38,13 +39,13 @@ def _run(code, par, aux, O, D, t_out):
     for i in range(O.shape[0]):
         ox, oy, oz, dx, dy, dz = O[i, 0], O[i, 1], O[i, 2], D[i, 0], D[i, 1], D[i, 2]
         if code == 0:
-            t, _ = blob.blob_first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
+            t, _ = blob_kernels.blob_first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
         elif code == 1:
-            t, _ = isosurface.iso_first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
+            t, _ = isosurface_kernels.iso_first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
         elif code == 2:
-            t, _ = lathe.lathe_first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
+            t, _ = lathe_kernels.lathe_first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
         else:
-            t, _ = prism.prism_first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
+            t, _ = prism_kernels.prism_first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
         t_out[i] = t
 
 

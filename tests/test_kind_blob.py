@@ -10,6 +10,7 @@ import pytest
 from kind_checks import SCALES, assert_alternates, mesh_volume, scratch, table, welded_edge_uses
 from workbench.core.errors import WorkbenchError
 from workbench.scene.kinds import blob as B
+from workbench.scene.kinds import blob_kernels as BK
 
 REL = 1e-9
 
@@ -23,7 +24,7 @@ def _numba(b, O, D, tmin=-np.inf, tmax=np.inf, cap=16):
     head, aux = B.params(b, 0)
     par = table(head)
     out = np.zeros(cap)
-    n = B.blob_crossings(par, 0, aux, *map(float, O), *map(float, D), tmin, tmax, out, cap)
+    n = BK.blob_crossings(par, 0, aux, *map(float, O), *map(float, D), tmin, tmax, out, cap)
     return par, aux, out[:n]
 
 
@@ -49,7 +50,7 @@ def test_one_component_is_a_sphere(s, T):
         P = O + t * D
         assert np.allclose(n, (P - c) / R, rtol=0, atol=REL)
         head, aux = B.params(b, 0)
-        nn = np.array(B.blob_normal(table(head), 0, aux, 0, *P, scratch()[2]))
+        nn = np.array(BK.blob_normal(table(head), 0, aux, 0, *P, scratch()[2]))
         assert np.allclose(nn / np.linalg.norm(nn), n, rtol=0, atol=1e-12)
 
 
@@ -79,7 +80,7 @@ def test_numba_twin_agrees_and_crossings_alternate():
         assert len(got) == len(ref)
         assert np.allclose(got, [t for t, _ in ref], rtol=1e-12, atol=1e-12)
         assert_alternates(ref, lambda t: bool(B.inside(TWO, O + t * D)))
-        assert all(B.blob_inside(par, 0, aux, *(O + t * D), scratch()[2]) == B.inside(TWO, O + t * D)
+        assert all(BK.blob_inside(par, 0, aux, *(O + t * D), scratch()[2]) == B.inside(TWO, O + t * D)
                    for t in rng.uniform(-5, 5, 4))
         hit += bool(ref)
         for t, _ in ref:      # the field is the threshold on the surface

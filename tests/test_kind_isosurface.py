@@ -11,8 +11,9 @@ import pytest
 from kind_checks import SCALES, assert_alternates, mesh_volume, table, welded_edge_uses
 from workbench.core.errors import WorkbenchError
 from workbench.scene.kinds import isosurface as I
-from workbench.scene.kinds.expression import (MAX_STACK, compile_expression, evaluate, evaluate_gradient,
-                                              evaluate_numpy, gradient_numpy)
+from workbench.scene.kinds import isosurface_kernels as IK
+from workbench.scene.kinds.expression import MAX_STACK, compile_expression, evaluate_numpy, gradient_numpy
+from workbench.scene.kinds.expression_kernels import evaluate, evaluate_gradient
 
 REL = 1e-9
 GYROID = "sin(x)*cos(y) + sin(y)*cos(z) + sin(z)*cos(x)"
@@ -27,7 +28,7 @@ def _numba(s, O, D, tmin=-np.inf, tmax=np.inf, cap=16):
     head, aux = I.params(s, 0)
     par = table(head)
     ot, of = np.zeros(cap), np.zeros(cap, dtype=np.int64)
-    n = I.iso_crossings(par, 0, aux, *map(float, O), *map(float, D), tmin, tmax, ot, of, cap,
+    n = IK.iso_crossings(par, 0, aux, *map(float, O), *map(float, D), tmin, tmax, ot, of, cap,
                         np.zeros((MAX_STACK, 4)))
     return par, aux, ot[:n], of[:n]
 
@@ -94,7 +95,7 @@ def test_sphere_hits_and_normals():
         t, n = I.intersect(s, O, D)
         assert np.allclose(n, O + t * D, rtol=0, atol=REL)
         head, aux = I.params(s, 0)
-        nn = np.array(I.iso_normal(table(head), 0, aux, 0, *(O + t * D), np.zeros((MAX_STACK, 4))))
+        nn = np.array(IK.iso_normal(table(head), 0, aux, 0, *(O + t * D), np.zeros((MAX_STACK, 4))))
         assert np.allclose(nn / np.linalg.norm(nn), n, rtol=0, atol=1e-12)
 
 
@@ -201,4 +202,4 @@ def test_no_gradient_gives_a_zero_normal_not_nan():
     s = _iso("sqrt(x^2 + y^2 + z^2)", 1.0, 1.0, (-2,) * 3, (2,) * 3)
     assert I.normal(s, 0, np.zeros(3)).tolist() == [0.0, 0.0, 0.0]
     head, aux = I.params(s, 0)
-    assert I.iso_normal(table(head), 0, aux, 0, 0.0, 0.0, 0.0, np.zeros((MAX_STACK, 4))) == (0.0, 0.0, 0.0)
+    assert IK.iso_normal(table(head), 0, aux, 0, 0.0, 0.0, 0.0, np.zeros((MAX_STACK, 4))) == (0.0, 0.0, 0.0)

@@ -14,7 +14,8 @@ from workbench.core.tol import tol
 from workbench.renderers.raytrace import flatten as fl
 from workbench.renderers.raytrace.whitted import _alloc, _kernels
 from workbench.scene.io import scene_from_dict
-from workbench.scene.kinds import blob, isosurface, lathe, prism
+from workbench.scene.kinds import CSGNODE, blob, isosurface, lathe, prism
+from workbench.scene.kinds.csg import CSG_DIFFERENCE
 
 COMMON = {"material": "m"}
 BLOB = blob.read({"threshold": 0.3, "components": [{"center": [0, 0, 0], "radius": 1.0},
@@ -62,10 +63,10 @@ def _geometry(placed, csg=None):
     if csg is not None:
         a, b = (len(sd.ptype) + i for i in csg)
         rows["top"][a] = rows["top"][b] = False
-        prog = np.array([a, b, fl.CSG_DIFFERENCE], dtype=np.int64)
+        prog = np.array([a, b, CSG_DIFFERENCE], dtype=np.int64)
         par = np.zeros(fl.NPAR)
         par[:2] = (0, 3)
-        for key, v in (("ptype", fl.CSGNODE), ("top", True), ("xf", np.eye(4)[:3].reshape(-1)),
+        for key, v in (("ptype", CSGNODE), ("top", True), ("xf", np.eye(4)[:3].reshape(-1)),
                        ("nm", np.eye(3).reshape(-1)), ("par", par), ("solid", True), ("shadow", True),
                        ("ident", True), ("obj", len(rows["obj"]))):
             rows[key].append(v)

@@ -28,12 +28,14 @@ from numba import prange
 
 from ...core.tol import tol
 from ...scene.kinds import BOX, CSGNODE, POLYGON, QUADRIC, RECT, SPHERE
-from ...scene.kinds import blob as kb, isosurface as ki, lathe as kl, prism as kp
+from ...scene.kinds import blob, isosurface, lathe, prism
+from ...scene.kinds import blob_kernels as kb, isosurface_kernels as ki, lathe_kernels as kl, prism_kernels as kp
 from ...scene.kinds.csg import CSG_DEPTH, CSG_DIFFERENCE, CSG_INTERSECTION, CSG_UNION
 from ...scene.kinds.expression import MAX_STACK
 from .bvh import MAX_DEPTH
 from .flatten import SHADOW_CROSSINGS
 
+BLOB, ISOSURFACE, LATHE, PRISM = blob.PTYPE, isosurface.PTYPE, lathe.PTYPE, prism.PTYPE
 CHUNK = 64
 FAST_MATH = {"nsz", "arcp"}
 """The fast-math flags of the hot kernels: signed zeros may be ignored, a division may become a
@@ -275,13 +277,13 @@ def prim_hit(k, ptype, par, poly_v, aux, ox, oy, oz, dx, dy, dz, ux, uy, uz, inv
         return _polygon_hit(k, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax)
     if kind == QUADRIC:
         return _quadric_hit(k, par, ox, oy, oz, dx, dy, dz, tmin, tmax, zero)
-    if kind == kb.PTYPE:
+    if kind == BLOB:
         return kb.blob_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack)
-    if kind == ki.PTYPE:
+    if kind == ISOSURFACE:
         return ki.iso_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack)
-    if kind == kl.PTYPE:
+    if kind == LATHE:
         return kl.lathe_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack)
-    if kind == kp.PTYPE:
+    if kind == PRISM:
         return kp.prism_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack)
     return np.inf, 0
 
@@ -350,13 +352,13 @@ def leaf_events(k, ptype, par, aux, ox, oy, oz, dx, dy, dz, zero, et, ep, ef, st
         return m
     m = 0
     cap = et.shape[0]
-    if kind == kb.PTYPE:
+    if kind == BLOB:
         m = kb.blob_events(par, k, aux, ox, oy, oz, dx, dy, dz, et, ef, cap, stack)
-    elif kind == ki.PTYPE:
+    elif kind == ISOSURFACE:
         m = ki.iso_events(par, k, aux, ox, oy, oz, dx, dy, dz, et, ef, cap, stack)
-    elif kind == kl.PTYPE:
+    elif kind == LATHE:
         m = kl.lathe_events(par, k, aux, ox, oy, oz, dx, dy, dz, et, ef, cap, stack)
-    elif kind == kp.PTYPE:
+    elif kind == PRISM:
         m = kp.prism_events(par, k, aux, ox, oy, oz, dx, dy, dz, et, ef, cap, stack)
     m -= m % 2            # a list cut at the capacity ends inside: close the last interval
     for i in range(m):
@@ -698,13 +700,13 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
 def object_normal(k, face, ptype, par, aux, x, y, z, stack):
     """Outward normal (unnormalised) of primitive ``k`` at object-space point, by face."""
     kind = ptype[k]
-    if kind == kb.PTYPE:
+    if kind == BLOB:
         return kb.blob_normal(par, k, aux, face, x, y, z, stack)
-    if kind == ki.PTYPE:
+    if kind == ISOSURFACE:
         return ki.iso_normal(par, k, aux, face, x, y, z, stack)
-    if kind == kl.PTYPE:
+    if kind == LATHE:
         return kl.lathe_normal(par, k, aux, face, x, y, z, stack)
-    if kind == kp.PTYPE:
+    if kind == PRISM:
         return kp.prism_normal(par, k, aux, face, x, y, z, stack)
     if face >= 1 and (kind == BOX or kind == QUADRIC):
         a = (face - 1) // 2

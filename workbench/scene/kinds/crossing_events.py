@@ -24,7 +24,6 @@ evaluator) are the caller's scratch: nothing is allocated.
 """
 from __future__ import annotations
 
-import numba as nb
 import numpy as np
 
 
@@ -43,15 +42,3 @@ def alternate(hits: list[tuple[float, int]], inside_at) -> list[tuple[float, int
             out.append((t, f))
             status = after
     return out
-
-
-@nb.njit(cache=True, error_model="numpy")
-def sort_hits(out_t, out_f, m):
-    """Insertion sort of the first ``m`` hits by t (few hits: no allocation)."""
-    for i in range(1, m):
-        t, f = out_t[i], out_f[i]
-        j = i - 1
-        while j >= 0 and out_t[j] > t:
-            out_t[j + 1], out_f[j + 1] = out_t[j], out_f[j]
-            j -= 1
-        out_t[j + 1], out_f[j + 1] = t, f

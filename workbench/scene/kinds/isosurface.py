@@ -23,13 +23,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numba as nb
 import numpy as np
 
 from .. import model as m
 from ..parts import make_part
 from . import values as val
-from .expression import Program, compile_expression, evaluate, evaluate_gradient, evaluate_numpy, gradient_numpy
+from .expression import Program, compile_expression, evaluate_numpy, gradient_numpy
 from .marching_cubes import closed_grid, grid_cells, marching_cubes, pad_outside, shade_normals
 
 TYPE = "isosurface"
@@ -267,7 +266,7 @@ def patch_surfaces(obj: Isosurface, W: np.ndarray, h: float):
 
 
 # --------------------------------------------------------------------------- kernel rows
-# (the numba entry points' shared signatures: see .crossing_events)
+# (the numba entry points, in .isosurface_kernels: see .crossing_events for their signatures)
 
 def flatten(b, obj, index: int, W: np.ndarray, top: bool) -> int:
     """Its row of the ray tracer's primitive table through the builder ``b`` (the registry's
@@ -284,125 +283,3 @@ def params(s: Isosurface, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
     return (np.array([aux_offset, s.program.length, s.threshold, s.max_gradient, *s.bounds_min,
                       *s.bounds_max, s.program.depth], dtype=np.float64),
             np.ascontiguousarray(s.program.code))
-
-
-@nb.njit(cache=True, error_model="numpy")
-def _g(par, k, aux, ox, oy, oz, dx, dy, dz, t, stack):
-    return evaluate(aux, int(par[k, 0]), int(par[k, 1]), ox + t * dx, oy + t * dy, oz + t * dz,
-                    stack) - par[k, 2]
-
-
-@nb.njit(cache=True, error_model="numpy")
-def _narrow(par, k, aux, ox, oy, oz, dx, dy, dz, a, fa, b, fb, stack):
-    """The end past the change of ``g < 0`` in ``[a, b]`` (values ``fa``, ``fb``), narrowed to
-    adjacent floats by the Illinois method (regula falsi halving the value kept at an end that
-    stays twice; Dowell & Jarratt, BIT 11, 1971), bisecting wherever the secant point is not
-    strictly inside the bracket (a NaN value, a flat stretch)."""
-    sa = fa < 0.0
-    side = 0
-    for _ in range(BISECTIONS):
-        m = 0.5 * (a + b)
-        if m <= a or m >= b:
-            break
-        c = (a * fb - b * fa) / (fb - fa)
-        if not (a < c < b):
-            c = m
-        fc = _g(par, k, aux, ox, oy, oz, dx, dy, dz, c, stack)
-        if (fc < 0.0) == sa:
-            a, fa = c, fc
-            if side == -1:
-                fb *= 0.5
-            side = -1
-        else:
-            b, fb = c, fc
-            if side == 1:
-                fa *= 0.5
-            side = 1
-    return b
-
-
-@nb.njit(cache=True, error_model="numpy")
-def iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, cap, stack):
-    """Crossings ``tmin < t < tmax`` of the solid's boundary (see :func:`crossings`), written to
-    ``out_t``, ``out_f`` (face), at most ``cap``; returns their count.  ``stack``: (depth, 4)
-    scratch of the program's evaluators."""
-    t0, t1, f0, f1 = -np.inf, np.inf, 0, 0
-    for a in range(3):
-        o = ox if a == 0 else (oy if a == 1 else oz)
-        d = dx if a == 0 else (dy if a == 1 else dz)
-        lo, hi = par[k, 4 + a], par[k, 7 + a]
-        if d == 0.0:
-            if not lo <= o <= hi:
-                return 0
-            continue
-        ta, tb = (lo - o) / d, (hi - o) / d
-        fa, fb = 1 + 2 * a, 2 + 2 * a
-        if ta > tb:
-            ta, tb, fa, fb = tb, ta, fb, fa
-        if ta > t0:
-            t0, f0 = ta, fa
-        if tb < t1:
-            t1, f1 = tb, fb
-    if not t0 < t1:
-        return 0
-    L = par[k, 3] * math.sqrt(dx * dx + dy * dy + dz * dz)
-    h_min = MIN_STEP * (t1 - t0)
-    m = 0
-    t = t0
-    gt = _g(par, k, aux, ox, oy, oz, dx, dy, dz, t, stack)
-    status = gt < 0.0
-    if status and tmin < t0 < tmax:
-        out_t[m], out_f[m] = t0, f0
-        m += 1
-    while t < t1 and t < tmax and m < cap:
-        h = abs(gt) / L if math.isfinite(gt) else h_min
-        tn = min(t + max(h, h_min), t1)
-        gn = _g(par, k, aux, ox, oy, oz, dx, dy, dz, tn, stack)
-        if (gn < 0.0) != status:
-            b = _narrow(par, k, aux, ox, oy, oz, dx, dy, dz, t, gt, tn, gn, stack)
-            if tmin < b < tmax:
-                out_t[m], out_f[m] = b, 0
-                m += 1
-            status = not status
-            tn, gn = b, _g(par, k, aux, ox, oy, oz, dx, dy, dz, b, stack)
-        t, gt = tn, gn
-    if status and m < cap and tmin < t1 < tmax:
-        out_t[m], out_f[m] = t1, f1
-        m += 1
-    return m
-
-
-@nb.njit(cache=True, error_model="numpy")
-def iso_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
-    """Nearest hit ``tmin < t < tmax``: ``(t, face)``, ``(inf, 0)`` on a miss."""
-    if iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, 1, stack) == 1:
-        return out_t[0], out_f[0]
-    return np.inf, 0
-
-
-@nb.njit(cache=True, error_model="numpy")
-def iso_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
-    """Interval list along the whole line (entering / leaving alternate); returns the count."""
-    return iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, -np.inf, np.inf, out_t, out_f, cap, stack)
-
-
-@nb.njit(cache=True, error_model="numpy")
-def iso_normal(par, k, aux, face, x, y, z, stack):
-    """Outward normal at the object-space point (not normalised); ``stack``: (depth, 4)
-    scratch of the gradient evaluator."""
-    if face >= 1:
-        a = (face - 1) // 2
-        sgn = 1.0 if (face - 1) % 2 == 1 else -1.0
-        return (sgn if a == 0 else 0.0), (sgn if a == 1 else 0.0), (sgn if a == 2 else 0.0)
-    _, gx, gy, gz = evaluate_gradient(aux, int(par[k, 0]), int(par[k, 1]), x, y, z, stack)
-    if not (math.isfinite(gx) and math.isfinite(gy) and math.isfinite(gz)):
-        return 0.0, 0.0, 0.0      # no gradient there (sqrt(0)...): the kernels' zero normal
-    return gx, gy, gz
-
-
-@nb.njit(cache=True, error_model="numpy")
-def iso_inside(par, k, aux, x, y, z, stack):
-    """f(x, y, z) < threshold inside the bounds."""
-    if not (par[k, 4] <= x <= par[k, 7] and par[k, 5] <= y <= par[k, 8] and par[k, 6] <= z <= par[k, 9]):
-        return False
-    return evaluate(aux, int(par[k, 0]), int(par[k, 1]), x, y, z, stack) < par[k, 2]

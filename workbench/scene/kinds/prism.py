@@ -14,10 +14,8 @@ Aux layout: ``(x, z)`` per vertex; parameter row ``[aux offset, vertices, y0, y1
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
-import numba as nb
 import numpy as np
 
 from ...core.tol import tol
@@ -25,7 +23,7 @@ from .. import model as m
 from ..parts import make_part
 from ..polygon_pieces import convex_pieces, ear_triangles
 from . import values as val
-from .crossing_events import alternate, sort_hits
+from .crossing_events import alternate
 from .lathe import weld
 
 TYPE = "prism"
@@ -257,7 +255,7 @@ def analytic_normals(obj: Prism, P: np.ndarray):
 
 
 # --------------------------------------------------------------------------- kernel rows
-# (the numba entry points' shared signatures: see .crossing_events)
+# (the numba entry points, in .prism_kernels: see .crossing_events for their signatures)
 
 def flatten(b, obj, index: int, W: np.ndarray, top: bool) -> int:
     """Its row of the ray tracer's primitive table through the builder ``b`` (the registry's
@@ -273,108 +271,3 @@ def params(p: Prism, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
     """Parameter row head ``[aux offset, vertices, y0, y1, orientation]`` and aux (2 k,)."""
     return (np.array([aux_offset, len(p.polygon), p.y0, p.y1, p.orientation]),
             np.ascontiguousarray(p.polygon, dtype=np.float64).reshape(-1))
-
-
-@nb.njit(cache=True, error_model="numpy")
-def _in_polygon_nb(aux, off, n, x, z):
-    res = False
-    for i in range(n):
-        j, jn = off + 2 * i, off + 2 * ((i + 1) % n)
-        xa, za, xb, zb = aux[j], aux[j + 1], aux[jn], aux[jn + 1]
-        if za != zb and ((za > z) != (zb > z)) and x < xa + (z - za) * (xb - xa) / (zb - za):
-            res = not res
-    return res
-
-
-@nb.njit(cache=True, error_model="numpy")
-def prism_inside(par, k, aux, x, y, z, stack):
-    return par[k, 2] < y < par[k, 3] and _in_polygon_nb(aux, int(par[k, 0]), int(par[k, 1]), x, z)
-
-
-@nb.njit(cache=True, error_model="numpy")
-def _wall(aux, off, n, i, y0, y1, ox, oy, oz, dx, dy, dz):
-    """t of the hit of wall ``i`` (inf when missed)."""
-    j, jn = off + 2 * i, off + 2 * ((i + 1) % n)
-    ex, ez = aux[jn] - aux[j], aux[jn + 1] - aux[j + 1]
-    den = dx * ez - dz * ex
-    if den == 0.0:
-        return np.inf
-    wx, wz = aux[j] - ox, aux[j + 1] - oz
-    t = (wx * ez - wz * ex) / den
-    s = (wx * dz - wz * dx) / den
-    slack = TOL_CUT * (max(abs(ox), abs(oy), abs(oz)) + abs(t) * max(abs(dx), abs(dy), abs(dz)))
-    if 0.0 <= s <= 1.0 and y0 - slack <= oy + t * dy <= y1 + slack:
-        return t
-    return np.inf
-
-
-@nb.njit(cache=True, error_model="numpy")
-def prism_hits(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, tmin, tmax):
-    """Every wall and cap hit ``tmin < t < tmax`` (unsorted), at most ``cap``; returns the count."""
-    off, n, y0, y1 = int(par[k, 0]), int(par[k, 1]), par[k, 2], par[k, 3]
-    m = 0
-    if dy != 0.0:
-        for face in range(2):
-            t = ((y1 if face == 1 else y0) - oy) / dy
-            if tmin < t < tmax and m < cap and _in_polygon_nb(aux, off, n, ox + t * dx, oz + t * dz):
-                out_t[m], out_f[m] = t, face
-                m += 1
-    for i in range(n):
-        t = _wall(aux, off, n, i, y0, y1, ox, oy, oz, dx, dy, dz)
-        if tmin < t < tmax and m < cap:
-            out_t[m], out_f[m] = t, 2 + i
-            m += 1
-    return m
-
-
-@nb.njit(cache=True, error_model="numpy")
-def prism_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
-    """Nearest hit ``tmin < t < tmax``: ``(t, face)``, ``(inf, 0)`` on a miss."""
-    off, n, y0, y1 = int(par[k, 0]), int(par[k, 1]), par[k, 2], par[k, 3]
-    best, bf = tmax, -1
-    if dy != 0.0:
-        for face in range(2):
-            t = ((y1 if face == 1 else y0) - oy) / dy
-            if tmin < t < best and _in_polygon_nb(aux, off, n, ox + t * dx, oz + t * dz):
-                best, bf = t, face
-    for i in range(n):
-        t = _wall(aux, off, n, i, y0, y1, ox, oy, oz, dx, dy, dz)
-        if tmin < t < best:
-            best, bf = t, 2 + i
-    if bf < 0:
-        return np.inf, 0
-    return best, bf
-
-
-@nb.njit(cache=True, error_model="numpy")
-def prism_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
-    """Interval list along the whole line (entering / leaving alternate); returns the count."""
-    m = prism_hits(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, -np.inf, np.inf)
-    sort_hits(out_t, out_f, m)
-    w, status = 0, False
-    for i in range(m):
-        t = out_t[i]
-        nxt = out_t[i + 1] if i + 1 < m else np.inf
-        if nxt == t:
-            continue
-        tm = 0.5 * (t + nxt)
-        after = nxt < np.inf and prism_inside(par, k, aux, ox + tm * dx, oy + tm * dy, oz + tm * dz, stack)
-        if after != status:
-            out_t[w], out_f[w] = t, out_f[i]
-            w += 1
-            status = after
-    return w
-
-
-@nb.njit(cache=True, error_model="numpy")
-def prism_normal(par, k, aux, face, x, y, z, stack):
-    """Unit outward normal of ``face``."""
-    if face < 2:
-        return 0.0, (1.0 if face == 1 else -1.0), 0.0
-    off, n = int(par[k, 0]), int(par[k, 1])
-    i = face - 2
-    j, jn = off + 2 * i, off + 2 * ((i + 1) % n)
-    ex, ez = aux[jn] - aux[j], aux[jn + 1] - aux[j + 1]
-    ln = math.hypot(ex, ez)
-    o = par[k, 4]
-    return o * ez / ln, 0.0, -o * ex / ln
