@@ -62,7 +62,7 @@ def test_shown_panels_are_the_cli_images(gpu_session):
     for m in RASTER:
         shown = np.load(out / f"shown_{m}.npy")
         assert shown.shape == (H, W, 4) and (shown[..., 3] == 255).all()
-        # the window's GL panels draw the bare local model (stand-ins are not in the window yet)
+        # the panels draw the bare local model (no stand-ins)
         cli = workbench.render(replace(scene, camera=orbited), m, width=W, height=H, standins="off").image
         expected = to_srgb8(cli)
         assert expected.std() > 10, m  # a real picture, not a flat colour
@@ -91,7 +91,7 @@ def test_panels_are_copied_into_the_window_where_imgui_laid_them_out(gpu_session
 
 
 def test_difference_view_on_the_gpu_is_the_cpu_error_map(gpu_session):
-    from workbench.app.ui.colours import colour_scale
+    from workbench.app.ui.panels import colour_scale
     from workbench.compare.metrics import error_map
     out, _ = gpu_session
     flat, phong = np.load(out / "image_flat.npy"), np.load(out / "image_phong.npy")

@@ -517,19 +517,26 @@ class RasterSession:
         left = [f"{f}: not needed by the scene (not compiled)" for f in SHADER_FEATURES if f not in needs]
         if ft.BUMP in needs and self.mode != "phong":
             left.append(f"bump: {self.mode} shading has no per-fragment normal to perturb")
-        covered = self.plan.covered
+        covered = dict(self.plan.covered)
+        if not self.env_maps:  # e.g. only environment-mapped mirrors: no dynamic map built
+            covered.pop(ft.REFLECTION, None)
+            if not self.plan.blend:
+                covered.pop(ft.REFRACTION, None)
+        enabled = {ft.REFLECTION: self.plan.envmap, ft.REFRACTION: self.plan.envmap or self.plan.blend,
+                   ft.SHADOWS: self.plan.shadows, ft.ABSORPTION: True}
         for f, why in NOT_RASTER.items():
             if f in needs and f not in covered:
-                stand_in = f != ft.ABSORPTION
-                left.append(f"{f}: {why}" + (f" ({self.plan.off_reason})" if stand_in else ""))
+                left.append(f"{f}: {why}" + ("" if enabled[f] else f" ({self.plan.off_reason})"))
         used = sorted(f for f in needs if (f not in NOT_RASTER or f in covered)
                       and not (f == ft.BUMP and self.mode != "phong"))
+        self._covered = covered
         return left, used
 
     @property
     def standins_used(self) -> dict[str, str]:
         """Scene features drawn by a stand-in, and how."""
-        return dict(self.plan.covered)
+        self._reported()
+        return dict(self._covered)
 
     # ------------------------------------------------------------------ live edits
     @property

@@ -185,8 +185,10 @@ def refracts_through_map(mat: m.Material, kind: str, p: Plan) -> bool:
 
 
 def mapped_material(mat: m.Material, kind: str, p: Plan) -> bool:
-    """Whether a part of ``kind`` with ``mat`` gets an environment map under plan ``p``."""
-    return p.envmap and (mat.kr > 0 or refracts_through_map(mat, kind, p))
+    """Whether a part of ``kind`` with ``mat`` gets an environment map under plan ``p``: kr > 0
+    (unless the material reflects the scene's environment, the course's environment mapping,
+    which stays exact for it), or refraction through the map."""
+    return p.envmap and ((mat.kr > 0 and not mat.environment) or refracts_through_map(mat, kind, p))
 
 
 def blended_material(mat: m.Material, kind: str, p: Plan) -> bool:
