@@ -35,6 +35,7 @@ from numpy.polynomial import Polynomial
 from .. import model as m
 from ..parts import make_part
 from . import values as val
+from .aux_rows import flatten_aux
 from .marching_cubes import grid_cells, marching_cubes, shade_normals
 
 TYPE = "blob"
@@ -255,13 +256,8 @@ def patch_surfaces(obj: Blob, W: np.ndarray, h: float):
 # (the numba entry points, in .blob_kernels: see .crossing_events for their signatures)
 
 def flatten(b, obj, index: int, W: np.ndarray, top: bool) -> int:
-    """Its row of the ray tracer's primitive table through the builder ``b`` (the registry's
-    interface): ``b.bound`` its bounds, ``b.add_aux`` its variable-length data (returns the
-    offset), ``b.add`` the row with :func:`params`' head."""
-    b.bound(W, bound_points(obj))
-    head, data = params(obj, 0)
-    head[0] = b.add_aux(data)
-    return b.add(PTYPE, index, obj, W, head, top=top, solid=SOLID)
+    """Its row of the ray tracer's primitive table (:func:`.aux_rows.flatten_aux`)."""
+    return flatten_aux(b, obj, index, W, top, PTYPE, params(obj, 0), bound_points(obj), SOLID)
 
 
 def params(b: Blob, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:

@@ -28,6 +28,7 @@ import numpy as np
 from .. import model as m
 from ..parts import make_part
 from . import values as val
+from .aux_rows import flatten_aux
 from .expression import Program, compile_expression, evaluate_numpy, gradient_numpy
 from .marching_cubes import closed_grid, grid_cells, marching_cubes, pad_outside, shade_normals
 
@@ -269,13 +270,8 @@ def patch_surfaces(obj: Isosurface, W: np.ndarray, h: float):
 # (the numba entry points, in .isosurface_kernels: see .crossing_events for their signatures)
 
 def flatten(b, obj, index: int, W: np.ndarray, top: bool) -> int:
-    """Its row of the ray tracer's primitive table through the builder ``b`` (the registry's
-    interface): ``b.bound`` its bounds, ``b.add_aux`` its variable-length data (returns the
-    offset), ``b.add`` the row with :func:`params`' head."""
-    b.bound(W, bound_points(obj))
-    head, data = params(obj, 0)
-    head[0] = b.add_aux(data)
-    return b.add(PTYPE, index, obj, W, head, top=top, solid=SOLID)
+    """Its row of the ray tracer's primitive table (:func:`.aux_rows.flatten_aux`)."""
+    return flatten_aux(b, obj, index, W, top, PTYPE, params(obj, 0), bound_points(obj), SOLID)
 
 
 def params(s: Isosurface, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:

@@ -32,6 +32,7 @@ from ...core.tol import tol
 from .. import model as m
 from ..parts import make_part
 from . import values as val
+from .aux_rows import flatten_aux
 from .crossing_events import alternate
 
 TYPE = "lathe"
@@ -270,13 +271,8 @@ def analytic_normals(obj: Lathe, P: np.ndarray):
 # (the numba entry points, in .lathe_kernels: see .crossing_events for their signatures)
 
 def flatten(b, obj, index: int, W: np.ndarray, top: bool) -> int:
-    """Its row of the ray tracer's primitive table through the builder ``b`` (the registry's
-    interface): ``b.bound`` its bounds, ``b.add_aux`` its variable-length data (returns the
-    offset), ``b.add`` the row with :func:`params`' head."""
-    b.bound(W, bound_points(obj))
-    head, data = params(obj, 0)
-    head[0] = b.add_aux(data)
-    return b.add(PTYPE, index, obj, W, head, top=top, solid=solid(obj))
+    """Its row of the ray tracer's primitive table (:func:`.aux_rows.flatten_aux`)."""
+    return flatten_aux(b, obj, index, W, top, PTYPE, params(obj, 0), bound_points(obj), solid(obj))
 
 
 def params(la: Lathe, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
