@@ -75,3 +75,18 @@ def test_emitter_scene_reference_is_the_converged_path_tracer_and_is_cached(tmp_
     b = R.choose_reference(scene, 24, 24)
     assert b.run.result.stats["cache"] == "hit" and np.array_equal(a.image, b.image)
     assert b.describe()["noise_rmse"] == pytest.approx(a.noise)
+
+
+def test_matched_reference_follows_the_stand_ins_a_run_draws():
+    """Phong's matched reference on whitted (reflection, refraction, shadows): the Whitted tracer
+    with its default stand-ins, the bare local model's ray caster with ``standins=off``, the ray
+    caster with shadows when only shadow maps are drawn."""
+    whitted = load_scene("whitted")
+    assert R.matched_spec("phong", whitted)[0] == "raytrace"
+    assert R.matched_spec("phong", whitted, {"standins": "envmap"})[0] == "raytrace"
+    assert R.matched_spec("phong", whitted, {"standins": "off"}) == R.matched_spec("phong")
+    bare = R.matched_spec("phong")
+    assert bare[0] == "raycast" and bare[1].get("shadows") is False
+    shadows = R.matched_spec("gouraud", whitted, {"standins": "shadows"})
+    assert shadows[0] == "raycast" and shadows[1]["shadows"] is True
+    assert R.matched_spec("flat", whitted, {"standins": "on"}) == R.matched_spec("flat")

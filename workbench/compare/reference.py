@@ -279,18 +279,28 @@ _STANDIN_WHITTED = ("raytrace", {"max_depth": 12},
                     "blending, shadow maps) approximate; their approximation error counts here")
 
 
-def matched_spec(method: str, scene: Scene | None = None) -> tuple[str, dict, str] | None:
+def _standins_drawn(options: dict | None) -> frozenset[str]:
+    """The stand-ins a Gouraud/Phong run draws, from its ``standins`` option (default on)."""
+    value = str((options or {}).get("standins", "on")).strip().lower()
+    if value == "on":
+        return frozenset({"envmap", "blend", "shadows"})
+    return frozenset() if value == "off" else frozenset(x.strip() for x in value.split(","))
+
+
+def matched_spec(method: str, scene: Scene | None = None,
+                 options: dict | None = None) -> tuple[str, dict, str] | None:
     """``(reference method, options, what it computes)`` matching ``method``'s physics, or None
     for outside renderers and methods without one (a user's GLSL model has no ray-cast twin).
-    ``scene``: Gouraud and Phong with their default stand-ins match the Whitted ray tracer on a
-    scene that needs reflection or refraction, the ray caster with shadows on one that needs
-    shadows (else the table :data:`MATCHED`: the bare local model)."""
+    ``scene`` and the run's ``options``: Gouraud and Phong with stand-ins (on by default) match
+    the Whitted ray tracer on a scene that needs reflection or refraction when they draw an
+    environment map or blending, the ray caster with shadows on one that needs shadows when they
+    draw shadow maps; else (``standins=off`` too) the table :data:`MATCHED`: the bare local model."""
     spec = MATCHED.get(method)
     if spec is not None and scene is not None and method in ("gouraud", "phong"):
-        needs = F.scene_needs(scene)
-        if F.REFLECTION in needs or F.REFRACTION in needs:
+        needs, drawn = F.scene_needs(scene), _standins_drawn(options)
+        if (F.REFLECTION in needs or F.REFRACTION in needs) and drawn & {"envmap", "blend"}:
             spec = _STANDIN_WHITTED
-        elif F.SHADOWS in needs and scene.lights:
+        elif F.SHADOWS in needs and scene.lights and "shadows" in drawn:
             spec = _STANDIN_SHADOWS
     if spec is None:
         return None
@@ -319,9 +329,10 @@ class References:
         self.full = choose_reference(scene, width, height, method)
         self._matched: dict[tuple, Reference | None] = {}
 
-    def matched(self, method: str) -> Reference | None:
-        """``method``'s matched reference, or None (none exists, or it does not apply)."""
-        spec = matched_spec(method, self.scene)
+    def matched(self, method: str, options: dict | None = None) -> Reference | None:
+        """``method``'s matched reference for a run with ``options``, or None (none exists, or
+        it does not apply)."""
+        spec = matched_spec(method, self.scene, options)
         if spec is None:
             return None
         m, opts, what = spec

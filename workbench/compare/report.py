@@ -157,7 +157,7 @@ def compare(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
 
 def _matched_entry(refs: References, run: MethodRun) -> dict:
     """The run's error against its matched reference and the gap to its total error."""
-    mref = refs.matched(run.method)
+    mref = refs.matched(run.method, run.options)
     if mref is None:
         return {"none": matched_reason(run.method)}
     mt = metrics(run.image, mref.image)

@@ -220,7 +220,7 @@ def _matched_errors(refs: References, points: list[dict], images: list, jobs: in
     out, todo = {}, []
     for i, im in images:
         p = points[i]
-        ref = refs.matched(p["method"])
+        ref = refs.matched(p["method"], {p["knob"]: p["value"]})
         if ref is None:
             p["matched_reference"] = ""
             continue
