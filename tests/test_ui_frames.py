@@ -48,7 +48,10 @@ def test_static_frames_draw_nothing_and_a_camera_change_redraws_once(gpu_session
     assert sorted(start["draws"]) == sorted(RASTER)
     assert all(start["draws"][m] >= 1 for m in RASTER)
     assert static["draws"] == start["draws"]          # frames 2..5: nothing changed
-    assert static["reads"] == start["reads"]          # and no pixel came back from the GPU
+    # and no pixel came back from the GPU, but for the images the error plot took once its
+    # reference was there (from the reference cache it can be at once: a read per GL panel)
+    taken = set(static["plot_taken"]) - set(start["plot_taken"])
+    assert 0 <= static["reads"] - start["reads"] <= len(taken & set(RASTER))
     assert orbit["draws"] == {m: static["draws"][m] + 1 for m in RASTER}
 
 

@@ -566,8 +566,12 @@ class GpuPanels:
     def __call__(self, state: AppState) -> None:
         f = state.frame
         if f in (2, 5, 7):
+            plot = state.errors
             self.log[f"frame{f}"] = {"draws": {m: p.draws for m, p in state.gpu.raster.items()},
-                                     "reads": state.images.reads}
+                                     "reads": state.images.reads,
+                                     # images the error plot took for evaluation (read-backs)
+                                     "plot_taken": sorted({m for m, _ in [*plot.pending, *plot.matched_pending]}
+                                                          | set(plot.points) | set(plot.matched_points))}
         if f == 5:
             state.camera = cam.orbit(state.camera, 0.3, 0.1)
             state.diff_pair, state.diff_kind = ("flat", "phong"), "abs"
