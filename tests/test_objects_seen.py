@@ -107,42 +107,37 @@ def _scene(objects: list, s: float, distance: float = 4.0):
     return scene_from_dict(scene_dict(objects, camera=cam, lights=lights))
 
 
-@pytest.mark.gl
-@pytest.mark.parametrize("seed", range(6))
-def test_random_scene_objects_seen_alike(seed, gl_ctx):
-    """Seeded: two or three objects of random kinds side by side, the whole scene at a random
-    scale 10^U(-6, 6)."""
-    rng = np.random.default_rng(1000 + seed)
+def _side_by_side_alike(seed: int, pool, size: float) -> None:
+    """Two or three objects of kinds drawn from ``pool`` side by side (``size`` each, in units of
+    the scene's scale), the whole scene at a random scale 10^U(-6, 6): raster and ray caster
+    see the same objects (IoU >= 0.97)."""
+    rng = np.random.default_rng(seed)
     s = float(10.0 ** rng.uniform(-6.0, 6.0))
-    kinds = rng.choice(KINDS, size=int(rng.integers(2, 4)), replace=False)
+    kinds = rng.choice(pool, size=int(rng.integers(2, 4)), replace=False)
     objs = []
     for i, kind in enumerate(kinds):
-        o = _object(str(kind), 0.5 * s, rng)
+        o = _object(str(kind), size * s, rng)
         o["transform"]["translate"][0] += (i - (len(kinds) - 1) / 2) * 1.4 * s
         objs.append(o)
     sc = _scene(objs, s)
     ray, ras = coverage(sc, "raycast", W, H), coverage(sc, "phong", W, H)
     assert ray.sum() > 100, (seed, s, list(kinds))
     assert iou(ray, ras) >= 0.97, (seed, s, list(kinds), iou(ray, ras))
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("seed", range(6))
+def test_random_scene_objects_seen_alike(seed, gl_ctx):
+    """Seeded: objects of random kinds (:func:`_side_by_side_alike`)."""
+    _side_by_side_alike(1000 + seed, KINDS, 0.5)
 
 
 @pytest.mark.gl
 @pytest.mark.parametrize("seed", range(4))
 def test_new_kinds_objects_seen_alike(seed, gl_ctx):
-    """Seeded: two or three objects of the new kinds side by side, at a random scale
-    10^U(-6, 6): the raster's tessellations cover the ray caster's exact pixels."""
-    rng = np.random.default_rng(2000 + seed)
-    s = float(10.0 ** rng.uniform(-6.0, 6.0))
-    kinds = rng.choice(NEW_KINDS, size=int(rng.integers(2, 4)), replace=False)
-    objs = []
-    for i, kind in enumerate(kinds):
-        o = _object(str(kind), 0.7 * s, rng)
-        o["transform"]["translate"][0] += (i - (len(kinds) - 1) / 2) * 1.4 * s
-        objs.append(o)
-    sc = _scene(objs, s)
-    ray, ras = coverage(sc, "raycast", W, H), coverage(sc, "phong", W, H)
-    assert ray.sum() > 100, (seed, s, list(kinds))
-    assert iou(ray, ras) >= 0.97, (seed, s, list(kinds), iou(ray, ras))
+    """Seeded: objects of the new kinds: the raster's tessellations cover the ray caster's exact
+    pixels (:func:`_side_by_side_alike`)."""
+    _side_by_side_alike(2000 + seed, NEW_KINDS, 0.7)
 
 
 def _scale_cases():
