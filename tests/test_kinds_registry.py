@@ -11,10 +11,10 @@ from workbench.scene import features, model as m
 from workbench.scene.io import SceneError, scene_from_dict
 from workbench.scene.kinds import KINDS, crossings, kind_of
 
-LEAF = ("parse", "bound_points", "tessellate", "patch_surfaces", "flatten", "inside")
+LEAF = ("parse", "bound_points", "tessellate", "patch_surfaces", "flatten", "inside", "povray", "mitsuba")
 SOLID = ("solid_mesh", "analytic_normals")
 COMPOSITE = ("parse", "children", "tessellate", "patch_surfaces", "flatten", "crossings",
-             "containing", "world_bounds")
+             "containing", "world_bounds", "povray", "mitsuba")
 CONSTANTS = ("TYPE", "MODEL", "FEATURE", "PTYPE", "SOLID", "CONVEX", "COMPOSITE", "KEYS", "REQUIRED")
 
 

@@ -61,11 +61,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core import transform as tf
 from ..core.errors import NotApplicable
 from ..core.tol import tol
 from ..scene import features as F
 from ..scene import model as m
+from ..scene.kinds import is_solid, kind_of
 from ..scene.tessellate import tessellate_object
 
 #: Alpha below which an opacity cuts a surface out (the workbench's rule, ``model.Opacity``).
@@ -77,9 +77,6 @@ NEAR_CLIP_RATIO = 1e-6
 FAR_CLIP_MARGIN = 2.0
 #: Mitsuba's Russian roulette starts at this path depth (its default, stated for the stats).
 RR_DEPTH = 5
-
-_FLAT_KINDS = ("polygon", "plane", "box")
-_OPEN_KINDS = ("polygon", "plane")  # no inside: transmission does not enter a medium
 
 MODEL_NOTES = {
     F.TEXTURES: "textures not exported (uniform kd x colour used)",
@@ -235,6 +232,72 @@ def _scene_bounds(parts_pts: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     return P.min(0), P.max(0)
 
 
+class ShapeWriter:
+    """Adds one scene's shapes to the Mitsuba dictionary ``d``; object kinds add theirs through
+    it (``mitsuba(obj, x)``, see :mod:`workbench.scene.kinds`): :meth:`tessellated` (the
+    object's raster tessellation as PLY meshes), :meth:`analytic` (a Mitsuba shape dict of
+    its own, e.g. ``sphere``), :meth:`similarity_scale` and :meth:`leave`; ``level`` is the
+    export's tessellation level.  Shapes are named ``shape_00000``... in the order added."""
+
+    def __init__(self, scene: m.Scene, folder: str, d: dict, level: int, left: list[str]):
+        self.scene, self.folder, self.d, self.level, self.left = scene, folder, d, level, left
+        self.pts: list[np.ndarray] = []
+        self.shapes = self.triangles = 0
+
+    def leave(self, note: str) -> None:
+        """A ``"feature: reason"`` note for ``left_out``."""
+        self.left.append(note)
+
+    def similarity_scale(self, M: np.ndarray) -> float | None:
+        """The uniform scale of the linear part of ``M`` (4, 4), or None."""
+        return _similarity_scale(M)
+
+    def _emitted(self, shape: dict, material: str) -> dict:
+        mat = self.scene.materials[material]
+        if mat.is_emitter:
+            shape["emitter"] = {"type": "area", "radiance": rgb(np.asarray(mat.emission))}
+        return shape
+
+    def add_mesh(self, P, Fc, N, bsdf, emission=None, flat=False) -> dict:
+        """A PLY triangle mesh shape (world points ``P`` (V, 3), faces ``Fc`` (F, 3), vertex
+        normals ``N`` or None) with its BSDF dict and area-emitter radiance (3,) or None."""
+        path = os.path.join(self.folder, f"mesh_{self.shapes:05d}.ply")
+        write_ply(path, P, Fc, None if flat else N)
+        shape = {"type": "ply", "filename": path, "face_normals": bool(flat), "bsdf": bsdf}
+        if emission is not None:
+            shape["emitter"] = {"type": "area", "radiance": rgb(emission)}
+        self.d[f"shape_{self.shapes:05d}"] = shape
+        self.pts.append(np.asarray(P, dtype=np.float64))
+        self.shapes += 1
+        self.triangles += len(Fc)
+        return shape
+
+    def tessellated(self, obj: m.SceneObject, level: int, *, flat: bool = False,
+                    open_surface: bool = False) -> list[dict]:
+        """The object's raster tessellation at ``level`` (its own ``tessellation`` wins), one
+        PLY mesh per part with its material's BSDF (``thindielectric`` when ``open_surface``)
+        and emission; ``flat``: face normals.  Notes that Mitsuba's area emitter emits from
+        the front side only when the object's material emits."""
+        out = []
+        for part in tessellate_object(obj, level):
+            pm = self.scene.materials[part.material]
+            out.append(self.add_mesh(part.positions, part.faces, part.normals, material_bsdf(pm, open_surface),
+                                     np.asarray(pm.emission) if pm.is_emitter else None, flat))
+        if self.scene.materials[obj.material].is_emitter:
+            self.leave(f"{F.EMITTERS}: emissive surfaces emit from their front side only (Mitsuba's area "
+                       "emitter); the workbench adds emission on both sides")
+        return out
+
+    def analytic(self, shape: dict, material: str, lo: np.ndarray, hi: np.ndarray) -> dict:
+        """Add a Mitsuba shape dict of the kind's own (``type``, ``to_world``, ...) with the
+        material's BSDF and emitter; ``lo, hi`` (3,) its world bounds (for the clip range)."""
+        shape = self._emitted({**shape, "bsdf": material_bsdf(self.scene.materials[material])}, material)
+        self.d[f"shape_{self.shapes:05d}"] = shape
+        self.pts.append(np.array([lo, hi], dtype=np.float64))
+        self.shapes += 1
+        return shape
+
+
 def has_light(scene: m.Scene, background_light: bool = True) -> bool:
     """Whether anything in the scene emits light (lights, emissive materials, background)."""
     return bool(scene.lights) or (background_light and max(scene.background) > 0.0) or any(
@@ -267,22 +330,8 @@ def export_scene(scene: m.Scene, folder: str, tessellation: int, spp: int = 16,
     left: list[str] = []
     d: dict = {"type": "scene",
                "integrator": {"type": "path", "max_depth": -1, "rr_depth": RR_DEPTH, "hide_emitters": False}}
-    pts: list[np.ndarray] = []
-    count = {"shape": 0, "tri": 0}
-
-    def add_mesh(P, Fc, N, bsdf, emission=None, flat=False):
-        i = count["shape"]
-        path = os.path.join(folder, f"mesh_{i:05d}.ply")
-        write_ply(path, P, Fc, None if flat else N)
-        shape = {"type": "ply", "filename": path, "face_normals": bool(flat), "bsdf": bsdf}
-        if emission is not None:
-            shape["emitter"] = {"type": "area", "radiance": rgb(emission)}
-        d[f"shape_{i:05d}"] = shape
-        pts.append(np.asarray(P, dtype=np.float64))
-        count["shape"] += 1
-        count["tri"] += len(Fc)
-
-    open_mats = {o.material for o in scene.objects if o.kind in _OPEN_KINDS}
+    sw = ShapeWriter(scene, folder, d, tessellation, left)
+    open_mats = {o.material for o in scene.objects if not is_solid(o)}
     for name, mat in scene.materials.items():
         if any(o.material == name for o in scene.objects):
             left.extend(_material_left_out(mat, name in open_mats))
@@ -292,41 +341,18 @@ def export_scene(scene: m.Scene, folder: str, tessellation: int, spp: int = 16,
             left.append(f"{F.OPACITY}: object {obj.name or obj.kind!r} cut out (constant opacity "
                         f"{mat.opacity.value} < {OPACITY_CUT})")
             continue
-        emission = np.asarray(mat.emission) if mat.is_emitter else None
-        s = _similarity_scale(obj.world_from_object) if isinstance(obj, m.Sphere) else None
-        if s is not None:
-            M = np.asarray(obj.world_from_object) @ tf.translate(obj.center) @ tf.scale(obj.radius)
-            sph = {"type": "sphere", "to_world": M.tolist(), "bsdf": material_bsdf(mat)}
-            if emission is not None:
-                sph["emitter"] = {"type": "area", "radiance": rgb(emission)}
-            d[f"shape_{count['shape']:05d}"] = sph
-            count["shape"] += 1
-            c = M[:3, 3]
-            r = s * obj.radius
-            pts.append(np.array([c - r, c + r]))
-            continue
-        if isinstance(obj, m.Mesh) and obj.vertex_emission is not None:
-            left.append(f"{F.EMITTERS}: mesh vertex emission (hybrid's radiosity hand-over) not exported")
-        level = 1 if obj.kind in _FLAT_KINDS else tessellation
-        for part in tessellate_object(obj, level):
-            pm = scene.materials[part.material]
-            flat = part.kind in _FLAT_KINDS or (isinstance(obj, m.Mesh) and obj.normals is None)
-            add_mesh(part.positions, part.faces, part.normals,
-                     material_bsdf(pm, part.kind in _OPEN_KINDS),
-                     np.asarray(pm.emission) if pm.is_emitter else None, flat)
-        if mat.is_emitter:
-            left.append(f"{F.EMITTERS}: emissive surfaces emit from their front side only (Mitsuba's area "
-                        "emitter); the workbench adds emission on both sides")
+        if kind_of(obj).mitsuba(obj, sw) is None:
+            left.append(f"{obj.kind}: object kind not exported to Mitsuba 3")
     # lights
     black = {"type": "diffuse", "reflectance": rgb((0.0, 0.0, 0.0))}
     for light in scene.lights:
         if isinstance(light, m.AreaLight):
             v = np.asarray(light.vertices, dtype=np.float64)
             fan = np.array([[0, i, i + 1] for i in range(1, len(v) - 1)], dtype=np.int64)
-            add_mesh(v, fan, None, black, light.radiance, flat=True)
-    if not pts:
+            sw.add_mesh(v, fan, None, black, light.radiance, flat=True)
+    if not sw.pts:
         raise NotApplicable("method 'mitsuba': the scene has no geometry to render")
-    lo, hi = _scene_bounds(pts)
+    lo, hi = _scene_bounds(sw.pts)
     centre = 0.5 * (lo + hi)
     corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
     for k, light in enumerate(scene.lights):
@@ -363,5 +389,5 @@ def export_scene(scene: m.Scene, folder: str, tessellation: int, spp: int = 16,
                    "film": {"type": "hdrfilm", "width": int(cam.width), "height": int(cam.height),
                             "rfilter": {"type": "box"}, "pixel_format": "rgb",
                             "component_format": "float32", "sample_border": False}}
-    return Export(d, sorted(set(left)), count["tri"], count["shape"])
+    return Export(d, sorted(set(left)), sw.triangles, sw.shapes)
 

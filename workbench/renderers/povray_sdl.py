@@ -56,6 +56,7 @@ import numpy as np
 
 from ..scene import features as ft
 from ..scene import model as m
+from ..scene.kinds import kind_of, leaves
 from .texturing import frame
 
 FADE_FRACTION = 1e-4
@@ -103,17 +104,17 @@ def scene_size(scene: m.Scene) -> float:
         if isinstance(light, m.PointLight):
             pts.append(light.position)
 
-    def origins(o):
-        pts.append(np.asarray(o.world_from_object)[:3, 3])
-        if isinstance(o, m.CSG):
-            for c in (o.left, o.right):
-                origins(c)
     for o in scene.objects:
-        origins(o)
+        pts.extend(np.asarray(x.world_from_object)[:3, 3] for x in leaves(o))
     return float(max(1.0, np.abs(np.asarray(pts, dtype=np.float64)).max()))
 
 
-class _Writer:
+class Writer:
+    """Writes one scene's SDL; object kinds write theirs through it (``povray(obj, w,
+    in_csg)``, see :mod:`workbench.scene.kinds`): :meth:`vec`, :meth:`num`, :meth:`matrix`,
+    :meth:`texture` (pigment, finish, interior of a material by name), :meth:`leave` (a
+    ``"feature: reason"`` note) and :meth:`shape` (any object: CSG operands)."""
+
     def __init__(self, scene: m.Scene, blinn: bool):
         self.scene, self.blinn = scene, blinn
         self.size = scene_size(scene)
@@ -208,54 +209,28 @@ class _Writer:
             s += f" interior {{ ior {mat.ior:.10g} }}"
         return s
 
-    # ------------------------------------------------------------------ objects
-    def shape(self, o: m.SceneObject, in_csg: bool) -> str:
-        """The object's SDL: its shape in object space, texture, ``matrix``."""
-        tail = f"{self.texture(o.material)} {_matrix(o.world_from_object)}"
-        if isinstance(o, m.Sphere):
-            return f"sphere {{ {_v(o.center)}, {o.radius:.10g} {tail} }}"
-        if isinstance(o, m.Box):
-            return f"box {{ {_v(o.min)}, {_v(o.max)} {tail} }}"
-        if isinstance(o, (m.Plane, m.Polygon)):
-            v = o.corners() if isinstance(o, m.Plane) else np.asarray(o.vertices)
-            pts = ", ".join(_v(p) for p in [*v, v[0]])
-            return f"polygon {{ {len(v) + 1}, {pts} {tail} }}"
-        if isinstance(o, m.Quadric):
-            Q = np.asarray(o.Q, dtype=np.float64)
-            coef = (f"{_v([Q[0, 0], Q[1, 1], Q[2, 2]])}, {_v([2 * Q[0, 1], 2 * Q[0, 2], 2 * Q[1, 2]])}, "
-                    f"{_v([2 * Q[0, 3], 2 * Q[1, 3], 2 * Q[2, 3]])}, {Q[3, 3]:.10g}")
-            box = f"box {{ {_v(o.bounds_min)}, {_v(o.bounds_max)} }}"
-            if in_csg:
-                return f"intersection {{ quadric {{ {coef} }} {box} {tail} }}"
-            return f"quadric {{ {coef} clipped_by {{ {box} }} {tail} }}"
-        if isinstance(o, m.Mesh):
-            return self.mesh(o)
-        if isinstance(o, m.CSG):
-            op = {"union": "merge", "intersection": "intersection", "difference": "difference"}[o.op]
-            return (f"{op} {{\n  {self.shape(o.left, True)}\n  {self.shape(o.right, True)}\n"
-                    f"  {_matrix(o.world_from_object)} }}")
-        self.leave(f"{o.kind}: object kind not exported to POV-Ray")
-        return ""
+    # ------------------------------------------------------------------ for the kinds
+    def vec(self, a) -> str:
+        """``<x, y, z>`` (any length) with 10 significant digits."""
+        return _v(a)
 
-    def mesh(self, o: m.Mesh) -> str:
-        """``mesh2`` in world space: vertices ``W v``, unit normals ``n W^-1`` (row vectors), as
-        the ray tracer interpolates them (POV-Ray would interpolate object-space normals before
-        its transform: not the same under a non-uniform scale); the texture carries ``W``."""
-        if o.vertex_emission is not None:
-            self.leave(f"{ft.EMITTERS}: per-vertex emission of mesh {o.name or o.source!r} not exported")
-        W = np.asarray(o.world_from_object, dtype=np.float64)
-        V = np.asarray(o.vertices, dtype=np.float64) @ W[:3, :3].T + W[:3, 3]
-        F = np.asarray(o.faces)
-        out = [f"mesh2 {{\n vertex_vectors {{ {len(V)},\n" + ",\n".join(_v(p) for p in V) + " }"]
-        if o.normals is not None:
-            N = np.asarray(o.normals, dtype=np.float64) @ np.linalg.inv(W[:3, :3])
-            N /= np.maximum(np.linalg.norm(N, axis=1, keepdims=True), 1e-300)
-            out.append(f" normal_vectors {{ {len(N)},\n" + ",\n".join(_v(n) for n in N) + " }")
-        if o.uvs is not None:
-            out.append(f" uv_vectors {{ {len(V)},\n" + ",\n".join(_v(t) for t in np.asarray(o.uvs)) + " }")
-        out.append(f" face_indices {{ {len(F)},\n" + ",\n".join(f"<{a}, {b}, {c}>" for a, b, c in F) + " }")
-        out.append(f" {self.texture(o.material, _matrix(W) + ' ')} }}")
-        return "\n".join(out)
+    def num(self, x) -> str:
+        """A number with 10 significant digits."""
+        return f"{float(x):.10g}"
+
+    def matrix(self, W) -> str:
+        """``matrix <...>`` of a (4, 4) ``world_from_object`` (:func:`_matrix`)."""
+        return _matrix(W)
+
+    def shape(self, o: m.SceneObject, in_csg: bool) -> str:
+        """The object's SDL, written by its kind's ``povray(o, w, in_csg)`` (shape in object
+        space, texture, ``matrix``); a kind that cannot express the object returns None and
+        it is left out (noted)."""
+        sdl = kind_of(o).povray(o, self, in_csg)
+        if sdl is None:
+            self.leave(f"{o.kind}: object kind not exported to POV-Ray")
+            return ""
+        return sdl
 
     # ------------------------------------------------------------------ lights, camera
     def light(self, light) -> str:
@@ -290,7 +265,7 @@ def export(scene: m.Scene, width: int, height: int, *, max_trace_level: int = 5,
     ``assumed_gamma 1`` (linear colours throughout; the output is written with
     ``File_Gamma=1.0`` by the caller).
     """
-    w = _Writer(scene, blinn)
+    w = Writer(scene, blinn)
     parts = ["#version 3.7;",
              f"global_settings {{ assumed_gamma 1.0 max_trace_level {int(max_trace_level)} "
              f"adc_bailout {adc_bailout:.10g} ambient_light rgb {_v(scene.ambient)} }}",

@@ -87,6 +87,11 @@ def kind_of(obj: m.SceneObject) -> ModuleType:
         raise WorkbenchError(f"unknown object kind {obj.kind!r} (known: {', '.join(KINDS)})") from None
 
 
+def is_solid(obj: m.SceneObject) -> bool:
+    """Has an inside (:func:`.csg.is_solid`): a CSG operand, a medium for refraction."""
+    return csg.is_solid(obj, kind_of)
+
+
 def crossings(obj: m.SceneObject, W: np.ndarray, O, D, eps: float, solid: bool = False) -> list[csg.Crossing]:
     """Readable intersection: crossings of the world line ``O + t D`` with ``obj`` whose parent
     transform is ``W``, sorted by ``t``; a primitive is intersected in its object space (the

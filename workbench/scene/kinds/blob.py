@@ -264,3 +264,24 @@ def params(b: Blob, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
     """Parameter row head ``[aux offset, n, T]`` (3,) and aux (5 n,)."""
     return (np.array([aux_offset, len(b.components), b.threshold], dtype=np.float64),
             np.ascontiguousarray(b.components, dtype=np.float64).reshape(-1))
+
+
+# --------------------------------------------------------------------------- exporters
+def povray(b: Blob, w, in_csg: bool) -> str:
+    """POV-Ray's ``blob``: its field is the same (POV-Ray 3.7's ``Make_Blob``: each spherical
+    component adds ``strength (1 - (d/radius)^2)^2`` inside its radius; the solid is where the
+    sum exceeds ``threshold``), one ``sphere { <c>, radius, strength s }`` per component;
+    ``sturm`` (Sturm sequences instead of the closed-form quartic solver: exact roots, as our
+    interval solver)."""
+    comps = " ".join(f"sphere {{ {w.vec(c[:3])}, {w.num(c[3])}, strength {w.num(c[4])} }}" for c in b.components)
+    return (f"blob {{ threshold {w.num(b.threshold)} {comps} sturm {w.texture(b.material)} "
+            f"{w.matrix(b.world_from_object)} }}")
+
+
+def mitsuba(b: Blob, x) -> list[dict]:
+    """No blob in Mitsuba 3: its raster tessellation (marching cubes) at the export's level,
+    noted in ``left_out``."""
+    level = b.tessellation or x.level
+    x.leave(f"{FEATURE}: no blob primitive in Mitsuba 3: exported as its raster tessellation "
+            f"(marching cubes, {LEVEL_CELLS} x level cells along the longest side; level {level})")
+    return x.tessellated(b, level)

@@ -121,3 +121,14 @@ def normal(b: m.Box, face: int, P) -> np.ndarray:
 
 def inside(b: m.Box, q) -> bool:
     return bool(np.all(q > b.min) and np.all(q < b.max))
+
+
+# --------------------------------------------------------------------------- exporters
+def povray(b: m.Box, w, in_csg: bool) -> str:
+    """POV-Ray's ``box`` through the SDL writer ``w``."""
+    return f"box {{ {w.vec(b.min)}, {w.vec(b.max)} {w.texture(b.material)} {w.matrix(b.world_from_object)} }}"
+
+
+def mitsuba(b: m.Box, x) -> list[dict]:
+    """Its twelve triangles (level 1: exact), flat normals."""
+    return x.tessellated(b, 1, flat=True)

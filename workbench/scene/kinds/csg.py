@@ -252,3 +252,19 @@ def world_bounds(node: m.CSG, W: np.ndarray, bounds_of) -> tuple[np.ndarray, np.
     """Axis-aligned world box of the operands' boxes (``bounds_of(child, W)``)."""
     boxes = [bounds_of(c, W) for c in (node.left, node.right)]
     return np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
+
+
+# --------------------------------------------------------------------------- exporters
+_POVRAY_OPS = {"union": "merge", "intersection": "intersection", "difference": "difference"}
+
+
+def povray(node: m.CSG, w, in_csg: bool) -> str:
+    """POV-Ray's ``merge`` (the boundary of the union: no inner surfaces), ``intersection`` or
+    ``difference`` of its operands, each written by the SDL writer's dispatch ``w.shape``."""
+    return (f"{_POVRAY_OPS[node.op]} {{\n  {w.shape(node.left, True)}\n  {w.shape(node.right, True)}\n"
+            f"  {w.matrix(node.world_from_object)} }}")
+
+
+def mitsuba(node: m.CSG, x) -> list[dict]:
+    """The raster's mesh booleans at the export's level, smooth normals."""
+    return x.tessellated(node, x.level)

@@ -342,3 +342,33 @@ def gradient_numpy(program: Program, x, y, z) -> tuple[np.ndarray, np.ndarray]:
                 stack.append(r)
     v, d = stack[0]
     return np.asarray(v, dtype=np.float64), np.asarray(d, dtype=np.float64)
+
+
+# --------------------------------------------------------------------------- POV-Ray
+_POVRAY_UNARY = {name: name for name in UNARY} | {"log": "ln"}
+"""POV-Ray's names of the one-argument functions (its ``log`` is base 10, ``ln`` natural)."""
+
+
+def povray_function(program: Program) -> str:
+    """The program as the body of a POV-Ray 3.7 ``function { }`` (its "user-defined
+    functions" syntax): every operation parenthesised, ``^`` as ``pow(a, b)``, ``log`` as
+    ``ln``, constants (``pi``, ``e`` included) with 17 significant digits (the float64 value
+    exactly).  Read back from the postfix code, so what POV-Ray evaluates is what our
+    evaluators run."""
+    names = {ADD: "+", SUB: "-", MUL: "*", DIV: "/"}
+    calls = {POW: "pow", MIN: "min", MAX: "max", ATAN2: "atan2"}
+    stack: list[str] = []
+    for op_f, arg in program.code.reshape(-1, 2):
+        op = int(op_f)
+        if op == CONST:
+            stack.append(f"{float(arg):.17g}" if arg >= 0 else f"(-{-float(arg):.17g})")
+        elif op <= VAR_Z:
+            stack.append("xyz"[op - VAR_X])
+        elif op == NEG:
+            stack.append(f"(-{stack.pop()})")
+        elif op >= FIRST_UNARY:
+            stack.append(f"{_POVRAY_UNARY[UNARY[op - FIRST_UNARY]]}({stack.pop()})")
+        else:
+            b, a = stack.pop(), stack.pop()
+            stack.append(f"({a} {names[op]} {b})" if op in names else f"{calls[op]}({a}, {b})")
+    return stack[0]

@@ -29,7 +29,7 @@ from .. import model as m
 from ..parts import make_part
 from . import values as val
 from .aux_rows import flatten_aux
-from .expression import Program, compile_expression, evaluate_numpy, gradient_numpy
+from .expression import Program, compile_expression, evaluate_numpy, gradient_numpy, povray_function
 from .marching_cubes import closed_grid, grid_cells, marching_cubes, pad_outside, shade_normals
 
 TYPE = "isosurface"
@@ -279,3 +279,33 @@ def params(s: Isosurface, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
     return (np.array([aux_offset, s.program.length, s.threshold, s.max_gradient, *s.bounds_min,
                       *s.bounds_max, s.program.depth], dtype=np.float64),
             np.ascontiguousarray(s.program.code))
+
+
+# --------------------------------------------------------------------------- exporters
+POVRAY_ACCURACY = 1e-7
+"""POV-Ray's isosurface ``accuracy`` (its root search stops below it) as a fraction of the
+bounds' longest side (POV-Ray's default 0.001 is absolute and coarse)."""
+
+
+def povray(s: Isosurface, w, in_csg: bool) -> str:
+    """POV-Ray's ``isosurface``: ``function { }`` (:func:`.expression.povray_function`, read
+    back from the compiled program), ``contained_by { box }`` of the bounds (closed there, as
+    ours: no ``open``), ``threshold`` (inside is ``f < threshold`` in both), ``max_gradient``,
+    ``accuracy`` :data:`POVRAY_ACCURACY` of the bounds; inside CSG ``all_intersections``
+    (POV-Ray keeps only the first crossing of a ray by default)."""
+    lo, hi = bounds(s)
+    acc = POVRAY_ACCURACY * float((hi - lo).max())
+    every = " all_intersections" if in_csg else ""
+    return (f"isosurface {{ function {{ {povray_function(s.program)} }} "
+            f"contained_by {{ box {{ {w.vec(lo)}, {w.vec(hi)} }} }} threshold {w.num(s.threshold)} "
+            f"max_gradient {w.num(s.max_gradient)} accuracy {w.num(acc)}{every} "
+            f"{w.texture(s.material)} {w.matrix(s.world_from_object)} }}")
+
+
+def mitsuba(s: Isosurface, x) -> list[dict]:
+    """No implicit surface in Mitsuba 3: its raster tessellation (marching cubes, closed on
+    the bounds) at the export's level, noted in ``left_out``."""
+    level = s.tessellation or x.level
+    x.leave(f"{FEATURE}: no implicit surface in Mitsuba 3: exported as its raster tessellation "
+            f"(marching cubes, {LEVEL_CELLS} x level cells along the bounds' longest side; level {level})")
+    return x.tessellated(s, level)

@@ -279,3 +279,21 @@ def params(la: Lathe, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
     """Parameter row head ``[aux offset, points, closed, orientation]`` and aux (2 k,)."""
     return (np.array([aux_offset, len(la.points), float(la.closed), la.orientation]),
             np.ascontiguousarray(la.points, dtype=np.float64).reshape(-1))
+
+
+# --------------------------------------------------------------------------- exporters
+def povray(la: Lathe, w, in_csg: bool) -> str:
+    """POV-Ray's ``lathe { linear_spline k, <r, y>... }``: the profile's 2D points ``(r, y)``
+    swept about the y axis, as ours."""
+    pts = ", ".join(w.vec(q) for q in la.points)
+    return (f"lathe {{ linear_spline {len(la.points)}, {pts} {w.texture(la.material)} "
+            f"{w.matrix(la.world_from_object)} }}")
+
+
+def mitsuba(la: Lathe, x) -> list[dict]:
+    """No lathe in Mitsuba 3: its raster tessellation (``LEVEL_STEPS`` x level angular steps)
+    at the export's level, an open surface when its profile is open; noted in ``left_out``."""
+    level = la.tessellation or x.level
+    x.leave(f"{FEATURE}: no lathe primitive in Mitsuba 3: exported as its raster tessellation "
+            f"({LEVEL_STEPS} x level angular steps; level {level})")
+    return x.tessellated(la, level, open_surface=not la.closed)

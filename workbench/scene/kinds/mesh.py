@@ -143,3 +143,34 @@ def inside(mesh: m.Mesh, q) -> bool:
     den = la * lb * lc + np.einsum("ij,ij->i", a, b) * lc + np.einsum("ij,ij->i", b, c) * la \
         + np.einsum("ij,ij->i", c, a) * lb
     return bool(abs(np.sum(2.0 * np.arctan2(num, den))) / (4.0 * np.pi) > 0.5)
+
+
+# --------------------------------------------------------------------------- exporters
+def povray(o: m.Mesh, w, in_csg: bool) -> str:
+    """POV-Ray's ``mesh2`` in world space: vertices ``W v``, unit normals ``n W^-1`` (row
+    vectors), as the ray tracer interpolates them (POV-Ray would interpolate object-space
+    normals before its transform: not the same under a non-uniform scale); the texture
+    carries ``W``.  Per-vertex emission is left out (noted)."""
+    if o.vertex_emission is not None:
+        w.leave(f"emitters: per-vertex emission of mesh {o.name or o.source!r} not exported")
+    W = np.asarray(o.world_from_object, dtype=np.float64)
+    V = np.asarray(o.vertices, dtype=np.float64) @ W[:3, :3].T + W[:3, 3]
+    F = np.asarray(o.faces)
+    out = [f"mesh2 {{\n vertex_vectors {{ {len(V)},\n" + ",\n".join(w.vec(p) for p in V) + " }"]
+    if o.normals is not None:
+        N = np.asarray(o.normals, dtype=np.float64) @ np.linalg.inv(W[:3, :3])
+        N /= np.maximum(np.linalg.norm(N, axis=1, keepdims=True), 1e-300)
+        out.append(f" normal_vectors {{ {len(N)},\n" + ",\n".join(w.vec(n) for n in N) + " }")
+    if o.uvs is not None:
+        out.append(f" uv_vectors {{ {len(V)},\n" + ",\n".join(w.vec(t) for t in np.asarray(o.uvs)) + " }")
+    out.append(f" face_indices {{ {len(F)},\n" + ",\n".join(f"<{a}, {b}, {c}>" for a, b, c in F) + " }")
+    out.append(f" {w.texture(o.material, w.matrix(W) + ' ')} }}")
+    return "\n".join(out)
+
+
+def mitsuba(o: m.Mesh, x) -> list[dict]:
+    """Its triangles with its own vertex normals (flat without them); per-vertex emission
+    (hybrid's radiosity hand-over) is left out (noted)."""
+    if o.vertex_emission is not None:
+        x.leave("emitters: mesh vertex emission (hybrid's radiosity hand-over) not exported")
+    return x.tessellated(o, x.level, flat=o.normals is None)

@@ -66,3 +66,16 @@ def normal(p: m.Plane, face: int, P) -> np.ndarray:
 
 def inside(p: m.Plane, q) -> bool:
     return False
+
+
+# --------------------------------------------------------------------------- exporters
+def povray(p: m.Plane, w, in_csg: bool) -> str:
+    """POV-Ray's ``polygon`` (its four corners, closed by repeating the first) through the SDL writer ``w``."""
+    v = p.corners()
+    pts = ", ".join(w.vec(q) for q in [*v, v[0]])
+    return f"polygon {{ {len(v) + 1}, {pts} {w.texture(p.material)} {w.matrix(p.world_from_object)} }}"
+
+
+def mitsuba(p: m.Plane, x) -> list[dict]:
+    """Its triangles (level 1: exact), flat normals; an open surface (``thindielectric``)."""
+    return x.tessellated(p, 1, flat=True, open_surface=True)

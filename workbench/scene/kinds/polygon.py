@@ -94,3 +94,16 @@ def normal(p: m.Polygon, face: int, P) -> np.ndarray:
 
 def inside(p: m.Polygon, q) -> bool:
     return False
+
+
+# --------------------------------------------------------------------------- exporters
+def povray(p: m.Polygon, w, in_csg: bool) -> str:
+    """POV-Ray's ``polygon`` (its vertices, closed by repeating the first) through the SDL writer ``w``."""
+    v = np.asarray(p.vertices)
+    pts = ", ".join(w.vec(q) for q in [*v, v[0]])
+    return f"polygon {{ {len(v) + 1}, {pts} {w.texture(p.material)} {w.matrix(p.world_from_object)} }}"
+
+
+def mitsuba(p: m.Polygon, x) -> list[dict]:
+    """Its triangles (level 1: exact), flat normals; an open surface (``thindielectric``)."""
+    return x.tessellated(p, 1, flat=True, open_surface=True)

@@ -267,3 +267,21 @@ def params(p: Prism, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
     """Parameter row head ``[aux offset, vertices, y0, y1, orientation]`` and aux (2 k,)."""
     return (np.array([aux_offset, len(p.polygon), p.y0, p.y1, p.orientation]),
             np.ascontiguousarray(p.polygon, dtype=np.float64).reshape(-1))
+
+
+# --------------------------------------------------------------------------- exporters
+def povray(p: Prism, w, in_csg: bool) -> str:
+    """POV-Ray's ``prism { linear_sweep linear_spline y0, y1, k + 1, <x, z>... }``: POV-Ray's
+    2D points are ``(x, z)`` swept along y between the two heights, as ours; the polygon is
+    closed by repeating its first vertex (a linear spline prism needs it)."""
+    P = [*p.polygon, p.polygon[0]]
+    pts = ", ".join(w.vec(q) for q in P)
+    return (f"prism {{ linear_sweep linear_spline {w.num(p.y0)}, {w.num(p.y1)}, {len(P)}, {pts} "
+            f"{w.texture(p.material)} {w.matrix(p.world_from_object)} }}")
+
+
+def mitsuba(p: Prism, x) -> list[dict]:
+    """No prism in Mitsuba 3: its raster tessellation (exact: walls and ear-clipped caps),
+    flat normals, noted in ``left_out``."""
+    x.leave(f"{FEATURE}: no prism primitive in Mitsuba 3: exported as its triangles (exact)")
+    return x.tessellated(p, 1, flat=True)

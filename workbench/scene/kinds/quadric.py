@@ -415,3 +415,24 @@ def normal(q: m.Quadric, face: int, P) -> np.ndarray:
 def inside(q: m.Quadric, x) -> bool:
     P = np.r_[x, 1.0]
     return bool(P @ np.asarray(q.Q) @ P < 0.0 and bool(np.all(x >= q.bounds_min) and np.all(x <= q.bounds_max)))
+
+
+# --------------------------------------------------------------------------- exporters
+def povray(q: m.Quadric, w, in_csg: bool) -> str:
+    """POV-Ray's ``quadric`` (``A x^2 + B y^2 + C z^2 + D xy + E xz + F yz + G x + H y + I z +
+    J`` from the symmetric ``Q``: ``A = Q00, D = 2 Q01, G = 2 Q03, J = Q33``...; inside is
+    ``< 0`` in both) ``clipped_by`` its bounds box (an open, cut surface, as the ray tracer)
+    or, inside CSG, ``intersection``-ed with it (a solid with caps)."""
+    Q = np.asarray(q.Q, dtype=np.float64)
+    coef = (f"{w.vec([Q[0, 0], Q[1, 1], Q[2, 2]])}, {w.vec([2 * Q[0, 1], 2 * Q[0, 2], 2 * Q[1, 2]])}, "
+            f"{w.vec([2 * Q[0, 3], 2 * Q[1, 3], 2 * Q[2, 3]])}, {w.num(Q[3, 3])}")
+    box = f"box {{ {w.vec(q.bounds_min)}, {w.vec(q.bounds_max)} }}"
+    tail = f"{w.texture(q.material)} {w.matrix(q.world_from_object)}"
+    if in_csg:
+        return f"intersection {{ quadric {{ {coef} }} {box} {tail} }}"
+    return f"quadric {{ {coef} clipped_by {{ {box} }} {tail} }}"
+
+
+def mitsuba(q: m.Quadric, x) -> list[dict]:
+    """Its tessellation at the export's level, smooth normals."""
+    return x.tessellated(q, x.level)

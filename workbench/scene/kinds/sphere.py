@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...core import transform as tf
 from .. import model as m, readers as rd
 from ..parts import make_part
 
@@ -106,3 +107,22 @@ def normal(s: m.Sphere, face: int, P) -> np.ndarray:
 
 def inside(s: m.Sphere, q) -> bool:
     return bool(np.linalg.norm(q - np.asarray(s.center)) < s.radius)
+
+
+# --------------------------------------------------------------------------- exporters
+def povray(s: m.Sphere, w, in_csg: bool) -> str:
+    """POV-Ray's ``sphere`` through the SDL writer ``w`` (:class:`workbench.renderers.povray_sdl.Writer`)."""
+    return (f"sphere {{ {w.vec(s.center)}, {w.num(s.radius)} {w.texture(s.material)} "
+            f"{w.matrix(s.world_from_object)} }}")
+
+
+def mitsuba(s: m.Sphere, x) -> list[dict]:
+    """Mitsuba's analytic ``sphere`` (``to_world`` = world_from_object . T(center) . S(radius))
+    when the transform is a similarity, else its tessellation at the export's level, through
+    the shape writer ``x`` (:class:`workbench.renderers.mitsuba_export.ShapeWriter`)."""
+    k = x.similarity_scale(s.world_from_object)
+    if k is None:
+        return x.tessellated(s, x.level)
+    M = np.asarray(s.world_from_object) @ tf.translate(s.center) @ tf.scale(s.radius)
+    c, r = M[:3, 3], k * s.radius
+    return [x.analytic({"type": "sphere", "to_world": M.tolist()}, s.material, c - r, c + r)]
