@@ -25,6 +25,11 @@ sphere              ``sphere`` with ``to_world`` = world_from_object . T(center)
                     when the object's transform is a similarity; tessellated otherwise
 quadric, csg        tessellated (``tessellation`` level) with smooth normals
 mesh                triangle mesh, its own normals or flat
+blob, isosurface,   no such primitives in Mitsuba 3: their raster tessellation (marching
+lathe, prism        cubes, revolved profile at the ``tessellation`` level; the prism's exact
+                    triangles, flat), noted in ``left_out``; an open lathe is an open surface
+(each kind)         written by its module's ``mitsuba(obj, x)`` (:mod:`workbench.scene.kinds`)
+                    through :class:`ShapeWriter`
 kd x color          ``diffuse`` reflectance, inside ``twosided`` (workbench surfaces are
                     two-sided)
 kr                  ``conductor`` with ``material = "none"`` (perfect mirror),

@@ -11,13 +11,14 @@ eye ray through the screen point ``(x, y)`` in ``[-1/2, 1/2]^2`` is ``direction 
 up``, so pixel ``(i, j)`` gets ``x = (j + 1/2) / W - 1/2``, ``y = 1/2 - (i + 1/2) / H``:
 exactly :meth:`workbench.scene.model.Camera.rays` (tested by projecting a point).
 
-Geometry.  Object-space shapes followed by ``matrix`` (``world_from_object``, transposed to
-POV-Ray's row-vector form).  sphere, box, polygon (``Plane`` as its four corners), ``quadric``
-(``A x^2 + B y^2 + C z^2 + D xy + E xz + F yz + G x + H y + I z + J`` from the symmetric ``Q``:
-``A = Q00, D = 2 Q01, G = 2 Q03, J = Q33``...; inside is ``< 0`` in both) ``clipped_by`` its
-bounds box (an open, cut surface, as the ray tracer) or, inside CSG, ``intersection``-ed with
-it (a solid with caps); meshes as ``mesh2`` (vertex normals and uvs when given); CSG as
-``merge`` (the boundary of the union: no inner surfaces), ``intersection``, ``difference``.
+Geometry.  Each object kind writes its own SDL (its module's ``povray(obj, w, in_csg)``, see
+:mod:`workbench.scene.kinds`, through :class:`Writer`): object-space shapes followed by
+``matrix`` (``world_from_object``, transposed to POV-Ray's row-vector form).  sphere, box,
+polygon (``Plane`` as its four corners), ``quadric`` ``clipped_by`` its bounds box (inside
+CSG ``intersection``-ed with it), meshes as ``mesh2``, CSG as ``merge`` (the boundary of the
+union: no inner surfaces), ``intersection``, ``difference``; and POV-Ray's own ``blob`` (the
+same field), ``isosurface`` (the function read back from its compiled program), ``lathe``
+and ``prism`` (``linear_spline``).
 
 Local model (``local_model.py``) to ``finish``.  POV-Ray scales ambient, diffuse and
 emission by ``1 - transmit`` (measured with POV-Ray 3.7.0.10), so for a material with

@@ -52,6 +52,21 @@ Functions (``W`` and ``M`` are (4, 4) ``world_from_object`` including any CSG pa
 ``normal(obj, face, P) -> (3,)``  outward object-space normal (not normalised) at point ``P``.
 ``inside(obj, q) -> bool``  strict inside test of object-space point ``q`` (False for sheets).
 
+``povray(obj, w, in_csg) -> str | None``  the object's POV-Ray 3.7 SDL (shape in object
+    space, texture, ``matrix``) through the exporter's writer ``w``
+    (:class:`workbench.renderers.povray_sdl.Writer`): ``w.vec(a)``, ``w.num(x)`` (10
+    significant digits), ``w.matrix(W)``, ``w.texture(material)`` (pigment, finish, interior),
+    ``w.leave("feature: reason")`` and, for CSG operands, ``w.shape(child, True)``;
+    ``in_csg``: it is a CSG operand (a cut quadric becomes a capped solid, an isosurface
+    keeps all its crossings).  None: POV-Ray cannot express it (the writer notes it).
+``mitsuba(obj, x) -> list[dict] | None``  its Mitsuba 3 shapes, added through the exporter's
+    shape writer ``x`` (:class:`workbench.renderers.mitsuba_export.ShapeWriter`):
+    ``x.tessellated(obj, level, flat=, open_surface=)`` (its raster tessellation as PLY
+    meshes), ``x.analytic(shape_dict, material, lo, hi)`` (a Mitsuba primitive of its own),
+    ``x.similarity_scale(W)``, ``x.leave(note)`` (an approximation, in ``left_out``) and
+    ``x.level`` (the export's tessellation level).  Returns the shape dicts added; None: not
+    exported (noted).
+
 The numba functions (intersection and normal by ``par`` row) live in
 :mod:`workbench.renderers.raytrace.kernels`, which imports the ``PTYPE`` constants from here.
 
@@ -59,7 +74,8 @@ Composite kinds (``COMPOSITE = True``: CSG) take the dispatch as an argument ins
 importing it: ``parse(ctx, t, w, common, child, kind_of)``, ``children(obj)``,
 ``tessellate(obj, level, parent, kind_of)``, ``crossings(obj, W, O, D, eps, crossings_of)``,
 ``containing(obj, W, p, containing_of)``, ``world_bounds(obj, W, bounds_of)``; their
-``flatten`` calls ``b.leaf(child, index, W, top=False)`` for operands.
+``flatten`` calls ``b.leaf(child, index, W, top=False)`` for operands and their ``povray``
+the writer's ``w.shape`` (the exporters' dispatch, handed over in ``w``).
 """
 from __future__ import annotations
 

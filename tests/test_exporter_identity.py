@@ -1,0 +1,70 @@
+"""The exporters' output for bundled scenes is pinned: the POV-Ray SDL text and the Mitsuba
+scene dictionary that the exporters wrote before they asked each object kind's module
+(``povray``, ``mitsuba``; issue 14) are kept in ``tests/golden/exporters`` (written by
+main at 7c5be9a with :func:`mitsuba_record`), and the exporters must still write them
+exactly.  Regenerate only for an intended change of the mapping:
+``python -c "import tests.test_exporter_identity as t; t.write_golden()"``.
+"""
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+import workbench
+from workbench.renderers import mitsuba_export, povray_sdl
+
+GOLDEN = Path(__file__).resolve().parent / "golden" / "exporters"
+POV_SCENES = ("csg", "quadrics", "whitted", "cornell", "globe")
+MITSUBA_SCENES = ("csg", "cornell_spheres", "whitted")
+W, H = 64, 48
+LEVEL = 2
+
+
+def _ply_summary(path: str) -> str:
+    """``name: V vertices, F faces, normals yes/no`` from a PLY file's header."""
+    head = Path(path).read_bytes().split(b"end_header", 1)[0].decode("ascii")
+    v = re.search(r"element vertex (\d+)", head).group(1)
+    f = re.search(r"element face (\d+)", head).group(1)
+    return f"{Path(path).name}: {v} vertices, {f} faces, normals {'yes' if 'nx' in head else 'no'}"
+
+
+def mitsuba_record(name: str, folder: str) -> dict:
+    """The Mitsuba export of bundled scene ``name`` as plain JSON data (file names replaced by
+    their PLY summary)."""
+    ex = mitsuba_export.export_scene(workbench.load_scene(name), folder, LEVEL)
+
+    def plain(v):
+        if isinstance(v, dict):
+            return {k: plain(x) for k, x in v.items()}
+        if isinstance(v, list):
+            return [plain(x) for x in v]
+        if isinstance(v, str) and v.startswith(folder):
+            return _ply_summary(v)
+        return v
+    return json.loads(json.dumps({"dict": plain(ex.scene_dict), "left_out": ex.left_out,
+                                  "triangles": ex.triangles, "shapes": ex.shapes}))
+
+
+def write_golden() -> None:
+    import tempfile
+    GOLDEN.mkdir(parents=True, exist_ok=True)
+    for name in POV_SCENES:
+        (GOLDEN / f"{name}.pov").write_text(povray_sdl.export(workbench.load_scene(name), W, H).sdl)
+    for name in MITSUBA_SCENES:
+        with tempfile.TemporaryDirectory() as tmp:
+            (GOLDEN / f"{name}_mitsuba.json").write_text(json.dumps(mitsuba_record(name, tmp), indent=1, sort_keys=True))
+
+
+@pytest.mark.parametrize("name", POV_SCENES)
+def test_povray_sdl_of_bundled_scenes_is_unchanged(name):
+    ex = povray_sdl.export(workbench.load_scene(name), W, H)
+    assert ex.sdl == (GOLDEN / f"{name}.pov").read_text()
+
+
+@pytest.mark.parametrize("name", MITSUBA_SCENES)
+def test_mitsuba_dict_of_bundled_scenes_is_unchanged(name, tmp_path):
+    got = mitsuba_record(name, str(tmp_path))
+    assert got == json.loads((GOLDEN / f"{name}_mitsuba.json").read_text())
