@@ -150,3 +150,16 @@ def test_left_out_lists_what_is_dropped(tmp_path, name, expected):
         assert any(x.startswith(prefix) for x in ex.left_out), (prefix, ex.left_out)
     if not expected:
         assert ex.left_out == []
+
+
+def test_memory_estimate_covers_the_triangles_of_the_new_kinds(tmp_path):
+    # marching cubes grow with the surface, not as a sphere's rings: the old per-object guess
+    # (2 (8 L)^2 4 triangles) held 33k at level 4 where the export writes 66k
+    from workbench.renderers import mitsuba_method as mm
+    from workbench.renderers.base import get_renderer
+    scene = workbench.load_scene("kinds")
+    ex = mx.export_scene(scene, str(tmp_path), 4)
+    est = get_renderer("mitsuba").estimate_bytes(scene, 16, 12, tessellation=4)
+    assert est >= mm.CHILD_BASE_BYTES + mm.BYTES_PER_PIXEL * 16 * 12 + mm.BYTES_PER_TRIANGLE * ex.triangles
+    assert any(x.startswith("blobs: no blob primitive") for x in ex.left_out)
+    assert any(x.startswith("isosurfaces:") for x in ex.left_out) and any(x.startswith("lathes:") for x in ex.left_out)

@@ -46,6 +46,7 @@ from ..core.tol import tol
 from ..scene.model import Scene
 from ..scene.tessellate import MAX_LEVEL
 from .base import Knob, Option, RenderResult
+from .estimates import triangle_bound
 from .mitsuba_export import RR_DEPTH, export_scene
 from ..scene.features import scene_needs
 
@@ -183,21 +184,14 @@ class MitsubaRenderer:
 
     def estimate_bytes(self, scene: Scene, width: int, height: int, **options) -> int:
         """Peak memory of a render (child process and the parent's images), bytes: a fixed child
-        base, per pixel and per triangle of the meshes (analytic spheres count as none; curved
-        tessellated objects are bounded by their level's triangle count)."""
+        base, per pixel and per triangle of the meshes, bounded by the raster's
+        :func:`.estimates.triangle_bound` at the export's level (the exporter writes every
+        object's raster tessellation, or less: analytic spheres, flat kinds at level 1; the
+        marching-cubes kinds grow with the level as their surface does, from their level-1
+        count)."""
         level = int(options.get("tessellation", self.options["tessellation"].default))
-        tris = 0
-        for obj in scene.objects:
-            if obj.kind in ("polygon", "plane"):
-                tris += 2 * max(len(getattr(obj, "vertices", ())), 4)
-            elif obj.kind == "box":
-                tris += 12
-            elif obj.kind == "mesh":
-                tris += len(obj.faces)
-            elif obj.kind != "sphere":
-                lv = obj.tessellation or level
-                tris += 2 * (8 * lv) * (8 * lv) * 4  # a quadric / CSG leaf pair at that level, generously
-        return int(CHILD_BASE_BYTES + BYTES_PER_PIXEL * width * height + BYTES_PER_TRIANGLE * tris)
+        return int(CHILD_BASE_BYTES + BYTES_PER_PIXEL * width * height
+                   + BYTES_PER_TRIANGLE * triangle_bound(scene, level))
 
     def render(self, scene: Scene, width: int, height: int, *, spp: int = 64, seed: int = 0,
                variant: str = "auto", tessellation: int = 16, background_light: bool = True,
