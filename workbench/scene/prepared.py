@@ -7,15 +7,16 @@ the result: the world bounds of every object and of the whole scene, its extent 
 every relative tolerance in :mod:`workbench.core.tol`), the area lights as emissive polygons,
 the camera's automatic near and far planes (:mod:`.clip_planes`) and the media holding the
 camera (:mod:`.media`).  Before this step the ray tracer took the extent from its primitive
-table, radiosity from its patch surfaces, the raster methods and pyrender their clip planes
-from the boxes of their own triangles, and four modules asked the scene for its area-light
-polygons.
+table, radiosity from a coarse tessellation of its surfaces, the raster methods and pyrender
+their clip planes from the boxes of their own triangles (pyrender without the area lights),
+and each tracer asked for the camera's media and the area-light polygons itself.
 
 Bounds are robust by construction: a box holds the object's kind's ``bound_points`` (every
-leaf of a CSG tree, under its composed ``world_from_object``) moved to world space, the hull of
-points that hold the object, so no hit, vertex or patch lies outside it; points with a
-non-finite coordinate are left out (an object with none has the empty box ``lo = +inf,
-hi = -inf`` and takes no part in the extent or the clip planes).
+leaf of a CSG tree, under its composed ``world_from_object``) moved to world space, the hull
+of points that hold the object, so no hit, vertex or patch lies outside it by more than the
+rounding of its own transform; points with a non-finite coordinate are left out (an object
+with none has the empty box ``lo = +inf, hi = -inf`` and takes no part in the extent or the
+clip planes).
 """
 from __future__ import annotations
 
