@@ -95,13 +95,11 @@ def test_events_of_each_row_match_the_readable_crossings():
 
 
 class _Builder:
-    """The ray tracer's builder interface the kinds' ``flatten`` writes through."""
+    """The ray tracer's builder interface the kinds' ``flatten`` writes through (no bounds:
+    the prepared scene takes them from each kind's ``bound_points``)."""
 
     def __init__(self):
-        self.rows, self.aux, self.n_aux, self.pts = [], [], 0, []
-
-    def bound(self, W, pts):
-        self.pts.append(pts)
+        self.rows, self.aux, self.n_aux = [], [], 0
 
     def add_aux(self, data):
         self.aux.append(data)
@@ -124,4 +122,4 @@ def test_flatten_through_the_builder_gives_the_same_table():
     assert [r[0] for r in b.rows] == ptype.tolist()
     assert np.array_equal(np.array([r[1] for r in b.rows]), par)
     assert np.array_equal(np.concatenate(b.aux), aux)
-    assert [r[2] for r in b.rows] == [True, True, True, True] and len(b.pts) == 4
+    assert [r[2] for r in b.rows] == [True, True, True, True]

@@ -69,6 +69,7 @@ def test_area_light_is_one_polygon_in_every_method():
     from workbench.scene.tessellate import area_light_parts
     from workbench.renderers.raytrace.flatten import flatten
     from workbench.renderers.raytrace.reference import Context
+    from workbench.scene.prepared import prepare
     scene = _scene([{"type": "sphere", "material": "w", "radius": 0.5}])
     ((k, poly, mat),) = scene.area_light_polygons()
     assert k == 0 and np.array_equal(poly.vertices, scene.lights[0].vertices)
@@ -78,7 +79,7 @@ def test_area_light_is_one_polygon_in_every_method():
     assert sd.materials[sd.mat[-1]] == mat and sd.mat_tab[sd.mat[-1], 14] == 1.0
     ctx = Context(scene)                                  # readable reference tracer
     assert np.array_equal(ctx.items[-1].obj.vertices, poly.vertices) and ctx.materials[mat.name] == mat
-    ((part, pmat),) = area_light_parts(scene)             # raster, zbuffer
+    ((part, pmat),) = area_light_parts(prepare(scene).area_lights)  # raster, zbuffer
     assert pmat == mat and np.allclose(np.sort(part.positions, 0)[[0, -1]],
                                        np.sort(poly.vertices, 0)[[0, -1]])
     patches, _ = patches_from_scene(scene, 10.0)          # radiosity

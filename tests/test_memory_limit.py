@@ -116,11 +116,12 @@ def test_memory_limit_sources(monkeypatch):
 
 
 def test_patch_count_matches_cutting():
-    from workbench.renderers.radiosity.patches import count_patches, patches_from_scene, scene_extent
+    from workbench.renderers.radiosity.patches import count_patches, patches_from_scene
+    from workbench.scene.prepared import prepare
     for name in ("cornell", "cornell_spheres", "whitted", "mesh"):
         scene = workbench.load_scene(ROOT / "scenes" / f"{name}.toml")
         for size in (0.2, 0.03):
-            h = size * scene_extent(scene)
+            h = size * prepare(scene).extent
             assert count_patches(scene, h) == len(patches_from_scene(scene, h)[0])
 
 

@@ -8,7 +8,8 @@ import pytest
 import workbench
 from workbench.core.errors import NotApplicable, WorkbenchError
 from workbench.renderers.radiosity.method import solve_scene, RadiosityRenderer
-from workbench.renderers.radiosity.patches import patches_from_scene, scene_extent
+from workbench.renderers.radiosity.patches import patches_from_scene
+from workbench.scene.prepared import prepare
 
 
 def _opts(**kw):
@@ -87,7 +88,7 @@ def test_bad_options():
 
 def test_patch_size_is_the_knob():
     scene = workbench.load_scene("cornell")
-    ext = scene_extent(scene)
+    ext = prepare(scene).extent
     counts = [len(patches_from_scene(scene, f * ext)[0]) for f in (0.2, 0.1, 0.05)]
     assert counts[0] < counts[1] < counts[2]
     p, _ = patches_from_scene(scene, 0.05 * ext)

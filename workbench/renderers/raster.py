@@ -60,8 +60,8 @@ import numpy as np
 from ..core.errors import WorkbenchError
 from ..scene import features as ft
 from ..scene.model import AREA_LIGHT_PREFIX, AreaLight, Camera, Environment, Material, Scene
-from ..scene.clip_planes import auto_near_far
 from ..scene.parts import Part
+from ..scene.prepared import prepare
 from ..scene.tessellate import (DEFAULT_LEVEL, MAX_LEVEL, NORMAL_RULES, area_light_parts, tessellate_scene,
                                 with_normal_rule)
 from .estimates import raster_bytes
@@ -253,10 +253,12 @@ class RasterSession:
         t0 = time.perf_counter()
         pairs = [(with_normal_rule(p, normals), scene.materials[p.material], p.material)
                  for p in _parts(scene, tessellation)]
-        pairs += [(p, m, None) for p, m in area_light_parts(scene)]
+        #: bounds, clip planes and area lights (.scene.prepared), built once per session
+        self.prepared = prepare(scene)
+        pairs += [(p, m, None) for p, m in area_light_parts(self.prepared.area_lights)]
         self.timings["tessellate"] = time.perf_counter() - t0
         self.n_triangles = sum(p.n_triangles for p, _, _ in pairs)
-        #: (K, 2, 3) world box of every part: the automatic clip planes (.scene.clip_planes)
+        #: (K, 2, 3) world box of every part: what the stand-ins' maps cover
         self.part_boxes = np.array([[p.positions.min(0), p.positions.max(0)] for p, _, _ in pairs])
         self.lights = scene.point_lights()
         self._light_values = light_uniforms(self.lights)
@@ -656,7 +658,7 @@ class RasterSession:
 
     # ------------------------------------------------------------------ drawing
     def near_far(self, camera: Camera) -> tuple[float, float]:
-        return auto_near_far(camera, self.part_boxes)
+        return self.prepared.clip_planes(camera)
 
     def framebuffer(self, width: int, height: int):
         """A cached float32 RGBA colour + depth FBO of this size (depth format per

@@ -53,8 +53,8 @@ import numpy as np
 from ..core.errors import WorkbenchError
 from ..core.tol import tol
 from ..scene import features as ft
-from ..scene.clip_planes import auto_near_far
 from ..scene.model import AreaLight, DirectionalLight, Scene
+from ..scene.prepared import prepare
 from ..scene.tessellate import DEFAULT_LEVEL, MAX_LEVEL, tessellate_scene
 from .estimates import raster_bytes
 from . import gl
@@ -175,17 +175,13 @@ def _pose_looking(position: np.ndarray, direction: np.ndarray) -> np.ndarray:
     return pose
 
 
-def _near_far(scene: Scene, ps) -> tuple[float, float]:
-    """Clip planes from each mesh's world box (the raster methods' rule, .scene.clip_planes)."""
-    return auto_near_far(scene.camera, np.array([mesh.bounds for mesh in ps.meshes]))
-
-
 def _render_here(scene: Scene, width: int, height: int, level: int, frames: int = 1) -> dict:
     """Build and render in the calling thread; ``frames`` > 1 times repeated frames."""
     import pyrender
     t0 = time.perf_counter()
     ps, left_out = build_scene(scene, level)
-    near, far = _near_far(scene, ps)
+    prepared = prepare(scene)
+    near, far = prepared.near, prepared.far
     cam = scene.camera
     pc = pyrender.PerspectiveCamera(yfov=np.radians(cam.fov_y), aspectRatio=width / height, znear=near, zfar=far)
     ps.add(pc, pose=np.linalg.inv(cam.camera_from_world()))
@@ -208,7 +204,7 @@ def _render_here(scene: Scene, width: int, height: int, level: int, frames: int 
     depth = np.where(depth > 0, depth, np.inf)
     return {"image": image.astype(np.float32), "depth": depth.astype(np.float32), "left_out": left_out,
             "build": t_build, "first_frame": t_first, "frame_times": times,
-            "gl_renderer": _gl_renderer_string()}
+            "gl_renderer": _gl_renderer_string(), "near": float(near), "far": float(far)}
 
 
 def _gl_renderer_string() -> str:
@@ -375,5 +371,6 @@ class PyrenderRenderer:
                 left.append(f"{f}: {why}")
         used = sorted(f for f in needs if not any(x.startswith(f + ":") for x in left))
         timings = {"build": res["build"], "draw": res["first_frame"], "compile": 0.0}
-        stats = {"gl_renderer": res["gl_renderer"], "isolated": bool(isolate or _must_isolate())}
+        stats = {"gl_renderer": res["gl_renderer"], "isolated": bool(isolate or _must_isolate()),
+                 "near": res["near"], "far": res["far"]}
         return RenderResult(self.name, res["image"], timings, stats, used, left, depth=res["depth"])

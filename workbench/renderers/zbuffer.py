@@ -40,9 +40,9 @@ from ..core.errors import WorkbenchError
 from ..core.tol import tol
 from ..core.transform import normalize
 from ..scene import features as ft
-from ..scene.clip_planes import auto_near_far
 from ..scene.model import Camera, Material, Scene
 from ..scene.parts import Part
+from ..scene.prepared import prepare
 from ..scene.tessellate import (DEFAULT_LEVEL, MAX_LEVEL, NORMAL_RULES, area_light_parts, tessellate_scene,
                                 with_normal_rule)
 from . import texturing as tx
@@ -206,11 +206,10 @@ def rasterise(scene: Scene, camera: Camera, *, tessellation: int, normals: str, 
     t0 = time.perf_counter()
     pairs = [(with_normal_rule(p, normals), scene.materials[p.material])
              for p in tessellate_scene(scene, tessellation)]
-    pairs += area_light_parts(scene)
+    prepared = prepare(scene.with_camera(camera))
+    pairs += area_light_parts(prepared.area_lights)
     timings["tessellate"] = time.perf_counter() - t0
-    boxes = np.array([[p.positions.min(0), p.positions.max(0)] for p, _ in pairs]).reshape(-1, 2, 3)
-    n0, f0 = auto_near_far(camera, boxes)
-    near, far = near or n0, far or f0
+    near, far = near or prepared.near, far or prepared.far
     if not 0.0 < near < far:
         raise WorkbenchError(f"clip planes need 0 < near < far, got near {near:.6g} and far {far:.6g}")
     eye = np.asarray(camera.position, dtype=np.float64)

@@ -90,11 +90,11 @@ def tessellate_scene(scene: m.Scene, level: int = DEFAULT_LEVEL) -> list[Part]:
     return parts
 
 
-def area_light_parts(scene: m.Scene) -> list[tuple[Part, m.Material]]:
+def area_light_parts(area_lights) -> list[tuple[Part, m.Material]]:
     """Area lights as emissive polygons of radiance ``color * intensity`` (what the raster
-    methods draw of them), each with its own material."""
-    return [(part, mat) for _, polygon, mat in scene.area_light_polygons()
-            for part in tessellate_object(polygon, 1)]
+    methods draw of them), each with its own material; ``area_lights``: the prepared scene's
+    ``(k, polygon, material)`` (:attr:`.prepared.PreparedScene.area_lights`)."""
+    return [(part, mat) for _, polygon, mat in area_lights for part in tessellate_object(polygon, 1)]
 
 
 #: Vertex-normal rules of the raster methods' ``normals`` option: ``"smooth"`` keeps the

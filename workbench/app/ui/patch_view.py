@@ -52,8 +52,9 @@ def radiosity_options(state: AppState) -> dict:
 
 def scene_patches(state: AppState):
     """The panel's patches (``patch_size`` times the scene's extent, as the method cuts them)."""
-    from ...renderers.radiosity.patches import patches_from_scene, scene_extent
-    size = radiosity_options(state)["patch_size"] * scene_extent(state.scene)
+    from ...renderers.radiosity.patches import patches_from_scene
+    from ...scene.prepared import prepare
+    size = radiosity_options(state)["patch_size"] * prepare(state.scene).extent
     return patches_from_scene(state.scene, size)[0]
 
 

@@ -53,7 +53,7 @@ class Tracer:
                                  f"{options.pixel_filter!r}")
         self.full = options.transport == "full"
         self.ctx = rt.Context(self.scene, fresnel=options.fresnel)
-        sd = flatten(self.scene)
+        sd = flatten(self.scene, prepared=self.ctx.prepared)
         if (sd.tri_e > 0).any() or any(sd.mat_tab[sd.mat[k], 13:16].max() > 0 for k in np.flatnonzero(sd.ptype == MESH)):
             raise WorkbenchError("pathtrace reference: emissive meshes are not covered")
         self.em = build_emitters(sd)
@@ -65,7 +65,7 @@ class Tracer:
         self.lights = [lt for lt in scene.lights if not isinstance(lt, m.AreaLight)] if self.full else []
         self.cam = camera_frame(self.scene.camera, width, height)
         self.beta = MIS[options.mis]
-        self.media0 = rt.enclosing_media(self.scene, self.scene.camera.position)
+        self.media0 = list(self.ctx.prepared.camera_media)
         if options.transport == "diffuse":
             self.media0 = []
 

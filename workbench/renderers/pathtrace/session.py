@@ -19,6 +19,7 @@ import numpy as np
 from ...core.errors import NotApplicable, WorkbenchError
 from ...core.tol import tol
 from ...scene import model as m
+from ...scene.prepared import prepare
 from ..raytrace.flatten import flatten, light_rows
 from ..raytrace.whitted import TEX_COLS, camera_frame, fused_textures
 from .emitters import build_emitters
@@ -93,7 +94,9 @@ class PathTraceSession:
         t0 = time.perf_counter()
         self.scene = scene.with_camera(scene.camera.with_resolution(width, height))
         self.width, self.height, self.seed = int(width), int(height), int(seed)
-        sd = flatten(triangulated(self.scene) if triangulate else self.scene)
+        traced = triangulated(self.scene) if triangulate else self.scene
+        prepared = prepare(traced)  # the same bounds and media as self.scene's (flat, opaque)
+        sd = flatten(traced, prepared=prepared)
         for i, mt in enumerate(sd.materials):  # area lights as triangles: still front-face emitters
             if mt.name.startswith(FRONT_ONLY):
                 sd.mat_tab[i, 16] = 1.0
@@ -115,9 +118,8 @@ class PathTraceSession:
         self.textured = tex is not None
         if tex is None:
             tex = np.zeros((len(sd.mat_tab), TEX_COLS))
-        from ..raytrace.reference import enclosing_media
         names = [mt.name for mt in sd.materials]
-        media = [names.index(mt.name) for mt in enclosing_media(self.scene, self.scene.camera.position)][-4:]
+        media = [names.index(mt.name) for mt in prepared.camera_media][-4:]
         if transport == "diffuse":  # every surface opaque: no medium
             media = []
         self.opts = np.array([FRESNEL[fresnel], tol.ray_offset, tol.t_min, tol.zero, sd.extent,

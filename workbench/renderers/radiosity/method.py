@@ -14,10 +14,11 @@ import numpy as np
 from ...core.errors import NotApplicable, WorkbenchError
 from ...scene import features as ft
 from ...scene.model import Scene
+from ...scene.prepared import prepare
 from ..base import Knob, Option, RenderResult
 from . import solvers
 from .formfactors import FormFactors, compute
-from .patches import PatchSet, patches_from_scene, scene_extent
+from .patches import PatchSet, patches_from_scene
 
 #: features radiosity builds, and why it leaves out each of the others
 HANDLED = {ft.EMITTERS, ft.AREA_LIGHTS, ft.POLYGONS, ft.PLANES, ft.BOXES, ft.MESHES, ft.SPHERES,
@@ -89,7 +90,7 @@ def estimate_solve_bytes(scene: Scene, opts: dict) -> tuple[int, int]:
     from .patches import count_patches
     if not opts["patch_size"] > 0:
         raise WorkbenchError(f"patch_size must be a positive fraction of the scene's diagonal, got {opts['patch_size']}")
-    P = count_patches(scene, opts["patch_size"] * scene_extent(scene))
+    P = count_patches(scene, opts["patch_size"] * prepare(scene).extent)
     res = int(opts["hemicube_resolution"])
     total = _FIXED_BYTES + P * _BYTES_PER_PATCH
     matrix_free = opts["solver"] == "progressive" and opts["form_factors"] == "hemicube"
@@ -180,7 +181,7 @@ def solve_scene(scene: Scene, opts: dict, method: str) -> Solution:
         raise WorkbenchError(f"{method}: row_cache_mb must be >= 0, got {opts['row_cache_mb']}")
     timings: dict = {"compile": 0.0}
     t0 = time.perf_counter()
-    extent = scene_extent(scene)
+    extent = prepare(scene).extent  # patch sizes are fractions of the scene's diagonal
     patches, left_out = patches_from_scene(scene, opts["patch_size"] * extent)
     timings["patches"] = time.perf_counter() - t0
     needs = ft.scene_needs(scene)

@@ -305,16 +305,6 @@ def _assemble(surfaces: list, h: float) -> PatchSet:
                     tuple(x[5] for x in surfaces), tuple(x[4] for x in surfaces), tuple(grids))
 
 
-def scene_extent(scene: m.Scene) -> float:
-    """Diagonal of the bounding box of the scene's surfaces (patch sizes are fractions of it)."""
-    surfaces, _ = _surfaces(scene, np.inf)
-    pts = [g if k == "polygon" else g[0] for k, g, *_ in surfaces]
-    if not pts:
-        return 1.0
-    p = np.concatenate(pts)
-    return float(max(np.linalg.norm(p.max(0) - p.min(0)), tol.zero))
-
-
 def patches_from_scene(scene: m.Scene, patch_size: float) -> tuple[PatchSet, list[str]]:
     """Cut every surface of ``scene`` into patches no longer than ``patch_size`` (scene units;
     curved surfaces: triangles about that long).

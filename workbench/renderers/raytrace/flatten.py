@@ -31,6 +31,7 @@ import numpy as np
 from ...core.tol import tol
 from ...scene import model as m
 from ...scene.kinds import kind_of
+from ...scene.prepared import PreparedScene, prepare
 
 if TYPE_CHECKING:
     from .bvh import Bvh4
@@ -73,7 +74,7 @@ class SceneData:
     materials: list             # Material objects, index = mat
     mat_tab: np.ndarray         # (M, 24) numeric material table (see _material_row)
     lights: np.ndarray          # (L, 14) light table (see _light_rows)
-    extent: float               # diagonal of the scene's bounds
+    extent: float               # diagonal of the scene's bounds (PreparedScene.extent)
     n_objects: int
     bvh_build_time: float = 0.0
     aux: np.ndarray = field(default_factory=lambda: np.zeros(1))
@@ -125,7 +126,6 @@ class _Builder:
         self.materials = list(scene.materials.values())
         self.mat_index = {mt.name: i for i, mt in enumerate(self.materials)}
         self.front_only: set[int] = set()
-        self.bounds: list[np.ndarray] = []
         self.aux: list[np.ndarray] = []
         self.n_aux = 0
 
@@ -148,11 +148,6 @@ class _Builder:
                    shadow=shadow, wfo=np.asarray(world_from_object, dtype=np.float64), has_uv=False)
         self.rows.append(row)
         return len(self.rows) - 1
-
-    def bound(self, world_from_object, pts):
-        """Object-space points (n, 3) that the scene's extent must hold."""
-        pts = np.asarray(pts, dtype=np.float64).reshape(-1, 3)
-        self.bounds.append(pts @ world_from_object[:3, :3].T + world_from_object[:3, 3])
 
     def leaf(self, o: m.SceneObject, obj_index: int, parent: np.ndarray, *, top: bool) -> int:
         """Rows of object ``o`` under transform ``parent`` (its kind's ``flatten``)."""
@@ -194,14 +189,18 @@ def _triangles(meshes):
             np.concatenate(tp))
 
 
-def flatten(scene: m.Scene, accel: str = "bvh") -> SceneData:
+def flatten(scene: m.Scene, accel: str = "bvh", prepared: PreparedScene | None = None) -> SceneData:
     """Build the kernel arrays for ``scene`` (area lights become emissive polygons), the
-    triangles' acceleration structure ``accel`` (:data:`.accel.ACCELS`) over the triangles."""
+    triangles' acceleration structure ``accel`` (:data:`.accel.ACCELS`) over the triangles.
+
+    ``prepared``: the render's :class:`~workbench.scene.prepared.PreparedScene` of ``scene``
+    (its area lights and extent); built here when not given."""
     import time
+    prepared = prepared if prepared is not None else prepare(scene)
     b = _Builder(scene)
     for i, o in enumerate(scene.objects):
         b.leaf(o, i, np.eye(4), top=True)
-    for k, polygon, mat in scene.area_light_polygons():
+    for k, polygon, mat in prepared.area_lights:
         b.area_light(k, polygon, mat)
     rows = b.rows
 
@@ -219,9 +218,6 @@ def flatten(scene: m.Scene, accel: str = "bvh") -> SceneData:
     else:
         bvh = empty_bvh4()
     bvh_time = time.perf_counter() - t0
-    allb = np.concatenate(b.bounds) if b.bounds else np.zeros((1, 3))
-    finite = allb[np.isfinite(allb).all(1)]
-    extent = float(np.linalg.norm(np.ptp(finite, axis=0))) if len(finite) else 1.0
     mat_tab = np.stack([_material_row(mt, i in b.front_only) for i, mt in enumerate(b.materials)])
     return SceneData(
         ptype=col("ptype", np.int64), top=col("top", np.bool_), obj=col("obj", np.int64),
@@ -236,5 +232,5 @@ def flatten(scene: m.Scene, accel: str = "bvh") -> SceneData:
         bvh=bvh,
         materials=b.materials, mat_tab=np.ascontiguousarray(mat_tab),
         lights=np.ascontiguousarray(light_rows(scene.point_lights()).reshape(-1, 14)),
-        extent=max(extent, tol.zero), n_objects=len(scene.objects), bvh_build_time=bvh_time,
+        extent=prepared.extent, n_objects=len(scene.objects), bvh_build_time=bvh_time,
         aux=np.ascontiguousarray(np.concatenate(b.aux) if b.aux else np.zeros(1)))

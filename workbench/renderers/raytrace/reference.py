@@ -24,7 +24,7 @@ from ...scene import model as m
 from ...scene.features import scene_needs
 from ...scene.kinds import MESH, crossings, kind_of
 from ...scene.kinds.csg import is_solid
-from ...scene.media import enclosing_media
+from ...scene.prepared import prepare
 from .. import local_model
 from . import shapes
 from .flatten import MAX_CUTOUTS, OPACITY_CUT, SHADOW_CROSSINGS
@@ -62,14 +62,14 @@ class Context:
     """The scene made ready for the reference tracer."""
 
     def __init__(self, scene: m.Scene, **options):
-        from .flatten import flatten
         self.scene = scene
         self.opts = {**DEFAULTS, **options}
-        self.extent = flatten(scene).extent
+        self.prepared = prepare(scene)
+        self.extent = self.prepared.extent
         self.lights = scene.point_lights()
         self.items = [Item(i, o, np.asarray(o.world_from_object)) for i, o in enumerate(scene.objects)]
         self.materials = dict(scene.materials)
-        for k, polygon, mat in scene.area_light_polygons():
+        for k, polygon, mat in self.prepared.area_lights:
             self.materials[mat.name] = mat
             self.items.append(Item(len(scene.objects) + k, polygon, np.eye(4), shadow=False))
         self.texturing = None
@@ -331,7 +331,7 @@ def render(scene: m.Scene, width: int, height: int, **options) -> np.ndarray:
     """The reference image (H, W, 3) float64, one ray per pixel centre (slow: small images)."""
     ctx = Context(scene.with_camera(scene.camera.with_resolution(width, height)), **options)
     O, D = ctx.scene.camera.rays()
-    media = enclosing_media(scene, scene.camera.position)
+    media = ctx.prepared.camera_media
     img = np.zeros((height, width, 3))
     for i in range(height):
         for j in range(width):
@@ -352,7 +352,7 @@ def ray_tree(scene: m.Scene, i: int, j: int, **options) -> dict:
     ctx = Context(scene, **options)
     O, D = scene.camera.rays()
     tree: list = []
-    color = raytrace(ctx, O[i, j], D[i, j], media=enclosing_media(scene, scene.camera.position), tree=tree)
+    color = raytrace(ctx, O[i, j], D[i, j], media=ctx.prepared.camera_media, tree=tree)
     root = tree[0]
     root["color"] = color.tolist()
     return root

@@ -40,6 +40,7 @@ from ...core.errors import WorkbenchError
 from ...core.tol import tol
 from ...scene import features as F
 from ...scene.model import Mesh, Scene
+from ...scene.prepared import prepare
 from ..base import Knob, Option, RenderResult
 from .accel import ACCELS, accel_extra_bytes
 from .flatten import MAX_CUTOUTS, OPACITY_CUT, SHADOW_CROSSINGS, SceneData, flatten
@@ -357,7 +358,7 @@ _COUNTS = ("shadow_rays", "ended_by_depth", "ended_by_threshold", "total_interna
 class _Tracer:
     """State of one render: scene arrays, options, counters."""
 
-    def __init__(self, scene: Scene, sd: SceneData, opts: dict, recursive: bool):
+    def __init__(self, scene: Scene, sd: SceneData, opts: dict, recursive: bool, media: tuple):
         self.scene, self.sd = scene, sd
         self.col = _Colorizer(scene, sd)
         needs = F.scene_needs(scene)
@@ -374,9 +375,8 @@ class _Tracer:
                                float(opts["transmissive_shadows"]), float(opts["blinn"]),
                                float(self.do_shadow), float(refl), float(refr), tol.ray_offset,
                                tol.t_min, tol.zero, sd.extent, float(not self.env)])
-        from ...scene.media import enclosing_media
         names = [mt.name for mt in sd.materials]
-        self.media = [names.index(mt.name) for mt in enclosing_media(scene, scene.camera.position)][-4:]
+        self.media = [names.index(mt.name) for mt in media][-4:]
         self.kopts = np.r_[self.kopts, len(self.media), self.media + [0] * (4 - len(self.media))]
         self.ambient = np.asarray(scene.ambient, dtype=np.float64)
         self.geo = sd.kernel_args()
@@ -542,12 +542,13 @@ class _WhittedBase:
             raise WorkbenchError(f"method {self.name!r}: option 'spp' must be within 1..4096, got {o['spp']}")
         timings = {}
         t0 = time.perf_counter()
-        sd = flatten(scene, o["accel"])
+        prepared = prepare(scene)
+        sd = flatten(scene, o["accel"], prepared)
         timings["build"] = time.perf_counter() - t0
         timings["bvh_build"] = sd.bvh_build_time
         opts = dict(o)
         opts.setdefault("max_depth", 1)
-        tr = _Tracer(scene, sd, opts, self.recursive)
+        tr = _Tracer(scene, sd, opts, self.recursive, prepared.camera_media)
         timings["compile"] = ensure_compiled(sd, tr.fused)
         spp = opts["spp"]
         cam = scene.camera

@@ -31,7 +31,8 @@ Functions (``W`` and ``M`` are (4, 4) ``world_from_object`` including any CSG pa
 ``parse(ctx, t, w, common) -> MODEL``  validate table ``t`` (named ``w`` in messages) with the
     readers of :mod:`..readers`; ``common`` holds the common fields already read.  Bad input:
     ``ctx.fail(where, what)``, one line naming the key and what was expected.
-``bound_points(obj) -> (n, 3)``  object-space points whose hull holds the object.
+``bound_points(obj) -> (n, 3)``  object-space points whose hull holds the object (the
+    prepared scene's bounds, extent and clip planes, :mod:`workbench.scene.prepared`).
 ``tessellate(obj, level, M) -> list[Part]``  triangles for the raster methods (:mod:`..parts`).
 ``solid_mesh(obj, level) -> (P (V, 3), F (F, 3))``  SOLID kinds: a closed, welded object-space
     mesh for the raster's CSG booleans.
@@ -42,9 +43,9 @@ Functions (``W`` and ``M`` are (4, 4) ``world_from_object`` including any CSG pa
     the patch builder cuts from its tessellation at triangles about ``h`` long.
 ``flatten(b, obj, index, W, top) -> row``  its rows of the kernels' primitive table, through
     the ray tracer's builder ``b``: ``b.add(PTYPE, index, obj, W, par, top=, solid=,
-    shadow=)`` (``par``: at most ``NPAR`` floats, the kernel functions' parameters),
-    ``b.bound(W, points)`` (the scene's extent), and for kinds with variable-length data the
-    builder's arrays (``b.poly_v``, ``b.meshes``).
+    shadow=)`` (``par``: at most ``NPAR`` floats, the kernel functions' parameters), and for
+    kinds with variable-length data the builder's arrays (``b.poly_v``, ``b.meshes``,
+    ``b.add_aux``).
 ``hits(obj, O, D, solid) -> [(t, face), ...]``  readable intersection of the object-space line
     ``O + t D`` (every crossing, sorted; a SOLID kind's alternate entering / leaving; ``solid``
     is True for a CSG leaf).  ``face`` (int) picks the normal.  Meshes have none (the

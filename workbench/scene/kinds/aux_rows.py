@@ -6,11 +6,10 @@ import numpy as np
 
 
 def flatten_aux(b, obj, index: int, W: np.ndarray, top: bool, ptype: int,
-                params: tuple[np.ndarray, np.ndarray], points: np.ndarray, solid: bool) -> int:
-    """The registry's ``flatten`` for such a kind, through the builder ``b``: ``b.bound`` the
-    object's bound ``points`` (K, 3) under ``W``, ``b.add_aux`` its ``params[1]`` (returns the
-    offset, written into ``params[0][0]``), ``b.add`` the row with the head ``params[0]``."""
-    b.bound(W, points)
+                params: tuple[np.ndarray, np.ndarray], solid: bool) -> int:
+    """The registry's ``flatten`` for such a kind, through the builder ``b``: ``b.add_aux``
+    its ``params[1]`` (returns the offset, written into ``params[0][0]``), ``b.add`` the row
+    with the head ``params[0]``."""
     head, data = params
     head[0] = b.add_aux(data)
     return b.add(ptype, index, obj, W, head, top=top, solid=solid)

@@ -84,7 +84,6 @@ def patch_surfaces(b: m.Box, W: np.ndarray, h: float):
 # --------------------------------------------------------------------------- ray tracing
 def flatten(bld, b: m.Box, index: int, W: np.ndarray, top: bool) -> int:
     """Primitive row: ``par = (min (3), max (3))``."""
-    bld.bound(W, bound_points(b))
     return bld.add(PTYPE, index, b, W, (*b.min, *b.max), top=top, solid=SOLID)
 
 

@@ -271,7 +271,7 @@ def patch_surfaces(obj: Isosurface, W: np.ndarray, h: float):
 
 def flatten(b, obj, index: int, W: np.ndarray, top: bool) -> int:
     """Its row of the ray tracer's primitive table (:func:`.aux_rows.flatten_aux`)."""
-    return flatten_aux(b, obj, index, W, top, PTYPE, params(obj, 0), bound_points(obj), SOLID)
+    return flatten_aux(b, obj, index, W, top, PTYPE, params(obj, 0), SOLID)
 
 
 def params(s: Isosurface, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:

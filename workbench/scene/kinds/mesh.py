@@ -129,7 +129,6 @@ def flatten(b, mesh: m.Mesh, index: int, W: np.ndarray, top: bool) -> int:
     k = b.add(PTYPE, index, mesh, W, (), top=False, solid=SOLID)
     b.rows[k]["has_uv"] = mesh.uvs is not None
     b.meshes.append((k, mesh, W))
-    b.bound(W, np.asarray(mesh.vertices))
     return k
 
 

@@ -44,7 +44,6 @@ def patch_surfaces(p: m.Plane, W: np.ndarray, h: float):
 def flatten(b, p: m.Plane, index: int, W: np.ndarray, top: bool) -> int:
     """Primitive row: ``par = (point (3), u (3), v (3), n (3), w/2, h/2)``."""
     u, v, n = p.frame()
-    b.bound(W, p.corners())
     return b.add(PTYPE, index, p, W, (*p.point, *u, *v, *n, p.size[0] / 2, p.size[1] / 2), top=top,
                  solid=SOLID)
 

@@ -61,7 +61,6 @@ def _convex_row(b, verts, index, p, W, top, shadow) -> int:
                 solid=SOLID, shadow=shadow)
     b.poly_v.append(v)
     b.n_poly += len(v)
-    b.bound(W, v)
     return row
 
 

@@ -260,7 +260,7 @@ def analytic_normals(obj: Prism, P: np.ndarray):
 
 def flatten(b, obj, index: int, W: np.ndarray, top: bool) -> int:
     """Its row of the ray tracer's primitive table (:func:`.aux_rows.flatten_aux`)."""
-    return flatten_aux(b, obj, index, W, top, PTYPE, params(obj, 0), bound_points(obj), SOLID)
+    return flatten_aux(b, obj, index, W, top, PTYPE, params(obj, 0), SOLID)
 
 
 def params(p: Prism, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:

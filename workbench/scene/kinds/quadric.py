@@ -326,7 +326,6 @@ def flatten(b, q: m.Quadric, index: int, W: np.ndarray, top: bool) -> int:
     """Primitive row: ``par = (Q00 Q01 Q02 Q03 Q11 Q12 Q13 Q22 Q23 Q33, bounds min (3),
     bounds max (3))``."""
     Q = np.asarray(q.Q)
-    b.bound(W, bound_points(q))
     return b.add(PTYPE, index, q, W, (Q[0, 0], Q[0, 1], Q[0, 2], Q[0, 3], Q[1, 1], Q[1, 2], Q[1, 3],
                                       Q[2, 2], Q[2, 3], Q[3, 3], *q.bounds_min, *q.bounds_max),
                  top=top, solid=SOLID)

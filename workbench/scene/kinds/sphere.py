@@ -75,7 +75,6 @@ def patch_surfaces(s: m.Sphere, W: np.ndarray, h: float):
 # --------------------------------------------------------------------------- ray tracing
 def flatten(b, s: m.Sphere, index: int, W: np.ndarray, top: bool) -> int:
     """Primitive row: ``par = (cx, cy, cz, r)``."""
-    b.bound(W, bound_points(s))
     return b.add(PTYPE, index, s, W, (*s.center, s.radius), top=top, solid=SOLID)
 
 
