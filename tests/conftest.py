@@ -37,22 +37,28 @@ def gl_ctx():
 
 
 class _WindowContext:
-    """A headless context standing in for the window's: its ``screen`` a 1 x 1 framebuffer."""
+    """A headless context standing in for the window's: its ``screen`` a 1 x 1 framebuffer.
+    Its state (viewport, depth_func, blend_func...) is the context's: read and set through."""
 
     def __init__(self, ctx):
-        self._ctx, self.screen = ctx, ctx.simple_framebuffer((1, 1))
+        object.__setattr__(self, "_ctx", ctx)
+        object.__setattr__(self, "screen", ctx.simple_framebuffer((1, 1)))
 
     def __getattr__(self, name):
         return getattr(self._ctx, name)
+
+    def __setattr__(self, name, value):
+        setattr(self._ctx, name, value)
 
 
 @pytest.fixture
 def window_ctx(gl_ctx):
     """The thread's context in the role of the UI window's (``AppState.ctx``) without a
     window: UI frame functions run in-process."""
+    from workbench.renderers import gl
     ctx = _WindowContext(gl_ctx)
     yield ctx
-    ctx.screen.release()
+    gl.release_framebuffer(ctx.screen)  # not left bound (the next test's first FBO failed)
 
 
 def _free_display() -> int:

@@ -195,12 +195,26 @@ def test_bad_standin_options_are_one_line_errors(opts):
     assert "\n" not in str(e.value)
 
 
-def test_light_edit_with_shadow_maps_asks_for_a_new_session(gl_ctx):
+def test_a_moved_light_redraws_the_shadow_maps_in_the_same_session(gl_ctx):
+    """A light's move is a live edit (it used to ask for a new session): the shadow maps are
+    redrawn from the new position (read by the live programs from uniforms, SHADOW_LIVE; the
+    image against a new session's: test_ui_standins), a colour edit keeps them."""
     from dataclasses import replace
     w = workbench.load_scene("whitted")
+    cam = w.camera.with_resolution(32, 24)
     s = RasterSession(w, "phong", standins=sti.StandinOptions(envmap_resolution=16, shadow_resolution=32))
-    moved = replace(w, lights=[replace(w.lights[0], position=(-3.0, 6.0, -5.0))] + list(w.lights[1:]))
-    assert not s.update(moved)
+    before = s.draw(cam)
+    light = w.lights[0]
+    coloured = replace(w, lights=[replace(light, color=(1.0, 0.5, 0.5))] + list(w.lights[1:]))
+    assert s.update(coloured) and s.live
+    s.draw(cam)
+    assert s.maps_drawn == {"shadow": 1, "environment": 2}
+    moved = replace(w, lights=[replace(light, position=(-2.0, 6.0, -3.0))] + list(w.lights[1:]))
+    assert s.update(moved)
+    image = s.draw(cam)
+    assert s.maps_drawn == {"shadow": 2, "environment": 3}
+    assert s.shadow_atlas.layout.pos[0] == (-2.0, 6.0, -3.0)
+    assert np.abs(image - before).max() > 0.1  # the shadows moved
     s.release()
 
 

@@ -65,8 +65,9 @@ def test_shown_panels_are_the_cli_images(gpu_session):
     for m in RASTER:
         shown = np.load(out / f"shown_{m}.npy")
         assert shown.shape == (H, W, 4) and (shown[..., 3] == 255).all()
-        # the panels draw the bare local model (no stand-ins)
-        cli = workbench.render(replace(scene, camera=orbited), m, width=W, height=H, standins="off").image
+        # the panels draw what the CLI draws with their options (Gouraud's and Phong's
+        # stand-ins on by default: environment maps, blending, shadow maps on whitted)
+        cli = workbench.render(replace(scene, camera=orbited), m, width=W, height=H).image
         expected = to_srgb8(cli)
         assert expected.std() > 10, m  # a real picture, not a flat colour
         assert np.abs(shown[..., :3].astype(int) - expected).max() <= 1, m

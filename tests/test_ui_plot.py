@@ -91,6 +91,7 @@ def _frames_until(state, done, seconds=90.0) -> bool:
 
 def test_a_total_point_does_not_wait_for_the_matched_reference(slow_matched):
     state = new_state("whitted", ["phong"], panel_size=16)
+    state.options["phong"]["standins"] = "off"  # matched: the table's entry (MATCHED)
     shape = (state.camera.height, state.camera.width, 3)
     image = np.linspace(0.0, 1.0, int(np.prod(shape)), dtype=np.float32).reshape(shape)
     state.images["phong"], state.timings["phong"] = image, 0.01

@@ -70,8 +70,8 @@ def test_each_slider_frame_shows_its_values(slider_session):
             prev[m] = img
     scene = _scene_after(EDITS[-1])
     for m in RASTER:
-        cli = workbench.render(scene, m, width=scene.camera.width, height=scene.camera.height,
-                               standins="off").image  # the panels draw the bare model
+        cli = workbench.render(scene, m, width=scene.camera.width,
+                               height=scene.camera.height).image  # with stand-ins, as the panels
         assert np.abs(np.load(out / f"edit{EDITS[-1]}_{m}.npy") - cli).max() <= 1e-4, m
 
 
@@ -83,7 +83,7 @@ def test_rested_values_are_compiled_back_in(slider_session):
     scene = _scene_after(EDITS[-1])
     for m in RASTER:
         img = np.load(out / f"settled_{m}.npy")
-        cli = workbench.render(scene, m, width=scene.camera.width, height=scene.camera.height,
-                               standins="off").image  # the panels draw the bare model
+        cli = workbench.render(scene, m, width=scene.camera.width,
+                               height=scene.camera.height).image  # with stand-ins, as the panels
         assert np.abs(img - cli).max() <= 1e-6, m
         assert np.abs(img - np.load(out / f"edit{EDITS[-1]}_{m}.npy")).max() <= 1e-4, m

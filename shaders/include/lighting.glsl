@@ -15,22 +15,8 @@
 // MAT_KS, MAT_SHININESS from raster_shaders.material_defines), like the lights: llvmpipe reads
 // a uniform per fragment, and the compiler folds literals (kd = 1, ka = 0, n = 0, ...).
 
-// Live variants (raster_shaders.material_defines, drawn while a slider edits the values): the
-// MAT_* names above are these uniforms (LIVE_MATERIAL), the lights' positions and colours
-// in FOR_EACH_LIGHT read these arrays (LIVE_LIGHTS).
-#ifdef LIVE_MATERIAL
-uniform vec3 u_mat_color;
-uniform vec3 u_mat_emission;
-uniform float u_mat_ka;
-uniform float u_mat_kd;
-uniform float u_mat_ks;
-uniform float u_mat_kr;
-uniform float u_mat_shininess;
-#endif
-#ifdef LIVE_LIGHTS
-uniform vec3 u_light_pos[N_LIGHTS];
-uniform vec3 u_light_color[N_LIGHTS];
-#endif
+// Live variants: the MAT_* names above and the lights' values are uniforms (live_values.glsl).
+#include "live_values.glsl"
 
 #ifndef FOR_EACH_LIGHT
 #define FOR_EACH_LIGHT(X)

@@ -5,6 +5,7 @@
 // no cube-map convention.
 // Needs: TOL_ZERO (common.glsl).
 #include "common.glsl"
+#include "live_values.glsl"
 
 #if defined(ENV_CUBE) || defined(SHADOW_MAPS)
 // The face of a cube map centred at the origin that direction d crosses (major axis).
@@ -131,12 +132,21 @@ vec3 env_terms(vec3 P, vec3 N, vec3 S, vec3 C) {
 // towards the light and along its normal before the depth test (the normal offset keeps
 // surfaces lit at grazing angles, where a depth map's texel spans a long stretch of depth, from
 // shadowing themselves; too small: acne; too large: shadows detach, "peter panning").
+// SHADOW_LIVE (the live-lights variant, drawn while a light is being moved): the positions and
+// ranges, which follow the lights, are uniforms (the maps are redrawn, the program kept).
 uniform sampler2D u_shadow_atlas;
 uniform mat4 u_shadow_clip[SHADOW_TILES];
 const int SHADOW_BASE[N_LIGHTS] = SHADOW_BASE_LIST;
 const bool SHADOW_CUBE[N_LIGHTS] = SHADOW_CUBE_LIST;
+#ifdef SHADOW_LIVE
+uniform vec3 u_shadow_pos[N_LIGHTS];
+uniform vec2 u_shadow_range[N_LIGHTS];
+#define SHADOW_POS u_shadow_pos
+#define SHADOW_RANGE u_shadow_range
+#else
 const vec3 SHADOW_POS[N_LIGHTS] = SHADOW_POS_LIST;
 const vec2 SHADOW_RANGE[N_LIGHTS] = SHADOW_RANGE_LIST;
+#endif
 
 // 1 where light k reaches P (unit shading normal N, towards the viewer: the side a light
 // that counts lights) when the depth stored in its map is not nearer than P, else 0.  One

@@ -68,9 +68,9 @@ from .estimates import raster_bytes
 from ..scene.tessellate_topology import closed_outward, provoking_layout
 from . import gl
 from . import texturing as tx
-from .base import Knob, Option, RenderResult
+from .base import Knob, Option, RenderResult, check_memory, convert_options
 from .raster_shaders import (LIVE_MATERIAL_FIELDS, ProgramCache, base_defines, light_kind,
-                             light_uniforms, material_defines, material_uniforms)
+                             light_uniforms, light_values, material_defines, material_uniforms)
 from . import raster_standins as sti
 
 DEPTH_CHOICES = (16, 24, 32)
@@ -341,6 +341,8 @@ class RasterSession:
                              n_lights=len(self.lights))
         self.shadow_layout = self.shadow_atlas = None
         self._shadows_drawn = self._env_drawn = False
+        #: how many times each kind of map was drawn (a camera move draws none; tests read it)
+        self.maps_drawn = {"shadow": 0, "environment": 0}
         self.env_maps: dict = {}
         if self.plan.shadows:
             self.shadow_layout = sti.shadow_layout(self.lights, self.part_boxes, options.shadow_resolution,
@@ -453,7 +455,22 @@ class RasterSession:
         if d.light_uniforms:
             for k, v in self._light_values.items():
                 u.set(k, v)
+            if d.standins is not None and d.standins.shadows is not None:
+                self._shadow_uniforms(u, d.standins.shadows, live=True)
         d.uniforms = u
+
+    @staticmethod
+    def _shadow_uniforms(u: _Uniforms, layout: sti.ShadowLayout, live: bool) -> None:
+        """The shadow layout's uniforms: the tiles' clip matrices (only directional lights'
+        tiles are read: the compiler keeps the array up to the last one, whose length the data
+        must match) and, in a live-lights program (``SHADOW_LIVE``), the lights' positions and
+        cube ranges."""
+        if "u_shadow_clip" in u.prog:
+            n = u.prog["u_shadow_clip"].array_length
+            u.set("u_shadow_clip", sti.mat4_array(layout.clips[:n]))
+        if live:
+            u.set("u_shadow_pos", np.array(layout.pos, dtype=np.float64).reshape(-1, 3))
+            u.set("u_shadow_range", np.array(layout.ranges, dtype=np.float64).reshape(-1, 2))
 
     def _static_uniforms(self, prog, d: _Draw) -> _Uniforms:
         """Samplers, the bump gradient's transform, the sky colours, the depth levels and the
@@ -465,11 +482,8 @@ class RasterSession:
         if env is not None:
             u.set("u_env_centre", tuple(float(x) for x in env.centre))
             u.set("u_env_range", (float(env.near), float(env.far)))
-        if d.standins is not None and d.standins.shadows is not None and "u_shadow_clip" in prog:
-            # only directional lights' tiles are read: the compiler keeps the array up to the
-            # last one, whose length the data must match
-            n = prog["u_shadow_clip"].array_length
-            u.set("u_shadow_clip", sti.mat4_array(d.standins.shadows.clips[:n]))
+        if d.standins is not None and d.standins.shadows is not None:
+            self._shadow_uniforms(u, d.standins.shadows, live=False)
         if mat.bump is not None:  # per part, not per material
             u.set("u_grad_from_object", np.linalg.inv(part.world_from_object[:3, :3]))
         env = self.scene.environment
@@ -556,6 +570,13 @@ class RasterSession:
         edited materials' draws (all lit draws for a
         light edit) switch to live programs (compiled once per variant, then only uniforms
         change: no recompile, no upload); :meth:`settle` compiles the values back in.
+
+        The stand-ins' maps follow: the environment maps are redrawn at the next frame after
+        any edit taken here (they show the lit scene); the shadow maps only when a light moved
+        (its new layout read from uniforms by the live programs, ``SHADOW_LIVE``), not for a
+        colour or intensity edit (depth only).  With stand-ins, a material edit of kt or ior
+        (literals of the refraction and the blending) or of kr from or to 0 (an environment map
+        more or less) is not taken.
         Returns False, changing nothing, for any other difference (new objects, environment,
         ambient, area lights, light kinds...): the caller builds a new session."""
         old = self.scene
@@ -587,11 +608,23 @@ class RasterSession:
         if [light_kind(x) for x in lights] != [light_kind(x) for x in self.lights]:
             return False
         lights_edited = any(not _same(a, b) for a, b in zip(lights, self.lights))
-        if lights_edited and self.shadow_atlas is not None:
-            return False  # the shadow maps are the lights' views: a new session
+        moved = [not np.array_equal(light_values(a)[0], light_values(b)[0]) for a, b in zip(lights, self.lights)]
         if self.plan.any and any(getattr(scene.materials[n], k) != getattr(old.materials[n], k)
-                                 for n in edited for k in ("kr", "kt", "ior")):
+                                 for n in edited for k in ("kt", "ior")):
             return False  # which stand-ins a material gets, and their literals
+        if self.plan.any and any(self._standin_role(scene.materials[d.name], d) != self._standin_role(d.material, d)
+                                 for d in self.draws if d.name in edited):
+            return False  # kr from or to 0: an environment map more or less
+        if any(moved) and self.shadow_atlas is not None:
+            # the shadow maps are the lights' views: redrawn at the next frame (a colour or
+            # intensity edit changes no depth: the maps are kept)
+            layout = sti.shadow_layout(lights, self.part_boxes, self.standin_options.shadow_resolution,
+                                       self.standin_options.shadow_bias)
+            self.shadow_layout = self.shadow_atlas.layout = layout
+            self._shadows_drawn = False
+            for d in self.draws:
+                if d.standins is not None and d.standins.shadows is not None:
+                    d.standins = replace(d.standins, shadows=layout)
         self.scene, self.lights = scene, lights
         if lights_edited:
             self._light_values = light_uniforms(lights)
@@ -618,7 +651,10 @@ class RasterSession:
         at most ``budget`` programs per call (None: all; llvmpipe compiles a program's machine
         code at its first draw, so a caller that draws after each call spreads the work over
         frames); once no draw is live, release the literal programs no draw uses any more
-        (live ones are kept for the next edit).  Returns True when no draw is live."""
+        (live ones are kept for the next edit) and have the environment maps redrawn at the
+        next frame (drawn by the live programs, they differed from the literal ones' by float32
+        rounding).  Returns True when no draw is live."""
+        was_live = self.live
         self.live_materials, self.live_lights, self.live_areas = set(), False, set()
         start = self.programs.compiles
         for d in self.draws + [d.tint for d in self.draws if d.tint is not None]:
@@ -629,6 +665,8 @@ class RasterSession:
         self._uniforms_of.clear()
         if self.live:
             return False
+        if was_live:
+            self._env_drawn = False
         used = [d.prog for d in self.draws] + ([self.background.prog] if self.background else [])
         used += [d.tint.prog for d in self.draws if d.tint is not None]
         if self.shadow_atlas is not None:
@@ -687,8 +725,8 @@ class RasterSession:
     def draw_to(self, fbo, camera: Camera, near: float | None = None, far: float | None = None):
         """Draw the scene seen by ``camera`` into ``fbo`` (colour attachment 0 + depth), after
         the stand-ins' maps when the scene changed since they were drawn (shadow maps: at the
-        first frame, since a light or geometry edit builds a new session; environment maps: at
-        the first frame and after every edit :meth:`update` takes).  Neither depends on the
+        first frame and after a light moved, :meth:`update`; environment maps: at the first
+        frame, after every edit :meth:`update` takes and once the values settle).  Neither depends on the
         camera, so a camera move redraws neither.  Returns the (near, far) used."""
         if not (near and far):  # the automatic planes only when needed (Python, per draw)
             n0, f0 = self.near_far(camera)
@@ -719,6 +757,7 @@ class RasterSession:
                 for viewport, face in env.faces():
                     self._draw_pass(env.fbo, viewport, face, env.near, env.far, skip=env.key)
         self._env_drawn = True
+        self.maps_drawn["environment"] += 1
 
     def _draw_shadow_maps(self) -> None:
         """Depth of every surface (area lights' polygons excepted: their stand-in lights sit on
@@ -740,6 +779,11 @@ class RasterSession:
                     self._vertex_array(d, prog).render(moderngl.TRIANGLES)
         self._camera_of.pop(id(prog), None)
         self._shadows_drawn = True
+        self.maps_drawn["shadow"] += 1
+
+    def _standin_role(self, mat: Material, d: _Draw) -> tuple[bool, bool]:
+        """(environment-mapped, blended) of draw ``d``'s part with material ``mat``."""
+        return sti.mapped_material(mat, d.part.kind, self.plan), sti.blended_material(mat, d.part.kind, self.plan)
 
     def _vertex_array(self, d: _Draw, prog):
         """The vertex array of draw ``d``'s buffers for ``prog`` (made once per program)."""
@@ -946,10 +990,33 @@ class _RasterRenderer:
 
     memory_options = ("tessellation", "envmap_resolution", "shadow_resolution")
 
-    def session(self, scene: Scene, *, tessellation: int = DEFAULT_LEVEL, ctx=None) -> RasterSession:
-        """A :class:`RasterSession` drawing this method (the interactive window's GL panels,
-        ``ui_kind`` ``"gl"``) in ``ctx`` (default: the thread's context)."""
-        return RasterSession(scene, self.mode or self.name, tessellation=tessellation, ctx=ctx)
+    #: Whether the method draws the stand-ins (:mod:`.raster_standins`): Gouraud and Phong; flat
+    #: shading and users' shading models draw the bare local model.
+    draws_standins = False
+
+    def session(self, scene: Scene, width: int | None = None, height: int | None = None, *, ctx=None,
+                max_memory=None, **options) -> RasterSession:
+        """A :class:`RasterSession` drawing this method as :meth:`render` would with
+        ``options`` (the same names and defaults: tessellation, blinn, depth_bits,
+        interpolation, normals, standins and their knobs; ``view``, ``near`` and ``far`` are the
+        draw's, not the session's), for the interactive window's GL panels (``ui_kind``
+        ``"gl"``), in ``ctx`` (default: the thread's context).  Its estimate
+        (:meth:`estimate_bytes` at ``width`` x ``height``, by default the scene camera's) is
+        checked against the limit of :func:`workbench.core.memory.memory_limit` (``max_memory``)
+        before anything is allocated (:func:`.base.check_memory`: one-line WorkbenchError)."""
+        return self._session(scene, width, height, ctx, max_memory, None, options)
+
+    def _session(self, scene: Scene, width, height, ctx, max_memory, shading, options: dict) -> RasterSession:
+        opts = convert_options(self, options)
+        w = int(width or scene.camera.width)
+        h = int(height or scene.camera.height)
+        sized = scene.with_camera(scene.camera.with_resolution(w, h))
+        check_memory(self, sized, w, h, {**opts, "shading": shading}, max_memory)
+        standins = self._standins(opts["standins"], opts["envmap_resolution"], opts["shadow_resolution"],
+                                  opts["shadow_bias"], opts["envmap_iterations"])
+        return RasterSession(scene, self.mode or self.name, tessellation=opts["tessellation"], blinn=opts["blinn"],
+                             depth_bits=opts["depth_bits"], ctx=ctx, shading=shading,
+                             interpolation=opts["interpolation"], normals=opts["normals"], standins=standins)
 
     def estimate_bytes(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
                        standins: str = "on", envmap_resolution: int = sti.DEFAULT_ENV_RESOLUTION,
@@ -1014,7 +1081,9 @@ class FlatRenderer(_RasterRenderer):
 
 class GouraudRenderer(_RasterRenderer):
     name = "gouraud"
+    draws_standins = True
 
 
 class PhongRenderer(_RasterRenderer):
     name = "phong"
+    draws_standins = True

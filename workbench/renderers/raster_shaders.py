@@ -255,11 +255,12 @@ def material_defines(scene: Scene, material: Material, mode: str, *, n_lights: i
     if screen_space:
         d["SCREEN_SPACE"] = ""
     if standins is not None:
-        d.update(standin_defines(material, standins, lit=bool(d.get("FOR_EACH_LIGHT(X)"))))
+        d.update(standin_defines(material, standins, lit=bool(d.get("FOR_EACH_LIGHT(X)")),
+                                 live_lights="LIVE_LIGHTS" in d))
     return d
 
 
-def standin_defines(material: Material, s, *, lit: bool) -> dict[str, object]:
+def standin_defines(material: Material, s, *, lit: bool, live_lights: bool = False) -> dict[str, object]:
     """The ``#define``s of the stand-ins one draw compiles (``shaders/include/standins.glsl``;
     ``s`` a :class:`~.raster_standins.DrawStandins`): ``ENV_CUBE`` + ``ENV_RES`` + ``ENV_ITERATIONS``
     (the object's dynamic environment map: kr reflection), ``ENV_KT`` + ``MAT_KT`` + ``MAT_IOR`` (kt
@@ -267,7 +268,8 @@ def standin_defines(material: Material, s, *, lit: bool) -> dict[str, object]:
     blended transparency), and for a lit material ``SHADOW_MAPS`` with the shadow atlas's
     layout (``SHADOW_RES``, ``SHADOW_COLS``, ``SHADOW_TILES``, the per-light lists
     ``SHADOW_BASE_LIST``, ``SHADOW_CUBE_LIST``, ``SHADOW_POS_LIST``, ``SHADOW_RANGE_LIST`` and the world-space
-    ``SHADOW_BIAS``)."""
+    ``SHADOW_BIAS``); with ``live_lights`` ``SHADOW_LIVE`` instead of the position and range
+    lists (uniforms ``u_shadow_pos``, ``u_shadow_range``: a moved light keeps its program)."""
     d: dict[str, object] = {}
     if s.env_res > 0:
         d["ENV_CUBE"], d["ENV_RES"], d["ENV_ITERATIONS"] = "", int(s.env_res), int(s.env_iterations)
@@ -281,8 +283,12 @@ def standin_defines(material: Material, s, *, lit: bool) -> dict[str, object]:
         d["SHADOW_RES"], d["SHADOW_COLS"], d["SHADOW_TILES"] = int(L.resolution), int(L.cols), int(L.tiles)
         d["SHADOW_BASE_LIST"] = "int[](" + ", ".join(str(int(b)) for b in L.base) + ")"
         d["SHADOW_CUBE_LIST"] = "bool[](" + ", ".join("true" if c else "false" for c in L.cube) + ")"
-        d["SHADOW_POS_LIST"] = "vec3[](" + ", ".join(_vec3(p) for p in L.pos) + ")"
-        d["SHADOW_RANGE_LIST"] = "vec2[](" + ", ".join(f"vec2({_float(n)}, {_float(f)})" for n, f in L.ranges) + ")"
+        if live_lights:
+            d["SHADOW_LIVE"] = ""
+        else:
+            d["SHADOW_POS_LIST"] = "vec3[](" + ", ".join(_vec3(p) for p in L.pos) + ")"
+            d["SHADOW_RANGE_LIST"] = ("vec2[](" + ", ".join(f"vec2({_float(n)}, {_float(f)})" for n, f in L.ranges)
+                                      + ")")
         d["SHADOW_BIAS"] = _float(L.bias_world)
     return d
 

@@ -32,8 +32,9 @@ renderer in place of the ray tracer's secondary rays.
   depth texture; a fragment is lit by a light when its depth seen from the light, after
   moving it ``shadow_bias`` x scene extent towards the light, is not beyond the stored depth.
   Point sampling: jagged edges at the map's resolution (aliasing); a small bias gives acne.
-  Shadow maps depend on the geometry and lights only: drawn once per session (a light or
-  geometry edit builds a new session).
+  Shadow maps depend on the geometry and the lights' positions only: drawn once per session
+  and again after a light moves (:meth:`.raster.RasterSession.update`; a colour or intensity
+  edit keeps them; a geometry edit builds a new session).
 
 Each is built only when the scene needs it (``reflection``, ``refraction``, ``shadows`` in
 :func:`workbench.scene.features.scene_needs`) and the option ``standins`` allows it
@@ -57,6 +58,8 @@ from ..scene import model as m
 from ..scene.model import Camera, DirectionalLight, Scene
 
 KINDS = ("envmap", "blend", "shadows")
+#: The options of the stand-ins (the CLI's ``--set`` names, the window's stand-in controls).
+OPTIONS = ("standins", "envmap_resolution", "shadow_resolution", "shadow_bias", "envmap_iterations")
 ENV_RESOLUTIONS = (8, 2048)
 SHADOW_RESOLUTIONS = (16, 8192)
 DEFAULT_ENV_RESOLUTION = 128

@@ -41,7 +41,6 @@ from ..core.errors import ShaderSourceError, WorkbenchError
 from ..core.resources import data_dir
 from ..scene.model import Scene
 from .base import USER_PREFIX as PREFIX, Option, RenderResult
-from ..scene.tessellate import DEFAULT_LEVEL
 from .raster import RasterSession, _RasterRenderer
 from .raster_shaders import base_defines, build_source
 
@@ -241,13 +240,14 @@ class UserShadingRenderer(_RasterRenderer):
         for q in model.parameters:
             self.options[q.name] = Option(float, q.default, q.help or f"parameter of {Path(model.path).name}")
 
-    def session(self, scene: Scene, *, tessellation: int = DEFAULT_LEVEL, ctx=None) -> RasterSession:
+    def session(self, scene: Scene, width: int | None = None, height: int | None = None, *, ctx=None,
+                max_memory=None, **options) -> RasterSession:
         """A Phong :class:`~.raster.RasterSession` with the user's model at its parameters'
-        defaults (the interactive window's GL panel); a compile error raises
-        :class:`WorkbenchError` naming the user's file and line."""
-        values = tuple((q.name, float(q.default)) for q in self.model.parameters)
-        return RasterSession(scene, "phong", tessellation=tessellation, ctx=ctx,
-                             shading=ShadingProgram(self.model, values))
+        values in ``options`` (defaults: theirs; the other options and the memory check as
+        :meth:`.raster._RasterRenderer.session`), for the interactive window's GL panel; a
+        compile error raises :class:`WorkbenchError` naming the user's file and line."""
+        values = tuple((q.name, float(options.pop(q.name, q.default))) for q in self.model.parameters)
+        return self._session(scene, width, height, ctx, max_memory, ShadingProgram(self.model, values), options)
 
     def render(self, scene: Scene, width: int, height: int, **options) -> RenderResult:
         values = tuple((q.name, float(options.pop(q.name, q.default))) for q in self.model.parameters)

@@ -1,11 +1,11 @@
 """Each panel's picture, kept on the GPU and redrawn only when what it shows changes.
 
 * GL methods (``ui_kind`` ``"gl"``: flat, Gouraud, Phong, a user's shading model) draw through a cached
-  :class:`~workbench.renderers.raster.RasterSession` (one per scene, method and
-  tessellation; replaced sessions are released) into the session's float framebuffer, in the
-  window's own moderngl context, and only when the panel's inputs change: the scene version
-  (materials, lights), the tessellation knob and the shared camera (which carries the panel
-  size).  A frame in which nothing changed draws nothing.  A material or light slider keeps
+  :class:`~workbench.renderers.raster.RasterSession` (one per scene, method and options,
+  built by :func:`.gl_sessions.build_session`; replaced sessions are released) into the
+  session's float framebuffer, in the window's own moderngl context, and only when the
+  panel's inputs change: the scene version (materials, lights), the panel's options
+  (tessellation, stand-ins) and the shared camera (which carries the panel size).  A frame in which nothing changed draws nothing.  A material or light slider keeps
   the session (``RasterSession.update``): the edited values are drawn by live programs that
   read them from uniforms (compiled once, no geometry upload), and once the values have
   rested for :data:`LIVE_REST_SECONDS` they are compiled back in (``settle``: the literal
@@ -233,7 +233,7 @@ class ScreenBlits:
 class RasterPanel:
     """A raster panel's session and what it last drew.
 
-    ``session_key`` is (scene version, tessellation); ``drawn`` the camera of the last draw
+    ``session_key`` is (scene version, the panel's options); ``drawn`` the camera of the last draw
     (None: never drawn or values changed); ``draws`` counts draws (tests and the benchmark
     read it); ``edited`` when values last changed in place (:data:`LIVE_REST_SECONDS`)."""
 
@@ -338,13 +338,12 @@ def linear_source(state: AppState, method: str) -> tuple[object, bool]:
 def refresh_raster(state: AppState, method: str) -> bool:
     """Redraw ``method``'s panel if its inputs changed; returns whether it drew."""
     from ...core.errors import WorkbenchError
-    from ...renderers.base import get_renderer
     from ...renderers.raster import RasterSession
+    from .gl_sessions import build_session, session_status
     g = gpu(state)
-    tess = int(state.options[method]["tessellation"])
-    key = (state.scene_version, tess)
+    key = (state.scene_version, tuple(sorted(state.options[method].items())))
     panel = g.raster.get(method)
-    if (panel is not None and panel.session_key != key and panel.session_key[1] == tess
+    if (panel is not None and panel.session_key != key and panel.session_key[1] == key[1]
             and panel.session.update(state.scene)):
         # only material or light values changed: same session, live programs
         panel.session_key, panel.drawn, panel.edited = key, None, time.perf_counter()
@@ -357,8 +356,8 @@ def refresh_raster(state: AppState, method: str) -> bool:
             del g.raster[method]
             g.linear.pop(method, None)
         try:
-            session = get_renderer(method).session(state.scene, tessellation=tess, ctx=state.ctx)
-        except WorkbenchError as e:  # a user's model that does not compile: one line, no image
+            session = build_session(state, method)
+        except WorkbenchError as e:  # over the memory limit, a model that does not compile: one line
             state.panel_errors[method] = (key, str(e))
             state.status[method] = str(e)
             if method in state.images:  # del, not pop: a pending read of a released session
@@ -367,7 +366,7 @@ def refresh_raster(state: AppState, method: str) -> bool:
             return False
         state.panel_errors.pop(method, None)
         panel = g.raster[method] = RasterPanel(session, key)
-        state.status[method] = f"{panel.session.n_triangles} triangles"
+        state.status[method] = session_status(panel.session)
     if (panel.session.live and time.perf_counter() - panel.edited > LIVE_REST_SECONDS
             and g.settle_frame != state.frame):
         # the values rested: compiled back in (the static variant), one program per frame

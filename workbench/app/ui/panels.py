@@ -9,6 +9,7 @@ from .frames import (difference_on_gpu, image_stats, panel_texture, show_image, 
                      upload_linear)
 from .colours import colour_scale, hot_table
 from .export import export
+from .gl_sessions import KNOB_VALUES, STANDIN_CHOICES, draws_standins
 from .inspect import pixel_under_mouse, probe_tooltip, select_ray_tree
 from .patch_view import select_patch
 from .placement import PANEL_GAP, PANEL_LINES, focus, panel_grid
@@ -134,6 +135,35 @@ def parameters(state: AppState) -> None:
         check_fits(state, f"knob {m}")
         if changed:
             set_option(state, m, knob.name, values[idx])
+        if draws_standins(m):
+            standin_controls(state, m)
+
+
+def standin_controls(state: AppState, method: str) -> None:
+    """The stand-ins of a Gouraud or Phong panel (:mod:`.gl_sessions`): the ``standins``
+    option (on, off or a subset) on its own line, and its knobs (``envmap_resolution``,
+    ``shadow_resolution``, ``shadow_bias``, ``envmap_iterations``) under a closed tree node; the
+    CLI's option names and defaults."""
+    opts = state.options[method]
+    cur = str(opts["standins"])
+    choices = list(STANDIN_CHOICES) if cur in STANDIN_CHOICES else [cur, *STANDIN_CHOICES]
+    imgui.set_next_item_width(-label_room("standins"))
+    changed, k = imgui.combo(f"standins##{method}", choices.index(cur), choices)
+    check_fits(state, f"standins {method}")
+    if changed:
+        set_option(state, method, "standins", choices[k])
+    if not imgui.tree_node(f"{method}: stand-in knobs"):
+        return
+    imgui.push_item_width(-label_room(*KNOB_VALUES))
+    for name, values in KNOB_VALUES.items():
+        values = list(values) if opts[name] in values else sorted({*values, opts[name]})
+        idx = values.index(opts[name])
+        changed, idx = imgui.slider_int(f"{name}##{method}", idx, 0, len(values) - 1, format=str(values[idx]))
+        check_fits(state, f"{name} {method}")
+        if changed:
+            set_option(state, method, name, values[idx])
+    imgui.pop_item_width()
+    imgui.tree_pop()
 
 
 def handle_mouse(state: AppState) -> None:

@@ -162,15 +162,22 @@ def _evaluate(image: np.ndarray, reference: np.ndarray) -> dict:
 
 
 def _matched(state: AppState, plot: ErrorPlot, method: str):
-    """``method``'s matched reference for the current key: ``(image, "")`` once rendered,
-    ``(None, progress)`` while it renders, ``(False, "")`` when the method has none (outside
-    renderers, a user's shading model) or it does not apply to the scene."""
-    if method in plot.matched:
+    """``method``'s matched reference for the current key and the panel's options (Gouraud's
+    and Phong's follows their stand-ins, :func:`~workbench.compare.reference.matched_spec` as
+    ``compare`` calls it): ``(image, "")`` once rendered, ``(None, progress)`` while it
+    renders, ``(False, "")`` when the method has none (outside renderers, a user's shading
+    model) or it does not apply to the scene.  Held in ``plot.matched[method]`` for the options
+    ``plot.matched_options[method]`` (other options: looked up again)."""
+    options = state.options[method]
+    held = tuple(sorted(options.items()))
+    if method in plot.matched and plot.matched_options.get(method) == held:
         return plot.matched[method], ""
+    plot.matched.pop(method, None)
+    plot.matched_options[method] = held
     from ...compare.reference import finest_options, matched_spec
     from .frames import tiled
     from .jobs import JobBoard
-    spec = matched_spec(method)
+    spec = matched_spec(method, state.scene, options)
     if spec is None:
         plot.matched[method] = False
         return False, ""
@@ -238,6 +245,7 @@ def track(state: AppState) -> None:
         plot.gave_up = False
         plot.points, plot.pending, plot.failed = {}, {}, {}
         plot.matched, plot.matched_points, plot.matched_pending = {}, {}, {}
+        plot.matched_options = {}
         plot.matched_message = ""
     _collect(plot, plot.pending, plot.points, "error")
     _collect(plot, plot.matched_pending, plot.matched_points, "matched error")

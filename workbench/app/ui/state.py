@@ -64,7 +64,8 @@ class ErrorPlot:
     the method's matched reference (its discretisation error, the error split of
     :mod:`workbench.compare.reference`), evaluated on its own when that reference arrives.
     ``matched[method]`` is that reference's image once rendered, or False (the method has
-    none); ``matched_boards`` render them, one :class:`~.jobs.JobBoard` per (reference method,
+    none), for the panel's options ``matched_options[method]`` (Gouraud's and Phong's
+    matched reference follows their stand-ins); ``matched_boards`` render them, one :class:`~.jobs.JobBoard` per (reference method,
     options) (a board runs one job per method); ``matched_message`` says which are still
     rendering.
     """
@@ -80,6 +81,7 @@ class ErrorPlot:
     pending: dict = field(default_factory=dict)
     failed: dict = field(default_factory=dict)
     matched: dict = field(default_factory=dict)
+    matched_options: dict = field(default_factory=dict)
     matched_points: dict = field(default_factory=dict)
     matched_pending: dict = field(default_factory=dict)
     matched_boards: dict = field(default_factory=dict)
@@ -201,9 +203,16 @@ def method_kind(state: AppState, method: str) -> str:
 
 def default_options(method: str) -> dict:
     """The method's quality knob at its default value; a progressive method's (``ui_kind``
-    ``"progressive"``) at its most accurate, which it refines towards pass by pass."""
+    ``"progressive"``) at its most accurate, which it refines towards pass by pass; for a
+    method that draws the raster's stand-ins (Gouraud, Phong: ``draws_standins``) also their
+    options (:data:`~workbench.renderers.raster_standins.OPTIONS`) at the CLI's defaults, so a
+    panel draws what ``workbench render`` draws."""
+    from ...renderers.raster_standins import OPTIONS
     r = get_renderer(method)
-    return {r.knob.name: r.knob.values[-1] if r.ui_kind == "progressive" else r.knob.default}
+    opts = {r.knob.name: r.knob.values[-1] if r.ui_kind == "progressive" else r.knob.default}
+    if getattr(r, "draws_standins", False):
+        opts.update({k: r.options[k].default for k in OPTIONS})
+    return opts
 
 
 def first_view(scene: Scene, allowed) -> list[str]:
