@@ -152,7 +152,7 @@ def _bisect(c, a: float, b: float) -> float:
 def roots_in(c, lo: float, hi: float) -> list[float]:
     """Points in ``(lo, hi]`` where ``peval(c) > 0`` changes (odd-multiplicity roots), sorted:
     the roots of each derivative isolate the monotone pieces of the one above it."""
-    chain = [list(c)]
+    chain = [[float(a) for a in c]]
     while len(chain[-1]) > 2:
         chain.append(deriv(chain[-1]))
     crit: list[float] = []
