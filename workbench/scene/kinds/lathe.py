@@ -278,7 +278,11 @@ def intersect(la: Lathe, O, D, tmin: float = 0.0, tmax: float = np.inf):
 # --------------------------------------------------------------------------- tessellation
 def mesh(la: Lathe, steps: int):
     """Each segment swept in ``steps`` angular steps: ``(P, N, F)`` with the segment's normal on
-    its own vertices (smooth around the axis, creased between segments)."""
+    its own vertices (smooth around the axis, creased between segments).  A smooth profile's
+    segments are cut in ``steps * PROFILE_STEPS / LEVEL_STEPS`` pieces each (at least 1) with
+    the curve's normals (:func:`.lathe_spline.mesh`)."""
+    if la.smooth:
+        return spl.mesh(la.segments, la.orientation, steps, max(1, steps * spl.PROFILE_STEPS // LEVEL_STEPS))
     ang = np.linspace(0.0, 2.0 * np.pi, steps + 1)
     c, s = np.cos(ang), np.sin(ang)
     c[-1], s[-1] = 1.0, 0.0          # the seam's two copies at exactly the same place
@@ -305,10 +309,8 @@ def mesh(la: Lathe, steps: int):
 
 
 def level_mesh(la: Lathe, level: int):
-    """:func:`mesh` at ``LEVEL_STEPS * level`` angular steps; a smooth profile's segments cut in
-    ``PROFILE_STEPS * level`` pieces each (:func:`.lathe_spline.mesh`)."""
-    if la.smooth:
-        return spl.mesh(la.segments, la.orientation, LEVEL_STEPS * level, spl.PROFILE_STEPS * level)
+    """:func:`mesh` at ``LEVEL_STEPS * level`` angular steps (a smooth profile's segments cut in
+    ``PROFILE_STEPS * level`` pieces each)."""
     return mesh(la, LEVEL_STEPS * level)
 
 
