@@ -202,8 +202,37 @@ def polish(seg: np.ndarray, O, D, s: float, t: float) -> tuple[float, float]:
     return s, t
 
 
+def meets_hull(seg: np.ndarray, O, D) -> bool:
+    """Whether the line meets the cylinder ``rho <= rmax``, ``ymin <= y <= ymax`` around the
+    segment's Bezier control points (the curve lies in their convex hull), padded by ``SIGMA``
+    of their size: a quick reject."""
+    b = np.stack([seg[:, 0], seg[:, 0] + seg[:, 1] / 3.0, seg[:, 0] + 2.0 * seg[:, 1] / 3.0 + seg[:, 2] / 3.0,
+                  seg.sum(1)], 1)
+    pad = SIGMA * float(np.abs(b).max())
+    rmax, ylo, yhi = b[0].max() + pad, b[1].min() - pad, b[1].max() + pad
+    lo, hi = -math.inf, math.inf
+    if D[1] == 0.0:
+        if not ylo <= O[1] <= yhi:
+            return False
+    else:
+        ta, tb = (ylo - O[1]) / D[1], (yhi - O[1]) / D[1]
+        lo, hi = min(ta, tb), max(ta, tb)
+    a = D[0] * D[0] + D[2] * D[2]
+    m = O[0] * D[0] + O[2] * D[2]
+    c = O[0] * O[0] + O[2] * O[2] - rmax * rmax
+    if a == 0.0:
+        return c <= 0.0
+    disc = m * m - a * c
+    if disc < 0.0:
+        return False
+    sq = math.sqrt(disc)
+    return max(lo, (-m - sq) / a) <= min(hi, (-m + sq) / a)
+
+
 def segment_hits(seg: np.ndarray, O, D) -> list[tuple[float, float]]:
     """``(t, s)`` of every crossing of the line with the segment's surface."""
+    if not meets_hull(seg, O, D):
+        return []
     a = D[0] * D[0] + D[2] * D[2]
     found = []
     if abs(D[1]) > STEEP * math.sqrt(a):
