@@ -70,6 +70,12 @@ def _objects():
             "i", common)),
         ("lathe, 6-point cup", 2, lathe, lathe.read(
             {"points": [[0, 0], [1, 0], [1.5, 2], [1.2, 2], [0.8, 0.3], [0, 0.3]]}, "l", common)),
+        ("lathe, cubic spline, 6 segments", 2, lathe, lathe.read(
+            {"spline": "cubic", "points": [[0.0, 2.2], [0.0, 0.0], [0.8, 0.05], [1.0, 1.0], [1.3, 2.0], [1.1, 2.1],
+                                           [0.7, 1.2], [0.0, 1.0], [0.0, -1.0]]}, "l", common)),
+        ("lathe, bezier, 2 segments", 2, lathe, lathe.read(
+            {"spline": "bezier", "points": [[0.0, 0.0], [0.6, 0.0], [0.9, 0.5], [0.9, 1.0], [0.9, 1.0], [0.9, 1.5],
+                                            [0.5, 2.0], [0.0, 2.0]]}, "l", common)),
         ("prism, 10-vertex star", 3, prism, prism.read({"polygon": star, "heights": [0, 0.5]}, "p", common)),
     ]
 

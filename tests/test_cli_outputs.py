@@ -116,7 +116,7 @@ def test_write_together_is_all_or_nothing(tmp_path):
     (["render", "whitted", "-o", "x.png", "--size", "10"], "render: argument --size: expected WIDTHxHEIGHT"),
     (["render", "whitted", "-o", "x.png", "--size", "abc"], "argument --size"),
     (["render", "whitted", "-o", "x.png", "--size", "0x5"], "within 1..16384"),
-    (["study", "whitted", "--out", "d", "--sweep", "raycast"], "argument --sweep: expected METHOD:OPTION"),
+    (["study", "whitted", "--out", "d", "--sweep", "raycast"], "argument --sweep: expected [METHOD:]OPTION"),
     (["render", "whitted"], "required: -o/--output"),
     (["render", "whitted", "-o", "x.png", "--bogus"], "unrecognized arguments: --bogus"),
     (["frobnicate"], "invalid choice: 'frobnicate'"),

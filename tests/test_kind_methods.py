@@ -1,4 +1,4 @@
-"""The new kinds (blob, isosurface, lathe, prism) in the methods that take them from their
+"""The new kinds (blob, isosurface, lathe polyline and bezier, prism) in the methods that take them from their
 tessellation: radiosity cuts them into patches (one per triangle) and lights them; the raster
 and the ray caster see the same pixels."""
 from __future__ import annotations
@@ -16,7 +16,9 @@ NEW = [{"type": "blob", "threshold": 0.3, "material": "m",
        {"type": "prism", "material": "m", "polygon": [[1, -0.5], [2, -0.5], [2, 0.5], [1.5, 0], [1, 0.5]],
         "heights": [-1, 0]},
        {"type": "isosurface", "material": "m", "function": "x^2 + y^2 + z^2", "threshold": 0.25, "max_gradient": 3.5,
-        "bounds": {"min": [-0.8, -0.8, -0.8], "max": [0.8, 0.8, 0.8]}, "transform": {"translate": [0, 0.5, 1.5]}}]
+        "bounds": {"min": [-0.8, -0.8, -0.8], "max": [0.8, 0.8, 0.8]}, "transform": {"translate": [0, 0.5, 1.5]}},
+       {"type": "lathe", "spline": "bezier", "material": "m", "transform": {"translate": [0.5, -1.0, -1.6]},
+        "points": [[0, 0], [0.4, 0], [0.5, 0.4], [0.4, 0.7], [0.4, 0.7], [0.3, 1.0], [0.2, 1.2], [0, 1.2]]}]
 FLOOR = {"type": "plane", "point": [0, -1, 0], "normal": [0, 1, 0], "size": [8, 8], "material": "m"}
 LIGHT = [{"type": "area", "vertices": [[-1, 3, -1], [1, 3, -1], [1, 3, 1], [-1, 3, 1]], "color": [1, 1, 1],
           "intensity": 5.0}]

@@ -66,7 +66,7 @@ def _object(kind: str, s: float, rng: np.random.Generator) -> dict:
     if kind == "mesh":
         return {"type": "mesh", "generate": {"kind": "torus", "subdivisions": 2, "radius": 0.7 * r},
                 "material": "m", "transform": tf}
-    if kind in NEW_KINDS:
+    if kind in NEW_KINDS or kind in SMOOTH_LATHES:
         return _new_object(kind, r, tf)
     if kind == "csg":
         return {"type": "csg", "op": "difference", "material": "m", "transform": tf,
@@ -91,6 +91,14 @@ def _new_object(kind: str, r: float, tf: dict) -> dict:
     if kind == "lathe":
         prof = [[0.0, -0.8], [0.5, -0.8], [0.3, -0.3], [0.7, 0.4], [0.4, 0.8], [0.0, 0.6]]
         return {"type": "lathe", "material": "m", "transform": tf, "points": [[r * a, r * b] for a, b in prof]}
+    if kind == "lathe_cubic":
+        prof = [[0.0, 1.0], [0.0, -0.8], [0.6, -0.7], [0.3, -0.2], [0.8, 0.4], [0.4, 0.8], [0.0, 0.6], [0.0, -1.0]]
+        return {"type": "lathe", "spline": "cubic", "material": "m", "transform": tf,
+                "points": [[r * a, r * b] for a, b in prof]}
+    if kind == "lathe_bezier":
+        prof = [[0.0, -0.8], [0.6, -0.8], [0.9, 0.0], [0.5, 0.2], [0.5, 0.2], [0.2, 0.4], [0.8, 0.9], [0.0, 0.8]]
+        return {"type": "lathe", "spline": "bezier", "material": "m", "transform": tf,
+                "points": [[r * a, r * b] for a, b in prof]}
     star = [[r * (1.0 if i % 2 == 0 else 0.45) * float(np.cos(t)), r * (1.0 if i % 2 == 0 else 0.45) * float(np.sin(t))]
             for i, t in enumerate(np.linspace(0.0, 2.0 * np.pi, 11)[:-1])]
     prism = {"type": "prism", "material": "m", "polygon": star, "heights": [-0.3 * r, 0.3 * r]}
@@ -138,6 +146,17 @@ def test_new_kinds_objects_seen_alike(seed, gl_ctx):
     """Seeded: objects of the new kinds: the raster's tessellations cover the ray caster's exact
     pixels (:func:`_side_by_side_alike`)."""
     _side_by_side_alike(2000 + seed, NEW_KINDS, 0.7)
+
+
+SMOOTH_LATHES = ("lathe_cubic", "lathe_bezier")
+"""Lathes with a smooth profile (cubic Catmull-Rom, bezier): the raster's curve is sampled."""
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("seed", range(2))
+def test_smooth_lathes_objects_seen_alike(seed, gl_ctx):
+    """Seeded: smooth lathes beside a sphere (:func:`_side_by_side_alike`)."""
+    _side_by_side_alike(3000 + seed, SMOOTH_LATHES + ("sphere",), 0.7)
 
 
 def _scale_cases():

@@ -87,7 +87,7 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
           size: tuple[int, int] | None = None, quick: bool = False, repeat: int | None = None,
           reference: str | None = None, reference_image: tuple[np.ndarray, str] | None = None,
           sweeps: dict[str, tuple[str, list]] | None = None, jobs: int = 1, progress: bool = True,
-          command: str = "") -> dict:
+          command: str = "", fixed: dict[str, dict] | None = None) -> dict:
     """Sweep each method's knob, time it and measure its error; write the study files.
 
     Parameters
@@ -103,6 +103,8 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
     sweeps : ``{method: (option, values)}`` to sweep another option than the method's knob
         (e.g. radiosity's ``hemicube_resolution``), values cheapest first.
     jobs : worker processes for the error evaluation (after all timing is done).
+    fixed : ``{method: {option: value}}`` held at every point of that method's sweep (e.g.
+        ``standins=off`` for Gouraud and Phong; the matched reference follows them).
     """
     names = default_methods() if not methods else list(methods)
     check_methods(names)  # unknown names, unusable glsl: files
@@ -120,6 +122,14 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
                 convert_options(get_renderer(m), {option: v})
             except WorkbenchError as e:
                 raise WorkbenchError(f"--sweep {m}:{option}: {e}") from None
+    fixed = fixed or {}
+    for m, opts in fixed.items():
+        if m not in names:
+            raise WorkbenchError(f"--set {m}:...: method {m!r} is not among the studied methods")
+        try:
+            convert_options(get_renderer(m), dict(opts))
+        except WorkbenchError as e:
+            raise WorkbenchError(f"--set for {m}: {e}") from None
     repeat = (2 if quick else 5) if repeat is None else int(repeat)
     if repeat < 1:
         raise WorkbenchError(f"a study needs at least one warm run per point, got repeat={repeat}")
@@ -153,13 +163,14 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
                disable=not progress, leave=False)
     skip: dict[str, str] = {}
     for m, knob, value, why in plan:
-        p = {"method": m, "knob": knob, "value": value, "status": "failed" if why else "ok", "reason": why}
+        p = {"method": m, "knob": knob, "value": value, "status": "failed" if why else "ok", "reason": why,
+             "options": dict(fixed.get(m, {}))}
         if why or m in skip:
             p.update(status=p["status"] if why else "not_applicable", reason=why or skip[m])
             bar.update(repeat + 1)
             points.append(p)
             continue
-        run = timed_run(scene, m, w, h, repeat=repeat, options={knob: value})
+        run = timed_run(scene, m, w, h, repeat=repeat, options={**fixed.get(m, {}), knob: value})
         bar.update(repeat + 1)
         p.update(status=run.status, reason=run.reason)
         if run.status == "not_applicable":
@@ -220,7 +231,7 @@ def _matched_errors(refs: References, points: list[dict], images: list, jobs: in
     out, todo = {}, []
     for i, im in images:
         p = points[i]
-        ref = refs.matched(p["method"], {p["knob"]: p["value"]})
+        ref = refs.matched(p["method"], {**p.get("options", {}), p["knob"]: p["value"]})
         if ref is None:
             p["matched_reference"] = ""
             continue

@@ -1,5 +1,8 @@
-"""``lathe``: surface of revolution about the y axis of a profile polyline of ``(r, y)`` points
-(POV-Ray's ``lathe`` with ``linear_spline``).
+"""``lathe``: surface of revolution about the y axis of a profile of ``(r, y)`` points: a polyline
+(POV-Ray's ``lathe`` with ``linear_spline``, the default) or, with ``spline = "quadratic" |
+"cubic" | "bezier"``, POV-Ray's smooth ``quadratic_spline`` / ``cubic_spline`` / ``bezier_spline``
+lathe (:mod:`.lathe_spline` defines those curves, their intersection and normals; this module's
+formulas below are the polyline's).
 
 Each segment ``(r0, y0) -> (r1, y1)`` sweeps a piece of a cone (a cylinder when ``r0 = r1``;
 an annulus of the plane ``y = y0`` when ``y0 = y1``).  With the segment's radius
@@ -19,7 +22,9 @@ The lathe is a solid (an inside for CSG, refraction) when its profile is closed:
 and last points coincide, or both lie on the axis (r = 0).  Inside: the point's ``(rho, y)``
 is inside the closed profile (even-odd rule).
 
-Aux layout: ``(r, y)`` per point; parameter row ``[aux offset, points, closed, orientation]``.
+Aux layout: ``(r, y)`` per point; parameter row ``[aux offset, points, closed, orientation,
+spline code, segments]`` (code 0: linear); a smooth profile's aux is
+:func:`.lathe_spline.aux` (``SEG_FLOATS`` per segment).
 """
 from __future__ import annotations
 
@@ -31,6 +36,7 @@ import numpy as np
 from ...core.tol import tol
 from .. import model as m
 from ..parts import make_part
+from . import lathe_spline as spl
 from . import values as val
 from .aux_rows import flatten_aux
 from .crossing_events import alternate
@@ -43,8 +49,8 @@ SOLID = True
 """When its profile is closed (:func:`solid`); an open lathe is a sheet."""
 CONVEX = False
 COMPOSITE = False
-KEYS = frozenset({"points"})
-REQUIRED = KEYS
+KEYS = frozenset({"points", "spline"})
+REQUIRED = frozenset({"points"})
 LEVEL_STEPS = 8
 """Angular steps per tessellation level (as a sphere's segments)."""
 MAX_POINTS = 256
@@ -55,16 +61,27 @@ TOL_ZERO = tol.zero
 
 @dataclass(frozen=True, eq=False)
 class Lathe(m.SceneObject):
-    """Profile ``points`` (k, 2) of ``(r, y)``, r >= 0."""
+    """Profile ``points`` (k, 2) of ``(r, y)`` (r >= 0 on the curve) joined by ``spline``
+    (one of :data:`.lathe_spline.SPLINES`)."""
 
     points: np.ndarray = field(default_factory=lambda: np.array([[1.0, -1.0], [1.0, 1.0]]))
+    spline: str = "linear"
     kind = "lathe"
 
     @property
+    def smooth(self) -> bool:
+        return self.spline != "linear"
+
+    @property
+    def segments(self) -> np.ndarray:
+        """(S, 2, 4) the curve's polynomial segments (:func:`.lathe_spline.segments`)."""
+        return spl.segments(self.points, self.spline)
+
+    @property
     def closed(self) -> bool:
-        """A solid: first and last points equal, or both on the axis."""
-        p = self.points
-        return bool((p[0] == p[-1]).all() or (p[0, 0] == 0.0 and p[-1, 0] == 0.0))
+        """A solid: the curve's first and last points equal, or both on the axis."""
+        a, b = spl.ends(self.points, self.spline)
+        return bool((a == b).all() or (a[0] == 0.0 and b[0] == 0.0))
 
     @property
     def orientation(self) -> float:
@@ -72,6 +89,8 @@ class Lathe(m.SceneObject):
         (r, y) plane (or is open), -1 when clockwise: the sign that makes normals outward."""
         if not self.closed:
             return 1.0
+        if self.smooth:
+            return 1.0 if spl.signed_area2(self.segments) >= 0.0 else -1.0
         r, y = self.points[:, 0], self.points[:, 1]
         area2 = float(np.sum(r * np.roll(y, -1) - np.roll(r, -1) * y))
         return 1.0 if area2 >= 0.0 else -1.0
@@ -82,9 +101,15 @@ MODEL = Lathe
 
 # --------------------------------------------------------------------------- parse
 def read(t: dict, where: str, common: dict) -> Lathe:
-    """Read ``{points = [[r, y], ...]}`` (at least 2 points, r >= 0, no zero-length segment)."""
+    """Read ``{points = [[r, y], ...], spline = "linear"}`` (linear: at least 2 points, r >= 0,
+    no zero-length segment; smooth: :func:`_read_smooth`)."""
     val.check_keys(t, where, val.COMMON | KEYS, REQUIRED)
-    P = val.points(t, where, "points", 2, least=2, most=MAX_POINTS)
+    spline = t.get("spline", "linear")
+    if spline not in spl.SPLINES:
+        val.fail(f"{where}.spline", f"expected one of {', '.join(map(repr, spl.SPLINES))}, got {spline!r}")
+    P = val.points(t, where, "points", 2, least=spl.LEAST[spline], most=MAX_POINTS)
+    if spline != "linear":
+        return _read_smooth(P, spline, where, common)
     if (P[:, 0] < 0).any():
         i = int(np.argmax(P[:, 0] < 0))
         val.fail(f"{where}.points[{i}]", f"radius must be >= 0, got {P[i, 0]!r}")
@@ -95,6 +120,33 @@ def read(t: dict, where: str, common: dict) -> Lathe:
     if (P[:, 0] == 0.0).all():
         val.fail(f"{where}.points", "every point is on the axis (r = 0): the profile sweeps no surface")
     return Lathe(points=P, **common)
+
+
+def _read_smooth(P: np.ndarray, spline: str, where: str, common: dict) -> Lathe:
+    """A smooth profile: a bezier's points come in fours, each segment starting where the
+    previous ended; no segment is a single point; the curve's radius is >= 0 (control points
+    off the curve may have any radius) and somewhere > 0."""
+    if spline == "bezier":
+        if len(P) % 4:
+            val.fail(f"{where}.points", f"a bezier profile has 4 points per segment, got {len(P)}")
+        for i in range(4, len(P), 4):
+            if (P[i] != P[i - 1]).any():
+                val.fail(f"{where}.points[{i}]", f"a bezier segment must start where the previous ends "
+                         f"(points[{i - 1}] = {P[i - 1].tolist()})")
+    segs = spl.segments(P, spline)
+    rmax = 0.0
+    for i, seg in enumerate(segs):
+        if (seg[:, 1:] == 0.0).all():
+            val.fail(f"{where}.points", f"{spline} segment {i} is a single point")
+        lo, hi = spl.extremes(seg[0])
+        size = float(np.abs(seg).max())
+        if lo < -tol.cut * size:
+            val.fail(f"{where}.points", f"the {spline} curve's radius dips to {lo:.6g} < 0 on segment {i}: "
+                     "move its control points away from the axis")
+        rmax = max(rmax, hi)
+    if rmax <= 0.0:
+        val.fail(f"{where}.points", "the curve is on the axis (r = 0): the profile sweeps no surface")
+    return Lathe(points=P, spline=spline, **common)
 
 
 def parse(ctx, t: dict, where: str, common: dict) -> Lathe:
@@ -114,6 +166,10 @@ def bound_points(la: Lathe) -> np.ndarray:
 
 
 def bounds(la: Lathe) -> tuple[np.ndarray, np.ndarray]:
+    if la.smooth:
+        a = spl.aux(la.segments).reshape(-1, spl.SEG_FLOATS)
+        r = a[:, 8].max()
+        return np.array([-r, a[:, 9].min(), -r]), np.array([r, a[:, 10].max(), r])
     r = la.points[:, 0].max()
     return (np.array([-r, la.points[:, 1].min(), -r]), np.array([r, la.points[:, 1].max(), r]))
 
@@ -160,6 +216,9 @@ def inside(la: Lathe, P) -> np.ndarray:
     res = np.zeros(rho.shape, dtype=bool)
     if not la.closed:
         return res
+    if la.smooth:
+        segs = la.segments
+        return np.vectorize(lambda a, b: spl.inside(segs, float(a), float(b)), otypes=[bool])(rho, y)
     p = la.points
     for (ra, ya), (rb, yb) in zip(p, np.roll(p, -1, axis=0)):
         if ya == yb:
@@ -175,10 +234,17 @@ def crossings(la: Lathe, O, D) -> list[tuple[float, int]]:
     alternate entering / leaving (:func:`.crossing_events.alternate`); an open one's are
     every hit."""
     O, D = np.asarray(O, dtype=np.float64), np.asarray(D, dtype=np.float64)
-    hits = [(t, i) for i in range(len(la.points) - 1) for t in segment_hits(la, i, O, D)]
+    hits = all_hits(la, O, D)
     if not la.closed:
         return sorted(hits)
     return alternate(hits, lambda t: bool(inside(la, O + t * D)))
+
+
+def all_hits(la: Lathe, O, D) -> list[tuple[float, int]]:
+    """``(t, segment)`` of every crossing of the line with every segment's surface."""
+    if la.smooth:
+        return [(t, i) for i, seg in enumerate(la.segments) for t, _ in spl.segment_hits(seg, O, D)]
+    return [(t, i) for i in range(len(la.points) - 1) for t in segment_hits(la, i, O, D)]
 
 
 def hits(la: Lathe, O, D, solid: bool = False) -> list[tuple[float, int]]:
@@ -188,6 +254,8 @@ def hits(la: Lathe, O, D, solid: bool = False) -> list[tuple[float, int]]:
 
 def normal(la: Lathe, face: int, P) -> np.ndarray:
     """Unit normal of segment ``face`` at P (3,) (outward for a closed lathe)."""
+    if la.smooth:
+        return spl.normal(la.segments[face], la.orientation, P)
     (r0, y0), (r1, y1) = la.points[face], la.points[face + 1]
     nr, ny = la.orientation * (y1 - y0), -la.orientation * (r1 - r0)
     rho = math.hypot(P[0], P[2])
@@ -200,7 +268,7 @@ def normal(la: Lathe, face: int, P) -> np.ndarray:
 def intersect(la: Lathe, O, D, tmin: float = 0.0, tmax: float = np.inf):
     """First hit ``tmin < t < tmax``: ``(t, unit normal)``, or ``(inf, None)``."""
     O, D = np.asarray(O, dtype=np.float64), np.asarray(D, dtype=np.float64)
-    hits = [(t, i) for i in range(len(la.points) - 1) for t in segment_hits(la, i, O, D) if tmin < t < tmax]
+    hits = [(t, i) for t, i in all_hits(la, O, D) if tmin < t < tmax]
     if not hits:
         return np.inf, None
     t, i = min(hits)
@@ -210,7 +278,11 @@ def intersect(la: Lathe, O, D, tmin: float = 0.0, tmax: float = np.inf):
 # --------------------------------------------------------------------------- tessellation
 def mesh(la: Lathe, steps: int):
     """Each segment swept in ``steps`` angular steps: ``(P, N, F)`` with the segment's normal on
-    its own vertices (smooth around the axis, creased between segments)."""
+    its own vertices (smooth around the axis, creased between segments).  A smooth profile's
+    segments are cut in ``steps * PROFILE_STEPS / LEVEL_STEPS`` pieces each (at least 1) with
+    the curve's normals (:func:`.lathe_spline.mesh`)."""
+    if la.smooth:
+        return spl.mesh(la.segments, la.orientation, steps, max(1, steps * spl.PROFILE_STEPS // LEVEL_STEPS))
     ang = np.linspace(0.0, 2.0 * np.pi, steps + 1)
     c, s = np.cos(ang), np.sin(ang)
     c[-1], s[-1] = 1.0, 0.0          # the seam's two copies at exactly the same place
@@ -236,10 +308,16 @@ def mesh(la: Lathe, steps: int):
     return P, N, F.astype(np.int64)
 
 
+def level_mesh(la: Lathe, level: int):
+    """:func:`mesh` at ``LEVEL_STEPS * level`` angular steps (a smooth profile's segments cut in
+    ``PROFILE_STEPS * level`` pieces each)."""
+    return mesh(la, LEVEL_STEPS * level)
+
+
 def solid_mesh(la: Lathe, level: int) -> tuple[np.ndarray, np.ndarray]:
     """Closed, welded object-space mesh ``(P, F)`` of a closed lathe at ``LEVEL_STEPS * level``
     steps (for the raster's CSG booleans)."""
-    P, _, F = mesh(la, LEVEL_STEPS * level)
+    P, _, F = level_mesh(la, level)
     return weld(P, F)
 
 
@@ -251,8 +329,8 @@ def weld(P: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def tessellate(obj: Lathe, level: int, M: np.ndarray) -> list:
-    """The raster's triangles: one Part of :func:`mesh` at level * LEVEL_STEPS steps."""
-    P, N, F = mesh(obj, LEVEL_STEPS * level)
+    """The raster's triangles: one Part of :func:`level_mesh`."""
+    P, N, F = level_mesh(obj, level)
     return [make_part(obj, M, P, N, F, None, None)]
 
 
@@ -276,8 +354,13 @@ def flatten(b, obj, index: int, W: np.ndarray, top: bool) -> int:
 
 
 def params(la: Lathe, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
-    """Parameter row head ``[aux offset, points, closed, orientation]`` and aux (2 k,)."""
-    return (np.array([aux_offset, len(la.points), float(la.closed), la.orientation]),
+    """Parameter row head ``[aux offset, points, closed, orientation, spline code, segments]``
+    and aux: (2 k,) the points of a polyline, :func:`.lathe_spline.aux` of a smooth profile."""
+    if la.smooth:
+        segs = la.segments
+        return (np.array([aux_offset, len(la.points), float(la.closed), la.orientation,
+                          spl.CODE[la.spline], len(segs)]), spl.aux(segs))
+    return (np.array([aux_offset, len(la.points), float(la.closed), la.orientation, 0.0, len(la.points) - 1]),
             np.ascontiguousarray(la.points, dtype=np.float64).reshape(-1))
 
 

@@ -8,7 +8,9 @@ import math
 import numba as nb
 import numpy as np
 
+from .blob import BISECTIONS
 from .lathe import TOL_CUT, TOL_ZERO
+from .lathe_spline import NEWTON, SEED_MARGIN, SEG_FLOATS, SIGMA, STEEP
 
 
 @nb.njit(cache=True, error_model="numpy")
@@ -69,6 +71,8 @@ def _segment_roots(aux, j, ox, oy, oz, dx, dy, dz, zero):
 @nb.njit(cache=True, error_model="numpy")
 def lathe_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
     """Nearest hit ``tmin < t < tmax``: ``(t, segment)``, ``(inf, 0)`` on a miss."""
+    if par[k, 4] != 0.0:
+        return _spline_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, stack)
     off, n = int(par[k, 0]), int(par[k, 1])
     best, bf = tmax, -1
     for i in range(n - 1):
@@ -87,6 +91,8 @@ def lathe_inside(par, k, aux, x, y, z, stack):
     """Even-odd test of ``(rho, y)`` against the closed profile."""
     if par[k, 2] == 0.0:
         return False
+    if par[k, 4] != 0.0:
+        return _spline_inside(par, k, aux, x, y, z, stack)
     off, n = int(par[k, 0]), int(par[k, 1])
     rho = math.hypot(x, z)
     res = False
@@ -106,12 +112,15 @@ def lathe_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
     dropped: a line meets at most two per segment)."""
     off, n = int(par[k, 0]), int(par[k, 1])
     m = 0
-    for i in range(n - 1):
-        cnt, t0, t1 = _segment_roots(aux, off + 2 * i, ox, oy, oz, dx, dy, dz, TOL_ZERO)
-        for r in range(cnt):
-            if m < cap:
-                out_t[m], out_f[m] = (t0 if r == 0 else t1), i
-                m += 1
+    if par[k, 4] != 0.0:
+        m = _spline_collect(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack)
+    else:
+        for i in range(n - 1):
+            cnt, t0, t1 = _segment_roots(aux, off + 2 * i, ox, oy, oz, dx, dy, dz, TOL_ZERO)
+            for r in range(cnt):
+                if m < cap:
+                    out_t[m], out_f[m] = (t0 if r == 0 else t1), i
+                    m += 1
     sort_hits(out_t, out_f, m)
     w, status = 0, False
     for i in range(m):
@@ -131,6 +140,8 @@ def lathe_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
 @nb.njit(cache=True, error_model="numpy")
 def lathe_normal(par, k, aux, face, x, y, z, stack):
     """Normal of segment ``face`` at the object-space point (unit)."""
+    if par[k, 4] != 0.0:
+        return _spline_normal(par, k, aux, face, x, y, z, stack)
     j = int(par[k, 0]) + 2 * face
     o = par[k, 3]
     nr, ny = o * (aux[j + 3] - aux[j + 1]), -o * (aux[j + 2] - aux[j])
@@ -138,4 +149,282 @@ def lathe_normal(par, k, aux, face, x, y, z, stack):
     if rho == 0.0:
         return 0.0, math.copysign(1.0, ny), 0.0
     ln = math.hypot(nr, ny)
+    return nr * x / (rho * ln), ny / ln, nr * z / (rho * ln)
+
+
+# --------------------------------------------------------------------------- smooth profiles
+# (.lathe_spline's method; the caller's ``stack`` scratch, (>= 24, 4) float64, holds the
+# polynomials and roots: flat slot i is stack[i // 4, i % 4])
+_LEVEL = 8          # slots per polynomial of the derivative chain (degree <= 6)
+_CRIT = 56          # the roots found at the previous level
+_NEW = 64           # the roots of the current level
+_HITS_T = 72        # a segment's hits: t
+_HITS_S = 84        # and s
+_MAX_HITS = 12
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _get(st, i):
+    return st[i >> 2, i & 3]
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _put(st, i, v):
+    st[i >> 2, i & 3] = v
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _peval(st, base, deg, s):
+    v = 0.0
+    for i in range(deg, -1, -1):
+        v = v * s + _get(st, base + i)
+    return v
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _illinois(st, base, deg, a, b):
+    """The end past the change of ``poly > 0`` in ``[a, b]``, narrowed to adjacent floats by the
+    Illinois method (as :func:`.blob_kernels._change`)."""
+    fa, fb = _peval(st, base, deg, a), _peval(st, base, deg, b)
+    sa = fa > 0.0
+    side = 0
+    for _ in range(BISECTIONS):
+        m = 0.5 * (a + b)
+        if m <= a or m >= b:
+            break
+        c = (a * fb - b * fa) / (fb - fa)
+        if not (a < c < b):
+            c = m
+        fc = _peval(st, base, deg, c)
+        if (fc > 0.0) == sa:
+            a, fa = c, fc
+            if side == -1:
+                fb *= 0.5
+            side = -1
+        else:
+            b, fb = c, fc
+            if side == 1:
+                fa *= 0.5
+            side = 1
+    return b
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _roots_in(st, deg, lo, hi):
+    """Sign changes of the polynomial in slots ``0..deg`` in ``(lo, hi]``, isolated by the roots
+    of its derivatives (:func:`.lathe_spline.roots_in`); written to slots ``_CRIT..``, returns
+    their count."""
+    for lev in range(1, deg):
+        d = deg - lev
+        for i in range(d + 1):
+            _put(st, lev * _LEVEL + i, (i + 1) * _get(st, (lev - 1) * _LEVEL + i + 1))
+    nc = 0
+    for lev in range(deg - 1, -1, -1):
+        d = deg - lev
+        base = lev * _LEVEL
+        nn = 0
+        a = lo
+        fa = _peval(st, base, d, a) > 0.0
+        for j in range(nc + 1):
+            b = _get(st, _CRIT + j) if j < nc else hi
+            fb = _peval(st, base, d, b) > 0.0
+            if b > a and fa != fb:
+                _put(st, _NEW + nn, _illinois(st, base, d, a, b))
+                nn += 1
+            a, fa = b, fb
+        for j in range(nn):
+            _put(st, _CRIT + j, _get(st, _NEW + j))
+        nc = nn
+    return nc
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _cubic(aux, j, s):
+    return ((aux[j + 3] * s + aux[j + 2]) * s + aux[j + 1]) * s + aux[j]
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _dcubic(aux, j, s):
+    return (3.0 * aux[j + 3] * s + 2.0 * aux[j + 2]) * s + aux[j + 1]
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _polish(aux, j, ox, oy, oz, dx, dy, dz, s, t):
+    """Newton steps of :func:`.lathe_spline.polish`."""
+    for _ in range(NEWTON):
+        rs, ys = _cubic(aux, j, s), _cubic(aux, j + 4, s)
+        drs, dys = _dcubic(aux, j, s), _dcubic(aux, j + 4, s)
+        px, pz = ox + t * dx, oz + t * dz
+        f1 = ys - oy - t * dy
+        f2 = px * px + pz * pz - rs * rs
+        j11, j12, j21, j22 = dys, -dy, -2.0 * rs * drs, 2.0 * (px * dx + pz * dz)
+        det = j11 * j22 - j12 * j21
+        if det == 0.0:
+            break
+        ds = (-f1 * j22 + j12 * f2) / det
+        dt = (-j11 * f2 + j21 * f1) / det
+        if not (math.isfinite(ds) and math.isfinite(dt)) or abs(ds) > SEED_MARGIN:
+            break
+        s, t = s + ds, t + dt
+    return s, t
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _in_bounds(aux, j, ox, oy, oz, dx, dy, dz, tmin, tmax):
+    """Whether the line within ``(tmin, tmax)`` meets the segment's cylinder ``rho <= rmax``,
+    ``ymin <= y <= ymax`` (aux ``j + 8 .. j + 10``)."""
+    rmax, ylo, yhi = aux[j + 8], aux[j + 9], aux[j + 10]
+    lo, hi = tmin, tmax
+    if dy == 0.0:
+        if oy < ylo or oy > yhi:
+            return False
+    else:
+        ta, tb = (ylo - oy) / dy, (yhi - oy) / dy
+        lo, hi = max(lo, min(ta, tb)), min(hi, max(ta, tb))
+    a = dx * dx + dz * dz
+    m = ox * dx + oz * dz
+    c = ox * ox + oz * oz - rmax * rmax
+    if a == 0.0:
+        return c <= 0.0 and lo <= hi
+    disc = m * m - a * c
+    if disc < 0.0:
+        return False
+    sq = math.sqrt(disc)
+    return max(lo, (-m - sq) / a) <= min(hi, (-m + sq) / a)
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _spline_segment_hits(aux, j, ox, oy, oz, dx, dy, dz, st):
+    """Every crossing of the line with the surface of the segment at aux[j:]: ``(t, s)`` in
+    slots ``_HITS_T..``, ``_HITS_S..``; returns the count (:func:`.lathe_spline.segment_hits`)."""
+    a = dx * dx + dz * dz
+    m = ox * dx + oz * dz
+    q = ox * ox + oz * oz
+    n = 0
+    if abs(dy) > STEEP * math.sqrt(a):
+        # P(s) = a u^2 + 2 dy m u + dy^2 (q - r^2), u = y(s) - oy, in slots 0..6
+        for i in range(7):
+            _put(st, i, 0.0)
+        for i in range(4):
+            ui = aux[j + 4 + i] - (oy if i == 0 else 0.0)
+            _put(st, i, _get(st, i) + 2.0 * dy * m * ui)
+            for k in range(4):
+                uk = aux[j + 4 + k] - (oy if k == 0 else 0.0)
+                _put(st, i + k, _get(st, i + k) + a * ui * uk - dy * dy * aux[j + i] * aux[j + k])
+        _put(st, 0, _get(st, 0) + dy * dy * q)
+        nr = _roots_in(st, 6, -SIGMA, 1.0 + SIGMA)
+        for r in range(nr):
+            s = _get(st, _CRIT + r)
+            s, t = _polish(aux, j, ox, oy, oz, dx, dy, dz, s, (_cubic(aux, j + 4, s) - oy) / dy)
+            if -SIGMA <= s <= 1.0 + SIGMA and n < _MAX_HITS:
+                _put(st, _HITS_T + n, t)
+                _put(st, _HITS_S + n, s)
+                n += 1
+        return n
+    tc = -m / a
+    for i in range(4):
+        _put(st, i, aux[j + 4 + i])
+    _put(st, 0, aux[j + 4] - (oy + dy * tc))
+    nr = _roots_in(st, 3, -SEED_MARGIN, 1.0 + SEED_MARGIN)
+    for r in range(nr):
+        s0 = _get(st, _CRIT + r)
+        R = _cubic(aux, j, s0)
+        b, c = 2.0 * m, q - R * R
+        disc = b * b - 4.0 * a * c
+        if not disc > 0.0:
+            continue
+        qq = -0.5 * (b + math.copysign(math.sqrt(disc), b))
+        for w in range(2):
+            s, t = _polish(aux, j, ox, oy, oz, dx, dy, dz, s0, qq / a if w == 0 else c / qq)
+            if -SIGMA <= s <= 1.0 + SIGMA and n < _MAX_HITS:
+                _put(st, _HITS_T + n, t)
+                _put(st, _HITS_S + n, s)
+                n += 1
+    return n
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _spline_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, st):
+    off, nseg = int(par[k, 0]), int(par[k, 5])
+    best, bf = tmax, -1
+    for i in range(nseg):
+        j = off + SEG_FLOATS * i
+        if not _in_bounds(aux, j, ox, oy, oz, dx, dy, dz, tmin, best):
+            continue
+        n = _spline_segment_hits(aux, j, ox, oy, oz, dx, dy, dz, st)
+        for r in range(n):
+            t = _get(st, _HITS_T + r)
+            if tmin < t < best:
+                best, bf = t, i
+    if bf < 0:
+        return np.inf, 0
+    return best, bf
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _spline_collect(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, st):
+    off, nseg = int(par[k, 0]), int(par[k, 5])
+    m = 0
+    for i in range(nseg):
+        j = off + SEG_FLOATS * i
+        if not _in_bounds(aux, j, ox, oy, oz, dx, dy, dz, -np.inf, np.inf):
+            continue
+        n = _spline_segment_hits(aux, j, ox, oy, oz, dx, dy, dz, st)
+        for r in range(n):
+            if m < cap:
+                out_t[m], out_f[m] = _get(st, _HITS_T + r), i
+                m += 1
+    return m
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _spline_inside(par, k, aux, x, y, z, st):
+    """Even-odd count of :func:`.lathe_spline.inside`."""
+    off, nseg = int(par[k, 0]), int(par[k, 5])
+    rho = math.hypot(x, z)
+    res = False
+    for i in range(nseg):
+        j = off + SEG_FLOATS * i
+        if y < aux[j + 9] or y > aux[j + 10] or rho >= aux[j + 8]:
+            continue
+        for c in range(4):
+            _put(st, c, aux[j + 4 + c])
+        _put(st, 0, aux[j + 4] - y)
+        nr = _roots_in(st, 3, 0.0, 1.0)
+        for r in range(nr):
+            if _cubic(aux, j, _get(st, _CRIT + r)) > rho:
+                res = not res
+    return res
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _spline_param(aux, j, x, y, z, st):
+    """:func:`.lathe_spline.param_at`."""
+    rho = math.hypot(x, z)
+    best, bd = 0.0, np.inf
+    for which in range(3):
+        nr = 2
+        if which < 2:
+            for c in range(4):
+                _put(st, c, aux[j + (4 if which == 0 else 0) + c])
+            _put(st, 0, _get(st, 0) - (y if which == 0 else rho))
+            nr = _roots_in(st, 3, -SEED_MARGIN, 1.0 + SEED_MARGIN)
+        for r in range(nr):
+            s = _get(st, _CRIT + r) if which < 2 else float(r)
+            d = math.hypot(_cubic(aux, j, s) - rho, _cubic(aux, j + 4, s) - y)
+            if d < bd:
+                best, bd = s, d
+    return best
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _spline_normal(par, k, aux, face, x, y, z, st):
+    j = int(par[k, 0]) + SEG_FLOATS * face
+    o = par[k, 3]
+    s = _spline_param(aux, j, x, y, z, st)
+    nr, ny = o * _dcubic(aux, j + 4, s), -o * _dcubic(aux, j, s)
+    rho = math.hypot(x, z)
+    ln = math.hypot(nr, ny)
+    if rho == 0.0 or ln == 0.0:
+        return 0.0, math.copysign(1.0, ny), 0.0
     return nr * x / (rho * ln), ny / ln, nr * z / (rho * ln)
