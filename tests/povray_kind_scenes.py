@@ -25,6 +25,14 @@ _TORUS = {"type": "isosurface", "name": "torus", "material": "jade", "function":
           "transform": {"rotate": [30.0, 0.0, 0.0], "translate": [-2.0, 1.0, 0.0]}}
 _VASE = {"type": "lathe", "name": "open_vase", "material": "gold",
          "points": [[0.5, 0.0], [0.8, 0.5], [0.4, 1.2], [0.6, 1.7]], "transform": {"translate": [1.5, 0.0, 0.0]}}
+_SPLINES = [  # one smooth lathe per POV-Ray spline, beside each other
+    {"type": "lathe", "name": "quadratic_cup", "material": "gold", "spline": "quadratic",
+     "points": [[0.2, -0.3], [0.5, 0.0], [0.8, 0.6], [0.5, 1.3], [0.7, 1.6]],
+     "transform": {"translate": [-1.8, 0.0, 0.0]}},
+    {"type": "lathe", "name": "bezier_bulb", "material": "coral", "spline": "bezier",
+     "points": [[0.0, 0.0], [1.2, 0.0], [0.9, 1.2], [0.3, 1.4], [0.3, 1.4], [0.1, 1.5], [0.4, 1.8], [0.0, 1.9]],
+     "transform": {"translate": [0.2, 0.0, 0.0]}},
+]
 _CSG = [
     {"type": "csg", "name": "prism_minus_blob", "material": "violet", "op": "difference",
      "transform": {"translate": [-1.6, 0.0, 0.5]},
@@ -52,7 +60,8 @@ def kind_scenes() -> dict[str, m.Scene]:
     for o in base.objects[1:]:
         out[o.kind] = replace(base, objects=(floor, o))
     data = tomllib.loads((Path(__file__).resolve().parents[1] / "scenes" / "kinds.toml").read_text())
-    for name, objs in (("isosurface_torus", [_TORUS]), ("lathe_open", [_VASE]), ("csg_new_kinds", _CSG)):
+    for name, objs in (("isosurface_torus", [_TORUS]), ("lathe_open", [_VASE]), ("lathe_splines", _SPLINES),
+                       ("csg_new_kinds", _CSG)):
         out[name] = scene_from_dict({**data, "objects": [data["objects"][0], *objs]})
     return out
 

@@ -51,7 +51,7 @@ def test_new_kinds_match_the_ray_tracer(name):
 
 @needs_povray
 @pytest.mark.slow
-@pytest.mark.parametrize("name", ["blob", "isosurface", "lathe", "prism", "isosurface_torus", "lathe_open",
+@pytest.mark.parametrize("name", ["blob", "isosurface", "lathe", "prism", "isosurface_torus", "lathe_open", "lathe_splines",
                                   "csg_new_kinds", "kinds"])
 def test_each_new_kind_matches_the_ray_tracer_at_320x240(name):
     _check(kind_scenes()[name], 320, 240)

@@ -13,8 +13,12 @@ from __future__ import annotations
 
 import importlib
 
-from .core.errors import NotApplicable, WorkbenchError  # noqa: F401
-from .scene.io import SceneError, load_scene  # noqa: F401
+from .core.jit_cache import use_code_keyed_cache
+
+use_code_keyed_cache()  # before any kernel compiles: numba's cache keyed by this code
+
+from .core.errors import NotApplicable, WorkbenchError  # noqa: E402,F401
+from .scene.io import SceneError, load_scene  # noqa: E402,F401
 
 __all__ = ["load_scene", "render", "available_methods", "SceneError", "WorkbenchError",
            "NotApplicable", "compare", "raytrace", "radiosity"]

@@ -49,6 +49,7 @@ import numpy as np
 
 from ..core.errors import WorkbenchError
 from ..core.imageio import atomic_write_bytes
+from ..core.jit_cache import code_fingerprint
 from ..renderers.base import RenderResult, convert_options, get_renderer, render
 from ..scene.model import Scene
 from .outputs import jsonable
@@ -56,7 +57,6 @@ from .outputs import jsonable
 #: Bumped whenever the entry layout or the key's content changes.
 CACHE_FORMAT = 2
 ENV_VAR = "WORKBENCH_REFERENCE_CACHE"
-_CODE_PACKAGES = ("core", "scene", "renderers")
 _VERSIONED = ("numpy", "numba", "mitsuba")
 _PATH_FIELDS = ("source", "path")
 
@@ -122,17 +122,6 @@ def _asset_paths(scene: Scene) -> list[str]:
     for obj in scene.objects:
         walk(obj)
     return sorted(paths)
-
-
-def code_fingerprint() -> str:
-    """SHA-256 over the workbench's core, scene and renderer sources (sorted by path)."""
-    root = Path(__file__).resolve().parents[1]
-    h = hashlib.sha256()
-    for pkg in _CODE_PACKAGES:
-        for p in sorted((root / pkg).rglob("*.py")):
-            h.update(str(p.relative_to(root)).encode())
-            h.update(p.read_bytes())
-    return h.hexdigest()
 
 
 def _versions() -> dict:
@@ -277,4 +266,4 @@ def clear_cache(directory: Path | str | None = None) -> int:
 
 
 __all__ = ["CACHE_FORMAT", "ENV_VAR", "cache_dir", "cache_key", "cached_render", "load_entry", "store_entry",
-           "cache_entries", "clear_cache", "code_fingerprint"]
+           "cache_entries", "clear_cache"]

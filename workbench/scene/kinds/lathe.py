@@ -366,10 +366,12 @@ def params(la: Lathe, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
 
 # --------------------------------------------------------------------------- exporters
 def povray(la: Lathe, w, in_csg: bool) -> str:
-    """POV-Ray's ``lathe { linear_spline k, <r, y>... }``: the profile's 2D points ``(r, y)``
-    swept about the y axis, as ours."""
+    """POV-Ray's ``lathe { X_spline k, <r, y>... }``: the profile's 2D points ``(r, y)``
+    swept about the y axis, as ours; ``spline = X`` names POV-Ray's own curve (linear,
+    quadratic, cubic, bezier: :mod:`.lathe_spline` follows POV-Ray's segment formulas), so the
+    points go over unchanged."""
     pts = ", ".join(w.vec(q) for q in la.points)
-    return (f"lathe {{ linear_spline {len(la.points)}, {pts} {w.texture(la.material)} "
+    return (f"lathe {{ {la.spline}_spline {len(la.points)}, {pts} {w.texture(la.material)} "
             f"{w.matrix(la.world_from_object)} }}")
 
 
