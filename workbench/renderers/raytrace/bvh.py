@@ -54,12 +54,8 @@ def _grow(acc, o, tb, k, cen):
 
 
 @nb.njit(cache=True)
-def _build(tri_v):
-    """The binned SAH build (module docstring).  The triangles' boxes and centroids are kept
-    in the order of ``idx`` (swapped with it), so that every pass over a node's range reads
-    memory in sequence; a node's box and centroid bounds come from its parent's partition,
-    and one pass bins the centroids along the three axes at once.  The tree is the same as a
-    build that rescans each node's triangles (same splits, same partition swaps)."""
+def triangle_boxes(tri_v):
+    """Each triangle's box ``(T, 6)`` (min xyz, max xyz) and box centre ``(T, 3)``."""
     T = tri_v.shape[0]
     tb = np.empty((T, 6))
     cen = np.empty((T, 3))
@@ -69,6 +65,18 @@ def _build(tri_v):
             hi = max(tri_v[i, a], tri_v[i, 3 + a], tri_v[i, 6 + a])
             tb[i, a], tb[i, 3 + a] = lo, hi
             cen[i, a] = 0.5 * (lo + hi)
+    return tb, cen
+
+
+@nb.njit(cache=True)
+def _build(tb, cen):
+    """The binned SAH build (module docstring) over boxes ``tb`` (T, 6) with centres ``cen``
+    (T, 3), both reordered in place.  The boxes and centroids are kept
+    in the order of ``idx`` (swapped with it), so that every pass over a node's range reads
+    memory in sequence; a node's box and centroid bounds come from its parent's partition,
+    and one pass bins the centroids along the three axes at once.  The tree is the same as a
+    build that rescans each node's triangles (same splits, same partition swaps)."""
+    T = tb.shape[0]
     idx = np.arange(T)
     cap = max(2 * T, 1)
     box = np.empty((cap, 6))
@@ -208,7 +216,7 @@ def build_bvh(tri_v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     box : (Nn, 6) node bounds (min xyz, max xyz).
     meta : (Nn, 3) int64, leaf ``(first, count, -1)``, inner ``(right child, 0, axis)``.
     """
-    return _build(np.ascontiguousarray(tri_v, dtype=np.float64))
+    return _build(*triangle_boxes(np.ascontiguousarray(tri_v, dtype=np.float64)))
 
 
 @nb.njit(cache=True)
@@ -320,12 +328,31 @@ def build_bvh4(tri_v: np.ndarray) -> tuple[np.ndarray, Bvh4]:
     bvh : :class:`Bvh4` over ``tri_v[order]``.
     """
     tri_v = np.ascontiguousarray(tri_v, dtype=np.float64)
-    order, box, meta = _build(tri_v)
+    order, box, meta = _build(*triangle_boxes(tri_v))
     node, child, leaf = _collapse(box, meta)
     bounds = box[0].copy()
     del box, meta
     tv4, first, groups = _pack_leaves(tri_v, order, leaf)
     return order, Bvh4(node, child, groups, first, tv4, bounds)
+
+
+def build_box_tree(boxes: np.ndarray) -> tuple[np.ndarray, tuple]:
+    """The same 4-wide tree over boxes (the analytic primitives' world bounds), leaves
+    without packing.
+
+    Parameters
+    ----------
+    boxes : (P, 6) float64 boxes (min xyz, max xyz), P >= 1.
+
+    Returns
+    -------
+    order : (P,) permutation: leaf ranges index ``boxes[order]``.
+    tree : ``(node (N4, 6, 4), child (N4, 4), leaf (L, 2))`` as :func:`_collapse` makes them.
+    """
+    tb = np.array(boxes, dtype=np.float64, order="C")
+    cen = np.ascontiguousarray(0.5 * (tb[:, :3] + tb[:, 3:]))
+    order, box, meta = _build(tb, cen)
+    return order, _collapse(box, meta)
 
 
 def empty_bvh4() -> Bvh4:

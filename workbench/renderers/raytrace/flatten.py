@@ -5,7 +5,8 @@ Every analytic primitive (sphere, rectangle, box, polygon, quadric) keeps its ow
 the ray is taken into it by ``object_from_world`` (the course's "objet transformé: appliquer la
 transformation au rayon"); the ray parameter ``t`` is unchanged by an affine map, so hits of
 different objects compare directly.  Triangle meshes are moved to world space once and share
-one BVH.  A CSG tree becomes a postfix program over its leaves.
+one BVH.  A CSG tree becomes a postfix program over its leaves.  The top-level analytic
+primitives with finite world bounds go into a structure of their own (:mod:`.accel`).
 
 Primitive table (``P`` rows)
 ----------------------------
@@ -30,9 +31,10 @@ import numpy as np
 
 from ...core.tol import tol
 from ...scene import model as m
-from ...scene.kinds import kind_of
+from ...scene.kinds import kind_of, world_bounds
 
 if TYPE_CHECKING:
+    from .accel import PrimTree
     from .bvh import Bvh4
 
 OPACITY_CUT = 0.5
@@ -70,6 +72,7 @@ class SceneData:
     tri_e: np.ndarray           # (T, 9) vertex emission (radiance)
     tri_prim: np.ndarray        # (T,) the mesh's primitive row
     bvh: Bvh4                   # 4-wide BVH over the triangles (see .bvh)
+    prims: PrimTree             # the analytic primitives' list and structure (see .accel)
     materials: list             # Material objects, index = mat
     mat_tab: np.ndarray         # (M, 24) numeric material table (see _material_row)
     lights: np.ndarray          # (L, 14) light table (see _light_rows)
@@ -84,7 +87,7 @@ class SceneData:
         """The geometry tuple passed to every numba kernel."""
         return (self.ptype, self.top, self.xf, self.nm, self.par, self.solid, self.shadow,
                 self.poly_v, self.csg_prog, self.tri_v, self.tri_n, self.tri_uv, self.tri_e,
-                self.tri_prim, *self.bvh, self.ident, self.aux)
+                self.tri_prim, *self.bvh, self.ident, self.aux, *self.prims)
 
 
 def _material_row(mat: m.Material, front_only: bool = False) -> np.ndarray:
@@ -194,14 +197,46 @@ def _triangles(meshes):
             np.concatenate(tp))
 
 
+def _prim_tree(rows: list[dict], owners: list, accel: str, scale: float) -> PrimTree:
+    """The top-level analytic primitive rows (``top`` and not a mesh's) and their structure
+    ``accel``: each row's box is its object's world bounds (:func:`~workbench.scene.kinds.world_bounds`;
+    an object makes one top-level row), padded (:func:`.accel.pad_boxes`); ``owners`` lists
+    ``(first row, object)`` of each top-level object in row order."""
+    from .accel import build_prim_tree, pad_boxes
+    top_rows, boxes = [], []
+    ends = [r for r, _ in owners[1:]] + [len(rows)]
+    for (r0, obj), r1 in zip(owners, ends):
+        mine = [r for r in range(r0, r1) if rows[r]["top"]]
+        if not mine:
+            continue
+        if accel == "none":
+            box = np.full(6, np.nan)
+        else:
+            with np.errstate(invalid="ignore", over="ignore"):  # an unbounded quadric: inf * 0
+                lo, hi = world_bounds(obj, np.eye(4))
+            box = np.concatenate([lo, hi])
+        for r in mine:
+            top_rows.append(r)
+            boxes.append(box)
+    boxes = np.array(boxes, dtype=np.float64).reshape(-1, 6)
+    if len(boxes):
+        with np.errstate(invalid="ignore", over="ignore"):
+            boxes = pad_boxes(boxes, scale)
+    return build_prim_tree(np.array(top_rows, dtype=np.int64), boxes, accel)
+
+
 def flatten(scene: m.Scene, accel: str = "bvh") -> SceneData:
-    """Build the kernel arrays for ``scene`` (area lights become emissive polygons), the
-    triangles' acceleration structure ``accel`` (:data:`.accel.ACCELS`) over the triangles."""
+    """Build the kernel arrays for ``scene`` (area lights become emissive polygons) and the
+    acceleration structure ``accel`` (:data:`.accel.ACCELS`) over the triangles and over the
+    bounded analytic primitives (``bvh_build_time``: both)."""
     import time
     b = _Builder(scene)
+    owners = []  # (first row, object) of each top-level object and area light
     for i, o in enumerate(scene.objects):
+        owners.append((len(b.rows), o))
         b.leaf(o, i, np.eye(4), top=True)
     for k, polygon, mat in scene.area_light_polygons():
+        owners.append((len(b.rows), polygon))
         b.area_light(k, polygon, mat)
     rows = b.rows
 
@@ -218,10 +253,13 @@ def flatten(scene: m.Scene, accel: str = "bvh") -> SceneData:
                                               (tri_v, tri_n, tri_uv, tri_e, tri_p))
     else:
         bvh = empty_bvh4()
-    bvh_time = time.perf_counter() - t0
     allb = np.concatenate(b.bounds) if b.bounds else np.zeros((1, 3))
     finite = allb[np.isfinite(allb).all(1)]
     extent = float(np.linalg.norm(np.ptp(finite, axis=0))) if len(finite) else 1.0
+    scale = max(float(np.abs(finite).max()) if len(finite) else 0.0, extent,
+                float(np.abs(scene.camera.position).max()))
+    prims = _prim_tree(rows, owners, accel, scale)
+    bvh_time = time.perf_counter() - t0
     mat_tab = np.stack([_material_row(mt, i in b.front_only) for i, mt in enumerate(b.materials)])
     return SceneData(
         ptype=col("ptype", np.int64), top=col("top", np.bool_), obj=col("obj", np.int64),
@@ -233,7 +271,7 @@ def flatten(scene: m.Scene, accel: str = "bvh") -> SceneData:
         poly_v=np.ascontiguousarray(np.concatenate(b.poly_v) if b.poly_v else np.zeros((1, 3))),
         csg_prog=np.array(b.prog if b.prog else [0], dtype=np.int64),
         tri_v=tri_v, tri_n=tri_n, tri_uv=tri_uv, tri_e=tri_e, tri_prim=tri_p,
-        bvh=bvh,
+        bvh=bvh, prims=prims,
         materials=b.materials, mat_tab=np.ascontiguousarray(mat_tab),
         lights=np.ascontiguousarray(light_rows(scene.point_lights()).reshape(-1, 14)),
         extent=max(extent, tol.zero), n_objects=len(scene.objects), bvh_build_time=bvh_time,

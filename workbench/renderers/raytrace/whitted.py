@@ -638,8 +638,9 @@ _COMMON = {
     "fresnel": Option(str, "none", "reflection/transmission split: none (constant kr, kt), schlick or exact dielectric", ("none", "schlick", "exact")),
     "progress": Option(bool, False, "show a tqdm progress bar (CLI)"),
     "on_tile": Option(_callback, None, "callback on_tile(y0, y1, x0, x1, tile) after each band of rows"),
-    "accel": Option(str, "bvh", "acceleration structure over the triangles: bvh (4-wide binned SAH), octree "
-                    "(the course's arbre octal) or none (every triangle tested); same images", ACCELS),
+    "accel": Option(str, "bvh", "acceleration structure over the triangles and the bounded analytic "
+                    "primitives: bvh (4-wide binned SAH), octree (the course's arbre octal) or none (every "
+                    "triangle and primitive tested); same images", ACCELS),
     "traversal_stats": Option(bool, False, "count nodes visited and primitives tested per pixel-centre "
                               "camera ray (stats accel_*; a pass of its own, timed apart)"),
 }
