@@ -31,7 +31,7 @@ import numpy as np
 
 from ...core.tol import tol
 from ...scene import model as m
-from ...scene.kinds import kind_of, world_bounds
+from ...scene.kinds import kind_of
 
 if TYPE_CHECKING:
     from .accel import PrimTree
@@ -197,24 +197,23 @@ def _triangles(meshes):
             np.concatenate(tp))
 
 
-def _prim_tree(rows: list[dict], owners: list, accel: str, scale: float) -> PrimTree:
-    """The top-level analytic primitive rows (``top`` and not a mesh's) and their structure
-    ``accel``: each row's box is its object's world bounds (:func:`~workbench.scene.kinds.world_bounds`;
-    an object makes one top-level row), padded (:func:`.accel.pad_boxes`); ``owners`` lists
-    ``(first row, object)`` of each top-level object in row order."""
+def _prim_tree(rows: list[dict], bounds: list, owners: list, accel: str, scale: float) -> PrimTree:
+    """The top-level analytic primitive rows (``top``; a mesh's row is not) and their structure
+    ``accel``.  A row's box is the world box of the bound points its object's kind gave
+    ``b.bound`` (``bounds``: every kind gives points whose hull holds the object; a CSG
+    node's operands give theirs), padded (:func:`.accel.pad_boxes`); ``owners`` lists each
+    top-level object's ``(first row, first entry of bounds)``, in row order."""
     from .accel import build_prim_tree, pad_boxes
     top_rows, boxes = [], []
-    ends = [r for r, _ in owners[1:]] + [len(rows)]
-    for (r0, obj), r1 in zip(owners, ends):
+    ends = owners[1:] + [(len(rows), len(bounds))]
+    for (r0, b0), (r1, b1) in zip(owners, ends):
         mine = [r for r in range(r0, r1) if rows[r]["top"]]
         if not mine:
             continue
-        if accel == "none":
-            box = np.full(6, np.nan)
-        else:
-            with np.errstate(invalid="ignore", over="ignore"):  # an unbounded quadric: inf * 0
-                lo, hi = world_bounds(obj, np.eye(4))
-            box = np.concatenate([lo, hi])
+        box = np.full(6, np.nan)
+        if accel != "none" and b1 > b0:
+            pts = np.concatenate(bounds[b0:b1])
+            box = np.concatenate([pts.min(0), pts.max(0)])  # NaN or inf: unbounded
         for r in mine:
             top_rows.append(r)
             boxes.append(box)
@@ -231,12 +230,12 @@ def flatten(scene: m.Scene, accel: str = "bvh") -> SceneData:
     bounded analytic primitives (``bvh_build_time``: both)."""
     import time
     b = _Builder(scene)
-    owners = []  # (first row, object) of each top-level object and area light
+    owners = []  # (first row, first bound points entry) of each top-level object and area light
     for i, o in enumerate(scene.objects):
-        owners.append((len(b.rows), o))
+        owners.append((len(b.rows), len(b.bounds)))
         b.leaf(o, i, np.eye(4), top=True)
     for k, polygon, mat in scene.area_light_polygons():
-        owners.append((len(b.rows), polygon))
+        owners.append((len(b.rows), len(b.bounds)))
         b.area_light(k, polygon, mat)
     rows = b.rows
 
@@ -258,7 +257,7 @@ def flatten(scene: m.Scene, accel: str = "bvh") -> SceneData:
     extent = float(np.linalg.norm(np.ptp(finite, axis=0))) if len(finite) else 1.0
     scale = max(float(np.abs(finite).max()) if len(finite) else 0.0, extent,
                 float(np.abs(scene.camera.position).max()))
-    prims = _prim_tree(rows, owners, accel, scale)
+    prims = _prim_tree(rows, b.bounds, owners, accel, scale)
     bvh_time = time.perf_counter() - t0
     mat_tab = np.stack([_material_row(mt, i in b.front_only) for i, mt in enumerate(b.materials)])
     return SceneData(
