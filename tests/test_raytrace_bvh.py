@@ -181,7 +181,7 @@ def test_the_fast_build_makes_the_readable_builds_tree():
     # parent's partition and bins three axes in one pass; the tree must be the plain one
     from workbench.renderers.raytrace.bvh import build_bvh
     from workbench.renderers.raytrace.bvh import BIN_SAMPLES
-    for seed, n in ((1, 700), (2, 300), (3, 2 * BIN_SAMPLES + 300)):  # the last: its root is sampled
+    for seed, n in ((1, 700), (2, 300), (3, 2 * BIN_SAMPLES + 100)):  # the last: its root is sampled
         tri = _soup(seed, n)
         order, box, meta = build_bvh(tri)
         ref = _readable_sah(tri)
