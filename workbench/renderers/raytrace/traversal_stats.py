@@ -1,4 +1,5 @@
-"""Traversal statistics of the triangles' acceleration structure (option ``traversal_stats``):
+"""Traversal statistics of the acceleration structures, the triangles' and the analytic
+primitives' (option ``traversal_stats``):
 nodes visited and primitives tested per camera ray, counted in a pass of their own so that
 the rendering kernels carry no counters (their speed is untouched; the pass costs about one
 more trace of the pixel centres and is timed apart, ``timings["traversal_stats"]``).

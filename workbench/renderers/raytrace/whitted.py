@@ -23,8 +23,9 @@ number of ray generations in a path, primary = 1, as the course's ``recurs_max``
 ``max_trace_level``), ``threshold`` (the course's perceptual threshold on the accumulated
 weight), ``spp`` (samples per pixel, stratified jitter, seeded by ``seed``), ``fresnel``
 (``none``: constant k_r, k_t; ``schlick``; ``exact`` dielectric), ``transmissive_shadows``,
-``blinn``, ``progress`` (tqdm bar), ``on_tile``, ``accel`` (the triangles' acceleration
-structure: ``bvh``, ``octree`` or ``none``, :mod:`.accel`) and ``traversal_stats`` (nodes visited
+``blinn``, ``progress`` (tqdm bar), ``on_tile``, ``accel`` (the acceleration
+structure over triangles and bounded analytic primitives: ``bvh``, ``octree`` or ``none``,
+:mod:`.accel`) and ``traversal_stats`` (nodes visited
 and primitives tested per camera ray, :mod:`.traversal_stats`).
 
 ``on_tile(y0, y1, x0, x1, tile)`` is called from the rendering thread after each band with
