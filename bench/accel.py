@@ -1,9 +1,13 @@
 """Acceleration structures of the ray tracer (``accel=bvh|octree|none``) on two triangle
-scenes, and the BVH build time before and after the build rewrite.
+scenes and on scenes of many analytic spheres, and the BVH build time before and after a
+revision of the build.
 
-Scenes: the bundled ``mesh`` (one 81,920-triangle blob on an analytic floor: dense, compact)
-and ``many`` (a 20 x 20 grid of 80-triangle icospheres over a floor, 32,000 triangles in 400
-objects with empty space between them: where a uniform subdivision and a SAH tree differ).
+Scenes: the bundled ``mesh`` (one 81,920-triangle blob on an analytic floor: dense, compact),
+``many`` (a 20 x 20 grid of 80-triangle icospheres over a floor, 32,000 triangles in 400
+objects with empty space between them: where a uniform subdivision and a SAH tree differ) and
+``spheres_1000`` / ``spheres_10000`` (that many analytic spheres of random centres and radii,
+seeded, in a cube over a floor: the analytic primitives' structure; ``none`` tests every
+sphere with every ray, camera and shadow alike).
 For each structure: build time (``timings["bvh_build"]`` of the render: the structure and the
 reordering of the triangle arrays; best of the runs), trace time of a ``raycast`` render
 (``timings["trace"]``, best of ``--repeat`` warm runs), nodes visited and triangle tests per
@@ -12,13 +16,13 @@ render, ``stats_render_trace_s``; the rendering kernels themselves carry no coun
 the memory estimate.  The images of the three structures are compared (equal: ``same_image``).
 
 BVH build before / after: ``build_bvh4`` on the mesh scene's triangles in one child process
-that loads both versions of ``bvh.py`` (``--before``: a git revision, default ``f2e4b0a``, the
-last one before the rewrite, exported with ``git archive`` to a temporary folder; after: this
-checkout) and alternates them, best and median of 15 builds each, wall and CPU seconds; the two trees' arrays are compared (the
-rewrite makes the same tree, so the BVH's quality (nodes visited, trace time) is unchanged).
+that loads both versions of ``bvh.py`` (``--before``: a git revision, default ``7c5be9a``, the
+last one before the sampled binning, exported with ``git archive`` to a temporary folder;
+after: this checkout) and alternates them, best and median of 15 builds each, wall and CPU
+seconds; the two trees' arrays are compared (``same_tree``) and their SAH costs given.
 
 Writes ``bench/results/accel.json`` and ``accel.md``.  Run:
-``.venv/bin/python bench/accel.py [--size 160x120] [--repeat 3] [--before f2e4b0a]``.
+``.venv/bin/python bench/accel.py [--size 160x120] [--repeat 3] [--before 7c5be9a]``.
 The machine is shared: its load average is recorded at the start and the end.
 """
 from __future__ import annotations
@@ -63,9 +67,21 @@ for k, f in codes.items():
     h = hashlib.sha256(order.tobytes())
     for a in bvh:
         h.update(np.ascontiguousarray(a).tobytes())
+    def area(b):
+        d = b[..., 3:] - b[..., :3]
+        return d[..., 0] * d[..., 1] + d[..., 1] * d[..., 2] + d[..., 2] * d[..., 0]
+    # SAH cost of the 4-wide tree: 1/2 per node box tested, 1 per triangle lane tested, over the root's area
+    root = np.concatenate([bvh.node[0, :3].min(1), bvh.node[0, 3:].max(1)])
+    with np.errstate(invalid="ignore"):
+        kids = area(np.moveaxis(bvh.node, 2, 1))  # (N4, 4); empty slots NaN, never read
+    inner = (bvh.child >= 0)
+    leafs = bvh.child <= -2
+    lanes = np.zeros_like(kids)
+    lanes[leafs] = 4 * bvh.leaf[-2 - bvh.child[leafs], 1]
+    sah = (0.5 * 4 * kids[inner].sum() + 0.5 * 4 * area(root) + (kids * lanes)[leafs].sum()) / area(root)
     out[k] = dict(wall_best_s=min(wall[k]), wall_median_s=float(np.median(wall[k])), cpu_best_s=min(cpu[k]),
                   cpu_median_s=float(np.median(cpu[k])), nodes_4wide=int(len(bvh.node)), leaves=int(len(bvh.leaf)),
-                  tree_sha256=h.hexdigest())
+                  sah_cost=float(sah), tree_sha256=h.hexdigest())
 print(json.dumps(out))
 """
 
@@ -84,27 +100,55 @@ def many_scene():
         "objects": objs})
 
 
+def spheres_scene(n: int, seed: int = 7):
+    """``n`` analytic spheres, random centres in a cube of side 10 and radii so that they fill
+    about 5 % of it, over a floor (a rectangle), one point light."""
+    from workbench.scene.io import scene_from_dict
+    rng = np.random.default_rng(seed)
+    r_mean = (0.05 * 1000.0 * 3.0 / (4.0 * np.pi * n)) ** (1.0 / 3.0)
+    objs = [{"type": "sphere", "material": "m" + str(i % 3), "center": [float(x) for x in rng.uniform(-5, 5, 3) + [0, 5.2, 0]],
+             "radius": float(r_mean * rng.uniform(0.5, 1.5))} for i in range(n)]
+    objs.append({"type": "plane", "material": "floor", "point": [0, 0, 0], "normal": [0, 1, 0], "size": [30, 30]})
+    return scene_from_dict({
+        "scene": {"name": f"spheres_{n}", "background": [0.08, 0.08, 0.1], "ambient": [0.12, 0.12, 0.12]},
+        "camera": {"position": [0.0, 7.0, 16.0], "look_at": [0.0, 4.5, 0.0], "fov_y": 50.0, "resolution": [320, 240]},
+        "lights": [{"type": "point", "position": [6.0, 14.0, 8.0], "intensity": 0.9}],
+        "materials": {"m0": {"color": [0.8, 0.3, 0.2], "ks": 0.3}, "m1": {"color": [0.2, 0.6, 0.3]},
+                      "m2": {"color": [0.3, 0.4, 0.8], "ks": 0.5}, "floor": {"color": [0.6, 0.6, 0.6]}},
+        "objects": objs})
+
+
 def structures(scene, w, h, repeat):
     import workbench
     from workbench.renderers.base import check_memory, convert_options, get_renderer
     r = get_renderer("raycast")
     out, images = {}, {}
     for a in ACCELS:
-        runs = [workbench.render(scene, "raycast", width=w, height=h, accel=a) for _ in range(repeat)]
+        runs = [workbench.render(scene, "raycast", width=w, height=h, accel=a)
+                for _ in range(1 if a == "none" and st_slow(scene) else repeat)]
         counted = workbench.render(scene, "raycast", width=w, height=h, accel=a, traversal_stats=True)
         st = counted.stats
         images[a] = runs[-1].image
         out[a] = dict(build_s=min(x.timings["bvh_build"] for x in runs),
                       trace_s=min(x.timings["trace"] for x in runs),
                       stats_pass_s=counted.timings["traversal_stats"], stats_render_trace_s=counted.timings["trace"],
+                      frame_s=min(x.timings["total"] for x in runs),
                       nodes_per_ray=st["accel_nodes_per_ray"],
+                      triangle_nodes_per_ray=st["accel_triangle_nodes_per_ray"],
+                      analytic_nodes_per_ray=st["accel_analytic_nodes_per_ray"],
+                      analytic_tests_per_ray=st["accel_analytic_tests_per_ray"],
                       triangle_tests_per_ray=st["accel_triangle_tests_per_ray"],
                       primitive_tests_per_ray=st["accel_primitive_tests_per_ray"],
-                      triangles=st["triangles"], triangle_rows=st["triangle_references"],
+                      triangles=st["triangles"], triangle_rows=st["triangle_references"], primitives=st["primitives"],
                       memory_estimate_mb=check_memory(r, scene, w, h, convert_options(r, {"accel": a})) / 2 ** 20)
     for a in ACCELS:
         out[a]["same_image_as_bvh"] = bool(np.array_equal(images[a], images["bvh"]))
     return out
+
+
+def st_slow(scene) -> bool:
+    """Brute force on a scene of many primitives: one run (it takes seconds)."""
+    return len(scene.objects) > 100
 
 
 def build_before_after(before: str):
@@ -113,7 +157,7 @@ def build_before_after(before: str):
     scene = workbench.load_scene("mesh")
     b = _Builder(scene)
     for i, o in enumerate(scene.objects):
-        b.object(o, i)
+        b.leaf(o, i, np.eye(4), top=True)
     tri = np.ascontiguousarray(_triangles(b.meshes)[0])
     res = {"triangles": int(len(tri)), "before_revision": before}
     with tempfile.TemporaryDirectory() as tmp:
@@ -138,24 +182,27 @@ def markdown(res) -> str:
     lines = [f"# Acceleration structures ({res['size']}, raycast; load average {res['load_average_start'][0]:.1f} "
              f"at the start, {res['load_average_end'][0]:.1f} at the end, {res['machine']})", ""]
     for name, rows in res["scenes"].items():
-        lines += [f"## {name} ({rows['bvh']['triangles']} triangles)", "",
-                  "| accel | build (ms) | trace (ms) | nodes / ray | triangle tests / ray | triangle rows | "
-                  "memory estimate (MiB) | same image | statistics pass (ms) |", "|---|---|---|---|---|---|---|---|---|"]
+        lines += [f"## {name} ({rows['bvh']['triangles']} triangles, {rows['bvh']['primitives']} analytic primitives)", "",
+                  "| accel | build (ms) | trace (ms) | frame (ms) | nodes / ray (triangles + analytic) | triangle tests / ray | "
+                  "analytic tests / ray | triangle rows | memory estimate (MiB) | same image | statistics pass (ms) |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|"]
         for a in ACCELS:
             r = rows[a]
-            lines.append(f"| {a} | {1e3 * r['build_s']:.1f} | {1e3 * r['trace_s']:.1f} | {r['nodes_per_ray']:.2f} | "
-                         f"{r['triangle_tests_per_ray']:.1f} | {r['triangle_rows']} | {r['memory_estimate_mb']:.0f} | "
-                         f"{'yes' if r['same_image_as_bvh'] else 'NO'} | {1e3 * r['stats_pass_s']:.1f} |")
+            lines.append(f"| {a} | {1e3 * r['build_s']:.1f} | {1e3 * r['trace_s']:.1f} | {1e3 * r['frame_s']:.1f} | "
+                         f"{r['triangle_nodes_per_ray']:.2f} + {r['analytic_nodes_per_ray']:.2f} | "
+                         f"{r['triangle_tests_per_ray']:.1f} | {r['analytic_tests_per_ray']:.1f} | {r['triangle_rows']} | "
+                         f"{r['memory_estimate_mb']:.0f} | {'yes' if r['same_image_as_bvh'] else 'NO'} | {1e3 * r['stats_pass_s']:.1f} |")
         lines.append("")
     b = res["bvh_build"]
     lines += [f"## BVH build, {b['triangles']} triangles (mesh scene), best / median of 15", "",
-              "| code | wall (ms) | CPU (ms) | 4-wide nodes | leaves |", "|---|---|---|---|---|"]
+              "| code | wall (ms) | CPU (ms) | 4-wide nodes | leaves | SAH cost |", "|---|---|---|---|---|---|"]
     for k in ("before", "after"):
         r = b[k]
         lines.append(f"| {k}{' (' + b['before_revision'] + ')' if k == 'before' else ''} | "
                      f"{1e3 * r['wall_best_s']:.1f} / {1e3 * r['wall_median_s']:.1f} | "
-                     f"{1e3 * r['cpu_best_s']:.1f} / {1e3 * r['cpu_median_s']:.1f} | {r['nodes_4wide']} | {r['leaves']} |")
-    lines += ["", f"Same tree before and after: {'yes' if b['same_tree'] else 'NO'}.", ""]
+                     f"{1e3 * r['cpu_best_s']:.1f} / {1e3 * r['cpu_median_s']:.1f} | {r['nodes_4wide']} | {r['leaves']} | "
+                     f"{r['sah_cost']:.2f} |")
+    lines += ["", f"Same tree before and after: {'yes' if b['same_tree'] else 'no'}.", ""]
     return "\n".join(lines)
 
 
@@ -163,7 +210,8 @@ def main(argv=None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="160x120")
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--before", default="f2e4b0a")
+    ap.add_argument("--before", default="7c5be9a")
+    ap.add_argument("--spheres", default="1000,10000", help="sphere counts of the many-spheres scenes")
     args = ap.parse_args(argv)
     w, h = (int(x) for x in args.size.lower().split("x"))
     import workbench
@@ -174,6 +222,8 @@ def main(argv=None) -> dict:
         workbench.render(many_scene(), "raycast", width=8, height=6, accel=a, traversal_stats=True)
     res["scenes"] = {"mesh": structures(workbench.load_scene("mesh"), w, h, args.repeat),
                      "many": structures(many_scene(), w, h, args.repeat)}
+    for n in (int(x) for x in args.spheres.split(",") if x):
+        res["scenes"][f"spheres_{n}"] = structures(spheres_scene(n), w, h, args.repeat)
     res["bvh_build"] = build_before_after(args.before)
     res["load_average_end"] = os.getloadavg()
     res["bench_s"] = time.perf_counter() - t0

@@ -71,7 +71,10 @@ def _geometry(placed, csg=None):
                        ("ident", True), ("obj", len(rows["obj"]))):
             rows[key].append(v)
     arr = {k: np.ascontiguousarray(np.array(v)) for k, v in rows.items()}
-    return replace(sd, ptype=arr["ptype"].astype(np.int64), top=arr["top"].astype(bool), xf=arr["xf"],
+    from workbench.renderers.raytrace.accel import build_prim_tree
+    top = np.flatnonzero(arr["top"])  # rows added by hand: the brute-force list of them all
+    return replace(sd, prims=build_prim_tree(top, np.full((len(top), 6), np.nan), "none"),
+                   ptype=arr["ptype"].astype(np.int64), top=arr["top"].astype(bool), xf=arr["xf"],
                    nm=arr["nm"], par=arr["par"], solid=arr["solid"].astype(bool),
                    shadow=arr["shadow"].astype(bool), ident=arr["ident"].astype(bool),
                    obj=arr["obj"].astype(np.int64), csg_prog=prog, aux=np.concatenate(aux))

@@ -60,10 +60,10 @@ def _subtree(bvh, leaves, code):
 
 @pytest.mark.parametrize("n", [2, 300])
 def test_4wide_tree_holds_each_triangle_once_inside_its_boxes(n):
-    from workbench.renderers.raytrace.bvh import _build, _collapse, build_bvh4
+    from workbench.renderers.raytrace.bvh import _build, _collapse, build_bvh4, triangle_boxes
     tv = _soup(1, n)
     order, bvh = build_bvh4(tv)
-    leaves = _collapse(*_build(tv)[1:])[2]
+    leaves = _collapse(*_build(triangle_boxes(tv))[1:])[2]
     assert np.array_equal(bvh.leaf[:, 1], (leaves[:, 1] + 3) // 4)  # groups of four per leaf
     tvo = tv[order]
     seen = []
@@ -125,8 +125,11 @@ def test_4wide_traversal_equals_brute_force_closest_and_any_hit():
 def _readable_sah(tri_v):
     """The binned SAH tree of :func:`.bvh.build_bvh` written plainly (recursion, numpy, every
     node's bounds rescanned): ``[(box, axis or -1, leaf triangle set or None), ...]`` in depth
-    first order, left child first."""
-    from workbench.renderers.raytrace.bvh import MAX_DEPTH, MAX_LEAF, N_BINS, TRAVERSAL_COST
+    first order, left child first.  A node of ``n >= 2 BIN_SAMPLES`` triangles estimates the SAH
+    from every ``(n // BIN_SAMPLES)``-th of them in the build's order (after its partitions'
+    swaps): this plain build keeps the input order, so it is the same only where no node
+    below the root is sampled (asserted)."""
+    from workbench.renderers.raytrace.bvh import BIN_SAMPLES, MAX_DEPTH, MAX_LEAF, N_BINS, TRAVERSAL_COST
     t = tri_v.reshape(-1, 3, 3)
     tb = np.concatenate([t.min(1), t.max(1)], 1)
     cen = 0.5 * (tb[:, :3] + tb[:, 3:])
@@ -141,6 +144,7 @@ def _readable_sah(tri_v):
     out = []
 
     def node(ids, depth):
+        assert depth == 0 or len(ids) < 2 * BIN_SAMPLES  # see the docstring
         box = union(tb[ids])
         cmin, ext = cen[ids].min(0), cen[ids].max(0) - cen[ids].min(0)
         rec = [box, -1, None]
@@ -152,9 +156,10 @@ def _readable_sah(tri_v):
         for ax in range(3):
             if not ext[ax] > 0.0:
                 continue
-            bins = ((cen[ids, ax] - cmin[ax]) * (N_BINS * (1.0 - 1e-9) / ext[ax])).astype(int)
+            smp = ids[::max(1, len(ids) // BIN_SAMPLES)]
+            bins = ((cen[smp, ax] - cmin[ax]) * (N_BINS * (1.0 - 1e-9) / ext[ax])).astype(int)
             for b in range(N_BINS - 1):
-                left, right = ids[bins <= b], ids[bins > b]
+                left, right = smp[bins <= b], smp[bins > b]
                 if len(left) and len(right):
                     c = area(union(tb[left])) * len(left) + area(union(tb[right])) * len(right)
                     if c < best:
@@ -175,7 +180,8 @@ def test_the_fast_build_makes_the_readable_builds_tree():
     # the numba build keeps boxes and centroids in idx order, takes a node's bounds from its
     # parent's partition and bins three axes in one pass; the tree must be the plain one
     from workbench.renderers.raytrace.bvh import build_bvh
-    for seed, n in ((1, 700), (2, 300)):
+    from workbench.renderers.raytrace.bvh import BIN_SAMPLES
+    for seed, n in ((1, 700), (2, 300), (3, 2 * BIN_SAMPLES + 100)):  # the last: its root is sampled
         tri = _soup(seed, n)
         order, box, meta = build_bvh(tri)
         ref = _readable_sah(tri)

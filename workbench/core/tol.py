@@ -50,6 +50,12 @@ class Tolerances:
         against them: ``cut * (|O| + |t D|)`` (infinity norms), a bound on the rounding of
         ``O + t D``, so that a ray through a point on the bounds' faces (an ellipsoid's pole)
         does not miss.
+    bounds_pad : float
+        Relative growth of an analytic primitive's world box in the ray tracer's acceleration
+        structure: ``bounds_pad * (|box|_inf + scale)`` on every side, ``scale`` the scene's
+        size and the camera's distance from the origin (100 times ``cut``: a cut quadric's hit
+        may lie ``cut`` relative outside its bounds, more in world units under a stretching
+        transform).  A looser box costs nothing measurable; a tight one could lose a hit.
     bump_step : float
         Finite-difference step of a bump map's height gradient, as a fraction of one pattern
         period (the step in object units is ``bump_step / scale``).
@@ -79,6 +85,7 @@ class Tolerances:
     hemicube_near: float = 1e-5
     hemicube_flat: float = 1e-3
     cut: float = 1e-9
+    bounds_pad: float = 1e-7
     bump_step: float = 1e-3
     degenerate: float = 1e-9
 

@@ -41,7 +41,11 @@ class PreparedScene:
         The scene it was built from (its camera gives :attr:`near`, :attr:`far` and
         :attr:`camera_media`).
     object_bounds : (N, 2, 3) float64
-        World box ``(lo, hi)`` of each of ``scene.objects``, in scene order.
+        World box ``(lo, hi)`` of each of ``scene.objects``, in scene order (of its finite
+        bound points).
+    unbounded : (N,) bool
+        The objects with a bound point at infinity (an unbounded quadric from the API): no
+        finite box holds them, so acceleration structures test them on every ray.
     area_lights : tuple of (k, Polygon, Material)
         Every area light as the emissive polygon the methods see
         (:meth:`.model.Scene.area_light_polygons`: light index, polygon, its material).
@@ -63,6 +67,7 @@ class PreparedScene:
 
     scene: m.Scene
     object_bounds: np.ndarray
+    unbounded: np.ndarray
     area_lights: tuple
     light_bounds: np.ndarray
     bounds: np.ndarray
@@ -114,9 +119,10 @@ def prepare(scene: m.Scene) -> PreparedScene:
     area_lights = tuple(scene.area_light_polygons())
     lights = [world_points(polygon, np.eye(4)) for _, polygon, _ in area_lights]
     object_bounds = np.array([_box(p) for p in objects]).reshape(-1, 2, 3)
+    unbounded = np.array([not all(np.isfinite(q).all() for q in p) for p in objects], dtype=bool)
     light_bounds = np.array([_box(p) for p in lights]).reshape(-1, 2, 3)
     bounds = _box([p for pts in objects + lights for p in pts])
     extent = float(np.linalg.norm(bounds[1] - bounds[0])) if np.isfinite(bounds).all() else 1.0
     near, far = auto_near_far(scene.camera, _finite_boxes(object_bounds, light_bounds))
-    return PreparedScene(scene, object_bounds, area_lights, light_bounds, bounds, max(extent, tol.zero),
+    return PreparedScene(scene, object_bounds, unbounded, area_lights, light_bounds, bounds, max(extent, tol.zero),
                          near, far, tuple(enclosing_media(scene, scene.camera.position)))

@@ -21,6 +21,7 @@ from ...core.errors import WorkbenchError
 from ...scene import features as F
 from ...scene.model import Scene
 from ..base import Knob, Option, RenderResult
+from ..raytrace.accel import ACCELS
 from .session import FRESNEL, MIS, PIXEL_FILTER, TRANSPORT, PathTraceSession, estimate_bytes
 
 _SAMPLES_PER_PASS = 1 << 20
@@ -54,6 +55,8 @@ class PathTraceRenderer:
                                tuple(PIXEL_FILTER)),
         "rr_start": Option(int, 3, "bounce from which Russian roulette plays (survival min(0.95, max throughput))"),
         "max_bounces": Option(int, 1000, "hard stop of a path (a guard: roulette ends paths long before)"),
+        "accel": Option(str, "bvh", "acceleration structure over the triangles and the bounded analytic "
+                        "primitives: bvh, octree or none (every one tested); same image", ACCELS),
         "progress": Option(bool, False, "show a tqdm progress bar (CLI)"),
         "on_pass": Option(_callback, None, "callback on_pass(spp_so_far, image, std_error) after each pass"),
     }
@@ -70,7 +73,7 @@ class PathTraceRenderer:
         and ``on_pass``."""
         return PathTraceSession(scene, width, height, seed=o["seed"], fresnel=o["fresnel"],
                                 rr_start=o["rr_start"], max_bounces=o["max_bounces"], mis=o["mis"],
-                                transport=o["transport"], pixel_filter=o["pixel_filter"])
+                                transport=o["transport"], pixel_filter=o["pixel_filter"], accel=o["accel"])
 
     def render(self, scene: Scene, width: int, height: int, **o) -> RenderResult:
         if not 1 <= o["spp"] <= MAX_SPP:

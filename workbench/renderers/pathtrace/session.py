@@ -69,6 +69,8 @@ class PathTraceSession:
     transport : ``full`` | ``diffuse`` | ``eye_specular`` (:data:`TRANSPORT`; the latter two
     ignore point and directional lights, textures and vertex emission).
     pixel_filter : ``box`` | ``center`` (:data:`PIXEL_FILTER`).
+    accel : the ray tracer's acceleration structure (``bvh``, ``octree``, ``none``:
+    :mod:`..raytrace.accel`; the same image for a given seed).
 
     Raises
     ------
@@ -79,7 +81,7 @@ class PathTraceSession:
 
     def __init__(self, scene: m.Scene, width: int, height: int, *, seed: int = 0, fresnel: str = "none",
                  rr_start: int = 3, max_bounces: int = 1000, mis: str = "power", triangulate: bool = True,
-                 transport: str = "full", pixel_filter: str = "box"):
+                 transport: str = "full", pixel_filter: str = "box", accel: str = "bvh"):
         if seed < 0:
             raise WorkbenchError(f"pathtrace: seed must be >= 0, got {seed}")
         if rr_start < 1 or max_bounces < 1:
@@ -96,7 +98,7 @@ class PathTraceSession:
         self.width, self.height, self.seed = int(width), int(height), int(seed)
         traced = triangulated(self.scene) if triangulate else self.scene
         prepared = prepare(traced)  # the same bounds and media as self.scene's (flat, opaque)
-        sd = flatten(traced, prepared=prepared)
+        sd = flatten(traced, accel, prepared=prepared)
         for i, mt in enumerate(sd.materials):  # area lights as triangles: still front-face emitters
             if mt.name.startswith(FRONT_ONLY):
                 sd.mat_tab[i, 16] = 1.0

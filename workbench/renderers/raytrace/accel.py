@@ -13,14 +13,24 @@ tested wins, and the order of the tests is the structure's.  The octree referenc
 once per cell it meets: the triangle arrays of the flattened scene then hold one row per
 reference (``order`` repeats triangles), so that a hit's row is its triangle's data.
 
-Analytic primitives (spheres, boxes, quadrics, ...) are tested one after the other by every
-ray whatever ``accel`` is (:func:`.kernels.closest`).
+Analytic primitives (spheres, boxes, quadrics, CSG nodes, ...) with ``bvh`` or ``octree``:
+every top-level primitive with finite world bounds is an item of a second tree of the same
+kind (:class:`PrimTree`, built over their padded world boxes: :func:`build_prim_tree`), its
+leaves listing primitive rows; the unbounded ones (a quadric without bounds, a CSG node with
+one among its operands) stay in a short list tested by every ray.  With ``none`` every
+primitive is in that list (the brute force of before).  :func:`.kernels.closest` tests the
+list, then the primitives' tree, then the triangles' tree: all three find the closest hit,
+and equal ``t`` goes to the lowest primitive row (as the brute-force loop in row order
+does), then to the analytic primitive before a triangle, so the images are the same.
 """
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
-from .bvh import Bvh4, _pack_leaves, build_bvh4
+from ...core.tol import tol
+from .bvh import Bvh4, _pack_leaves, build_box_tree, build_bvh4
 
 ACCELS = ("bvh", "octree", "none")
 """The values of the ``accel`` option, the default first."""
@@ -75,3 +85,57 @@ def accel_extra_bytes(n_triangles: int, accel: str) -> int:
         from .octree import REF_FACTOR
         return int((REF_FACTOR - 1) * n_triangles * _BYTES_PER_REFERENCE)
     return 0
+
+
+class PrimTree(NamedTuple):
+    """The analytic primitives' structure (module docstring), as the kernels take it."""
+    free: np.ndarray    # (F,) int64 rows tested by every ray, in row order
+    node: np.ndarray    # (N4, 6, 4) children's boxes (as Bvh4.node)
+    child: np.ndarray   # (N4, 4) int64: node >= 0, leaf l as -2 - l, empty -1
+    leaf: np.ndarray    # (L, 2) int64: (first reference, count)
+    ref: np.ndarray     # (R,) int64 primitive row of each reference (R = 0: no tree)
+    bounds: np.ndarray  # (6,) the tree's box
+
+
+def pad_boxes(boxes: np.ndarray, scale: float) -> np.ndarray:
+    """World boxes (P, 6) grown on every side by ``tol.bounds_pad * (|box|_inf + scale)``, so
+    that a hit a primitive reports (computed in its object space, a cut quadric's with its
+    slack ``tol.cut``) is never outside its box by rounding, and a flat primitive (a
+    rectangle in an axis plane) has a box of non-zero thickness."""
+    boxes = np.asarray(boxes, dtype=np.float64)
+    pad = tol.bounds_pad * (np.abs(boxes).max(axis=1) + scale)
+    return np.concatenate([boxes[:, :3] - pad[:, None], boxes[:, 3:] + pad[:, None]], axis=1)
+
+
+def build_prim_tree(rows: np.ndarray, boxes: np.ndarray, accel: str) -> PrimTree:
+    """The analytic primitives' structure.
+
+    Parameters
+    ----------
+    rows : (P,) int64 top-level primitive rows, increasing.
+    boxes : (P, 6) their padded world boxes; a row whose box is not finite is unbounded.
+    accel : one of :data:`ACCELS` (``none``: every row in the list, no tree).
+
+    Returns
+    -------
+    :class:`PrimTree`.
+    """
+    rows = np.asarray(rows, dtype=np.int64)
+    boxes = np.asarray(boxes, dtype=np.float64).reshape(-1, 6)
+    bounded = np.isfinite(boxes).all(axis=1) if accel != "none" else np.zeros(len(rows), dtype=bool)
+    free = np.ascontiguousarray(rows[~bounded])
+    if not bounded.any():
+        node = np.empty((1, 6, 4))
+        node[0, :3, :], node[0, 3:, :] = np.inf, -np.inf
+        return PrimTree(free, node, np.full((1, 4), -1, dtype=np.int64), np.zeros((1, 2), dtype=np.int64),
+                        np.zeros(0, dtype=np.int64), np.array([np.inf] * 3 + [-np.inf] * 3))
+    items, ib = rows[bounded], np.ascontiguousarray(boxes[bounded])
+    if accel == "bvh":
+        order, (node, child, leaf) = build_box_tree(ib)
+    elif accel == "octree":
+        from .octree import build_box_octree
+        order, (node, child, leaf) = build_box_octree(ib)
+    else:
+        raise ValueError(f"accel must be one of {', '.join(ACCELS)}, got {accel!r}")
+    bounds = np.concatenate([ib[:, :3].min(0), ib[:, 3:].max(0)])
+    return PrimTree(free, node, child, leaf, np.ascontiguousarray(items[order]), bounds)

@@ -5,7 +5,8 @@ Every analytic primitive (sphere, rectangle, box, polygon, quadric) keeps its ow
 the ray is taken into it by ``object_from_world`` (the course's "objet transformé: appliquer la
 transformation au rayon"); the ray parameter ``t`` is unchanged by an affine map, so hits of
 different objects compare directly.  Triangle meshes are moved to world space once and share
-one BVH.  A CSG tree becomes a postfix program over its leaves.
+one BVH.  A CSG tree becomes a postfix program over its leaves.  The top-level analytic
+primitives with finite world bounds go into a structure of their own (:mod:`.accel`).
 
 Primitive table (``P`` rows)
 ----------------------------
@@ -34,6 +35,7 @@ from ...scene.kinds import kind_of
 from ...scene.prepared import PreparedScene, prepare
 
 if TYPE_CHECKING:
+    from .accel import PrimTree
     from .bvh import Bvh4
 
 OPACITY_CUT = 0.5
@@ -71,6 +73,7 @@ class SceneData:
     tri_e: np.ndarray           # (T, 9) vertex emission (radiance)
     tri_prim: np.ndarray        # (T,) the mesh's primitive row
     bvh: Bvh4                   # 4-wide BVH over the triangles (see .bvh)
+    prims: PrimTree             # the analytic primitives' list and structure (see .accel)
     materials: list             # Material objects, index = mat
     mat_tab: np.ndarray         # (M, 24) numeric material table (see _material_row)
     lights: np.ndarray          # (L, 14) light table (see _light_rows)
@@ -85,7 +88,7 @@ class SceneData:
         """The geometry tuple passed to every numba kernel."""
         return (self.ptype, self.top, self.xf, self.nm, self.par, self.solid, self.shadow,
                 self.poly_v, self.csg_prog, self.tri_v, self.tri_n, self.tri_uv, self.tri_e,
-                self.tri_prim, *self.bvh, self.ident, self.aux)
+                self.tri_prim, *self.bvh, self.ident, self.aux, *self.prims)
 
 
 def _material_row(mat: m.Material, front_only: bool = False) -> np.ndarray:
@@ -189,18 +192,51 @@ def _triangles(meshes):
             np.concatenate(tp))
 
 
+def _prim_tree(rows: list[dict], owners: list, boxes: np.ndarray, accel: str, scale: float) -> PrimTree:
+    """The top-level analytic primitive rows (``top``; a mesh's row is not) and their structure
+    ``accel``.  ``owners`` lists the first row of each top-level object and area light, in row
+    order; ``boxes`` (len(owners), 6) their world boxes ``(lo, hi)`` (the prepared scene's,
+    from each kind's bound points; NaN: unbounded, tested by every ray), padded here
+    (:func:`.accel.pad_boxes`)."""
+    from .accel import build_prim_tree, pad_boxes
+    top_rows, row_boxes = [], []
+    ends = owners[1:] + [len(rows)]
+    for r0, r1, box in zip(owners, ends, boxes):
+        for r in range(r0, r1):
+            if rows[r]["top"]:
+                top_rows.append(r)
+                row_boxes.append(box if accel != "none" else np.full(6, np.nan))
+    row_boxes = np.array(row_boxes, dtype=np.float64).reshape(-1, 6)
+    if len(row_boxes):
+        with np.errstate(invalid="ignore", over="ignore"):
+            row_boxes = pad_boxes(row_boxes, scale)
+    return build_prim_tree(np.array(top_rows, dtype=np.int64), row_boxes, accel)
+
+
+def _owner_boxes(prepared: PreparedScene) -> np.ndarray:
+    """(N + K, 6) world boxes ``(lo, hi)`` of the scene's objects then area lights; NaN rows
+    for objects with a bound point at infinity (:attr:`PreparedScene.unbounded`)."""
+    obj = prepared.object_bounds.reshape(-1, 6).copy()
+    obj[prepared.unbounded] = np.nan
+    return np.concatenate([obj, prepared.light_bounds.reshape(-1, 6)])
+
+
 def flatten(scene: m.Scene, accel: str = "bvh", prepared: PreparedScene | None = None) -> SceneData:
-    """Build the kernel arrays for ``scene`` (area lights become emissive polygons), the
-    triangles' acceleration structure ``accel`` (:data:`.accel.ACCELS`) over the triangles.
+    """Build the kernel arrays for ``scene`` (area lights become emissive polygons) and the
+    acceleration structure ``accel`` (:data:`.accel.ACCELS`) over the triangles and over the
+    bounded analytic primitives (``bvh_build_time``: both).
 
     ``prepared``: the render's :class:`~workbench.scene.prepared.PreparedScene` of ``scene``
-    (its area lights and extent); built here when not given."""
+    (its area lights, extent and object boxes); built here when not given."""
     import time
     prepared = prepared if prepared is not None else prepare(scene)
     b = _Builder(scene)
+    owners = []  # first row of each top-level object and area light
     for i, o in enumerate(scene.objects):
+        owners.append(len(b.rows))
         b.leaf(o, i, np.eye(4), top=True)
     for k, polygon, mat in prepared.area_lights:
+        owners.append(len(b.rows))
         b.area_light(k, polygon, mat)
     rows = b.rows
 
@@ -217,6 +253,9 @@ def flatten(scene: m.Scene, accel: str = "bvh", prepared: PreparedScene | None =
                                               (tri_v, tri_n, tri_uv, tri_e, tri_p))
     else:
         bvh = empty_bvh4()
+    finite = prepared.bounds if np.isfinite(prepared.bounds).all() else np.zeros((1, 3))
+    scale = max(float(np.abs(finite).max()), prepared.extent, float(np.abs(scene.camera.position).max()))
+    prims = _prim_tree(rows, owners, _owner_boxes(prepared), accel, scale)
     bvh_time = time.perf_counter() - t0
     mat_tab = np.stack([_material_row(mt, i in b.front_only) for i, mt in enumerate(b.materials)])
     return SceneData(
@@ -229,7 +268,7 @@ def flatten(scene: m.Scene, accel: str = "bvh", prepared: PreparedScene | None =
         poly_v=np.ascontiguousarray(np.concatenate(b.poly_v) if b.poly_v else np.zeros((1, 3))),
         csg_prog=np.array(b.prog if b.prog else [0], dtype=np.int64),
         tri_v=tri_v, tri_n=tri_n, tri_uv=tri_uv, tri_e=tri_e, tri_prim=tri_p,
-        bvh=bvh,
+        bvh=bvh, prims=prims,
         materials=b.materials, mat_tab=np.ascontiguousarray(mat_tab),
         lights=np.ascontiguousarray(light_rows(scene.point_lights()).reshape(-1, 14)),
         extent=prepared.extent, n_objects=len(scene.objects), bvh_build_time=bvh_time,

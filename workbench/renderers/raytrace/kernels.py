@@ -652,38 +652,138 @@ def bvh_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
 
 
 @nb.njit(error_model="numpy", inline="always")
+def row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, zero, eps, stack, st, sp_, sf, sn):
+    """Closest hit ``tmin < t < tmax`` of top-level analytic primitive row ``k`` (a CSG node
+    evaluates its program) for the world ray.  Returns ``(t, prim, face)``: ``prim`` the row
+    hit (a CSG leaf's own row), ``face + 16`` for a flipped CSG normal; ``t = inf`` on a miss."""
+    (ptype, top, xf, nm, par, solid, shadow, poly_v, prog, tri_v, tri_n, tri_uv, tri_e,
+     tri_prim, bvh_node, bvh_child, bvh_leaf, bvh_first, bvh_tv4, bvh_bounds, ident, aux,
+     pfree, pnode, pchild, pleaf, pref, pbounds) = geo
+    if ident[k]:  # object space is world space: no transform, the world unit direction
+        lo = (ox, oy, oz, dx, dy, dz)
+        inv_s = inv_w
+    else:
+        lo = _to_object(xf, k, ox, oy, oz, dx, dy, dz)
+        inv_s = 1.0 / math.sqrt(lo[3] * lo[3] + lo[4] * lo[4] + lo[5] * lo[5])
+    if ptype[k] == CSGNODE:
+        t, code, f = csg_hit(int(par[k, 0]), int(par[k, 1]), prog, ptype, xf, par, aux, ox, oy, oz,
+                             dx, dy, dz, tmin, tmax, zero, eps, st, sp_, sf, sn, stack)
+        return t, abs(code) - 1, f + (16 if code < 0 else 0)
+    t, f = prim_hit(k, ptype, par, poly_v, aux, lo[0], lo[1], lo[2], lo[3], lo[4], lo[5],
+                    lo[3] * inv_s, lo[4] * inv_s, lo[5] * inv_s, inv_s, tmin, tmax, zero,
+                    st[0], sf[0], stack)
+    return t, k, f
+
+
+PRIM_STACK_BASE = max(BVH_STACK, MAX_STACK)
+"""First row of the scratch stack used by the analytic primitives' traversal
+(:func:`prim_tree_hit`): rows below it stay free for an isosurface's expression evaluator,
+which runs inside that traversal."""
+
+
+@nb.njit(**NO_REFCOUNT)
+def prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero, eps,
+                  stack, st, sp_, sf, sn):
+    """Closest hit through the analytic primitives' 4-wide tree (:class:`.accel.PrimTree`;
+    traversal as :func:`bvh_hit`'s, one primitive row per leaf item).  ``best``: the nearest
+    hit so far (of row ``brow``, ``-1`` for none); a hit replaces it if nearer, or as near
+    and of a lower row (the brute-force loop's order).  Returns ``(t, prim, face, row)``,
+    ``row = -1`` if nothing replaced ``best``."""
+    return prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero,
+                          eps, stack, st, sp_, sf, sn, False, sn)
+
+
+@nb.njit(error_model="numpy", inline="always")
+def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero, eps,
+                   stack, st, sp_, sf, sn, count, cnt):
+    """:func:`prim_tree_hit`; with ``count`` (the traversal statistics' pass,
+    :mod:`.traversal_stats`) it adds the 4-wide nodes visited to ``cnt[0]`` and the primitive
+    tests to ``cnt[1]`` (the rendering kernels pass ``False``: no counting)."""
+    (ptype, top, xf, nm, par, solid, shadow, poly_v, prog, tri_v, tri_n, tri_uv, tri_e,
+     tri_prim, bvh_node, bvh_child, bvh_leaf, bvh_first, bvh_tv4, bvh_bounds, ident, aux,
+     pfree, pnode, pchild, pleaf, pref, pbounds) = geo
+    ix, iy, iz = 1.0 / dx, 1.0 / dy, 1.0 / dz
+    cx = 0 if ix >= 0.0 else 3
+    cy = 1 if iy >= 0.0 else 4
+    cz = 2 if iz >= 0.0 else 5
+    pl = (np.uint64(cx), np.uint64(cy), np.uint64(cz), np.uint64(3 - cx), np.uint64(5 - cy), np.uint64(7 - cz))
+    bp, bf, found = -1, 0, -1
+    base = PRIM_STACK_BASE
+    top_ = stack.shape[0] - 1
+    code, sp = 0, base
+    while True:
+        while code >= 0:
+            if count:
+                cnt[0] += 1
+            nd = np.uint64(code)
+            t0 = box_lane(pnode, nd, 0, pl, ox, oy, oz, ix, iy, iz, tmin, best)
+            t1 = box_lane(pnode, nd, 1, pl, ox, oy, oz, ix, iy, iz, tmin, best)
+            t2 = box_lane(pnode, nd, 2, pl, ox, oy, oz, ix, iy, iz, tmin, best)
+            t3 = box_lane(pnode, nd, 3, pl, ox, oy, oz, ix, iy, iz, tmin, best)
+            b0, code, tn = sp, -1, np.inf
+            if t0 < np.inf:
+                code, tn = pchild[nd, 0], t0
+            if t1 < np.inf:
+                sp, code, tn = _visit_child(stack, b0, sp, top_, t1, pchild[nd, 1], code, tn)
+            if t2 < np.inf:
+                sp, code, tn = _visit_child(stack, b0, sp, top_, t2, pchild[nd, 2], code, tn)
+            if t3 < np.inf:
+                sp, code, tn = _visit_child(stack, b0, sp, top_, t3, pchild[nd, 3], code, tn)
+        if code < -1:
+            lf = -2 - code
+            for q in range(pleaf[lf, 0], pleaf[lf, 0] + pleaf[lf, 1]):
+                k = pref[q]
+                if shadow_only and not shadow[k]:
+                    continue
+                if count:
+                    cnt[1] += 1
+                # up to and including best: a tie goes to the lower row
+                t, p, f = row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, np.nextafter(best, np.inf),
+                                  zero, eps, stack, st, sp_, sf, sn)
+                if t < best or (t == best and k < brow):
+                    best, bp, bf, brow, found = t, p, f, k, k
+                    if any_hit:
+                        return best, bp, bf, found
+        code = -1
+        while sp > base:
+            sp -= 1
+            if stack[sp, 0] <= best:
+                code = int(stack[sp, 1])
+                break
+        if code == -1:
+            break
+    return best, bp, bf, found
+
+
+@nb.njit(error_model="numpy", inline="always")
 def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
             st, sp_, sf, sn):
-    """Nearest hit of a world ray over all primitives (linear loop over analytic primitives,
-    BVH over triangles).  Returns ``(t, prim, face, tri, b1, b2)``; ``prim = -1`` on a miss,
+    """Nearest hit of a world ray over all primitives: the list of analytic primitives tested
+    one by one, then the analytic primitives' structure, then the triangles' (see
+    :mod:`.accel`).  Returns ``(t, prim, face, tri, b1, b2)``; ``prim = -1`` on a miss,
     negative ``face`` is never returned (a flipped CSG normal is ``face + 16``)."""
     (ptype, top, xf, nm, par, solid, shadow, poly_v, prog, tri_v, tri_n, tri_uv, tri_e,
-     tri_prim, bvh_node, bvh_child, bvh_leaf, bvh_first, bvh_tv4, bvh_bounds, ident, aux) = geo
+     tri_prim, bvh_node, bvh_child, bvh_leaf, bvh_first, bvh_tv4, bvh_bounds, ident, aux,
+     pfree, pnode, pchild, pleaf, pref, pbounds) = geo
     best, bp, bf, btri, bb1, bb2 = tmax, -1, 0, -1, 0.0, 0.0
+    brow = -1
     inv_w = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
-    for k in range(ptype.shape[0]):
-        if not top[k] or (shadow_only and not shadow[k]):
+    for q in range(pfree.shape[0]):
+        k = pfree[q]
+        if shadow_only and not shadow[k]:
             continue
-        if ident[k]:  # object space is world space: no transform, the world unit direction
-            lo = (ox, oy, oz, dx, dy, dz)
-            inv_s = inv_w
-        else:
-            lo = _to_object(xf, k, ox, oy, oz, dx, dy, dz)
-            inv_s = 1.0 / math.sqrt(lo[3] * lo[3] + lo[4] * lo[4] + lo[5] * lo[5])
-        if ptype[k] == CSGNODE:
-            t, code, f = csg_hit(int(par[k, 0]), int(par[k, 1]), prog, ptype, xf, par, aux, ox, oy, oz,
-                                 dx, dy, dz, tmin, best, zero, eps, st, sp_, sf, sn, stack)
-            if t < best:
-                best, bp, bf = t, abs(code) - 1, f + (16 if code < 0 else 0)
-                btri = -1
-        else:
-            t, f = prim_hit(k, ptype, par, poly_v, aux, lo[0], lo[1], lo[2], lo[3], lo[4], lo[5],
-                            lo[3] * inv_s, lo[4] * inv_s, lo[5] * inv_s, inv_s, tmin, best, zero,
-                            st[0], sf[0], stack)
-            if t < best:
-                best, bp, bf, btri = t, k, f, -1
+        t, p, f = row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, zero, eps, stack, st, sp_, sf, sn)
+        if t < best:
+            best, bp, bf, brow = t, p, f, k
         if any_hit and bp >= 0:
             return best, bp, bf, btri, bb1, bb2
+    if pref.shape[0] > 0 and _bounds_hit(pbounds, ox, oy, oz, dx, dy, dz, tmin, best):
+        t, p, f, row = prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only,
+                                     np.bool_(any_hit), zero, eps, stack, st, sp_, sf, sn)
+        if row >= 0:
+            best, bp, bf = t, p, f
+            if any_hit:
+                return best, bp, bf, btri, bb1, bb2
     if tri_v.shape[0] > 0 and _bounds_hit(bvh_bounds, ox, oy, oz, dx, dy, dz, tmin, best):
         # np.bool_: a runtime flag, not a literal True/False (one compiled bvh_hit for all)
         t, tri, b1, b2 = bvh_hit((bvh_node, bvh_child, bvh_leaf, bvh_first, bvh_tv4),
@@ -739,7 +839,8 @@ def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_
     mapping to the texturing module), object-space point and vertex emission at a hit, written
     to row ``i`` of the output arrays (``stack``: scratch of an isosurface's gradient)."""
     (ptype, top, xf, nm, par, solid, shadow, poly_v, prog, tri_v, tri_n, tri_uv, tri_e,
-     tri_prim, bvh_node, bvh_child, bvh_leaf, bvh_first, bvh_tv4, bvh_bounds, ident, aux) = geo
+     tri_prim, bvh_node, bvh_child, bvh_leaf, bvh_first, bvh_tv4, bvh_bounds, ident, aux,
+     pfree, pnode, pchild, pleaf, pref, pbounds) = geo
     x = xf[k, 0] * px + xf[k, 1] * py + xf[k, 2] * pz + xf[k, 3]
     y = xf[k, 4] * px + xf[k, 5] * py + xf[k, 6] * pz + xf[k, 7]
     z = xf[k, 8] * px + xf[k, 9] * py + xf[k, 10] * pz + xf[k, 11]
@@ -780,11 +881,13 @@ def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_
 # ----------------------------------------------------------------------------- batch kernels
 @nb.njit(error_model="numpy", inline="always")
 def scratch():
-    """Per-thread work arrays of :func:`closest`: the BVH traversal stack (rows: entry distance,
-    child code: a 4-wide node or a leaf; also the operand stack (rows: value, gradient) of an
-    isosurface's expression, which is never evaluated during a traversal) and the CSG stack of
-    interval lists (times, signed primitive codes, faces, counts)."""
-    return (np.empty((max(BVH_STACK, MAX_STACK), 4)), np.empty((CSG_DEPTH, CSG_EVENTS)),
+    """Per-thread work arrays of :func:`closest`: the traversal stack (rows: entry distance,
+    child code: a 4-wide node or a leaf; the triangles' traversal uses it from row 0, the
+    analytic primitives' from row :data:`PRIM_STACK_BASE`, and the rows below that are also
+    the operand stack (rows: value, gradient) of an isosurface's expression, evaluated inside
+    the primitives' traversal, never inside the triangles') and the CSG stack of interval
+    lists (times, signed primitive codes, faces, counts)."""
+    return (np.empty((PRIM_STACK_BASE + BVH_STACK, 4)), np.empty((CSG_DEPTH, CSG_EVENTS)),
             np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64),
             np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64), np.empty(CSG_DEPTH, dtype=np.int64))
 

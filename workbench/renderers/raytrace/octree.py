@@ -233,8 +233,16 @@ def build_octree(tri_v: np.ndarray) -> tuple[np.ndarray, tuple]:
     for a in range(3):
         c = tri_v[:, a::3]
         tb[:, a], tb[:, 3 + a] = c.min(1), c.max(1)
+    return build_box_octree(tb)
+
+
+def build_box_octree(tb: np.ndarray) -> tuple[np.ndarray, tuple]:
+    """The octree of items given by their boxes ``tb`` (T, 6) (min xyz, max xyz), T >= 1: the
+    triangles' boxes, or the analytic primitives' world bounds.  Returns ``refs`` (R,) (the
+    item of each reference) and the tree, as :func:`build_octree`."""
+    tb = np.ascontiguousarray(tb, dtype=np.float64)
     lo, hi = tb[:, :3].min(0), tb[:, 3:].max(0)
     side = float((hi - lo).max())
     root_hi = np.maximum(lo + side, hi)  # a cube, unless rounding left lo + side short of hi
-    cell_box, kids, rng, refs = _cells(tb, lo, root_hi, MAX_LEAF, MAX_DEPTH, REF_FACTOR * len(tri_v))
+    cell_box, kids, rng, refs = _cells(tb, lo, root_hi, MAX_LEAF, MAX_DEPTH, REF_FACTOR * len(tb))
     return refs, _layout(cell_box, kids, rng)

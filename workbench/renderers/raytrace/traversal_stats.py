@@ -1,30 +1,38 @@
-"""Traversal statistics of the triangles' acceleration structure (option ``traversal_stats``):
+"""Traversal statistics of the acceleration structures, the triangles' and the analytic
+primitives' (option ``traversal_stats``):
 nodes visited and primitives tested per camera ray, counted in a pass of their own so that
 the rendering kernels carry no counters (their speed is untouched; the pass costs about one
 more trace of the pixel centres and is timed apart, ``timings["traversal_stats"]``).
 
 :func:`count_hit` is :func:`.kernels.bvh_hit` (closest hit) step for step with two counters:
 the same box and triangle tests in the same order, so it returns the same hit (tested) and
-its counts are the real traversal's.  Counting rules, per ray:
+its counts are the real traversal's; the analytic primitives' tree is walked by the rendering
+kernels' own :func:`.kernels.prim_tree_walk` with its counting switched on.  Counting rules,
+per ray and per structure (the triangles', the analytic primitives'):
 
 * nodes: 1 for the structure's root box (:func:`.kernels.closest`'s bounds test), plus one
   per further 4-wide node whose children's boxes the ray tests (the root's own visit is the
   bounds test's: a ray that misses the root box visits 1 node, one that enters it visits the
-  root and the nodes it goes on to).  Rays that meet no triangle box are counted too.
+  root and the nodes it goes on to).  Rays that meet no box are counted too.  A scene without
+  triangles counts the triangles' 1; without a tree of analytic primitives (``accel=none``,
+  or every primitive unbounded), nothing for it.
 * triangle tests: four per leaf group tested (a group's lanes are tested side by side; a
   group of fewer than four triangles repeats its last one).
-* primitive tests: the triangle tests plus one per top-level analytic primitive (every ray
-  tests each of them, whatever the structure).
+* analytic tests: one per primitive of the list (tested by every ray) and one per primitive
+  of a leaf of the tree the ray visits (a primitive referenced by several octree cells is
+  counted at each).
 """
 from __future__ import annotations
+
+import math
 
 import numba as nb
 import numpy as np
 from numba import prange
 
 from ...core.tol import tol
-from .kernels import (CHUNK, NO_REFCOUNT, _bounds_hit, _tasks, _visit_child, box_lane, closest, scratch,
-                      tri_lane)
+from .kernels import (CHUNK, NO_REFCOUNT, _bounds_hit, _tasks, _visit_child, box_lane, prim_tree_walk, row_hit,
+                      scratch, tri_lane)
 
 
 @nb.njit(**NO_REFCOUNT)
@@ -101,12 +109,27 @@ def count_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, stack, cnt):
 @nb.njit(**NO_REFCOUNT)
 def _count_chunk(geo_analytic, bvh, bounds, has_tri, O, D, zero, rel_eps, extent, counts, i0, i1, scr):
     stack, st, sp_, sf, sn = scr
+    free, pref, pbounds = geo_analytic[22], geo_analytic[26], geo_analytic[27]
     for i in range(i0, i1):
         ox, oy, oz, dx, dy, dz = O[i, 0], O[i, 1], O[i, 2], D[i, 0], D[i, 1], D[i, 2]
         eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
-        # the analytic primitives' nearest hit: the far end of the triangles' search
-        best = closest(geo_analytic, ox, oy, oz, dx, dy, dz, 0.0, np.inf, False, False, zero, eps,
-                       stack, st, sp_, sf, sn)[0]
+        inv_w = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
+        # the analytic primitives' nearest hit, as closest finds it (the list, then the
+        # tree), counted: it is the far end of the triangles' search
+        best, brow = np.inf, -1
+        counts[i, 2], counts[i, 3] = 0, 0
+        for q in range(free.shape[0]):
+            counts[i, 3] += 1
+            t, p, f = row_hit(geo_analytic, free[q], ox, oy, oz, dx, dy, dz, inv_w, 0.0, best, zero, eps,
+                              stack, st, sp_, sf, sn)
+            if t < best:
+                best, brow = t, free[q]
+        if pref.shape[0] > 0:
+            if _bounds_hit(pbounds, ox, oy, oz, dx, dy, dz, 0.0, best):
+                best = prim_tree_walk(geo_analytic, ox, oy, oz, dx, dy, dz, inv_w, 0.0, best, brow, False, False,
+                                      zero, eps, stack, st, sp_, sf, sn, True, counts[i, 2:])[0]
+            else:
+                counts[i, 2] = 1
         counts[i, 0], counts[i, 1] = 1, 0
         if has_tri and _bounds_hit(bounds, ox, oy, oz, dx, dy, dz, 0.0, best):
             counts[i, 0] = 0
@@ -115,9 +138,9 @@ def _count_chunk(geo_analytic, bvh, bounds, has_tri, O, D, zero, rel_eps, extent
 
 @nb.njit(cache=True, error_model="numpy", parallel=True)
 def count_rays(geo_analytic, bvh, bounds, has_tri, O, D, zero, rel_eps, extent, counts):
-    """Per ray ``counts[i] = (nodes visited, triangle tests)`` of the closest-hit search from
-    ``t = 0`` (see the module docstring); ``geo_analytic`` is the kernels' geometry tuple
-    without its triangles."""
+    """Per ray ``counts[i] = (triangle nodes visited, triangle tests, analytic nodes visited,
+    analytic primitive tests)`` of the closest-hit search from ``t = 0`` (see the module
+    docstring); ``geo_analytic`` is the kernels' geometry tuple without its triangles."""
     n = O.shape[0]
     nchunks = (n + CHUNK - 1) // CHUNK
     nit = _tasks(nchunks)
@@ -129,12 +152,13 @@ def count_rays(geo_analytic, bvh, bounds, has_tri, O, D, zero, rel_eps, extent, 
 
 
 def ray_counts(sd, O: np.ndarray, D: np.ndarray) -> np.ndarray:
-    """(N, 2) int64 nodes visited and triangle tests of each ray ``O + t D``, t >= 0, of the
-    flattened scene ``sd`` (:class:`.flatten.SceneData`)."""
+    """(N, 4) int64 per ray ``O + t D``, t >= 0, of the flattened scene ``sd``
+    (:class:`.flatten.SceneData`): nodes visited and tests in the triangles' structure, then
+    in the analytic primitives' (the list's primitives counted as tests)."""
     geo = list(sd.kernel_args())
     geo[9] = np.zeros((0, 9))  # tri_v: no triangles, the analytic primitives only
     b = sd.bvh
-    counts = np.zeros((len(O), 2), dtype=np.int64)
+    counts = np.zeros((len(O), 4), dtype=np.int64)
     count_rays(tuple(geo), (b.node, b.child, b.leaf, b.first, b.tv4), b.bounds, len(sd.tri_v) > 0,
                np.ascontiguousarray(O, dtype=np.float64), np.ascontiguousarray(D, dtype=np.float64),
                tol.zero, tol.ray_offset, sd.extent, counts)
@@ -142,12 +166,13 @@ def ray_counts(sd, O: np.ndarray, D: np.ndarray) -> np.ndarray:
 
 
 def primary_ray_counts(sd, O: np.ndarray, D: np.ndarray) -> dict:
-    """The render's ``stats`` entries from its camera rays ``O, D`` (N, 3): the means over the
-    rays of nodes visited (``accel_nodes_per_ray``), triangle tests
-    (``accel_triangle_tests_per_ray``) and primitive tests (``accel_primitive_tests_per_ray``:
-    triangle tests plus the top-level analytic primitives, each tested by every ray)."""
-    c = ray_counts(sd, O, D)
-    n_analytic = int(np.count_nonzero(sd.top))
-    return {"accel_nodes_per_ray": float(c[:, 0].mean()),
-            "accel_triangle_tests_per_ray": float(c[:, 1].mean()),
-            "accel_primitive_tests_per_ray": float(c[:, 1].mean() + n_analytic)}
+    """The render's ``stats`` entries from its camera rays ``O, D`` (N, 3), means over the
+    rays: nodes visited in both structures (``accel_nodes_per_ray``; the triangles' alone
+    ``accel_triangle_nodes_per_ray``, the analytic primitives' ``accel_analytic_nodes_per_ray``),
+    triangle tests (``accel_triangle_tests_per_ray``), analytic primitive tests
+    (``accel_analytic_tests_per_ray``) and both (``accel_primitive_tests_per_ray``)."""
+    c = ray_counts(sd, O, D).mean(axis=0)
+    return {"accel_nodes_per_ray": float(c[0] + c[2]),
+            "accel_triangle_nodes_per_ray": float(c[0]), "accel_analytic_nodes_per_ray": float(c[2]),
+            "accel_triangle_tests_per_ray": float(c[1]), "accel_analytic_tests_per_ray": float(c[3]),
+            "accel_primitive_tests_per_ray": float(c[1] + c[3])}

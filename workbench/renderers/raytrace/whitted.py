@@ -23,8 +23,9 @@ number of ray generations in a path, primary = 1, as the course's ``recurs_max``
 ``max_trace_level``), ``threshold`` (the course's perceptual threshold on the accumulated
 weight), ``spp`` (samples per pixel, stratified jitter, seeded by ``seed``), ``fresnel``
 (``none``: constant k_r, k_t; ``schlick``; ``exact`` dielectric), ``transmissive_shadows``,
-``blinn``, ``progress`` (tqdm bar), ``on_tile``, ``accel`` (the triangles' acceleration
-structure: ``bvh``, ``octree`` or ``none``, :mod:`.accel`) and ``traversal_stats`` (nodes visited
+``blinn``, ``progress`` (tqdm bar), ``on_tile``, ``accel`` (the acceleration
+structure over triangles and bounded analytic primitives: ``bvh``, ``octree`` or ``none``,
+:mod:`.accel`) and ``traversal_stats`` (nodes visited
 and primitives tested per camera ray, :mod:`.traversal_stats`).
 
 ``on_tile(y0, y1, x0, x1, tile)`` is called from the rendering thread after each band with
@@ -639,8 +640,9 @@ _COMMON = {
     "fresnel": Option(str, "none", "reflection/transmission split: none (constant kr, kt), schlick or exact dielectric", ("none", "schlick", "exact")),
     "progress": Option(bool, False, "show a tqdm progress bar (CLI)"),
     "on_tile": Option(_callback, None, "callback on_tile(y0, y1, x0, x1, tile) after each band of rows"),
-    "accel": Option(str, "bvh", "acceleration structure over the triangles: bvh (4-wide binned SAH), octree "
-                    "(the course's arbre octal) or none (every triangle tested); same images", ACCELS),
+    "accel": Option(str, "bvh", "acceleration structure over the triangles and the bounded analytic "
+                    "primitives: bvh (4-wide binned SAH), octree (the course's arbre octal) or none (every "
+                    "triangle and primitive tested); same images", ACCELS),
     "traversal_stats": Option(bool, False, "count nodes visited and primitives tested per pixel-centre "
                               "camera ray (stats accel_*; a pass of its own, timed apart)"),
 }

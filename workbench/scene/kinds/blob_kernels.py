@@ -174,13 +174,18 @@ def blob_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out, cap):
         if e1 > lo_t:
             tm = 0.5 * (e0 + e1)
             p0, p1, p2, p3, p4 = _interval_quartic(aux, off, n, T, ox, oy, oz, ux, uy, uz, tm)
-            a, b = max(e0, lo_t) - tm, min(e1, hi_t) - tm
+            # the root search spans the interval up to its chord end whatever tmax is, so that
+            # a root does not depend on tmax (the ray tracer's structures test primitives in
+            # different orders, with different tmax, and must find the same t)
+            a, b = max(e0, lo_t) - tm, e1 - tm
             while m < cap:
                 v = _quartic_change(p0, p1, p2, p3, p4, a, b)
                 if v == np.inf:
                     break
                 t = tm + v
-                if t > lo_t and t < hi_t:
+                if not t < hi_t:  # so are the interval's next roots
+                    break
+                if t > lo_t:
                     out[m] = t / s
                     m += 1
                 a = v
