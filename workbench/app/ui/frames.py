@@ -197,14 +197,15 @@ class ScreenBlits:
     gui is done (``before_imgui_render``).  ``last`` lists (name, item rectangle) drawn by
     the last flush (tests compare them with screenshots)."""
 
-    def __init__(self, ctx, passes: DisplayPasses):
-        self.ctx, self.passes = ctx, passes
+    def __init__(self, ctx):
+        self.ctx = ctx
         self.queue: list[tuple] = []
         self.last: list[tuple[str, tuple]] = []
 
     def show(self, name: str, image: tuple, size, uv0, uv1) -> None:
-        """An item of ``size`` showing the (u, v) window [uv0, uv1] of ``image`` = (pass
-        name, {sampler: texture}, {uniform: value}, image size (w, h)), row 0 on top."""
+        """An item of ``size`` showing the (u, v) window [uv0, uv1] of ``image`` = (draw,
+        image size (w, h)), row 0 on top, ``draw(origin, texels_per_pixel)`` its pass into
+        the bound window framebuffer (as :meth:`DisplayPasses.to_window` takes them)."""
         from imgui_bundle import imgui
         imgui.dummy(size)
         if imgui.is_item_visible():
@@ -230,7 +231,7 @@ class ScreenBlits:
         for name, image, (x0, y0, x1, y1), (u0, v0), (u1, v1), (cx0, cy0, cx1, cy1) in self.queue:
             if cx1 <= cx0 or cy1 <= cy0:
                 continue
-            pass_name, inputs, uniforms, (w, h) = image
+            draw, (w, h) = image
             a0, a1, b0, b1 = u0 * w, u1 * w, v0 * h, v1 * h
             ia0, ia1, ib0, ib1 = math.floor(a0), math.ceil(a1), math.floor(b0), math.ceil(b1)
             kx, ky = (x1 - x0) / (a1 - a0), (y1 - y0) / (b1 - b0)  # window pixels per texel
@@ -244,8 +245,7 @@ class ScreenBlits:
             Y0, Y1 = round(fb_h - dy0 * sy), round(fb_h - dy1 * sy)
             if X1 == X0 or Y1 == Y0:
                 continue
-            self.passes.to_window(pass_name, inputs, (ia0, ib0, X0, Y0),
-                                  ((ia1 - ia0) / (X1 - X0), (ib1 - ib0) / (Y1 - Y0)), **uniforms)
+            draw((ia0, ib0, X0, Y0), ((ia1 - ia0) / (X1 - X0), (ib1 - ib0) / (Y1 - Y0)))
             self.last.append((name, (x0, y0, x1, y1)))
         self.queue = []
         self.ctx.scissor = None
@@ -312,8 +312,7 @@ def gpu(state: AppState) -> PanelGPU:
     """``state.gpu``, created on first use in the window's context."""
     if state.gpu is None:
         from .display_modes import ModeDisplay
-        passes = DisplayPasses(state.ctx)
-        state.gpu = PanelGPU(passes, ScreenBlits(state.ctx, passes),
+        state.gpu = PanelGPU(DisplayPasses(state.ctx), ScreenBlits(state.ctx),
                              modes=ModeDisplay(state.ctx, getattr(state.jobs, "notify", None)))
     return state.gpu
 
@@ -707,14 +706,30 @@ def show_panel(state: AppState, method: str, size, uv0=(0.0, 0.0), uv1=(1.0, 1.0
     copying it were two); an image that stays is encoded once into its display texture
     (:func:`panel_texture`), which is then copied (cheaper than encoding every frame), as is
     the display texture of any other mode."""
-    if state.display.get(method, "direct24") == "direct24" and changing(state, method):
-        gpu(state).modes.forget(method)
+    g = gpu(state)
+    mode = state.display.get(method, "direct24")
+    image = None
+    if changing(state, method):
         source, flip = linear_source(state, method)
-        image = ("srgb", {"u_linear": source}, {"u_flip": int(flip)}, source.size)
-    else:
+        if mode == "direct24":
+            g.modes.forget(method)
+            image = (lambda o, k: g.passes.to_window("srgb", {"u_linear": source}, o, k,
+                                                     u_flip=int(flip)), source.size)
+        else:
+            todo = g.modes.step(method, state.images.version(method), mode,
+                                lambda: state.images[method], method in state.textures)
+            if todo is not None and todo[0] == "pass":
+                # the mode's GPU view drawn into the window; its display texture is made once
+                # the image stays (the next frame that shows the same image)
+                g.modes.shown.pop(method, None)
+                image = (lambda o, k: g.modes.to_window(source, flip, *todo[1:], o, k),
+                         source.size)
+            elif todo is not None:
+                upload_linear(state, method, todo[1])
+    if image is None:
         tex = panel_texture(state, method)
-        image = ("copy", {"u_image": tex}, {}, tex.size)
-    gpu(state).blits.show(method, image, size, uv0, uv1)
+        image = (lambda o, k: g.passes.to_window("copy", {"u_image": tex}, o, k), tex.size)
+    g.blits.show(method, image, size, uv0, uv1)
 
 
 def show_difference(state: AppState, size, uv0=(0.0, 0.0), uv1=(1.0, 1.0)) -> None:
@@ -726,11 +741,12 @@ def show_difference(state: AppState, size, uv0=(0.0, 0.0), uv1=(1.0, 1.0)) -> No
     if (changing(state, "difference") and held is not None
             and held[0] == state.images.version("difference")):
         values, table, stats = held[1:]
-        image = ("colour_map", {"u_value": values, "u_table": table, "u_stats": stats},
-                 {"u_floor": SCALE_FLOOR}, values.size)
+        inputs = {"u_value": values, "u_table": table, "u_stats": stats}
+        image = (lambda o, k: g.passes.to_window("colour_map", inputs, o, k, u_floor=SCALE_FLOOR),
+                 values.size)
     else:
         tex = shown_texture(state, "difference")
-        image = ("copy", {"u_image": tex}, {}, tex.size)
+        image = (lambda o, k: g.passes.to_window("copy", {"u_image": tex}, o, k), tex.size)
     g.blits.show("difference", image, size, uv0, uv1)
 
 

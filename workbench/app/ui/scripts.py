@@ -345,7 +345,7 @@ class DragCheck:
 
     def _texture(self, state: AppState, m: str) -> np.ndarray:
         h, w = state.camera.height, state.camera.width
-        return np.frombuffer(state.textures[m].read(), np.uint8).reshape(h, w, -1)[..., :3]
+        return np.frombuffer(shown_texture(state, m).read(), np.uint8).reshape(h, w, -1)[..., :3]
 
     def __call__(self, state: AppState) -> None:
         from ...core.display import apply_display_mode
@@ -368,10 +368,13 @@ class DragCheck:
                 probe = {m: [state.images.pixel(m, i, j, (h, w)).tolist() for i, j in pixels]
                          for m in state.methods}
                 shown = state.images["raytrace"]
+                # the display textures first (during a drag the window draws the panels
+                # without them; made here through the same mode pass), then what they hold
+                colours = {m: int(len(np.unique(self._texture(state, m).reshape(-1, 3), axis=0)))
+                           for m in self._gl(state)}
                 self.log["drag"].append({
                     "kinds": {m: md.shown[m][2] for m in self._gl(state)},
-                    "colours": {m: int(len(np.unique(self._texture(state, m).reshape(-1, 3), axis=0)))
-                                for m in self._gl(state)},
+                    "colours": colours,
                     "exact_started": md.started - self.started0,
                     "raytrace_kept": bool(np.array_equal(shown, self.before)),
                     "probe": probe,
@@ -597,21 +600,26 @@ class GpuPanels:
 class DragRest:
     """A camera drag of ``frames`` frames (the camera orbits every frame, so the GL panels
     draw every frame without waiting for their draws and are drawn into the window straight
-    from their linear images), then rest.  In the first frame at rest (the window then shows
+    from their linear images, through the display mode ``display`` sets for some), then rest.  In the first frame at rest (the window then shows
     the drag's last frame) it saves the X server's picture of the window (``drag_screen.png``),
     the panel and difference rectangles of the last drag frame, each GL panel's linear image
     (``image_M.npy``) and the camera; in the second it logs each GL panel's draws (the drag's,
     and one timed draw at rest) and times, and quits (``ui.png``: the
     rested window, the panels copied from their display textures)."""
 
-    def __init__(self, out: Path, frames: int = 6, step: float = 0.05):
+    def __init__(self, out: Path, frames: int = 6, step: float = 0.05,
+                 display: dict[str, str] | None = None):
         self.out, self.frames, self.step, self.log = out, frames, step, {}
+        self.display = display or {}
 
     def __call__(self, state: AppState) -> None:
         from . import screenshot
         from .glfw_title import window_title
         f, last = state.frame, 2 + self.frames
         gl = [m for m in state.methods if method_kind(state, m) == "gl"]
+        if f == 0:
+            for m, mode in self.display.items():
+                set_display(state, m, mode)
         if f == 2:
             self.draws0 = {m: state.gpu.raster[m].draws for m in gl}
         if 2 <= f < last:
@@ -778,7 +786,7 @@ SCRIPTS = {"check": Check, "features": Features, "radiosity": Radiosity, "pyrend
            "fps_indexed": lambda out: Fps(out, display="indexed16-kmeans-fs"),
            "drag_check": DragCheck, "export_check": ExportCheck, "screens": Screens,
            "fps_static": lambda out: Fps(out, step=0.0, raytrace_spp=16, wait_cpu=True),
-           "gpu_panels": GpuPanels, "slider_frames": SliderFrames, "drag_rest": DragRest,
+           "gpu_panels": GpuPanels, "slider_frames": SliderFrames, "drag_rest": lambda out: DragRest(out, display={"gouraud": "direct16-565-bayer"}),
            "fps_material_drag": lambda out: SliderFps(out, "material"),
            "fps_slider_drag": lambda out: SliderFps(out, "material+light"),
            "layout": Layout, "idle": Idle, "idle_quick": lambda out: Idle(out, seconds=3.0),
