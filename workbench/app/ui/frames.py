@@ -13,10 +13,17 @@
 * Every panel's linear image has a GPU copy (:func:`linear_source`: a raster panel's
   framebuffer, else a float texture uploaded once per change of the image) and reaches the
   screen through GPU passes (:class:`DisplayPasses`, ``shaders/display*``): sRGB encoding
-  (IEC 61966-2-1, the numbers of :func:`workbench.core.imageio.to_srgb8`) into an RGBA8
-  texture, and the difference view's ``"abs"`` map and colour scale.  These textures are
-  copied into the window's framebuffer under imgui's drawing (:class:`ScreenBlits`), not
-  drawn by imgui as quads.
+  (IEC 61966-2-1, the numbers of :func:`workbench.core.imageio.to_srgb8`), and the
+  difference view's ``"abs"`` map, its maximum and mean reduced on the GPU, and colour
+  scale.  They draw into the window's framebuffer under imgui's drawing
+  (:class:`ScreenBlits`), not drawn by imgui as quads: straight from the linear image while
+  it changes, from an RGBA8 display texture made once when it stays.
+* During a drag (a panel drawn in consecutive frames) the frame does not wait for the GPU
+  where it need not: no ``glFinish`` after a panel's draw (it is timed once the camera
+  rests, by one more draw of the same image: :func:`timed_draw`) and no read-back for the
+  difference view's colour scale (its numbers are read one frame later:
+  :func:`take_gpu_stats`).  llvmpipe itself still waits where a pass reads a panel whose
+  draw is not done.
 * Pixels come back to the CPU only when asked for: ``state.images[m]`` of a raster panel is a
   pending read (:class:`~.images.PanelImages`), resolved once per draw by the probe, the
   difference view, the export or a script.
@@ -178,34 +185,86 @@ class DisplayPasses:
 
 
 class ScreenBlits:
-    """Big images (the panels, the difference view) drawn straight into the window's
-    framebuffer under imgui's drawing, each by the display pass that makes it
-    (:meth:`DisplayPasses.to_window`: a linear image sRGB-encoded, the difference's colour map,
-    or a display texture copied), scaled to its item's rectangle as a nearest blit would.
+    """Big images (the panels, the difference view) put straight into the window's
+    framebuffer under imgui's drawing, scaled to their item's rectangle as a nearest blit:
 
-    Not imgui's textured, blended quads: on llvmpipe a 512 x 512 quad costs a shaded and
-    blended fragment per pixel (4 panels: ~5.5 ms against ~0.4 ms for blits, measured in a
-    standalone context).  Not ``glBlitFramebuffer`` of RGBA8 display textures either, as
-    before: encoding each changed image into its texture and then blitting it cost
-    llvmpipe ~4 ms per 512 x 384 panel where one pass into the window costs ~1.3 (three
-    panels of a drag: 44.5 against 25.8 ms of CPU with their draws, ``bench/ui_drag_profile.py``
-    and README); display textures are now made only when asked for (:func:`shown_texture`).
+    * while an image changes (a drag), drawn by the display pass that makes it
+      (:meth:`DisplayPasses.to_window`: a linear image sRGB-encoded, a display mode's GPU
+      view, the difference's colour map): one pass where encoding into an RGBA8 display
+      texture and blitting that were two;
+    * an image that stays is encoded once into its display texture, which is then copied by
+      ``glBlitFramebuffer`` each frame (3 panels: 8.5 ms of CPU against 10.2 for a copying
+      pass, ``display_copy.frag``, used where the window's GLFW gives no
+      ``glBlitFramebuffer``; ``bench/ui_frame_gpu.py``'s context at a load of 10).
+
+    Not imgui's textured, blended quads: on llvmpipe a shaded and blended fragment per pixel
+    (4 panels: ~5.5 ms against ~0.4 ms for blits, measured in a standalone context).
+    Scripts and tests read display textures through :func:`shown_texture`.
 
     :meth:`show` stands in for ``imgui.image`` (an empty item of the same size, so hovering,
-    the probe and the mouse work as before) and queues the draw, clipped to what imgui would
+    the probe and the mouse work as before) and queues the image, clipped to what imgui would
     show of the item (its window's clip rectangle); :meth:`flush` draws the queue once the
-    gui is done (``before_imgui_render``).  ``last`` lists (name, item rectangle) drawn by
-    the last flush (tests compare them with screenshots)."""
+    gui is done (``before_imgui_render``), so imgui's popups and floating windows still draw
+    over the panels.  ``last`` lists (name, item rectangle) drawn by the last flush (tests
+    compare them with screenshots)."""
 
-    def __init__(self, ctx):
-        self.ctx = ctx
+    def __init__(self, ctx, passes: DisplayPasses):
+        import ctypes
+        from pathlib import Path
+
+        import imgui_bundle
+        self.ctx, self.passes = ctx, passes
         self.queue: list[tuple] = []
         self.last: list[tuple[str, tuple]] = []
+        self.read_fbos: dict[int, object] = {}
+        try:
+            glfw = ctypes.CDLL(str(Path(imgui_bundle.__file__).parent / "libglfw.so.3"))
+            glfw.glfwGetProcAddress.restype = ctypes.c_void_p
+            glfw.glfwGetProcAddress.argtypes = [ctypes.c_char_p]
+            bind = glfw.glfwGetProcAddress(b"glBindFramebuffer")
+            blit = glfw.glfwGetProcAddress(b"glBlitFramebuffer")
+        except (OSError, AttributeError):
+            bind = blit = None
+        u, i = ctypes.c_uint, ctypes.c_int
+        self.bind = ctypes.CFUNCTYPE(None, u, u)(bind) if bind else None
+        self.blit = ctypes.CFUNCTYPE(None, i, i, i, i, i, i, i, i, u, u)(blit) if blit else None
+
+    @staticmethod
+    def drawn(draw, size: tuple[int, int]) -> tuple:
+        """An image (for :meth:`show`) of ``size`` (w, h) drawn by ``draw(origin,
+        texels_per_pixel)``, a pass into the bound window framebuffer as
+        :meth:`DisplayPasses.to_window` takes them."""
+        def run(src, dst):
+            (s0, t0, s1, t1), (x0, y0, x1, y1) = src, dst
+            draw((s0, t0, x0, y0), ((s1 - s0) / (x1 - x0), (t1 - t0) / (y1 - y0)))
+        return run, size
+
+    def copied(self, texture) -> tuple:
+        """An image (for :meth:`show`) that is ``texture`` (a display texture, row 0 on top)
+        as it is."""
+        if self.blit is None:
+            return self.drawn(lambda o, k: self.passes.to_window("copy", {"u_image": texture}, o, k),
+                              texture.size)
+
+        def run(src, dst):
+            self.bind(0x8CA8, self._read_fbo(texture).glo)  # GL_READ_FRAMEBUFFER
+            self.bind(0x8CA9, 0)  # GL_DRAW_FRAMEBUFFER: the window's
+            self.blit(*src, *dst, 0x4000, 0x2600)  # GL_COLOR_BUFFER_BIT, GL_NEAREST
+            self.blitted.add(texture.glo)
+        return run, texture.size
+
+    def _read_fbo(self, texture):
+        from ...renderers import gl
+        fbo = self.read_fbos.get(texture.glo)
+        if fbo is None or fbo.color_attachments[0] is not texture:  # new, or a reused name
+            if fbo is not None:
+                gl.release_framebuffer(fbo)
+            fbo = self.read_fbos[texture.glo] = self.ctx.framebuffer(color_attachments=[texture])
+        return fbo
 
     def show(self, name: str, image: tuple, size, uv0, uv1) -> None:
-        """An item of ``size`` showing the (u, v) window [uv0, uv1] of ``image`` = (draw,
-        image size (w, h)), row 0 on top, ``draw(origin, texels_per_pixel)`` its pass into
-        the bound window framebuffer (as :meth:`DisplayPasses.to_window` takes them)."""
+        """An item of ``size`` showing the (u, v) window [uv0, uv1] of ``image`` (row 0 on
+        top: :meth:`drawn` or :meth:`copied`)."""
         from imgui_bundle import imgui
         imgui.dummy(size)
         if imgui.is_item_visible():
@@ -219,36 +278,48 @@ class ScreenBlits:
     def flush(self) -> None:
         """Draw the queued images into the window's framebuffer (window coordinates times the
         framebuffer scale, y up; the source window rounded out to whole texels and the
-        destination stretched to match, as the blits did, then clipped by the scissor)."""
+        destination stretched to match, then clipped by the scissor)."""
         import math
 
         from imgui_bundle import imgui
+
+        from ...renderers import gl
         io = imgui.get_io()
         sx, sy = io.display_framebuffer_scale.x, io.display_framebuffer_scale.y
         fb_h = io.display_size.y * sy
-        self.last = []
+        self.last, self.blitted = [], set()
         self.ctx.screen.use()  # moderngl sets the scissor of the bound framebuffer
         for name, image, (x0, y0, x1, y1), (u0, v0), (u1, v1), (cx0, cy0, cx1, cy1) in self.queue:
             if cx1 <= cx0 or cy1 <= cy0:
                 continue
-            draw, (w, h) = image
+            run, (w, h) = image
             a0, a1, b0, b1 = u0 * w, u1 * w, v0 * h, v1 * h
             ia0, ia1, ib0, ib1 = math.floor(a0), math.ceil(a1), math.floor(b0), math.ceil(b1)
             kx, ky = (x1 - x0) / (a1 - a0), (y1 - y0) / (b1 - b0)  # window pixels per texel
             dx0, dx1 = x0 - (a0 - ia0) * kx, x1 + (ia1 - a1) * kx
             dy0, dy1 = y0 - (b0 - ib0) * ky, y1 + (ib1 - b1) * ky
+            # texel row ib0 (the top) goes to the top of the item: destination y reversed
+            dst = (round(dx0 * sx), round(fb_h - dy0 * sy), round(dx1 * sx), round(fb_h - dy1 * sy))
+            if dst[0] == dst[2] or dst[1] == dst[3]:
+                continue
             self.ctx.scissor = (round(cx0 * sx), round(fb_h - cy1 * sy),
                                 round((cx1 - cx0) * sx), round((cy1 - cy0) * sy))
-            # texel column ia0 at the item's left, texel row ib0 (the top) at its top: window
-            # y runs the other way
-            X0, X1 = round(dx0 * sx), round(dx1 * sx)
-            Y0, Y1 = round(fb_h - dy0 * sy), round(fb_h - dy1 * sy)
-            if X1 == X0 or Y1 == Y0:
-                continue
-            draw((ia0, ib0, X0, Y0), ((ia1 - ia0) / (X1 - X0), (ib1 - ib0) / (Y1 - Y0)))
+            run((ia0, ib0, ia1, ib1), dst)
             self.last.append((name, (x0, y0, x1, y1)))
+        # a display texture re-made at another size (a scene of another aspect) gets a new
+        # name: the read framebuffers of textures not copied this frame are released (they
+        # piled up, one per re-made texture)
+        for glo in [g for g in self.read_fbos if g not in self.blitted]:
+            gl.release_framebuffer(self.read_fbos.pop(glo))
         self.queue = []
         self.ctx.scissor = None
+        if self.bind is not None:
+            self.bind(0x8D40, 0)  # GL_FRAMEBUFFER: the window's, as moderngl believes
+
+    def release(self) -> None:
+        for fbo in self.read_fbos.values():
+            fbo.release()
+        self.read_fbos.clear()
 
 
 @dataclass
@@ -312,7 +383,8 @@ def gpu(state: AppState) -> PanelGPU:
     """``state.gpu``, created on first use in the window's context."""
     if state.gpu is None:
         from .display_modes import ModeDisplay
-        state.gpu = PanelGPU(DisplayPasses(state.ctx), ScreenBlits(state.ctx),
+        passes = DisplayPasses(state.ctx)
+        state.gpu = PanelGPU(passes, ScreenBlits(state.ctx, passes),
                              modes=ModeDisplay(state.ctx, getattr(state.jobs, "notify", None)))
     return state.gpu
 
@@ -713,8 +785,8 @@ def show_panel(state: AppState, method: str, size, uv0=(0.0, 0.0), uv1=(1.0, 1.0
         source, flip = linear_source(state, method)
         if mode == "direct24":
             g.modes.forget(method)
-            image = (lambda o, k: g.passes.to_window("srgb", {"u_linear": source}, o, k,
-                                                     u_flip=int(flip)), source.size)
+            image = g.blits.drawn(lambda o, k: g.passes.to_window(
+                "srgb", {"u_linear": source}, o, k, u_flip=int(flip)), source.size)
         else:
             todo = g.modes.step(method, state.images.version(method), mode,
                                 lambda: state.images[method], method in state.textures)
@@ -722,13 +794,12 @@ def show_panel(state: AppState, method: str, size, uv0=(0.0, 0.0), uv1=(1.0, 1.0
                 # the mode's GPU view drawn into the window; its display texture is made once
                 # the image stays (the next frame that shows the same image)
                 g.modes.shown.pop(method, None)
-                image = (lambda o, k: g.modes.to_window(source, flip, *todo[1:], o, k),
-                         source.size)
+                image = g.blits.drawn(lambda o, k: g.modes.to_window(source, flip, *todo[1:], o, k),
+                                      source.size)
             elif todo is not None:
                 upload_linear(state, method, todo[1])
     if image is None:
-        tex = panel_texture(state, method)
-        image = (lambda o, k: g.passes.to_window("copy", {"u_image": tex}, o, k), tex.size)
+        image = g.blits.copied(panel_texture(state, method))
     g.blits.show(method, image, size, uv0, uv1)
 
 
@@ -742,11 +813,10 @@ def show_difference(state: AppState, size, uv0=(0.0, 0.0), uv1=(1.0, 1.0)) -> No
             and held[0] == state.images.version("difference")):
         values, table, stats = held[1:]
         inputs = {"u_value": values, "u_table": table, "u_stats": stats}
-        image = (lambda o, k: g.passes.to_window("colour_map", inputs, o, k, u_floor=SCALE_FLOOR),
-                 values.size)
+        image = g.blits.drawn(lambda o, k: g.passes.to_window(
+            "colour_map", inputs, o, k, u_floor=SCALE_FLOOR), values.size)
     else:
-        tex = shown_texture(state, "difference")
-        image = (lambda o, k: g.passes.to_window("copy", {"u_image": tex}, o, k), tex.size)
+        image = g.blits.copied(shown_texture(state, "difference"))
     g.blits.show("difference", image, size, uv0, uv1)
 
 
@@ -780,6 +850,7 @@ def release_gl(state: AppState) -> None:
         for tex in state.gpu.uploads.values():
             tex.release()
         state.gpu.passes.release()
+        state.gpu.blits.release()
         state.gpu.modes.release()
         state.gpu = None
     for tex in state.textures.values():
