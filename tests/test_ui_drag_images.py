@@ -105,3 +105,28 @@ def test_a_drag_draws_each_panel_once_a_frame_and_once_more_timed_at_rest(drag):
     _, log, _, _ = drag
     assert log["draws"] == {m: FRAMES + 1 for m in RASTER}, log["draws"]
     assert all(log["timed"].values()) and all(t > 0 for t in log["timings"].values())
+
+
+def test_difference_statistics_reduced_on_the_gpu_are_the_map_s(window_ctx):
+    """The colour scale's maximum and the printed mean come from display_stats.frag's
+    reduction, not from a read-back of the map: the same maximum, and the sum up to float32
+    rounding (at most one rounding per term added: |error| <= n eps sum); the map itself is
+    read whole or one value at a time (the probe) only when asked."""
+    from workbench.app.ui.frames import DisplayPasses, read_value, read_values
+    passes = DisplayPasses(window_ctx)
+    rng = np.random.default_rng(3)
+    for w, h in [(512, 384), (13, 7), (1, 1)]:
+        values = rng.random((h, w)).astype(np.float32) ** 3
+        tex = window_ctx.texture((w, h), 1, values.tobytes(), dtype="f4")
+        stats = passes.statistics(tex)
+        assert stats.size == (1, 1)
+        vmax, total = np.frombuffer(stats.read(), np.float32)[:2]
+        assert vmax == values.max(), (w, h)
+        exact = values.astype(np.float64).sum()
+        assert abs(total - exact) <= values.size * np.finfo(np.float32).eps * exact, (w, h)
+        assert np.array_equal(read_values(tex), values)
+        i, j = h // 2, w - 1
+        assert read_value(tex, i, j, (h, w))[0] == values[i, j]
+        assert read_value(tex, i, j, (h + 1, w)) is None
+        tex.release()
+    passes.release()

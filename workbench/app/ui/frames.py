@@ -725,6 +725,7 @@ def read_values(texture) -> np.ndarray:
 def read_value(texture, i: int, j: int, shape: tuple[int, int]) -> np.ndarray | None:
     """Texel (row ``i`` from the top, column ``j``) of a value texture as a (1,) float32 array,
     or None unless the texture is ``shape`` (H, W)."""
+    from ...renderers import gl
     w, h = texture.size
     if tuple(shape) != (h, w):
         return None
@@ -732,7 +733,6 @@ def read_value(texture, i: int, j: int, shape: tuple[int, int]) -> np.ndarray | 
     try:
         raw = fbo.read(viewport=(j, i, 1, 1), components=1, dtype="f4")
     finally:
-        from ...renderers import gl
         gl.release_framebuffer(fbo)
     return np.frombuffer(raw, np.float32).copy()
 
