@@ -50,7 +50,6 @@ class WindowStandIn:
 
 
 def main() -> None:
-    import moderngl
 
     import workbench
     from workbench.app.ui import camera as cam
