@@ -50,7 +50,6 @@ class WindowStandIn:
 
 
 def main() -> None:
-
     import workbench
     from workbench.app.ui import camera as cam
     from workbench.app.ui.frames import SCALE_FLOOR, DisplayPasses
