@@ -113,6 +113,7 @@ def test_difference_statistics_reduced_on_the_gpu_are_the_map_s(window_ctx):
     rounding (at most one rounding per term added: |error| <= n eps sum); the map itself is
     read whole or one value at a time (the probe) only when asked."""
     from workbench.app.ui.frames import DisplayPasses, read_value, read_values
+    bound = window_ctx.fbo  # the passes end on the stand-in screen, which the fixture releases
     passes = DisplayPasses(window_ctx)
     rng = np.random.default_rng(3)
     for w, h in [(512, 384), (13, 7), (1, 1)]:
@@ -130,3 +131,4 @@ def test_difference_statistics_reduced_on_the_gpu_are_the_map_s(window_ctx):
         assert read_value(tex, i, j, (h + 1, w)) is None
         tex.release()
     passes.release()
+    bound.use()
