@@ -9,6 +9,8 @@
 //    of the nearest entry per cell of 2^u_shift 8-bit levels per channel (built on the CPU
 //    from the CLUT: workbench.app.ui.display_modes.clut_table).
 // Output row 0 is the image's top row; u_flip = 1 when the source has row 0 at the bottom.
+// Into a display texture, or straight into the window (display_texel.glsl).
+#include "display_texel.glsl"
 uniform sampler2D u_linear;
 uniform sampler3D u_lut;
 uniform int u_flip;
@@ -37,7 +39,7 @@ float bayer8(ivec2 rc) {  // M_8(i, j) = 16 M_2(i, j) + 4 M_2(i/2, j/2) + M_2(i/
 
 void main() {
     ivec2 size = textureSize(u_linear, 0);
-    ivec2 ij = ivec2(gl_FragCoord.xy);  // column, output row (row 0 on top)
+    ivec2 ij = image_texel(size);  // column, output row (row 0 on top)
     ivec2 src = ij;
     if (u_flip == 1) src.y = size.y - 1 - src.y;
     vec3 e = floor(srgb_encode(texelFetch(u_linear, src, 0).rgb) * 255.0 + 0.5) / 255.0;

@@ -91,13 +91,15 @@ class ModeDisplay:
     awake until they are exact: :meth:`busy`); ``notify`` wakes the window."""
 
     def __init__(self, ctx, notify=None):
-        from ...renderers.raster_shaders import SHADER_DIR
+        from ...renderers.raster_shaders import SHADER_DIR, build_source
         self.ctx, self.notify = ctx, notify
-        self.prog = ctx.program(
-            vertex_shader=(SHADER_DIR / "display.vert").read_text(encoding="utf-8"),
-            fragment_shader=(SHADER_DIR / "display_mode.frag").read_text(encoding="utf-8"))
-        self.prog["u_linear"].value, self.prog["u_lut"].value = 0, 1
-        self.vao = ctx.vertex_array(self.prog, [])
+        self.progs = {}
+        for where, defines in (("texture", {}), ("window", {"TO_WINDOW": ""})):
+            prog = self.progs[where] = ctx.program(
+                vertex_shader=(SHADER_DIR / "display.vert").read_text(encoding="utf-8"),
+                fragment_shader=build_source("display_mode.frag", defines))
+            prog["u_linear"].value, prog["u_lut"].value = 0, 1
+        self.vaos = {where: ctx.vertex_array(prog, []) for where, prog in self.progs.items()}
         self.changed: dict[str, tuple] = {}
         self.tables: dict[tuple, object] = {}
         self.exact: dict[str, tuple] = {}
@@ -112,28 +114,39 @@ class ModeDisplay:
     def run(self, source, flip: bool, target, mode, table=None) -> None:
         """Fill ``target`` (RGBA8) with ``source`` (linear float texture) through ``mode``:
         its levels (direct; Bayer for ``-bayer``) or the CLUT ``table`` (3D texture)."""
-        import moderngl
-
         from ...renderers import gl
+        fbo = self.ctx.framebuffer(color_attachments=[target])
+        fbo.use()
+        self._draw("texture", source, flip, mode, table)
+        gl.release_framebuffer(fbo)
+        if self.ctx.screen is not None:  # back to the window's framebuffer for imgui
+            self.ctx.screen.use()
+
+    def to_window(self, source, flip: bool, mode, table, origin: tuple,
+                  texels_per_pixel: tuple) -> None:
+        """Draw ``source`` through ``mode`` as :meth:`run` does, straight into the bound
+        window framebuffer (within its scissor, scaled as
+        :meth:`.frames.DisplayPasses.to_window` says)."""
+        self.progs["window"]["u_window"].value = origin
+        self.progs["window"]["u_texels_per_pixel"].value = texels_per_pixel
+        self._draw("window", source, flip, mode, table)
+
+    def _draw(self, where: str, source, flip: bool, mode, table) -> None:
+        import moderngl
         if table is None:
             if self.dummy_table is None:
                 self.dummy_table = self.ctx.texture3d((1, 1, 1), 3, bytes(3))
             table = self.dummy_table
-        fbo = self.ctx.framebuffer(color_attachments=[target])
-        fbo.use()
         self.ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.CULL_FACE)
         source.use(0)
         table.use(1)
-        p = self.prog
+        p = self.progs[where]
         p["u_flip"].value = int(flip)
         p["u_indexed"].value = int(mode.kind == "indexed")
         p["u_shift"].value = LUT_SHIFT
         p["u_bayer"].value = int(mode.kind == "direct" and mode.dither == "ordered")
         p["u_levels"].value = tuple(float(2 ** b - 1) for b in mode.bits)
-        self.vao.render(moderngl.TRIANGLES, vertices=3)
-        gl.release_framebuffer(fbo)
-        if self.ctx.screen is not None:  # back to the window's framebuffer for imgui
-            self.ctx.screen.use()
+        self.vaos[where].render(moderngl.TRIANGLES, vertices=3)
 
     def table(self, key: tuple, palette: np.ndarray):
         """The 3D texture of ``palette``'s :func:`clut_table`, kept under ``key``."""
@@ -233,6 +246,6 @@ class ModeDisplay:
         for tex in self.tables.values():
             tex.release()
         self.tables.clear()
-        for obj in (self.dummy_table, self.vao, self.prog):
+        for obj in (self.dummy_table, *self.vaos.values(), *self.progs.values()):
             if obj is not None:
                 obj.release()

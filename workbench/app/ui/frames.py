@@ -13,10 +13,17 @@
 * Every panel's linear image has a GPU copy (:func:`linear_source`: a raster panel's
   framebuffer, else a float texture uploaded once per change of the image) and reaches the
   screen through GPU passes (:class:`DisplayPasses`, ``shaders/display*``): sRGB encoding
-  (IEC 61966-2-1, the numbers of :func:`workbench.core.imageio.to_srgb8`) into an RGBA8
-  texture, and the difference view's ``"abs"`` map and colour scale.  These textures are
-  copied into the window's framebuffer under imgui's drawing (:class:`ScreenBlits`), not
-  drawn by imgui as quads.
+  (IEC 61966-2-1, the numbers of :func:`workbench.core.imageio.to_srgb8`), and the
+  difference view's ``"abs"`` map, its maximum and mean reduced on the GPU, and colour
+  scale.  They draw into the window's framebuffer under imgui's drawing
+  (:class:`ScreenBlits`), not drawn by imgui as quads: straight from the linear image while
+  it changes, from an RGBA8 display texture made once when it stays.
+* During a drag (a panel drawn in consecutive frames) the frame does not wait for the GPU
+  where it need not: no ``glFinish`` after a panel's draw (it is timed once the camera
+  rests, by one more draw of the same image: :func:`timed_draw`) and no read-back for the
+  difference view's colour scale (its numbers are read one frame later:
+  :func:`take_gpu_stats`).  llvmpipe itself still waits where a pass reads a panel whose
+  draw is not done.
 * Pixels come back to the CPU only when asked for: ``state.images[m]`` of a raster panel is a
   pending read (:class:`~.images.PanelImages`), resolved once per draw by the probe, the
   difference view, the export or a script.
@@ -35,6 +42,11 @@ from .state import AppState, method_kind
 LIVE_REST_SECONDS = 0.5
 """How long edited material or light values must stay unchanged before a GL panel compiles
 them back into its programs (until then it draws them from uniforms)."""
+SCALE_FLOOR = 1e-6
+"""The difference view's colour scale runs from 0 to the map's maximum, or to this if the
+maximum is smaller (two equal images show the scale's first colour)."""
+STATS_BLOCK = 8
+"""Texels along each side of the blocks one step of :meth:`DisplayPasses.statistics` reduces."""
 
 
 def tiled(method: str) -> bool:
@@ -50,26 +62,54 @@ class DisplayPasses:
     * :meth:`encode` (``display_srgb.frag``): linear float -> RGBA8 sRGB;
     * :meth:`difference` (``display_difference.frag``): two linear images -> their per-pixel
       mean absolute difference (R32F), the ``"abs"`` error map;
+    * :meth:`statistics` (``display_stats.frag``): a value image -> its maximum and sum,
+      reduced on the GPU by steps of :data:`STATS_BLOCK` x :data:`STATS_BLOCK` texels;
     * :meth:`colour_map` (``display_colour_map.frag``): a value image -> RGBA8 colours of a
-      table (the difference view's colour scale).
+      table (the difference view's colour scale) up to the maximum :meth:`statistics` left
+      on the GPU (no read-back between them).
 
-    Also one float scratch texture per image size for :meth:`upload`."""
+    :meth:`to_window` draws ``srgb``, ``colour_map`` or ``copy`` (``display_copy.frag``: a
+    display texture as it is) straight into the window, scaled to the image's rectangle.
+
+    Also one float scratch texture per image size for :meth:`upload` and one chain of
+    reduction textures per image size for :meth:`statistics`."""
 
     def __init__(self, ctx):
         self.ctx = ctx
-        self.programs = {name: self._program(name) for name in ("srgb", "difference", "colour_map")}
+        self.programs = {name: self._program(name)
+                         for name in ("srgb", "difference", "colour_map", "stats")}
+        self.programs.update({f"{name} to window": self._program(name, to_window=True)
+                              for name in ("srgb", "colour_map", "copy")})
         self.vaos = {name: ctx.vertex_array(prog, []) for name, prog in self.programs.items()}
         self.scratch: dict[tuple[int, int], object] = {}
+        self.chains: dict[tuple[int, int], list] = {}
 
-    def _program(self, name: str):
-        from ...renderers.raster_shaders import SHADER_DIR
+    def _program(self, name: str, to_window: bool = False):
+        from ...renderers.raster_shaders import SHADER_DIR, build_source
         prog = self.ctx.program(
             vertex_shader=(SHADER_DIR / "display.vert").read_text(encoding="utf-8"),
-            fragment_shader=(SHADER_DIR / f"display_{name}.frag").read_text(encoding="utf-8"))
-        for unit, sampler in enumerate(("u_linear", "u_a", "u_b", "u_value", "u_table")):
+            fragment_shader=build_source(f"display_{name}.frag",
+                                         {"TO_WINDOW": ""} if to_window else {}))
+        for unit, sampler in enumerate(("u_linear", "u_a", "u_b", "u_value", "u_table", "u_stats",
+                                        "u_image")):
             if sampler in prog:
                 prog[sampler].value = unit
         return prog
+
+    def to_window(self, name: str, inputs: dict, origin: tuple, texels_per_pixel: tuple,
+                  **uniforms) -> None:
+        """Draw pass ``name`` (``"srgb"``, ``"colour_map"`` or ``"copy"``) with ``inputs``
+        {sampler: texture} into the bound window framebuffer, within its scissor; its image's
+        texel edge ``origin[:2]`` at window point ``origin[2:]`` (framebuffer pixels, y up) and
+        ``texels_per_pixel`` (x, y) (``shaders/include/display_texel.glsl``)."""
+        import moderngl
+        ctx, prog = self.ctx, self.programs[f"{name} to window"]
+        ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.CULL_FACE)
+        for sampler, tex in inputs.items():
+            tex.use(prog[sampler].value)
+        for k, v in {**uniforms, "u_window": origin, "u_texels_per_pixel": texels_per_pixel}.items():
+            prog[k].value = v
+        self.vaos[f"{name} to window"].render(moderngl.TRIANGLES, vertices=3)
 
     def upload(self, image: np.ndarray, texture=None):
         """(H, W, 3) linear image (row 0 on top) -> ``texture`` (a float RGB texture of its
@@ -110,37 +150,72 @@ class DisplayPasses:
         self._run("difference", target, {"u_a": a[0], "u_b": b[0]},
                   u_flip_a=int(a[1]), u_flip_b=int(b[1]))
 
-    def colour_map(self, values, table, vmax: float, target) -> None:
+    def statistics(self, values):
+        """The maximum (r) and sum (g) of ``values`` (R32F, values >= 0) in a 1 x 1 RG32F
+        texture, left on the GPU: each step sums and takes the maximum of blocks of at most
+        :data:`STATS_BLOCK` x :data:`STATS_BLOCK` texels of the previous one (a 512 x 384 map:
+        64 x 48, 8 x 6, 1 x 1)."""
+        chain = self.chains.get(values.size)
+        if chain is None:
+            chain, (w, h) = [], values.size
+            while not chain or (w, h) != (1, 1):
+                w, h = -(-w // STATS_BLOCK), -(-h // STATS_BLOCK)
+                chain.append(self.ctx.texture((w, h), 2, dtype="f4"))
+            self.chains[values.size] = chain
+        source, first = values, 1
+        for target in chain:
+            block = tuple(-(-n // m) for n, m in zip(source.size, target.size))
+            self._run("stats", target, {"u_value": source}, u_block=block, u_first=first)
+            source, first = target, 0
+        return chain[-1]
+
+    def colour_map(self, values, table, stats, target) -> None:
         """Fill ``target`` (RGBA8) with the colours of ``table`` ((n, 1) texture) for
-        ``values`` (R32F) in [0, ``vmax``]."""
-        self._run("colour_map", target, {"u_value": values, "u_table": table},
-                  u_scale=1.0 / vmax if vmax > 0 else 0.0)
+        ``values`` (R32F) in [0, vmax], vmax the maximum in ``stats`` (:meth:`statistics`)
+        or :data:`SCALE_FLOOR` if larger."""
+        self._run("colour_map", target, {"u_value": values, "u_table": table, "u_stats": stats},
+                  u_floor=SCALE_FLOOR)
 
     def release(self) -> None:
-        for obj in [*self.scratch.values(), *self.vaos.values(), *self.programs.values()]:
+        chains = [t for chain in self.chains.values() for t in chain]
+        for obj in [*self.scratch.values(), *chains, *self.vaos.values(), *self.programs.values()]:
             obj.release()
         self.scratch.clear()
+        self.chains.clear()
 
 
 class ScreenBlits:
-    """Big panel images copied straight into the window's framebuffer (``glBlitFramebuffer``,
-    nearest) under imgui's drawing, instead of being drawn by imgui as textured, blended
-    quads: on llvmpipe a 512 x 512 blit costs a copy, a quad a shaded and blended fragment per
-    pixel (4 panels: ~0.4 ms against ~5.5 ms, measured in a standalone context).
+    """Big images (the panels, the difference view) put straight into the window's
+    framebuffer under imgui's drawing, scaled to their item's rectangle as a nearest blit:
+
+    * while an image changes (a drag), drawn by the display pass that makes it
+      (:meth:`DisplayPasses.to_window`: a linear image sRGB-encoded, a display mode's GPU
+      view, the difference's colour map): one pass where encoding into an RGBA8 display
+      texture and blitting that were two;
+    * an image that stays is encoded once into its display texture, which is then copied by
+      ``glBlitFramebuffer`` each frame (3 panels: 8.5 ms of CPU against 10.2 for a copying
+      pass, ``display_copy.frag``, used where the window's GLFW gives no
+      ``glBlitFramebuffer``; ``bench/ui_frame_gpu.py``'s context at a load of 10).
+
+    Not imgui's textured, blended quads: on llvmpipe a shaded and blended fragment per pixel
+    (4 panels: ~5.5 ms against ~0.4 ms for blits, measured in a standalone context).
+    Scripts and tests read display textures through :func:`shown_texture`.
 
     :meth:`show` stands in for ``imgui.image`` (an empty item of the same size, so hovering,
-    the probe and the mouse work as before) and queues the copy, clipped to what imgui would
-    show of the item; :meth:`flush` runs the queue after every window's gui and before imgui
-    renders (the frame is already cleared), so imgui's popups, tooltips and floating windows
-    still draw over the panels.  The GL entry points come from the window's GLFW
-    (``glfwGetProcAddress``); without them :meth:`show` falls back to ``imgui.image``."""
+    the probe and the mouse work as before) and queues the image, clipped to what imgui would
+    show of the item (its window's clip rectangle); :meth:`flush` draws the queue once the
+    gui is done (``before_imgui_render``), so imgui's popups and floating windows still draw
+    over the panels.  ``last`` lists (name, item rectangle) drawn by the last flush (tests
+    compare them with screenshots)."""
 
-    def __init__(self, ctx):
+    def __init__(self, ctx, passes: DisplayPasses):
         import ctypes
         from pathlib import Path
 
         import imgui_bundle
-        self.ctx, self.queue, self.last = ctx, [], []
+        self.ctx, self.passes = ctx, passes
+        self.queue: list[tuple] = []
+        self.last: list[tuple[str, tuple]] = []
         self.read_fbos: dict[int, object] = {}
         try:
             glfw = ctypes.CDLL(str(Path(imgui_bundle.__file__).parent / "libglfw.so.3"))
@@ -154,21 +229,29 @@ class ScreenBlits:
         self.bind = ctypes.CFUNCTYPE(None, u, u)(bind) if bind else None
         self.blit = ctypes.CFUNCTYPE(None, i, i, i, i, i, i, i, i, u, u)(blit) if blit else None
 
-    def show(self, name: str, texture, size, uv0, uv1) -> None:
-        """An item of ``size`` showing the (u, v) window [uv0, uv1] of ``texture`` (row 0 on
-        top, as imgui reads textures)."""
-        from imgui_bundle import imgui
+    @staticmethod
+    def drawn(draw, size: tuple[int, int]) -> tuple:
+        """An image (for :meth:`show`) of ``size`` (w, h) drawn by ``draw(origin,
+        texels_per_pixel)``, a pass into the bound window framebuffer as
+        :meth:`DisplayPasses.to_window` takes them."""
+        def run(src, dst):
+            (s0, t0, s1, t1), (x0, y0, x1, y1) = src, dst
+            draw((s0, t0, x0, y0), ((s1 - s0) / (x1 - x0), (t1 - t0) / (y1 - y0)))
+        return run, size
+
+    def copied(self, texture) -> tuple:
+        """An image (for :meth:`show`) that is ``texture`` (a display texture, row 0 on top)
+        as it is."""
         if self.blit is None:
-            imgui.image(imgui.ImTextureRef(texture.glo), size, uv0, uv1)
-            return
-        imgui.dummy(size)
-        if imgui.is_item_visible():
-            dl = imgui.get_window_draw_list()
-            lo, hi = imgui.get_item_rect_min(), imgui.get_item_rect_max()
-            clo, chi = dl.get_clip_rect_min(), dl.get_clip_rect_max()
-            self.queue.append((name, texture, (lo.x, lo.y, hi.x, hi.y), tuple(uv0), tuple(uv1),
-                               (max(lo.x, clo.x), max(lo.y, clo.y), min(hi.x, chi.x),
-                                min(hi.y, chi.y))))
+            return self.drawn(lambda o, k: self.passes.to_window("copy", {"u_image": texture}, o, k),
+                              texture.size)
+
+        def run(src, dst):
+            self.bind(0x8CA8, self._read_fbo(texture).glo)  # GL_READ_FRAMEBUFFER
+            self.bind(0x8CA9, 0)  # GL_DRAW_FRAMEBUFFER: the window's
+            self.blit(*src, *dst, 0x4000, 0x2600)  # GL_COLOR_BUFFER_BIT, GL_NEAREST
+            self.blitted.add(texture.glo)
+        return run, texture.size
 
     def _read_fbo(self, texture):
         from ...renderers import gl
@@ -179,8 +262,21 @@ class ScreenBlits:
             fbo = self.read_fbos[texture.glo] = self.ctx.framebuffer(color_attachments=[texture])
         return fbo
 
+    def show(self, name: str, image: tuple, size, uv0, uv1) -> None:
+        """An item of ``size`` showing the (u, v) window [uv0, uv1] of ``image`` (row 0 on
+        top: :meth:`drawn` or :meth:`copied`)."""
+        from imgui_bundle import imgui
+        imgui.dummy(size)
+        if imgui.is_item_visible():
+            dl = imgui.get_window_draw_list()
+            lo, hi = imgui.get_item_rect_min(), imgui.get_item_rect_max()
+            clo, chi = dl.get_clip_rect_min(), dl.get_clip_rect_max()
+            self.queue.append((name, image, (lo.x, lo.y, hi.x, hi.y), tuple(uv0), tuple(uv1),
+                               (max(lo.x, clo.x), max(lo.y, clo.y), min(hi.x, chi.x),
+                                min(hi.y, chi.y))))
+
     def flush(self) -> None:
-        """Copy the queued images into the window's framebuffer (window coordinates times the
+        """Draw the queued images into the window's framebuffer (window coordinates times the
         framebuffer scale, y up; the source window rounded out to whole texels and the
         destination stretched to match, then clipped by the scissor)."""
         import math
@@ -188,35 +284,32 @@ class ScreenBlits:
         from imgui_bundle import imgui
 
         from ...renderers import gl
-        GL_READ_FRAMEBUFFER, GL_DRAW_FRAMEBUFFER = 0x8CA8, 0x8CA9
-        GL_COLOR_BUFFER_BIT, GL_NEAREST = 0x4000, 0x2600
         io = imgui.get_io()
         sx, sy = io.display_framebuffer_scale.x, io.display_framebuffer_scale.y
         fb_h = io.display_size.y * sy
-        self.last = []
+        self.last, self.blitted = [], set()
         self.ctx.screen.use()  # moderngl sets the scissor of the bound framebuffer
-        for name, tex, (x0, y0, x1, y1), (u0, v0), (u1, v1), (cx0, cy0, cx1, cy1) in self.queue:
+        for name, image, (x0, y0, x1, y1), (u0, v0), (u1, v1), (cx0, cy0, cx1, cy1) in self.queue:
             if cx1 <= cx0 or cy1 <= cy0:
                 continue
-            w, h = tex.size
+            run, (w, h) = image
             a0, a1, b0, b1 = u0 * w, u1 * w, v0 * h, v1 * h
             ia0, ia1, ib0, ib1 = math.floor(a0), math.ceil(a1), math.floor(b0), math.ceil(b1)
             kx, ky = (x1 - x0) / (a1 - a0), (y1 - y0) / (b1 - b0)  # window pixels per texel
             dx0, dx1 = x0 - (a0 - ia0) * kx, x1 + (ia1 - a1) * kx
             dy0, dy1 = y0 - (b0 - ib0) * ky, y1 + (ib1 - b1) * ky
+            # texel row ib0 (the top) goes to the top of the item: destination y reversed
+            dst = (round(dx0 * sx), round(fb_h - dy0 * sy), round(dx1 * sx), round(fb_h - dy1 * sy))
+            if dst[0] == dst[2] or dst[1] == dst[3]:
+                continue
             self.ctx.scissor = (round(cx0 * sx), round(fb_h - cy1 * sy),
                                 round((cx1 - cx0) * sx), round((cy1 - cy0) * sy))
-            self.bind(GL_READ_FRAMEBUFFER, self._read_fbo(tex).glo)
-            self.bind(GL_DRAW_FRAMEBUFFER, 0)
-            # texture row ib0 (the top) goes to the top of the item: destination y reversed
-            self.blit(ia0, ib0, ia1, ib1, round(dx0 * sx), round(fb_h - dy0 * sy),
-                      round(dx1 * sx), round(fb_h - dy1 * sy), GL_COLOR_BUFFER_BIT, GL_NEAREST)
+            run((ia0, ib0, ia1, ib1), dst)
             self.last.append((name, (x0, y0, x1, y1)))
         # a display texture re-made at another size (a scene of another aspect) gets a new
-        # name: the read framebuffers of textures not shown this frame are released (they
+        # name: the read framebuffers of textures not copied this frame are released (they
         # piled up, one per re-made texture)
-        shown = {tex.glo for _, tex, *_ in self.queue}
-        for glo in [g for g in self.read_fbos if g not in shown]:
+        for glo in [g for g in self.read_fbos if g not in self.blitted]:
             gl.release_framebuffer(self.read_fbos.pop(glo))
         self.queue = []
         self.ctx.scissor = None
@@ -235,13 +328,17 @@ class RasterPanel:
 
     ``session_key`` is (scene version, the panel's options); ``drawn`` the camera of the last draw
     (None: never drawn or values changed); ``draws`` counts draws (tests and the benchmark
-    read it); ``edited`` when values last changed in place (:data:`LIVE_REST_SECONDS`)."""
+    read it); ``edited`` when values last changed in place (:data:`LIVE_REST_SECONDS`);
+    ``drawn_frame`` the frame of the last draw; ``timed`` whether ``state.timings`` holds the
+    time of the image shown (False after a draw of a drag: :func:`refresh_raster`)."""
 
     session: object
     session_key: tuple
     drawn: object = None
     draws: int = 0
     edited: float = 0.0
+    drawn_frame: int = -2
+    timed: bool = True
 
 
 @dataclass
@@ -261,6 +358,10 @@ class PanelGPU:
     """texture name -> key of the image it was last made from."""
     stats: dict[str, tuple] = field(default_factory=dict)
     """image name -> (version, maximum, mean) (:func:`image_stats`)."""
+    gpu_stats: dict[str, tuple] = field(default_factory=dict)
+    """image name -> (version, 1 x 1 texture of its maximum and sum, frame it was queued in,
+    pixel count): statistics reduced on the GPU (:func:`difference_on_gpu`), read back by
+    :func:`take_gpu_stats`."""
     compiled: int = 0
     """GL programs compiled by raster sessions since released (tests count compiles)."""
     settle_frame: int = -1
@@ -271,13 +372,19 @@ class PanelGPU:
     """CPU panel -> (id of its current job, the image shown before that job): :func:`over_stale`."""
     modes: object = None
     """:class:`.display_modes.ModeDisplay`: panels shown through another mode than direct24."""
+    shown_versions: dict[str, int] = field(default_factory=dict)
+    """image name -> ``state.images`` version shown last frame (:func:`changing`)."""
+    difference_inputs: tuple | None = None
+    """(``state.images.version("difference")``, its value texture, the colour table, its
+    statistics texture) of the difference view computed on the GPU (:func:`show_difference`)."""
 
 
 def gpu(state: AppState) -> PanelGPU:
     """``state.gpu``, created on first use in the window's context."""
     if state.gpu is None:
         from .display_modes import ModeDisplay
-        state.gpu = PanelGPU(DisplayPasses(state.ctx), ScreenBlits(state.ctx),
+        passes = DisplayPasses(state.ctx)
+        state.gpu = PanelGPU(passes, ScreenBlits(state.ctx, passes),
                              modes=ModeDisplay(state.ctx, getattr(state.jobs, "notify", None)))
     return state.gpu
 
@@ -376,19 +483,41 @@ def refresh_raster(state: AppState, method: str) -> bool:
         panel.drawn = None
     cam = state.camera
     if panel.drawn == cam and method in state.images:
+        if not panel.timed:  # the drag has ended: time a draw of the image shown
+            timed_draw(state, panel, method)
+            panel.draws += 1
         return False
-    t0 = time.perf_counter()
     fbo = panel.session.framebuffer(cam.width, cam.height)
-    panel.session.draw_to(fbo, cam, *shared_near_far(g, panel.session, cam))
-    state.ctx.finish()  # the time shown is the draw's, not just its submission
-    state.ctx.screen.use()  # back to the window's framebuffer for imgui
-    state.timings[method] = time.perf_counter() - t0
+    if panel.drawn_frame == state.frame - 1:
+        # drawn last frame too (a drag): no wait for the draw to end, so that llvmpipe's
+        # threads rasterise it while this thread goes on with the frame; it is timed once
+        # the camera rests
+        panel.session.draw_to(fbo, cam, *shared_near_far(g, panel.session, cam))
+        state.ctx.screen.use()  # back to the window's framebuffer for imgui
+        panel.timed = False
+    else:
+        timed_draw(state, panel, method, fbo)
     state.images.set_pending(method, lambda: RasterSession.read_image(fbo),
                              pixel=lambda i, j, shape: read_pixel(fbo, i, j, shape),
                              shape=(cam.height, cam.width))
     g.linear[method] = (fbo.color_attachments[0], True, state.images.version(method))
-    panel.drawn, panel.draws = cam, panel.draws + 1
+    panel.drawn, panel.draws, panel.drawn_frame = cam, panel.draws + 1, state.frame
     return True
+
+
+def timed_draw(state: AppState, panel: RasterPanel, method: str, fbo=None) -> None:
+    """Draw ``panel`` at ``state.camera`` into ``fbo`` (by default its framebuffer of the
+    camera's size, redrawing the image it holds: the same image) and wait for the draw to end:
+    ``state.timings[method]`` is the draw's time, not just its submission."""
+    cam = state.camera
+    if fbo is None:
+        fbo = panel.session.framebuffer(cam.width, cam.height)
+    t0 = time.perf_counter()
+    panel.session.draw_to(fbo, cam, *shared_near_far(gpu(state), panel.session, cam))
+    state.ctx.finish()
+    state.ctx.screen.use()  # back to the window's framebuffer for imgui
+    state.timings[method] = time.perf_counter() - t0
+    panel.timed = True
 
 
 def shared_near_far(g: PanelGPU, session, cam) -> tuple[float, float]:
@@ -465,6 +594,8 @@ def over_stale(state: AppState, method: str, job, image: np.ndarray) -> np.ndarr
 def update_images(state: AppState) -> None:
     """Bring every selected panel up to date (called once per frame, before the widgets)."""
     from .pyrender_proc import refresh_pyrender
+    if state.gpu is not None:
+        take_gpu_stats(state, "difference")
     state.jobs.keep_only(state.methods)
     if state.gpu is not None:  # a removed panel's approximation keeps nothing awake
         state.gpu.modes.approximate &= set(state.methods)
@@ -486,8 +617,10 @@ def in_progress(state: AppState) -> bool:
     proc = state.pyrender
     g = state.gpu
     return (state.jobs.busy() or (proc is not None and proc.busy) or state.errors.busy(state.frame)
-            or (g is not None and (any(p.session.live for p in g.raster.values())
-                                   or g.modes.busy())))
+            or (g is not None and (any(p.session.live or not p.timed for p in g.raster.values())
+                                   or g.modes.busy()
+                                   or any(g.stats.get(k, (None,))[0] != v[0]
+                                          for k, v in g.gpu_stats.items()))))
 
 
 def panel_texture(state: AppState, method: str):
@@ -514,10 +647,35 @@ def panel_texture(state: AppState, method: str):
     return state.textures[method]
 
 
+def take_gpu_stats(state: AppState, name: str, now: bool = False) -> None:
+    """Read back the statistics of ``name`` reduced on the GPU (:attr:`PanelGPU.gpu_stats`)
+    into :attr:`PanelGPU.stats`, if not already there, once the frame that queued them has
+    been shown (its buffer swap waited for them: the read waits for nothing), or at once with
+    ``now``."""
+    g = gpu(state)
+    queued = g.gpu_stats.get(name)
+    if queued is None or g.stats.get(name, (None,))[0] == queued[0]:
+        return
+    version, texture, frame, count = queued
+    if frame == state.frame and not now:
+        return
+    vmax, total = np.frombuffer(texture.read(), np.float32)[:2]
+    g.stats[name] = (version, float(vmax), float(total) / count)
+
+
 def image_stats(state: AppState, name: str) -> tuple[float, float]:
-    """(maximum, mean) of ``state.images[name]``, computed once per change of the image."""
+    """(maximum, mean) of ``state.images[name]``, computed once per change of the image.
+
+    An image whose statistics were reduced on the GPU this frame (the difference view during
+    a drag) gives the previous image's until the next frame (:func:`take_gpu_stats`): reading
+    them now would wait for everything the frame has drawn so far."""
     g = gpu(state)
     key = state.images.version(name)
+    queued = g.gpu_stats.get(name)
+    if queued is not None and queued[0] == key:
+        take_gpu_stats(state, name, now=name not in g.stats)
+        held = g.stats[name]
+        return held[1], held[2]
     held = g.stats.get(name)
     if held is None or held[0] != key:
         image = state.images[name]
@@ -525,27 +683,57 @@ def image_stats(state: AppState, name: str) -> tuple[float, float]:
     return held[1], held[2]
 
 
-def difference_on_gpu(state: AppState, a: str, b: str, table: np.ndarray) -> np.ndarray | None:
+def difference_on_gpu(state: AppState, a: str, b: str, table: np.ndarray) -> bool:
     """The ``"abs"`` error map of panels ``a`` and ``b`` computed on the GPU from their
-    linear copies (no read-back of either image), shown in texture ``"difference"`` through
-    ``table`` ((n, 3) uint8 colour scale from 0 to the map's maximum, uploaded once per
-    window).  Returns the (H, W)
-    float32 map (read back: the probe and the export use it), or None when the two images
-    differ in size (the caller's CPU path then reports it)."""
+    linear copies, to be shown through ``table`` ((n, 3) uint8 colour scale from 0 to the
+    map's maximum, uploaded once per window: :func:`show_difference`), with nothing read back:
+    the maximum is reduced on the GPU (:meth:`DisplayPasses.statistics`, with the sum for the
+    mean: :func:`image_stats`) and the (H, W) float32 map becomes ``state.images["difference"]``
+    as a pending read (the probe reads one pixel of it, the export all).  Returns False when
+    the two images differ in size (the caller's CPU path then reports it)."""
     g = gpu(state)
     (ta, fa), (tb, fb) = linear_source(state, a), linear_source(state, b)
     if ta.size != tb.size:
-        return None
+        return False
+    held = g.uploads.get("difference values")
+    if held is not None and held.size != ta.size and "difference" in state.images:
+        state.images["difference"]  # a pending map of the old size: read before its texture goes
     values = _float_texture(state, "difference values", ta.size, 1)
     g.passes.difference((ta, fa), (tb, fb), values)
-    err = np.frombuffer(values.read(), np.float32).reshape(ta.size[1], ta.size[0])
+    stats = g.passes.statistics(values)
     if "colour table" not in g.uploads:
         g.uploads["colour table"] = state.ctx.texture((len(table), 1), 3,
                                                       np.ascontiguousarray(table, np.uint8).tobytes(),
                                                       alignment=1)
-    g.passes.colour_map(values, g.uploads["colour table"], max(float(err.max()), 1e-6),
-                        display_texture(state, "difference", ta.size))
-    return err
+    w, h = ta.size
+    state.images.set_pending("difference", lambda: read_values(values),
+                             pixel=lambda i, j, shape: read_value(values, i, j, shape),
+                             shape=(h, w))
+    version = state.images.version("difference")
+    g.gpu_stats["difference"] = (version, stats, state.frame, w * h)
+    g.difference_inputs = (version, values, g.uploads["colour table"], stats)
+    return True
+
+
+def read_values(texture) -> np.ndarray:
+    """A value texture (R32F, row 0 on top) as an (H, W) float32 array."""
+    w, h = texture.size
+    return np.frombuffer(texture.read(), np.float32).reshape(h, w).copy()
+
+
+def read_value(texture, i: int, j: int, shape: tuple[int, int]) -> np.ndarray | None:
+    """Texel (row ``i`` from the top, column ``j``) of a value texture as a (1,) float32 array,
+    or None unless the texture is ``shape`` (H, W)."""
+    from ...renderers import gl
+    w, h = texture.size
+    if tuple(shape) != (h, w):
+        return None
+    fbo = texture.ctx.framebuffer(color_attachments=[texture])
+    try:
+        raw = fbo.read(viewport=(j, i, 1, 1), components=1, dtype="f4")
+    finally:
+        gl.release_framebuffer(fbo)
+    return np.frombuffer(raw, np.float32).copy()
 
 
 def upload(state: AppState, key: str, rgb8: np.ndarray):
@@ -571,14 +759,84 @@ def upload_linear(state: AppState, key: str, image: np.ndarray):
     return target
 
 
-def show_image(state: AppState, name: str, texture, size, uv0=(0.0, 0.0), uv1=(1.0, 1.0)) -> None:
-    """``imgui.image`` of a big panel texture, copied into the framebuffer instead of drawn
-    (:class:`ScreenBlits`); :func:`blit_panels` does the copies once the gui is done."""
-    gpu(state).blits.show(name, texture, size, uv0, uv1)
+def changing(state: AppState, name: str) -> bool:
+    """``state.images[name]`` is not the image shown last frame (a drag redraws it every
+    frame); records the version shown."""
+    g = gpu(state)
+    version = state.images.version(name)
+    changed = g.shown_versions.get(name) != version
+    g.shown_versions[name] = version
+    return changed
 
 
-def blit_panels(state: AppState) -> None:
-    """Copy this frame's panel images into the window (call before imgui renders)."""
+def show_panel(state: AppState, method: str, size, uv0=(0.0, 0.0), uv1=(1.0, 1.0)) -> None:
+    """``imgui.image`` of ``method``'s panel, drawn into the window by a GPU pass instead
+    (:class:`ScreenBlits`; :func:`draw_shown_images` draws once the gui is done).  A direct24
+    panel whose image changed since last frame is sRGB-encoded straight into the window from
+    its linear image (no display texture made: one pass where encoding into the texture and
+    copying it were two); an image that stays is encoded once into its display texture
+    (:func:`panel_texture`), which is then copied (cheaper than encoding every frame), as is
+    the display texture of any other mode."""
+    g = gpu(state)
+    mode = state.display.get(method, "direct24")
+    image = None
+    if changing(state, method):
+        source, flip = linear_source(state, method)
+        if mode == "direct24":
+            g.modes.forget(method)
+            image = g.blits.drawn(lambda o, k: g.passes.to_window(
+                "srgb", {"u_linear": source}, o, k, u_flip=int(flip)), source.size)
+        else:
+            todo = g.modes.step(method, state.images.version(method), mode,
+                                lambda: state.images[method], method in state.textures)
+            if todo is not None and todo[0] == "pass":
+                # the mode's GPU view drawn into the window; its display texture is made once
+                # the image stays (the next frame that shows the same image)
+                g.modes.shown.pop(method, None)
+                image = g.blits.drawn(lambda o, k: g.modes.to_window(source, flip, *todo[1:], o, k),
+                                      source.size)
+            elif todo is not None:
+                upload_linear(state, method, todo[1])
+    if image is None:
+        image = g.blits.copied(panel_texture(state, method))
+    g.blits.show(method, image, size, uv0, uv1)
+
+
+def show_difference(state: AppState, size, uv0=(0.0, 0.0), uv1=(1.0, 1.0)) -> None:
+    """``imgui.image`` of the difference view, drawn as :func:`show_panel` draws panels: the
+    ``"abs"`` map computed on the GPU colour-mapped straight into the window while it changes
+    every frame, else (and for a map computed on the CPU: FLIP) its display texture copied."""
+    g = gpu(state)
+    held = g.difference_inputs
+    if (changing(state, "difference") and held is not None
+            and held[0] == state.images.version("difference")):
+        values, table, stats = held[1:]
+        inputs = {"u_value": values, "u_table": table, "u_stats": stats}
+        image = g.blits.drawn(lambda o, k: g.passes.to_window(
+            "colour_map", inputs, o, k, u_floor=SCALE_FLOOR), values.size)
+    else:
+        image = g.blits.copied(shown_texture(state, "difference"))
+    g.blits.show("difference", image, size, uv0, uv1)
+
+
+def shown_texture(state: AppState, name: str):
+    """The display texture (RGBA8 or RGB8, row 0 on top) of what panel or view ``name``
+    (``"difference"``) shows, made if the window draws it without one (scripts and tests
+    read it; the window itself does not need it)."""
+    g = gpu(state)
+    held = g.difference_inputs
+    if name != "difference":
+        return panel_texture(state, name)
+    if held is not None and held[0] == state.images.version("difference"):
+        values, table, stats = held[1:]
+        if stale(state, "difference texture", held[0]) or "difference" not in state.textures:
+            g.passes.colour_map(values, table, stats,
+                                display_texture(state, "difference", values.size))
+    return state.textures["difference"]
+
+
+def draw_shown_images(state: AppState) -> None:
+    """Draw this frame's panel images into the window (call before imgui renders)."""
     if state.gpu is not None:
         state.gpu.blits.flush()
 

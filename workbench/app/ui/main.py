@@ -44,7 +44,7 @@ def run(state: AppState, max_frames: int | None = None, script=None,
 
     from ...renderers import gl
     from . import window_style
-    from .frames import blit_panels, in_progress, release_gl, update_images
+    from .frames import draw_shown_images, in_progress, release_gl, update_images
     from .layout import docking_params
     from .panels import status_bar
     from .plot import track
@@ -110,7 +110,7 @@ def run(state: AppState, max_frames: int | None = None, script=None,
         window_style.clear_to_window_background()
     params.callbacks.setup_imgui_style = setup_style
     params.callbacks.show_gui = show_gui
-    params.callbacks.before_imgui_render = lambda: (end_frame(), blit_panels(state))
+    params.callbacks.before_imgui_render = lambda: (end_frame(), draw_shown_images(state))
     params.callbacks.show_status = lambda: status_bar(state)
     params.callbacks.before_exit = before_exit
     immapp.run(params, immapp.AddOnsParams(with_implot=True))

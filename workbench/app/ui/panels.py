@@ -5,8 +5,8 @@ import numpy as np
 from imgui_bundle import imgui
 
 from . import camera as cam
-from .frames import (difference_on_gpu, image_stats, panel_texture, show_image, stale, upload,
-                     upload_linear)
+from .frames import (SCALE_FLOOR, difference_on_gpu, image_stats, show_difference, show_panel,
+                     stale, upload, upload_linear)
 from .colours import colour_scale, hot_table
 from .export import export
 from .gl_sessions import KNOB_VALUES, STANDIN_CHOICES, draws_standins
@@ -233,8 +233,7 @@ def image_panels(state: AppState) -> None:
         imgui.align_text_to_frame_padding()  # every panel's title on the same baseline
         text_in_width(f"{short_name(m)}  {'' if t is None else f'{t * 1e3:.1f} ms'}", w)
         if m in state.images:
-            tex = panel_texture(state, m)
-            show_image(state, m, tex, imgui.ImVec2(w, h), *cam.view_window(state.view))
+            show_panel(state, m, imgui.ImVec2(w, h), *cam.view_window(state.view))
             handle_mouse(state)
             ij = pixel_under_mouse(state)
             if ij is not None:
@@ -292,22 +291,21 @@ def difference_panel(state: AppState) -> None:
         return  # one is still the previous scene's (another size): nothing to compare yet
     # recomputed only when either image or the kind changed (a static frame reads no pixels)
     key = (a, b, state.diff_kind, state.images.version(a), state.images.version(b))
-    if stale(state, "difference", key) or "difference" not in state.textures:
-        err = difference_on_gpu(state, a, b, hot_table()) if state.diff_kind == "abs" else None
-        if err is None:  # FLIP (or images of different sizes: error_map says so)
+    if stale(state, "difference", key) or "difference" not in state.images:
+        if not (state.diff_kind == "abs" and difference_on_gpu(state, a, b, hot_table())):
+            # FLIP (or images of different sizes: error_map says so)
             err = error_map(state.images[a], state.images[b], state.diff_kind)
-            upload(state, "difference", colour_scale(err, max(float(err.max()), 1e-6)))
-        state.images["difference"] = err
-    tex = state.textures["difference"]
+            upload(state, "difference", colour_scale(err, max(float(err.max()), SCALE_FLOOR)))
+            state.images["difference"] = err
     vmax, mean = image_stats(state, "difference")
-    vmax = max(vmax, 1e-6)
+    vmax = max(vmax, SCALE_FLOOR)
     # the window's width at the camera's aspect, leaving room for the scale's two lines
     avail = imgui.get_content_region_avail()
     room_h = avail.y - 2 * imgui.get_frame_height_with_spacing()
     aspect = state.camera.width / state.camera.height
     w = max(32.0, min(avail.x, room_h * aspect))
     size = imgui.ImVec2(w, w / aspect)
-    show_image(state, "difference", tex, size, *cam.view_window(state.view))
+    show_difference(state, size, *cam.view_window(state.view))
     if "colour_scale" not in state.textures:
         upload(state, "colour_scale",
                colour_scale(np.tile(np.linspace(0, 1, 128, dtype=np.float32), (8, 1)), 1.0))

@@ -10,6 +10,7 @@ import numpy as np
 
 from . import camera as cam
 from .export import export
+from .frames import shown_texture
 from .inspect import select_ray_tree
 from .layout import window_report
 from .panels import status_text
@@ -344,7 +345,7 @@ class DragCheck:
 
     def _texture(self, state: AppState, m: str) -> np.ndarray:
         h, w = state.camera.height, state.camera.width
-        return np.frombuffer(state.textures[m].read(), np.uint8).reshape(h, w, -1)[..., :3]
+        return np.frombuffer(shown_texture(state, m).read(), np.uint8).reshape(h, w, -1)[..., :3]
 
     def __call__(self, state: AppState) -> None:
         from ...core.display import apply_display_mode
@@ -367,10 +368,13 @@ class DragCheck:
                 probe = {m: [state.images.pixel(m, i, j, (h, w)).tolist() for i, j in pixels]
                          for m in state.methods}
                 shown = state.images["raytrace"]
+                # the display textures first (during a drag the window draws the panels
+                # without them; made here through the same mode pass), then what they hold
+                colours = {m: int(len(np.unique(self._texture(state, m).reshape(-1, 3), axis=0)))
+                           for m in self._gl(state)}
                 self.log["drag"].append({
                     "kinds": {m: md.shown[m][2] for m in self._gl(state)},
-                    "colours": {m: int(len(np.unique(self._texture(state, m).reshape(-1, 3), axis=0)))
-                                for m in self._gl(state)},
+                    "colours": colours,
                     "exact_started": md.started - self.started0,
                     "raytrace_kept": bool(np.array_equal(shown, self.before)),
                     "probe": probe,
@@ -458,8 +462,8 @@ class Screens:
             return
         h, w = state.camera.height, state.camera.width
         for m in [*state.methods, "difference"]:
-            if m in state.textures:
-                tex = state.textures[m]
+            if m in state.images:
+                tex = shown_texture(state, m)
                 tw, th = tex.size
                 np.save(self.out / f"shown_{m}.npy", np.frombuffer(
                     tex.read(), np.uint8).reshape(th, tw, -1)[..., :3])
@@ -578,7 +582,7 @@ class GpuPanels:
         elif f == 7:
             w, h = state.camera.width, state.camera.height
             for m in [*state.gpu.raster, "difference"]:
-                shown = np.frombuffer(state.textures[m].read(), np.uint8).reshape(h, w, -1)
+                shown = np.frombuffer(shown_texture(state, m).read(), np.uint8).reshape(h, w, -1)
                 np.save(self.out / f"shown_{m}.npy", shown)
             reads, probe = state.images.reads, {}
             for m in state.gpu.raster:  # the probe's one-pixel reads, before any full read
@@ -590,6 +594,48 @@ class GpuPanels:
                 np.save(self.out / f"image_{m}.npy", state.images[m])
             self.log["blits"] = [[m, list(rect)] for m, rect in state.gpu.blits.last]
             self.log["position"] = list(state.camera.position)
+            state.quit = True
+
+
+class DragRest:
+    """A camera drag of ``frames`` frames (the camera orbits every frame, so the GL panels
+    draw every frame without waiting for their draws and are drawn into the window straight
+    from their linear images, through the display mode ``display`` sets for some), then rest.  In the first frame at rest (the window then shows
+    the drag's last frame) it saves the X server's picture of the window (``drag_screen.png``),
+    the panel and difference rectangles of the last drag frame, each GL panel's linear image
+    (``image_M.npy``) and the camera; in the second it logs each GL panel's draws (the drag's,
+    and one timed draw at rest) and times, and quits (``ui.png``: the
+    rested window, the panels copied from their display textures)."""
+
+    def __init__(self, out: Path, frames: int = 6, step: float = 0.05,
+                 display: dict[str, str] | None = None):
+        self.out, self.frames, self.step, self.log = out, frames, step, {}
+        self.display = display or {}
+
+    def __call__(self, state: AppState) -> None:
+        from . import screenshot
+        from .glfw_title import window_title
+        f, last = state.frame, 2 + self.frames
+        gl = [m for m in state.methods if method_kind(state, m) == "gl"]
+        if f == 0:
+            for m, mode in self.display.items():
+                set_display(state, m, mode)
+        if f == 2:
+            self.draws0 = {m: state.gpu.raster[m].draws for m in gl}
+        if 2 <= f < last:
+            state.camera = cam.orbit(state.camera, self.step, 0.02)
+        elif f == last:
+            self.log["drag_rects"] = [[m, list(r)] for m, r in state.gpu.blits.last]
+        elif f == last + 1:
+            screenshot.save(window_title(state), self.out / "drag_screen.png")
+            for m in gl:
+                np.save(self.out / f"image_{m}.npy", np.asarray(state.images[m], np.float32))
+            self.log.update(position=list(state.camera.position))
+        elif f == last + 2:
+            self.log.update(draws={m: state.gpu.raster[m].draws - self.draws0[m] for m in gl},
+                            timed={m: state.gpu.raster[m].timed for m in gl},
+                            timings={m: state.timings.get(m) for m in gl},
+                            rest_rects=[[m, list(r)] for m, r in state.gpu.blits.last])
             state.quit = True
 
 
@@ -740,7 +786,7 @@ SCRIPTS = {"check": Check, "features": Features, "radiosity": Radiosity, "pyrend
            "fps_indexed": lambda out: Fps(out, display="indexed16-kmeans-fs"),
            "drag_check": DragCheck, "export_check": ExportCheck, "screens": Screens,
            "fps_static": lambda out: Fps(out, step=0.0, raytrace_spp=16, wait_cpu=True),
-           "gpu_panels": GpuPanels, "slider_frames": SliderFrames,
+           "gpu_panels": GpuPanels, "slider_frames": SliderFrames, "drag_rest": lambda out: DragRest(out, display={"gouraud": "direct16-565-bayer"}),
            "fps_material_drag": lambda out: SliderFps(out, "material"),
            "fps_slider_drag": lambda out: SliderFps(out, "material+light"),
            "layout": Layout, "idle": Idle, "idle_quick": lambda out: Idle(out, seconds=3.0),
