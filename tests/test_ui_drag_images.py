@@ -51,8 +51,8 @@ def drag(xvfb, tmp_path_factory):
     c = panel_camera(scene.camera, SIZE)
     for _ in range(FRAMES):
         c = cam.orbit(c, 0.05, 0.02)
-    cli = {m: workbench.render(replace(scene, camera=c), m, width=c.width, height=c.height,
-                               standins="off").image for m in RASTER}
+    cli = {m: workbench.render(replace(scene, camera=c), m, width=c.width, height=c.height).image
+           for m in RASTER}  # the panels' options are the CLI's defaults (stand-ins on)
     return out, summary["script"], c, cli
 
 
