@@ -191,3 +191,20 @@ def test_the_fast_build_makes_the_readable_builds_tree():
             assert meta[i, 2] == axis
             if leaf is not None:
                 assert set(order[meta[i, 0]:meta[i, 0] + meta[i, 1]].tolist()) == leaf
+
+
+def test_two_thread_build_is_the_one_thread_tree_node_for_node():
+    """From ``PARALLEL_MIN`` items the root's subtrees are built by two threads and renumbered:
+    the same order, boxes and meta as one depth-first pass over the whole range."""
+    from workbench.renderers.raytrace import bvh as B
+    rng = np.random.default_rng(5)
+    c = np.concatenate([rng.normal(0, 1, (3 * B.PARALLEL_MIN, 3)), rng.normal(4, 0.1, (B.PARALLEL_MIN, 3))])
+    h = rng.uniform(0.001, 0.05, c.shape)
+    tb = np.concatenate([c - h, c + h], axis=1)
+    one = tb.copy()
+    idx = np.arange(len(one))
+    box, meta, pending, _ = B._build_nodes(one, idx, 0, len(one), 0, B._root_bounds(one), 2 * len(one))
+    assert len(pending) == 0
+    order2, box2, meta2 = B._build(tb.copy())
+    assert len(box) > 1000 and (meta[:, 2] == -1).sum() > 500  # a real tree, both subtrees deep
+    assert np.array_equal(order2, idx) and np.array_equal(box2, box) and np.array_equal(meta2, meta)

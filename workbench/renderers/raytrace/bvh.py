@@ -18,6 +18,7 @@ triangles are packed by four in the same way (``(G, 9, 4)``).
 """
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from typing import NamedTuple
 
 import numba as nb
@@ -70,8 +71,24 @@ def triangle_boxes(tri_v):
 
 
 @nb.njit(cache=True)
-def _build(tb):
-    """The binned SAH build (module docstring) over boxes ``tb`` (T, 6), reordered in place.
+def _root_bounds(tb):
+    """(12,) box and centroid bounds of all the boxes ``tb`` (T, 6)."""
+    acc = np.empty(12)
+    for a in range(3):
+        acc[a], acc[3 + a], acc[6 + a], acc[9 + a] = np.inf, -np.inf, np.inf, -np.inf
+    for k in range(tb.shape[0]):
+        _grow(acc, 0, tb, k)
+    return acc
+
+
+@nb.njit(cache=True, nogil=True)
+def _build_nodes(tb, idx, s0, e0, depth0, bounds0, limit):
+    """The binned SAH build (module docstring) of the items ``[s0, e0)`` of ``tb`` (T, 6) and
+    ``idx`` (T,), reordered in place, from a node at depth ``depth0`` with box and centroid
+    bounds ``bounds0`` (12,); at most ``limit`` nodes are made.  Returns the nodes' boxes
+    (n, 6) and meta (n, 3) (numbered from 0 at this range's root; leaves' ``first`` index
+    ``tb``) and the nodes still pending (k, 5) ``(start, end, parent, is_right, depth)``
+    with their bounds (k, 12), right child first: none unless the limit was reached.
     The boxes are kept in the order of ``idx`` (swapped with it), so that every pass over a
     node's range reads memory in sequence; a box's centroid (its centre) is recomputed where
     needed rather than stored and swapped beside it (less memory traffic, the same values); a
@@ -80,20 +97,14 @@ def _build(tb):
     every ``(n // BIN_SAMPLES)``-th of them only (the SAH estimated from a regular sample,
     Wald 2007; the partition is exact): on the mesh scene the binary tree's SAH cost rises
     0.1 % and the build's CPU time falls by about a sixth."""
-    T = tb.shape[0]
-    idx = np.arange(T)
-    cap = max(2 * T, 1)
+    cap = min(max(2 * (e0 - s0), 1), max(limit, 1))
     box = np.empty((cap, 6))
     meta = np.zeros((cap, 3), dtype=np.int64)
     stack = np.empty((MAX_DEPTH + 2, 5), dtype=np.int64)  # start, end, parent, is_right, depth
     bounds = np.empty((MAX_DEPTH + 2, 12))  # each pending node's box and centroid bounds
     acc = np.empty(24)  # two running boxes and centroid bounds (left at 0, right at 12)
-    for a in range(3):
-        acc[a], acc[3 + a], acc[6 + a], acc[9 + a] = np.inf, -np.inf, np.inf, -np.inf
-    for k in range(T):
-        _grow(acc, 0, tb, k)
-    bounds[0, :] = acc[:12]
-    stack[0, 0], stack[0, 1], stack[0, 2], stack[0, 3], stack[0, 4] = 0, T, -1, 0, 0
+    bounds[0, :] = bounds0
+    stack[0, 0], stack[0, 1], stack[0, 2], stack[0, 3], stack[0, 4] = s0, e0, -1, 0, depth0
     sp = 1
     n_nodes = 0
     bin_box = np.empty((3, N_BINS, 6))
@@ -104,7 +115,7 @@ def _build(tb):
     cmin = np.empty(3)
     ext = np.empty(3)
     scale = np.zeros(3)
-    while sp > 0:
+    while sp > 0 and n_nodes < cap:
         sp -= 1
         s, e, parent, is_right, depth = stack[sp, 0], stack[sp, 1], stack[sp, 2], stack[sp, 3], stack[sp, 4]
         node = n_nodes
@@ -202,7 +213,38 @@ def _build(tb):
         stack[sp, 0], stack[sp, 1], stack[sp, 2], stack[sp, 3], stack[sp, 4] = s, mid, node, 0, depth + 1
         bounds[sp, :] = acc[:12]
         sp += 1
-    return idx, box[:n_nodes].copy(), meta[:n_nodes].copy()
+    return box[:n_nodes].copy(), meta[:n_nodes].copy(), stack[:sp].copy(), bounds[:sp].copy()
+
+
+PARALLEL_MIN = 4096
+"""Items from which the root's two subtrees are built at once (two threads; numba ``nogil``)."""
+
+
+def _build(tb: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The binned SAH build over boxes ``tb`` (T, 6), reordered in place: ``(order (T,), box
+    (n, 6), meta (n, 3))`` as :func:`build_bvh`.  From :data:`PARALLEL_MIN` items the root
+    is split alone and its two subtrees are built by two threads; their nodes are renumbered
+    into the depth-first order one thread gives (left subtree after the root, then the right),
+    so the tree is the same node for node."""
+    T = tb.shape[0]
+    idx = np.arange(T)
+    b0 = _root_bounds(tb)
+    if T < PARALLEL_MIN:
+        box, meta, _, _ = _build_nodes(tb, idx, 0, T, 0, b0, 2 * T)
+        return idx, box, meta
+    rbox, rmeta, pending, pbounds = _build_nodes(tb, idx, 0, T, 0, b0, 1)
+    if len(pending) == 0:  # the root is a leaf
+        return idx, rbox, rmeta
+    (s_r, e_r, _, _, d_r), (s_l, e_l, _, _, d_l) = pending
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        left = pool.submit(_build_nodes, tb, idx, s_l, e_l, d_l, pbounds[1], 2 * (e_l - s_l))
+        right = pool.submit(_build_nodes, tb, idx, s_r, e_r, d_r, pbounds[0], 2 * (e_r - s_r))
+        (lbox, lmeta, _, _), (rbox_, rmeta_, _, _) = left.result(), right.result()
+    n_left = len(lbox)
+    lmeta[lmeta[:, 2] != -1, 0] += 1               # inner nodes' right children: renumbered
+    rmeta_[rmeta_[:, 2] != -1, 0] += 1 + n_left    # (leaves' first items index tb already)
+    rmeta[0, 0] = 1 + n_left
+    return idx, np.concatenate([rbox, lbox, rbox_]), np.concatenate([rmeta, lmeta, rmeta_])
 
 
 def build_bvh(tri_v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
