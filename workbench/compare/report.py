@@ -25,7 +25,8 @@ import numpy as np
 
 from ..core.errors import WorkbenchError
 from ..core.imageio import save_npy, save_png, save_png8
-from ..renderers.base import check_methods, default_methods, file_stem, stats_for_display
+from ..renderers.base import check_methods, default_methods, file_stem, get_renderer, render, stats_for_display
+from ..renderers.raster_standins import parse_standins
 from ..scene.model import Scene
 from . import figures
 from .html import esc, img_tag, page, table
@@ -100,6 +101,9 @@ def compare(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
             e["metrics"], m = metrics_and_maps(r.image, ref_img)
             maps[r.method] = (m["flip"], m["abs"])
             e["matched"] = _matched_entry(refs, r)
+            ladder = _standin_ladder(scene, r, w, h, ref_img)
+            if ladder:
+                e["standins_ladder"] = ladder
     # shared scale: the median over methods of their 99.5th percentile, at most display white
     # (1.0); larger errors saturate, so one far-off method does not blacken every other map
     abs_max = max(min(1.0, float(np.median([np.percentile(a, 99.5) for _, a in maps.values()] or [1.0]))), 1e-6)
@@ -164,6 +168,24 @@ def _matched_entry(refs: References, run: MethodRun) -> dict:
     return {"reference": mref.describe(), "metrics": mt}
 
 
+def _standin_ladder(scene: Scene, run: MethodRun, w: int, h: int, ref_img: np.ndarray) -> list[dict]:
+    """By how much each stand-in reduces the error (issue 15): the total RMSE of a run that
+    drew the raster's stand-ins (``stats["standins"]`` not empty), rendered again with none
+    (``standins=off``) and then adding its stand-ins one at a time in ``KINDS`` order
+    (environment maps, blending, shadow maps), its own options otherwise; the last step is
+    the run itself.  Empty for a method or run without stand-ins."""
+    if not getattr(get_renderer(run.method), "draws_standins", False) or not run.result.stats.get("standins"):
+        return []
+    kinds = parse_standins(run.options.get("standins", "on")).split(",")
+    steps = ["off"] + [",".join(kinds[:i + 1]) for i in range(len(kinds) - 1)]
+    ladder = []
+    for st in steps:
+        img = render(scene, run.method, width=w, height=h, **{**run.options, "standins": st}).image
+        ladder.append({"standins": st, "rmse": metrics(img, ref_img)["rmse"]})
+    ladder.append({"standins": ",".join(kinds), "rmse": metrics(run.image, ref_img)["rmse"]})
+    return ladder
+
+
 def _list(items) -> str:
     return "; ".join(items) if items else "none"
 
@@ -211,6 +233,7 @@ def render_html(report: dict, stage: Path, out_dir: Path) -> str:
           "<p class='muted'>" + esc(report["error_split"]) + ".</p>",
           "<p class='muted'>'differs physically': features the reference computes that the method leaves "
           "out; its error then measures the missing effect, not only discretisation.</p>",
+          _ladder_section(report["methods"]),
           "<h2>Error heat maps against the reference</h2>",
           "<p>FLIP (perceptual, scale 0..1) and mean |linear error| over RGB "
           f"(scale 0..{report['heatmap_scales']['abs'][1]:.3g}, shared by all methods: the median of their "
@@ -227,6 +250,20 @@ def render_html(report: dict, stage: Path, out_dir: Path) -> str:
                          + [[k, v] for k, v in e["stats"].items()]) + "</details>")
     b += ["<h2>Machine</h2>", table(["key", "value"], [[k, v] for k, v in report["machine"].items()])]
     return page(f"{scene['name']} comparison", "\n".join(b))
+
+
+def _ladder_section(methods: list[dict]) -> str:
+    """The stand-ins' table: each raster run's total RMSE with none of its stand-ins, then adding
+    them one at a time (:func:`_standin_ladder`)."""
+    rows = [[e["method"], step["standins"], step["rmse"],
+             "" if i == 0 else e["standins_ladder"][i - 1]["rmse"] - step["rmse"]]
+            for e in methods for i, step in enumerate(e.get("standins_ladder", []))]
+    if not rows:
+        return ""
+    return ("<h2>Stand-ins: how much each reduces the error</h2><p>The raster methods' stand-ins for "
+            "global effects (environment maps, blending, shadow maps), added one at a time to the bare "
+            "local model (<code>standins=off</code>); RMSE against the full reference.</p>"
+            + table(["method", "standins", "RMSE (total)", "reduction by this step"], rows, numeric={2, 3}))
 
 
 def _study_section(out_dir: Path) -> str:
