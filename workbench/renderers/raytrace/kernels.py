@@ -545,6 +545,53 @@ def _visit_child(stack, base, sp, top, t, code, near, tnear):
     return sp, near, tnear
 
 
+@nb.njit(error_model="numpy", inline="always")
+def node_ray(ox, oy, oz, dx, dy, dz, tmin):
+    """The ray as :func:`open_node` reads it: ``(pl, ox, oy, oz, ix, iy, iz, tmin)``, its
+    origin, inverse direction (``+-inf`` for a zero component: see :func:`_slab_interval`),
+    the start of its interval and ``pl``, the rows of the planes it enters a box by, then of
+    those it leaves by (:func:`box_lane`)."""
+    ix, iy, iz = 1.0 / dx, 1.0 / dy, 1.0 / dz
+    cx = 0 if ix >= 0.0 else 3
+    cy = 1 if iy >= 0.0 else 4
+    cz = 2 if iz >= 0.0 else 5
+    # unsigned row indices: no negative-index wrap-around per lane (it stops the vectorizer)
+    pl = (np.uint64(cx), np.uint64(cy), np.uint64(cz), np.uint64(3 - cx), np.uint64(5 - cy), np.uint64(7 - cz))
+    return pl, ox, oy, oz, ix, iy, iz, tmin
+
+
+@nb.njit(error_model="numpy", inline="always")
+def open_node(tree, code, ray, best, stack, sp, top):
+    """Visit of 4-wide node ``code`` of ``tree = (node, child)`` (the layout of
+    :func:`.bvh.build_bvh4`: children's boxes ``(N4, 6, 4)``, children ``(N4, 4)``) by
+    ``ray`` (:func:`node_ray`): the four children's boxes are tested side by side
+    (:func:`box_lane`; an entry beyond ``best`` is a miss), the nearest hit child is visited
+    next and the other hit children wait on ``stack`` above row ``sp`` (rows ``(entry
+    distance, child)``, nearest on top; of equal entries the lower slot is visited first:
+    :func:`_visit_child`), no higher than row ``top``.  The one node visit of the triangles'
+    traversal (:func:`bvh_hit`), the analytic primitives' (:func:`prim_tree_walk`) and the
+    traversal statistics' (:func:`.traversal_stats.count_hit`).  Returns ``(sp, code)``: the
+    new stack height and the child to visit next (``>= 0`` a node, ``<= -2`` a leaf, ``-1``
+    none hit)."""
+    node, child = tree
+    pl, ox, oy, oz, ix, iy, iz, tmin = ray
+    nd = np.uint64(code)
+    t0 = box_lane(node, nd, 0, pl, ox, oy, oz, ix, iy, iz, tmin, best)
+    t1 = box_lane(node, nd, 1, pl, ox, oy, oz, ix, iy, iz, tmin, best)
+    t2 = box_lane(node, nd, 2, pl, ox, oy, oz, ix, iy, iz, tmin, best)
+    t3 = box_lane(node, nd, 3, pl, ox, oy, oz, ix, iy, iz, tmin, best)
+    base, code, tn = sp, -1, np.inf
+    if t0 < np.inf:
+        code, tn = child[nd, 0], t0
+    if t1 < np.inf:
+        sp, code, tn = _visit_child(stack, base, sp, top, t1, child[nd, 1], code, tn)
+    if t2 < np.inf:
+        sp, code, tn = _visit_child(stack, base, sp, top, t2, child[nd, 2], code, tn)
+    if t3 < np.inf:
+        sp, code, tn = _visit_child(stack, base, sp, top, t3, child[nd, 3], code, tn)
+    return sp, code
+
+
 def _slp_vectorized(dispatcher):
     """Compile ``dispatcher`` with LLVM's superword-level-parallelism vectorizer, which packs
     the four box tests of a 4-wide node, and the four triangle tests of a leaf group, into
@@ -579,12 +626,7 @@ def bvh_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     when popped if the best hit is now nearer than their box; a leaf's triangles are tested four
     at a time.  Returns ``(t, tri, b1, b2)``."""
     node, child, leaf, first, tv4 = bvh
-    ix, iy, iz = 1.0 / dx, 1.0 / dy, 1.0 / dz  # +-inf for a zero component: see _slab_interval
-    cx = 0 if ix >= 0.0 else 3
-    cy = 1 if iy >= 0.0 else 4
-    cz = 2 if iz >= 0.0 else 5
-    # unsigned row indices: no negative-index wrap-around per lane (it stops the vectorizer)
-    pl = (np.uint64(cx), np.uint64(cy), np.uint64(cz), np.uint64(3 - cx), np.uint64(5 - cy), np.uint64(7 - cz))
+    ray = node_ray(ox, oy, oz, dx, dy, dz, tmin)
     # the watertight test's shear
     ax0, ax1, ax2 = abs(dx), abs(dy), abs(dz)
     kz = 0
@@ -607,20 +649,7 @@ def bvh_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     code, sp = 0, 0
     while True:
         while code >= 0:  # a 4-wide node
-            nd = np.uint64(code)
-            t0 = box_lane(node, nd, 0, pl, ox, oy, oz, ix, iy, iz, tmin, best)
-            t1 = box_lane(node, nd, 1, pl, ox, oy, oz, ix, iy, iz, tmin, best)
-            t2 = box_lane(node, nd, 2, pl, ox, oy, oz, ix, iy, iz, tmin, best)
-            t3 = box_lane(node, nd, 3, pl, ox, oy, oz, ix, iy, iz, tmin, best)
-            base, code, tn = sp, -1, np.inf
-            if t0 < np.inf:
-                code, tn = child[nd, 0], t0
-            if t1 < np.inf:
-                sp, code, tn = _visit_child(stack, base, sp, top, t1, child[nd, 1], code, tn)
-            if t2 < np.inf:
-                sp, code, tn = _visit_child(stack, base, sp, top, t2, child[nd, 2], code, tn)
-            if t3 < np.inf:
-                sp, code, tn = _visit_child(stack, base, sp, top, t3, child[nd, 3], code, tn)
+            sp, code = open_node((node, child), code, ray, best, stack, sp, top)
         if code < -1:  # a leaf
             lf = -2 - code
             for g in range(leaf[lf, 0], leaf[lf, 0] + leaf[lf, 1]):
@@ -702,11 +731,7 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_
     (ptype, top, xf, nm, par, solid, shadow, poly_v, prog, tri_v, tri_n, tri_uv, tri_e,
      tri_prim, bvh_node, bvh_child, bvh_leaf, bvh_first, bvh_tv4, bvh_bounds, ident, aux,
      pfree, pnode, pchild, pleaf, pref, pbounds) = geo
-    ix, iy, iz = 1.0 / dx, 1.0 / dy, 1.0 / dz
-    cx = 0 if ix >= 0.0 else 3
-    cy = 1 if iy >= 0.0 else 4
-    cz = 2 if iz >= 0.0 else 5
-    pl = (np.uint64(cx), np.uint64(cy), np.uint64(cz), np.uint64(3 - cx), np.uint64(5 - cy), np.uint64(7 - cz))
+    ray = node_ray(ox, oy, oz, dx, dy, dz, tmin)
     bp, bf, found = -1, 0, -1
     base = PRIM_STACK_BASE
     top_ = stack.shape[0] - 1
@@ -715,20 +740,7 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_
         while code >= 0:
             if count:
                 cnt[0] += 1
-            nd = np.uint64(code)
-            t0 = box_lane(pnode, nd, 0, pl, ox, oy, oz, ix, iy, iz, tmin, best)
-            t1 = box_lane(pnode, nd, 1, pl, ox, oy, oz, ix, iy, iz, tmin, best)
-            t2 = box_lane(pnode, nd, 2, pl, ox, oy, oz, ix, iy, iz, tmin, best)
-            t3 = box_lane(pnode, nd, 3, pl, ox, oy, oz, ix, iy, iz, tmin, best)
-            b0, code, tn = sp, -1, np.inf
-            if t0 < np.inf:
-                code, tn = pchild[nd, 0], t0
-            if t1 < np.inf:
-                sp, code, tn = _visit_child(stack, b0, sp, top_, t1, pchild[nd, 1], code, tn)
-            if t2 < np.inf:
-                sp, code, tn = _visit_child(stack, b0, sp, top_, t2, pchild[nd, 2], code, tn)
-            if t3 < np.inf:
-                sp, code, tn = _visit_child(stack, b0, sp, top_, t3, pchild[nd, 3], code, tn)
+            sp, code = open_node((pnode, pchild), code, ray, best, stack, sp, top_)
         if code < -1:
             lf = -2 - code
             for q in range(pleaf[lf, 0], pleaf[lf, 0] + pleaf[lf, 1]):

@@ -31,7 +31,7 @@ import numpy as np
 from numba import prange
 
 from ...core.tol import tol
-from .kernels import (CHUNK, NO_REFCOUNT, _bounds_hit, _tasks, _visit_child, box_lane, prim_tree_walk, row_hit,
+from .kernels import (CHUNK, NO_REFCOUNT, _bounds_hit, _tasks, node_ray, open_node, prim_tree_walk, row_hit,
                       scratch, tri_lane)
 
 
@@ -40,11 +40,7 @@ def count_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, stack, cnt):
     """:func:`.kernels.bvh_hit`'s closest-hit traversal, adding the 4-wide nodes visited to
     ``cnt[0]`` and the triangle tests to ``cnt[1]``.  Returns ``(t, tri)``."""
     node, child, leaf, first, tv4 = bvh
-    ix, iy, iz = 1.0 / dx, 1.0 / dy, 1.0 / dz
-    cx = 0 if ix >= 0.0 else 3
-    cy = 1 if iy >= 0.0 else 4
-    cz = 2 if iz >= 0.0 else 5
-    pl = (np.uint64(cx), np.uint64(cy), np.uint64(cz), np.uint64(3 - cx), np.uint64(5 - cy), np.uint64(7 - cz))
+    ray = node_ray(ox, oy, oz, dx, dy, dz, tmin)
     ax0, ax1, ax2 = abs(dx), abs(dy), abs(dz)
     kz = 0
     if ax1 > ax0 and ax1 >= ax2:
@@ -67,20 +63,7 @@ def count_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, stack, cnt):
     while True:
         while code >= 0:
             cnt[0] += 1
-            nd = np.uint64(code)
-            t0 = box_lane(node, nd, 0, pl, ox, oy, oz, ix, iy, iz, tmin, best)
-            t1 = box_lane(node, nd, 1, pl, ox, oy, oz, ix, iy, iz, tmin, best)
-            t2 = box_lane(node, nd, 2, pl, ox, oy, oz, ix, iy, iz, tmin, best)
-            t3 = box_lane(node, nd, 3, pl, ox, oy, oz, ix, iy, iz, tmin, best)
-            base, code, tn = sp, -1, np.inf
-            if t0 < np.inf:
-                code, tn = child[nd, 0], t0
-            if t1 < np.inf:
-                sp, code, tn = _visit_child(stack, base, sp, top, t1, child[nd, 1], code, tn)
-            if t2 < np.inf:
-                sp, code, tn = _visit_child(stack, base, sp, top, t2, child[nd, 2], code, tn)
-            if t3 < np.inf:
-                sp, code, tn = _visit_child(stack, base, sp, top, t3, child[nd, 3], code, tn)
+            sp, code = open_node((node, child), code, ray, best, stack, sp, top)
         if code < -1:
             lf = -2 - code
             for g in range(leaf[lf, 0], leaf[lf, 0] + leaf[lf, 1]):
