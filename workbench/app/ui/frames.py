@@ -13,7 +13,8 @@
 * Every panel's linear image has a GPU copy (:func:`linear_source`: a raster panel's
   framebuffer, else a float texture uploaded once per change of the image) and reaches the
   screen through GPU passes (:class:`DisplayPasses`, ``shaders/display*``): sRGB encoding
-  (IEC 61966-2-1, the numbers of :func:`workbench.core.imageio.to_srgb8`), and the
+  (IEC 61966-2-1, the numbers of :func:`workbench.core.imageio.to_srgb8`; during a drag the
+  window's sRGB framebuffer encodes, within one level of them), and the
   difference view's ``"abs"`` map, its maximum and mean reduced on the GPU, and colour
   scale.  They draw into the window's framebuffer under imgui's drawing
   (:class:`ScreenBlits`), not drawn by imgui as quads: straight from the linear image while
@@ -200,9 +201,10 @@ class ScreenBlits:
     framebuffer under imgui's drawing, scaled to their item's rectangle as a nearest blit:
 
     * while an image changes (a drag), drawn by the display pass that makes it
-      (:meth:`DisplayPasses.to_window`: a linear image sRGB-encoded, a display mode's GPU
-      view, the difference's colour map): one pass where encoding into an RGBA8 display
-      texture and blitting that were two;
+      (:meth:`DisplayPasses.to_window`: a linear image sRGB-encoded, by the window's own
+      framebuffer where it is sRGB-capable (:meth:`linear`), a display mode's GPU view, the
+      difference's colour map): one pass where encoding into an RGBA8 display texture and
+      blitting that were two;
     * an image that stays is encoded once into its display texture, which is then copied by
       ``glBlitFramebuffer`` each frame (3 panels: 8.5 ms of CPU against 10.2 for a copying
       pass, ``display_copy.frag``, used where the window's GLFW gives no
