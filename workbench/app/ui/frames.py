@@ -278,8 +278,10 @@ class ScreenBlits:
 
         def run(src, dst):
             self.ctx.enable_direct(GL_FRAMEBUFFER_SRGB)
-            passes.to_window("linear", {"u_linear": source}, src, dst, u_flip=int(flip))
-            self.ctx.disable_direct(GL_FRAMEBUFFER_SRGB)
+            try:
+                passes.to_window("linear", {"u_linear": source}, src, dst, u_flip=int(flip))
+            finally:  # imgui draws in display space: never with the encoding on
+                self.ctx.disable_direct(GL_FRAMEBUFFER_SRGB)
         return run, source.size
 
     def _window_encodes_srgb(self, address: int) -> bool:
