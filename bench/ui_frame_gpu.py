@@ -88,7 +88,7 @@ def main() -> None:
     def to_window(name, inputs, rect, **uniforms):
         x, y, w, h = rect
         ctx.scissor = rect
-        passes.to_window(name, inputs, (0, 0, x, y + h), (PANEL[0] / w, -PANEL[1] / h), **uniforms)
+        passes.to_window(name, inputs, (0, 0, *PANEL), (x, y + h, x + w, y), **uniforms)
 
     def window_encodes() -> None:
         screen.use()

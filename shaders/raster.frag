@@ -86,11 +86,14 @@ void main() {
     vec3 diffuse = v_diffuse;
     vec3 specular = v_specular;
 #if defined(MODE_GOURAUD) && defined(SHADOW_MAPS)
-    for (int k = 0; k < N_LIGHTS; ++k) {
-        float vis = shadow_visibility(k, v_world, N);
-        diffuse += vis * v_light_d[k];
-        specular += vis * v_light_s[k];
-    }
+    // unrolled over the lights (FOR_EACH_LIGHT, as light_terms in the vertex stage), so that
+    // every index is a constant: llvmpipe pays for a loop's dynamically indexed arrays
+    int k = 0;
+#define X(POINT, INV_SQ, LOBE, pos, color, lobe_normal) \
+    { float vis = shadow_visibility(k, v_world, N); \
+      diffuse += vis * v_light_d[k]; specular += vis * v_light_s[k]; ++k; }
+    FOR_EACH_LIGHT(X)
+#undef X
 #endif
 #endif
     vec3 color = MAT_EMISSION + C * diffuse + specular;

@@ -77,8 +77,9 @@ def test_panels_after_a_drag_are_a_fresh_render_at_the_final_camera(drag):
 
 
 def test_the_window_shows_them_during_the_drag_and_at_rest(drag):
-    """The drag's last frame (panels drawn from their linear images, Gouraud's through a
-    dithered 16-bit mode, the difference from the GPU's maximum) and the rested frame
+    """The drag's last frame (panels drawn from their linear images and encoded by the
+    window's sRGB framebuffer, Gouraud's through a dithered 16-bit mode, the difference from
+    the GPU's maximum) and the rested frame
     (display textures copied) both show the CLI's images through their modes and the CLI
     images' error map (flat against Gouraud, the view's first pair)."""
     from PIL import Image
@@ -87,6 +88,7 @@ def test_the_window_shows_them_during_the_drag_and_at_rest(drag):
     assert err.max() > 0.01
     colours = colour_scale(err, float(err.max())).astype(int)
     step = np.abs(np.diff(colour_scale(np.linspace(0, 1, 256)[None], 1.0)[0].astype(int), axis=0)).max()
+    assert log["window_srgb"]  # Mesa's window encodes sRGB: the drag used display_linear.frag
     during = np.asarray(Image.open(out / "drag_screen.png"))[..., :3].astype(int)
     rest = np.asarray(Image.open(out / "ui.png"))[..., :3].astype(int)
     for shot, rects in ((during, dict(log["drag_rects"])), (rest, dict(log["rest_rects"]))):

@@ -50,13 +50,20 @@ def rotate_xyz(angles_deg) -> np.ndarray:
     return rotate([0, 0, 1], az) @ rotate([0, 1, 0], ay) @ rotate([1, 0, 0], ax)
 
 
+def cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross product of two 3-vectors (3,), the same roundings as ``np.cross`` without its
+    axis handling (which costs ~20x the arithmetic on one pair: a camera drag forms several
+    view matrices a frame)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
 def look_at(eye, target, up) -> np.ndarray:
     """``camera_from_world`` for a camera at ``eye`` looking at ``target`` (OpenGL frame:
     the camera looks down its -z axis, x right, y up)."""
     eye = np.asarray(eye, dtype=np.float64)
     f = normalize(np.asarray(target, dtype=np.float64) - eye)
-    r = normalize(np.cross(f, np.asarray(up, dtype=np.float64)))
-    u = np.cross(r, f)
+    r = normalize(cross3(f, np.asarray(up, dtype=np.float64)))
+    u = cross3(r, f)
     m = np.eye(4)
     m[0, :3], m[1, :3], m[2, :3] = r, u, -f
     m[:3, 3] = -m[:3, :3] @ eye

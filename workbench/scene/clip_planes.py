@@ -45,9 +45,11 @@ def _clip(poly: np.ndarray, normal: np.ndarray) -> np.ndarray:
 _FACES = ((0, 1, 3, 2), (4, 5, 7, 6), (0, 1, 5, 4), (2, 3, 7, 6), (0, 2, 6, 4), (1, 3, 7, 5))
 
 
-def visible_depths(camera: Camera, box: np.ndarray) -> tuple[float, float, bool] | None:
+def visible_depths(camera: Camera, box: np.ndarray, view: np.ndarray | None = None
+                   ) -> tuple[float, float, bool] | None:
     """Depth range of the part of a world box (2, 3) inside the camera's frustum (sides only,
     no near or far plane): ``(z_min, z_max, holds_camera)`` or ``None`` when none of it is.
+    ``view``: the camera's ``camera_from_world`` (4, 4) if already formed.
 
     The intersection of a box and the frustum is a convex polyhedron whose vertices are box
     corners, box edges crossing a frustum side, frustum edges crossing a box face, or the
@@ -56,7 +58,7 @@ def visible_depths(camera: Camera, box: np.ndarray) -> tuple[float, float, bool]
     """
     lo, hi = np.asarray(box[0], dtype=np.float64), np.asarray(box[1], dtype=np.float64)
     corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-    V = camera.camera_from_world()
+    V = camera.camera_from_world() if view is None else view
     c = corners @ V[:3, :3].T + V[:3, 3]
     c = np.stack([c[:, 0], c[:, 1], -c[:, 2]], -1)  # x, y, depth (the camera looks down -z)
     ty = np.tan(np.radians(camera.fov_y) / 2.0)
@@ -81,7 +83,8 @@ def visible_depths(camera: Camera, box: np.ndarray) -> tuple[float, float, bool]
 def auto_near_far(camera: Camera, boxes: np.ndarray) -> tuple[float, float]:
     """Clip planes for the parts' world boxes (K, 2, 3) seen from ``camera`` (its own near and
     far win).  See the module docstring for the rule."""
-    ranges = [r for r in (visible_depths(camera, b) for b in np.asarray(boxes).reshape(-1, 2, 3)) if r]
+    view = camera.camera_from_world()
+    ranges = [r for r in (visible_depths(camera, b, view) for b in np.asarray(boxes).reshape(-1, 2, 3)) if r]
     ranges = [r for r in ranges if r[1] > 0.0]
     if not ranges:  # nothing in view: any valid pair
         far = camera.far or 1.0

@@ -92,14 +92,16 @@ class ModeDisplay:
 
     def __init__(self, ctx, notify=None):
         from ...renderers.raster_shaders import SHADER_DIR, build_source
+
+        from . import window_quad
         self.ctx, self.notify = ctx, notify
-        self.progs = {}
-        for where, defines in (("texture", {}), ("window", {"TO_WINDOW": ""})):
-            prog = self.progs[where] = ctx.program(
-                vertex_shader=(SHADER_DIR / "display.vert").read_text(encoding="utf-8"),
-                fragment_shader=build_source("display_mode.frag", defines))
+        self.progs = {"texture": ctx.program(
+            vertex_shader=(SHADER_DIR / "display.vert").read_text(encoding="utf-8"),
+            fragment_shader=build_source("display_mode.frag", {}))}
+        self.vaos = {"texture": ctx.vertex_array(self.progs["texture"], [])}
+        self.progs["window"], self.vaos["window"] = window_quad.program(ctx, "display_mode.frag")
+        for prog in self.progs.values():
             prog["u_linear"].value, prog["u_lut"].value = 0, 1
-        self.vaos = {where: ctx.vertex_array(prog, []) for where, prog in self.progs.items()}
         self.changed: dict[str, tuple] = {}
         self.tables: dict[tuple, object] = {}
         self.exact: dict[str, tuple] = {}
@@ -122,16 +124,13 @@ class ModeDisplay:
         if self.ctx.screen is not None:  # back to the window's framebuffer for imgui
             self.ctx.screen.use()
 
-    def to_window(self, source, flip: bool, mode, table, origin: tuple,
-                  texels_per_pixel: tuple) -> None:
+    def to_window(self, source, flip: bool, mode, table, src: tuple, dst: tuple) -> None:
         """Draw ``source`` through ``mode`` as :meth:`run` does, straight into the bound
-        window framebuffer (within its scissor, scaled as
-        :meth:`.frames.DisplayPasses.to_window` says)."""
-        self.progs["window"]["u_window"].value = origin
-        self.progs["window"]["u_texels_per_pixel"].value = texels_per_pixel
-        self._draw("window", source, flip, mode, table)
+        window framebuffer: its texel window ``src`` into the window rectangle ``dst``
+        (:func:`.window_quad.draw`), within the scissor."""
+        self._draw("window", source, flip, mode, table, src, dst)
 
-    def _draw(self, where: str, source, flip: bool, mode, table) -> None:
+    def _draw(self, where: str, source, flip: bool, mode, table, src=None, dst=None) -> None:
         import moderngl
         if table is None:
             if self.dummy_table is None:
@@ -146,7 +145,11 @@ class ModeDisplay:
         p["u_shift"].value = LUT_SHIFT
         p["u_bayer"].value = int(mode.kind == "direct" and mode.dither == "ordered")
         p["u_levels"].value = tuple(float(2 ** b - 1) for b in mode.bits)
-        self.vaos[where].render(moderngl.TRIANGLES, vertices=3)
+        if where == "window":
+            from . import window_quad
+            window_quad.draw(self.ctx, p, self.vaos[where], src, dst)
+        else:
+            self.vaos[where].render(moderngl.TRIANGLES, vertices=3)
 
     def table(self, key: tuple, palette: np.ndarray):
         """The 3D texture of ``palette``'s :func:`clut_table`, kept under ``key``."""

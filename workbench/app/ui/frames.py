@@ -13,7 +13,8 @@
 * Every panel's linear image has a GPU copy (:func:`linear_source`: a raster panel's
   framebuffer, else a float texture uploaded once per change of the image) and reaches the
   screen through GPU passes (:class:`DisplayPasses`, ``shaders/display*``): sRGB encoding
-  (IEC 61966-2-1, the numbers of :func:`workbench.core.imageio.to_srgb8`), and the
+  (IEC 61966-2-1, the numbers of :func:`workbench.core.imageio.to_srgb8`; during a drag the
+  window's sRGB framebuffer encodes, within one level of them), and the
   difference view's ``"abs"`` map, its maximum and mean reduced on the GPU, and colour
   scale.  They draw into the window's framebuffer under imgui's drawing
   (:class:`ScreenBlits`), not drawn by imgui as quads: straight from the linear image while
@@ -45,6 +46,7 @@ them back into its programs (until then it draws them from uniforms)."""
 SCALE_FLOOR = 1e-6
 """The difference view's colour scale runs from 0 to the map's maximum, or to this if the
 maximum is smaller (two equal images show the scale's first colour)."""
+GL_FRAMEBUFFER_SRGB = 0x8DB9
 STATS_BLOCK = 8
 """Texels along each side of the blocks one step of :meth:`DisplayPasses.statistics` reduces."""
 
@@ -56,8 +58,9 @@ def tiled(method: str) -> bool:
 
 
 class DisplayPasses:
-    """The GPU passes between the panels' linear images and the screen, each a full-screen
-    triangle (``shaders/display.vert``) reading its inputs with ``texelFetch`` (no filtering):
+    """The GPU passes between the panels' linear images and the screen, reading their inputs
+    with ``texelFetch`` (no filtering), each a full-screen triangle (``shaders/display.vert``)
+    into a texture or a quad over the image's rectangle of the window (:mod:`.window_quad`):
 
     * :meth:`encode` (``display_srgb.frag``): linear float -> RGBA8 sRGB;
     * :meth:`difference` (``display_difference.frag``): two linear images -> their per-pixel
@@ -68,48 +71,57 @@ class DisplayPasses:
       table (the difference view's colour scale) up to the maximum :meth:`statistics` left
       on the GPU (no read-back between them).
 
-    :meth:`to_window` draws ``srgb``, ``colour_map`` or ``copy`` (``display_copy.frag``: a
-    display texture as it is) straight into the window, scaled to the image's rectangle.
+    :meth:`to_window` draws ``srgb``, ``colour_map``, ``copy`` (``display_copy.frag``: a
+    display texture as it is) or ``linear`` (``display_linear.frag``: the linear image, for a
+    window that encodes sRGB itself) straight into the window, scaled to the image's rectangle.
 
     Also one float scratch texture per image size for :meth:`upload` and one chain of
     reduction textures per image size for :meth:`statistics`."""
 
     def __init__(self, ctx):
+        from . import window_quad
         self.ctx = ctx
         self.programs = {name: self._program(name)
                          for name in ("srgb", "difference", "colour_map", "stats")}
-        self.programs.update({f"{name} to window": self._program(name, to_window=True)
-                              for name in ("srgb", "colour_map", "copy")})
         self.vaos = {name: ctx.vertex_array(prog, []) for name, prog in self.programs.items()}
+        for name in ("srgb", "linear", "colour_map", "copy"):
+            key = f"{name} to window"
+            self.programs[key], self.vaos[key] = window_quad.program(ctx, f"display_{name}.frag")
+            self._bind_samplers(self.programs[key])
         self.scratch: dict[tuple[int, int], object] = {}
         self.chains: dict[tuple[int, int], list] = {}
 
-    def _program(self, name: str, to_window: bool = False):
-        from ...renderers.raster_shaders import SHADER_DIR, build_source
-        prog = self.ctx.program(
-            vertex_shader=(SHADER_DIR / "display.vert").read_text(encoding="utf-8"),
-            fragment_shader=build_source(f"display_{name}.frag",
-                                         {"TO_WINDOW": ""} if to_window else {}))
+    @staticmethod
+    def _bind_samplers(prog) -> None:
         for unit, sampler in enumerate(("u_linear", "u_a", "u_b", "u_value", "u_table", "u_stats",
                                         "u_image")):
             if sampler in prog:
                 prog[sampler].value = unit
+
+    def _program(self, name: str):
+        from ...renderers.raster_shaders import SHADER_DIR, build_source
+        prog = self.ctx.program(
+            vertex_shader=(SHADER_DIR / "display.vert").read_text(encoding="utf-8"),
+            fragment_shader=build_source(f"display_{name}.frag", {}))
+        self._bind_samplers(prog)
         return prog
 
-    def to_window(self, name: str, inputs: dict, origin: tuple, texels_per_pixel: tuple,
-                  **uniforms) -> None:
-        """Draw pass ``name`` (``"srgb"``, ``"colour_map"`` or ``"copy"``) with ``inputs``
-        {sampler: texture} into the bound window framebuffer, within its scissor; its image's
-        texel edge ``origin[:2]`` at window point ``origin[2:]`` (framebuffer pixels, y up) and
-        ``texels_per_pixel`` (x, y) (``shaders/include/display_texel.glsl``)."""
+    def to_window(self, name: str, inputs: dict, src: tuple, dst: tuple, **uniforms) -> None:
+        """Draw pass ``name`` (``"srgb"``, ``"linear"``, ``"colour_map"`` or ``"copy"``) with
+        ``inputs`` {sampler: texture} into the bound window framebuffer, within its scissor:
+        the texel window ``src`` of its image into the window rectangle ``dst``
+        (:func:`.window_quad.draw`).  ``"linear"`` writes linear values: the caller enables
+        the window's own sRGB encoding around it (:attr:`ScreenBlits.srgb`)."""
         import moderngl
+
+        from . import window_quad
         ctx, prog = self.ctx, self.programs[f"{name} to window"]
         ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.CULL_FACE)
         for sampler, tex in inputs.items():
             tex.use(prog[sampler].value)
-        for k, v in {**uniforms, "u_window": origin, "u_texels_per_pixel": texels_per_pixel}.items():
+        for k, v in uniforms.items():
             prog[k].value = v
-        self.vaos[f"{name} to window"].render(moderngl.TRIANGLES, vertices=3)
+        window_quad.draw(ctx, prog, self.vaos[f"{name} to window"], src, dst)
 
     def upload(self, image: np.ndarray, texture=None):
         """(H, W, 3) linear image (row 0 on top) -> ``texture`` (a float RGB texture of its
@@ -189,9 +201,10 @@ class ScreenBlits:
     framebuffer under imgui's drawing, scaled to their item's rectangle as a nearest blit:
 
     * while an image changes (a drag), drawn by the display pass that makes it
-      (:meth:`DisplayPasses.to_window`: a linear image sRGB-encoded, a display mode's GPU
-      view, the difference's colour map): one pass where encoding into an RGBA8 display
-      texture and blitting that were two;
+      (:meth:`DisplayPasses.to_window`: a linear image sRGB-encoded, by the window's own
+      framebuffer where it is sRGB-capable (:meth:`linear`), a display mode's GPU view, the
+      difference's colour map): one pass where encoding into an RGBA8 display texture and
+      blitting that were two;
     * an image that stays is encoded once into its display texture, which is then copied by
       ``glBlitFramebuffer`` each frame (3 panels: 8.5 ms of CPU against 10.2 for a copying
       pass, ``display_copy.frag``, used where the window's GLFW gives no
@@ -223,27 +236,27 @@ class ScreenBlits:
             glfw.glfwGetProcAddress.argtypes = [ctypes.c_char_p]
             bind = glfw.glfwGetProcAddress(b"glBindFramebuffer")
             blit = glfw.glfwGetProcAddress(b"glBlitFramebuffer")
+            query = glfw.glfwGetProcAddress(b"glGetFramebufferAttachmentParameteriv")
         except (OSError, AttributeError):
-            bind = blit = None
+            bind = blit = query = None
         u, i = ctypes.c_uint, ctypes.c_int
         self.bind = ctypes.CFUNCTYPE(None, u, u)(bind) if bind else None
         self.blit = ctypes.CFUNCTYPE(None, i, i, i, i, i, i, i, i, u, u)(blit) if blit else None
+        self.srgb = bool(query) and self._window_encodes_srgb(query)
+        """The window's framebuffer is sRGB-capable: with ``GL_FRAMEBUFFER_SRGB`` enabled it
+        encodes what a pass writes (:meth:`linear`)."""
 
     @staticmethod
     def drawn(draw, size: tuple[int, int]) -> tuple:
-        """An image (for :meth:`show`) of ``size`` (w, h) drawn by ``draw(origin,
-        texels_per_pixel)``, a pass into the bound window framebuffer as
-        :meth:`DisplayPasses.to_window` takes them."""
-        def run(src, dst):
-            (s0, t0, s1, t1), (x0, y0, x1, y1) = src, dst
-            draw((s0, t0, x0, y0), ((s1 - s0) / (x1 - x0), (t1 - t0) / (y1 - y0)))
-        return run, size
+        """An image (for :meth:`show`) of ``size`` (w, h) drawn by ``draw(src, dst)``, a pass
+        into the bound window framebuffer as :meth:`DisplayPasses.to_window` takes them."""
+        return draw, size
 
     def copied(self, texture) -> tuple:
         """An image (for :meth:`show`) that is ``texture`` (a display texture, row 0 on top)
         as it is."""
         if self.blit is None:
-            return self.drawn(lambda o, k: self.passes.to_window("copy", {"u_image": texture}, o, k),
+            return self.drawn(lambda src, dst: self.passes.to_window("copy", {"u_image": texture}, src, dst),
                               texture.size)
 
         def run(src, dst):
@@ -252,6 +265,37 @@ class ScreenBlits:
             self.blit(*src, *dst, 0x4000, 0x2600)  # GL_COLOR_BUFFER_BIT, GL_NEAREST
             self.blitted.add(texture.glo)
         return run, texture.size
+
+    def linear(self, source, flip: bool) -> tuple:
+        """An image (for :meth:`show`) that is the linear float texture ``source`` (row 0 at
+        the bottom with ``flip``) sRGB-encoded: by the window's framebuffer where it encodes
+        sRGB itself (:attr:`srgb`; the encoding may round a level the other way, see
+        ``display_linear.frag``), else by the exact pass ``display_srgb.frag``."""
+        passes = self.passes
+        if not self.srgb:
+            return self.drawn(lambda src, dst: passes.to_window(
+                "srgb", {"u_linear": source}, src, dst, u_flip=int(flip)), source.size)
+
+        def run(src, dst):
+            self.ctx.enable_direct(GL_FRAMEBUFFER_SRGB)
+            try:
+                passes.to_window("linear", {"u_linear": source}, src, dst, u_flip=int(flip))
+            finally:  # imgui draws in display space: never with the encoding on
+                self.ctx.disable_direct(GL_FRAMEBUFFER_SRGB)
+        return run, source.size
+
+    def _window_encodes_srgb(self, address: int) -> bool:
+        """Whether the window's back buffer stores sRGB (``GL_FRAMEBUFFER_ATTACHMENT_COLOR_ENCODING``
+        of ``GL_BACK_LEFT`` is ``GL_SRGB``; Mesa's GLX visuals are, GLFW does not promise it)."""
+        import ctypes
+        if self.ctx.screen is None or self.bind is None:
+            return False
+        get = ctypes.CFUNCTYPE(None, ctypes.c_uint, ctypes.c_uint, ctypes.c_uint,
+                               ctypes.POINTER(ctypes.c_int))(address)
+        value = ctypes.c_int(0)
+        self.bind(0x8D40, 0)  # GL_FRAMEBUFFER: the window's
+        get(0x8D40, 0x0402, 0x8210, ctypes.byref(value))  # GL_BACK_LEFT, ..._COLOR_ENCODING
+        return value.value == 0x8C40 and self.ctx.error == "GL_NO_ERROR"  # GL_SRGB
 
     def _read_fbo(self, texture):
         from ...renderers import gl
@@ -784,8 +828,7 @@ def show_panel(state: AppState, method: str, size, uv0=(0.0, 0.0), uv1=(1.0, 1.0
         source, flip = linear_source(state, method)
         if mode == "direct24":
             g.modes.forget(method)
-            image = g.blits.drawn(lambda o, k: g.passes.to_window(
-                "srgb", {"u_linear": source}, o, k, u_flip=int(flip)), source.size)
+            image = g.blits.linear(source, flip)
         else:
             todo = g.modes.step(method, state.images.version(method), mode,
                                 lambda: state.images[method], method in state.textures)
@@ -793,7 +836,7 @@ def show_panel(state: AppState, method: str, size, uv0=(0.0, 0.0), uv1=(1.0, 1.0
                 # the mode's GPU view drawn into the window; its display texture is made once
                 # the image stays (the next frame that shows the same image)
                 g.modes.shown.pop(method, None)
-                image = g.blits.drawn(lambda o, k: g.modes.to_window(source, flip, *todo[1:], o, k),
+                image = g.blits.drawn(lambda src, dst: g.modes.to_window(source, flip, *todo[1:], src, dst),
                                       source.size)
             elif todo is not None:
                 upload_linear(state, method, todo[1])
@@ -812,8 +855,8 @@ def show_difference(state: AppState, size, uv0=(0.0, 0.0), uv1=(1.0, 1.0)) -> No
             and held[0] == state.images.version("difference")):
         values, table, stats = held[1:]
         inputs = {"u_value": values, "u_table": table, "u_stats": stats}
-        image = g.blits.drawn(lambda o, k: g.passes.to_window(
-            "colour_map", inputs, o, k, u_floor=SCALE_FLOOR), values.size)
+        image = g.blits.drawn(lambda src, dst: g.passes.to_window(
+            "colour_map", inputs, src, dst, u_floor=SCALE_FLOOR), values.size)
     else:
         image = g.blits.copied(shown_texture(state, "difference"))
     g.blits.show("difference", image, size, uv0, uv1)

@@ -626,6 +626,7 @@ class DragRest:
             state.camera = cam.orbit(state.camera, self.step, 0.02)
         elif f == last:
             self.log["drag_rects"] = [[m, list(r)] for m, r in state.gpu.blits.last]
+            self.log["window_srgb"] = state.gpu.blits.srgb
         elif f == last + 1:
             screenshot.save(window_title(state), self.out / "drag_screen.png")
             for m in gl:

@@ -40,13 +40,16 @@ _BYTES_PER_TRIANGLE = 2000
 """A mesh triangle's share of the flattened scene (vertices, normals, uvs, emission: 33 doubles,
 the BVH build's temporaries and its packed groups) with a wide margin."""
 _BASE_BYTES = 64 << 20
-"""Per-thread scratch, the analytic primitives and the light tables: far below this."""
+"""Per-thread scratch and the light tables: far below this (the analytic primitives are
+counted apart, :func:`..raytrace.flatten.flatten_bytes`)."""
 
 
 def estimate_bytes(scene: m.Scene, width: int, height: int) -> int:
     """Upper bound of the memory a path-traced render of ``scene`` at ``width x height`` allocates."""
+    from ..raytrace.flatten import flatten_bytes
     triangles = sum(len(o.faces) for o in scene.objects if isinstance(o, m.Mesh))
-    return int(width) * int(height) * _BYTES_PER_PIXEL + triangles * _BYTES_PER_TRIANGLE + _BASE_BYTES
+    return (int(width) * int(height) * _BYTES_PER_PIXEL + triangles * _BYTES_PER_TRIANGLE
+            + flatten_bytes(scene) + _BASE_BYTES)
 
 
 def _kernels():

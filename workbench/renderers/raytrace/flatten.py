@@ -116,6 +116,33 @@ def light_rows(lights) -> np.ndarray:
     return rows
 
 
+BYTES_PER_ROW = 8192
+"""Upper bound of a primitive row's share of a render's peak: the prepared scene's per-object
+bounds, the builder's record per row, the kernel columns and the primitives' tree (measured,
+ray caster at 16 x 12 with 300 to 4000 spheres: 2.4-4.9 kB a sphere; the flattening alone,
+tracemalloc: 2.4-2.5 kB)."""
+AUX_COPIES = 3
+"""A kind's variable-length numbers (``params(obj, 0)[1]``: a lathe's profile, a blob's
+components) exist at most this many times while flattening: the kind's array, the builder's
+list and the concatenated ``aux`` column."""
+
+
+def flatten_bytes(scene: m.Scene) -> int:
+    """Upper bound of the bytes :func:`flatten` allocates for ``scene``'s analytic primitives
+    (a mesh's triangles are counted apart): :data:`BYTES_PER_ROW` per row, one row per object,
+    per node of a composite kind's tree (a CSG root's row and its leaves'; an inner node is
+    only a code of the root's program) and per area light, plus :data:`AUX_COPIES` times the
+    float64 numbers of each kind with variable-length data."""
+    def node_bytes(o) -> int:
+        kind = kind_of(o)
+        if getattr(kind, "COMPOSITE", False):
+            return BYTES_PER_ROW + sum(node_bytes(c) for c in kind.children(o))
+        aux = len(kind.params(o, 0)[1]) if hasattr(kind, "params") else 0
+        return BYTES_PER_ROW + AUX_COPIES * 8 * aux
+    lights = sum(isinstance(lt, m.AreaLight) for lt in scene.lights)
+    return sum(node_bytes(o) for o in scene.objects) + lights * BYTES_PER_ROW
+
+
 class _Builder:
     """What the kinds' ``flatten`` functions write into (:mod:`workbench.scene.kinds`)."""
 

@@ -44,7 +44,7 @@ from ...scene.model import Mesh, Scene
 from ...scene.prepared import prepare
 from ..base import Knob, Option, RenderResult
 from .accel import ACCELS, accel_extra_bytes
-from .flatten import MAX_CUTOUTS, OPACITY_CUT, SHADOW_CROSSINGS, SceneData, flatten
+from .flatten import MAX_CUTOUTS, OPACITY_CUT, SHADOW_CROSSINGS, SceneData, flatten, flatten_bytes
 
 _RAYS_PER_BAND = 1 << 16
 
@@ -123,7 +123,8 @@ def estimate_trace_bytes(scene: Scene, width: int, height: int, opts: dict, recu
     from ...scene import model as m
     spp = int(opts["spp"])
     tris = extra_triangles + sum(len(o.faces) for o in scene.objects if isinstance(o, m.Mesh))
-    total = _FIXED_BYTES + tris * _BYTES_PER_TRIANGLE + width * height * _BYTES_PER_PIXEL
+    total = (_FIXED_BYTES + tris * _BYTES_PER_TRIANGLE + width * height * _BYTES_PER_PIXEL
+             + flatten_bytes(scene))
     total += accel_extra_bytes(tris, opts.get("accel", "bvh"))
     total += width * height * spp * _BYTES_PER_PRIMARY_RAY
     G = generation_bound(scene, int(opts.get("max_depth", 1)), float(opts.get("threshold", 0.0)), recursive)
