@@ -5,36 +5,12 @@ from __future__ import annotations
 import os
 import shutil
 import subprocess
-import sys
 import time
 from pathlib import Path
 
 import pytest
 
 os.environ.setdefault("NUMBA_CACHE_DIR", str(Path(__file__).resolve().parents[1] / ".numba_cache"))
-
-
-@pytest.fixture(scope="session", autouse=True)
-def jit_warmup():
-    """On a fresh numba cache (a fresh clone, or code changed: the folder is keyed by the
-    code), ``tests/jit_warmup.py`` compiles the kernels the run reaches late in a process of
-    its own, on the other core, while the first tests compile the early ones; the run loads
-    them from the cache.  Nothing is started when the cache folder already holds kernels."""
-    import workbench
-    from workbench.core.jit_cache import use_code_keyed_cache
-    folder = use_code_keyed_cache()  # the run's folder (set when workbench was imported)
-    if any(folder.rglob("*.nbi")):
-        yield None
-        return
-    package_root = str(Path(workbench.__file__).resolve().parents[1])  # this run's workbench
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
-        [package_root, *filter(None, [os.environ.get("PYTHONPATH")])])}
-    proc = subprocess.Popen([sys.executable, str(Path(__file__).with_name("jit_warmup.py"))],
-                            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    yield proc
-    if proc.poll() is None:
-        proc.terminate()
-    proc.wait(30)
 
 
 @pytest.fixture(scope="session", autouse=True)
