@@ -790,8 +790,11 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
         if any_hit and bp >= 0:
             return best, bp, bf, btri, bb1, bb2
     if pref.shape[0] > 0 and _bounds_hit(pbounds, ox, oy, oz, dx, dy, dz, tmin, best):
-        t, p, f, row = prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only,
-                                     np.bool_(any_hit), zero, eps, stack, st, sp_, sf, sn)
+        # np.int64, np.bool_: runtime values, not literals (-1, True, False) from the inlined
+        # callers: one compiled prim_tree_hit for all (six specializations, ~20 s of JIT each)
+        t, p, f, row = prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, np.int64(brow),
+                                     np.bool_(shadow_only), np.bool_(any_hit), zero, eps, stack, st,
+                                     sp_, sf, sn)
         if row >= 0:
             best, bp, bf = t, p, f
             if any_hit:
