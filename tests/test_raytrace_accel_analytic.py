@@ -165,7 +165,8 @@ def test_the_path_tracer_gives_the_same_image_with_every_structure(name):
 def test_every_bundled_scene_gives_the_brute_force_image_with_every_structure(path):
     import workbench
     scene = workbench.load_scene(path)
-    for method in ("raycast", "raytrace"):
-        images = {a: workbench.render(scene, method, accel=a, width=40, height=30).image for a in ACCELS}
+    for method in ("raycast", "raytrace", "pathtrace"):
+        opts = dict(spp=4, seed=1) if method == "pathtrace" else {}
+        images = {a: workbench.render(scene, method, accel=a, width=40, height=30, **opts).image for a in ACCELS}
         for a in ("bvh", "octree"):
             assert np.array_equal(images[a], images["none"]), (method, a)
