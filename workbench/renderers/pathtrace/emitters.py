@@ -31,10 +31,12 @@ class Emitters:
     """Sampleable emitter triangles.
 
     tri : (E, 9) float64 world vertices; normal : (E, 3) unit normal (right-hand rule);
-    prim : (E,) int64 primitive row; mesh_tri : (E,) int64 mesh triangle index (BVH order) or -1;
+    prim : (E,) int64 primitive row; mesh_tri : (E,) int64 a row of the mesh triangle in the
+    flattened triangle arrays (its first; the octree repeats a triangle) or -1;
     cdf : (E,) float64 cumulative selection probabilities (last 1);
     lpdf_prim : (P,) float64 light-strategy density per unit area on analytic primitive k
-    (0: not sampled); lpdf_tri : (T,) the same on mesh triangles;
+    (0: not sampled); lpdf_tri : (T,) the same on mesh triangles, per row of the flattened
+    triangle arrays (equal on every row of one triangle);
     unsampled : reasons of the emitters left to BSDF sampling.
     """
 
@@ -115,12 +117,18 @@ def build_emitters(sd: SceneData) -> Emitters:
         mtris += [-1] * len(t)
         lums += [le.mean()] * len(t)
     if len(sd.tri_v):
-        le = emission[sd.mat[sd.tri_prim]] + sd.tri_e.reshape(-1, 3, 3).mean(1)
-        sel = np.flatnonzero(le.max(1) > 0.0)
+        # one entry per triangle, in the meshes' input order, whatever the structure's row order
+        # (the octree's rows repeat a triangle once per cell it meets: sampled once per
+        # reference, it would be chosen k times as often as its density says); its first row
+        # stands for it
+        _, first = np.unique(sd.tri_src, return_index=True)
+        le = emission[sd.mat[sd.tri_prim[first]]] + sd.tri_e[first].reshape(-1, 3, 3).mean(1)
+        lit = le.max(1) > 0.0
+        sel = first[lit]
         tris.append(sd.tri_v[sel])
         prims += list(sd.tri_prim[sel])
         mtris += list(sel)
-        lums += list(le[sel].mean(1))
+        lums += list(le[lit].mean(1))
     T = np.concatenate(tris) if tris else np.zeros((0, 9))
     e1, e2 = T[:, 3:6] - T[:, 0:3], T[:, 6:9] - T[:, 0:3]
     cr = np.cross(e1, e2)
@@ -133,17 +141,18 @@ def build_emitters(sd: SceneData) -> Emitters:
     power = area * lums
     total = power.sum()
     lpdf_prim = np.zeros(len(sd.ptype))
-    lpdf_tri = np.zeros(len(sd.tri_v))
+    lpdf_src = np.zeros(sd.tri_src.max() + 1 if len(sd.tri_src) else 0)
     if total > 0.0:
         cdf = np.cumsum(power) / total
         cdf[-1] = 1.0
         dens = lums / total
         analytic = mtris < 0
         lpdf_prim[prims[analytic]] = dens[analytic]
-        lpdf_tri[mtris[~analytic]] = dens[~analytic]
+        lpdf_src[sd.tri_src[mtris[~analytic]]] = dens[~analytic]
     else:
         cdf = np.zeros(0)
         T = T[:0]
+    lpdf_tri = lpdf_src[sd.tri_src]  # every row of a triangle: a hit's row is any of them
     n = cr / np.maximum(2.0 * area, tol.zero)[:, None] if len(cr) else np.zeros((0, 3))
     m = len(cdf)
     return Emitters(np.ascontiguousarray(T[:m]), np.ascontiguousarray(n[:m]), prims[:m].copy(),

@@ -201,7 +201,8 @@ class PathTraceSession:
                 "samples_per_s": n / trace if trace > 0 else 0.0,
                 "samples_per_cpu_s": n / self.timings["trace_cpu"] if self.timings["trace_cpu"] > 0 else 0.0,
                 "noise_rmse": self.noise_rmse, "emitter_triangles": len(self.emitters.cdf),
-                "triangles": int(len(self.sd.tri_v)), "scene_extent": self.sd.extent}
+                "triangles": int(len(np.unique(self.sd.tri_src))),
+                "triangle_references": int(len(self.sd.tri_v)), "scene_extent": self.sd.extent}
 
 
 def run_to_noise(session: PathTraceSession, target: float, *, max_spp: int = 1 << 16,

@@ -72,6 +72,8 @@ class SceneData:
     tri_uv: np.ndarray          # (T, 6)
     tri_e: np.ndarray           # (T, 9) vertex emission (radiance)
     tri_prim: np.ndarray        # (T,) the mesh's primitive row
+    tri_src: np.ndarray         # (T,) int64 the triangle of each row: its index among the
+                                # meshes' triangles in input order (octree: repeats)
     bvh: Bvh4                   # 4-wide BVH over the triangles (see .bvh)
     prims: PrimTree             # the analytic primitives' list and structure (see .accel)
     materials: list             # Material objects, index = mat
@@ -278,8 +280,10 @@ def flatten(scene: m.Scene, accel: str = "bvh", prepared: PreparedScene | None =
         order, bvh = build_accel(tri_v, accel)
         tri_v, tri_n, tri_uv, tri_e, tri_p = (np.ascontiguousarray(a[order]) for a in
                                               (tri_v, tri_n, tri_uv, tri_e, tri_p))
+        tri_src = np.ascontiguousarray(order, dtype=np.int64)
     else:
         bvh = empty_bvh4()
+        tri_src = np.zeros(0, dtype=np.int64)
     finite = prepared.bounds if np.isfinite(prepared.bounds).all() else np.zeros((1, 3))
     scale = max(float(np.abs(finite).max()), prepared.extent, float(np.abs(scene.camera.position).max()))
     prims = _prim_tree(rows, owners, _owner_boxes(prepared), accel, scale)
@@ -294,7 +298,7 @@ def flatten(scene: m.Scene, accel: str = "bvh", prepared: PreparedScene | None =
         wfo=col("wfo", np.float64).reshape(-1, 4, 4), has_uv=col("has_uv", np.bool_),
         poly_v=np.ascontiguousarray(np.concatenate(b.poly_v) if b.poly_v else np.zeros((1, 3))),
         csg_prog=np.array(b.prog if b.prog else [0], dtype=np.int64),
-        tri_v=tri_v, tri_n=tri_n, tri_uv=tri_uv, tri_e=tri_e, tri_prim=tri_p,
+        tri_v=tri_v, tri_n=tri_n, tri_uv=tri_uv, tri_e=tri_e, tri_prim=tri_p, tri_src=tri_src,
         bvh=bvh, prims=prims,
         materials=b.materials, mat_tab=np.ascontiguousarray(mat_tab),
         lights=np.ascontiguousarray(light_rows(scene.point_lights()).reshape(-1, 14)),
