@@ -35,7 +35,9 @@ frames) and the results go to ``bench/results/ui_fps.json``:
 * ``drag_indexed``: the ``drag_gl_only`` drag with every GL panel shown through
   ``indexed16-kmeans-fs`` (``scripts.Fps`` with ``display``: during the drag the panels map to
   the CLUT of their last exact image on the GPU, the exact mode is computed once the camera
-  rests, ``ui/display_modes.py``).
+  rests, ``ui/display_modes.py``);
+* ``drag_gl_bare``: the ``drag_gl_only`` drag with the panels' stand-ins off (``standins =
+  off``: the bare local models, the panels as they were before they drew the stand-ins).
 
 ``--cases a,b`` runs only those cases and keeps the other entries of the results file.
 
@@ -142,6 +144,7 @@ def main() -> None:
              "drag_with_raytrace_panel": lambda: measure(a.scene, a.size, a.window, True, "fps"),
              "drag_gl_only": lambda: measure(a.scene, a.size, a.window, False, "fps"),
              "drag_indexed": lambda: measure(a.scene, a.size, a.window, False, "fps_indexed"),
+             "drag_gl_bare": lambda: measure(a.scene, a.size, a.window, False, "fps_bare"),
              "material_drag": lambda: measure(a.scene, a.size, a.window, False, "fps_material_drag"),
              "slider_drag": lambda: measure(a.scene, a.size, a.window, False, "fps_slider_drag"),
              "raytrace_without_window": lambda: raytrace_without_window(a.scene, a.size),

@@ -270,13 +270,15 @@ class Fps:
     pixel (a longer background job).  With ``wait_cpu`` the count also ends when no background
     job runs any more (the rate is the one *while* a job runs), then the session stays open
     until the jobs end and logs the ray trace's run time with the window open.  ``display``
-    sets every panel's display mode first (e.g. an indexed CLUT)."""
+    sets every panel's display mode first (e.g. an indexed CLUT); ``standins`` the ``standins``
+    option of every panel that has it (``"off"``: the bare local models)."""
 
     def __init__(self, out: Path, seconds: float = 10.0, warmup: int = 10, step: float = 0.002,
                  raytrace_spp: int | None = None, wait_cpu: bool = False,
-                 display: str | None = None):
+                 display: str | None = None, standins: str | None = None):
         self.out, self.seconds, self.warmup, self.step, self.log = out, seconds, warmup, step, {}
         self.spp, self.wait_cpu, self.t0, self.display = raytrace_spp, wait_cpu, None, display
+        self.standins = standins
 
     def __call__(self, state: AppState) -> None:
         if state.frame == 0 and self.spp is not None:
@@ -285,6 +287,11 @@ class Fps:
             for m in state.methods:
                 set_display(state, m, self.display)
             self.log["display"] = self.display
+        if state.frame == 0 and self.standins is not None:
+            for m in state.methods:
+                if "standins" in state.options[m]:
+                    set_option(state, m, "standins", self.standins)
+            self.log["standins"] = self.standins
         if self.step:
             state.camera = cam.orbit(state.camera, self.step, 0.0)
         if state.frame == self.warmup:
@@ -785,6 +792,7 @@ def gl_object_counts(state: AppState, names: int = 4096) -> dict:
 SCRIPTS = {"check": Check, "features": Features, "radiosity": Radiosity, "pyrender": Pyrender,
            "fps": Fps,
            "fps_indexed": lambda out: Fps(out, display="indexed16-kmeans-fs"),
+           "fps_bare": lambda out: Fps(out, standins="off"),
            "drag_check": DragCheck, "export_check": ExportCheck, "screens": Screens,
            "fps_static": lambda out: Fps(out, step=0.0, raytrace_spp=16, wait_cpu=True),
            "gpu_panels": GpuPanels, "slider_frames": SliderFrames, "drag_rest": lambda out: DragRest(out, display={"gouraud": "direct16-565-bayer"}),
