@@ -196,3 +196,14 @@ def test_docking_layout_and_status_bar(session):
     assert status.startswith(summary["gl_renderer"])
     for m in METHODS:
         assert f"| {m} " in status and status.split(f"| {m} ")[1].split(" ms")[0].isdigit(), m
+
+
+@pytest.mark.parametrize("argv", [["whitted", "--methods", "nosuch"], ["nosuchscene"]])
+def test_the_window_module_refuses_bad_input_with_one_line(argv):
+    """``python -m workbench.app.ui.main`` (the tests' and benchmarks' entry) says what is wrong
+    in one line and exits 2 before opening a window, as ``workbench ui`` does."""
+    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", *argv], cwd=ROOT,
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 2
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("workbench: error: "), p.stderr

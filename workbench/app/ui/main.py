@@ -14,6 +14,7 @@ import threading
 import time
 from pathlib import Path
 
+from ...core.errors import WorkbenchError
 from ..args import size
 from .glfw_title import glfw_library, window_title
 from .state import AppState, new_state
@@ -143,8 +144,12 @@ def main(argv: list[str] | None = None) -> int:
     if not 8 <= args.size <= 4096:
         p.error(f"--size {args.size}: the panels' resolution must be 8 to 4096 pixels")
     from .scripts import SCRIPTS
-    state = new_state(args.scene, [m for m in args.methods.split(",") if m] or None,
-                      args.size)
+    try:
+        state = new_state(args.scene, [m for m in args.methods.split(",") if m] or None,
+                          args.size)
+    except WorkbenchError as e:  # a bad scene or method list: one line, as `workbench ui` says it
+        print(f"workbench: error: {e}", file=sys.stderr)
+        return 2
     script = None
     if args.test_script:
         args.out = args.out or Path("out/ui")
