@@ -28,6 +28,8 @@ import time
 
 import numpy as np
 
+from . import window_quad
+
 DISPLAY_REST_SECONDS = 0.25
 """How long a panel's image must stay unchanged before its exact display mode is computed."""
 LUT_SHIFT = 3
@@ -92,8 +94,6 @@ class ModeDisplay:
 
     def __init__(self, ctx, notify=None):
         from ...renderers.raster_shaders import SHADER_DIR, build_source
-
-        from . import window_quad
         self.ctx, self.notify = ctx, notify
         self.progs = {"texture": ctx.program(
             vertex_shader=(SHADER_DIR / "display.vert").read_text(encoding="utf-8"),
@@ -146,7 +146,6 @@ class ModeDisplay:
         p["u_bayer"].value = int(mode.kind == "direct" and mode.dither == "ordered")
         p["u_levels"].value = tuple(float(2 ** b - 1) for b in mode.bits)
         if where == "window":
-            from . import window_quad
             window_quad.draw(self.ctx, p, self.vaos[where], src, dst)
         else:
             self.vaos[where].render(moderngl.TRIANGLES, vertices=3)

@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import window_quad
 from .state import AppState, method_kind
 
 LIVE_REST_SECONDS = 0.5
@@ -79,7 +80,6 @@ class DisplayPasses:
     reduction textures per image size for :meth:`statistics`."""
 
     def __init__(self, ctx):
-        from . import window_quad
         self.ctx = ctx
         self.programs = {name: self._program(name)
                          for name in ("srgb", "difference", "colour_map", "stats")}
@@ -113,8 +113,6 @@ class DisplayPasses:
         (:func:`.window_quad.draw`).  ``"linear"`` writes linear values: the caller enables
         the window's own sRGB encoding around it (:attr:`ScreenBlits.srgb`)."""
         import moderngl
-
-        from . import window_quad
         ctx, prog = self.ctx, self.programs[f"{name} to window"]
         ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.CULL_FACE)
         for sampler, tex in inputs.items():

@@ -46,6 +46,10 @@ Functions (``W`` and ``M`` are (4, 4) ``world_from_object`` including any CSG pa
     shadow=)`` (``par``: at most ``NPAR`` floats, the kernel functions' parameters), and for
     kinds with variable-length data the builder's arrays (``b.poly_v``, ``b.meshes``,
     ``b.add_aux``).
+``params(obj, aux_offset) -> (head, aux)``  kinds with variable-length data (blob, isosurface,
+    lathe, prism): the parameter row's head and the numbers that go to the ``aux`` array
+    (:func:`.aux_rows.flatten_aux`); the ray tracer's memory estimate counts ``aux``
+    (:func:`workbench.renderers.raytrace.flatten.flatten_bytes`).
 ``hits(obj, O, D, solid) -> [(t, face), ...]``  readable intersection of the object-space line
     ``O + t D`` (every crossing, sorted; a SOLID kind's alternate entering / leaving; ``solid``
     is True for a CSG leaf).  ``face`` (int) picks the normal.  Meshes have none (the
