@@ -158,10 +158,14 @@ def main() -> None:
             time.sleep(0.05)
         with tempfile.TemporaryDirectory() as out:
             load = os.getloadavg()
-            res = subprocess.run([sys.executable, __file__, "--child", "--out", out,
-                                  *sys.argv[1:]], cwd=ROOT, check=True, timeout=600,
-                                 env={**os.environ, "DISPLAY": f":{n}"}, capture_output=True,
-                                 text=True).stdout
+            child = subprocess.run([sys.executable, __file__, "--child", "--out", out,
+                                    *sys.argv[1:]], cwd=ROOT, timeout=600,
+                                   env={**os.environ, "DISPLAY": f":{n}"}, capture_output=True,
+                                   text=True)
+            if child.returncode != 0:  # the window's own error, not the wrapper's traceback
+                sys.exit(f"ui_drag_profile: the window failed (exit {child.returncode}):\n"
+                         + "\n".join(child.stderr.strip().splitlines()[-15:]))
+            res = child.stdout
     finally:
         xvfb.terminate()
         xvfb.wait(10)
