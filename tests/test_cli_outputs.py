@@ -154,11 +154,35 @@ def test_study_refuses_bad_sweep_values_before_rendering(tmp_path, capsys, monke
     assert not (tmp_path / "s").exists()
 
 
-def test_study_with_nothing_rendered_is_an_error(tmp_path, capsys):
+def _no_reference(monkeypatch):
+    """Rendering a study's reference fails the test (it may take minutes: a study that has
+    nothing to compare must say so before)."""
+    from workbench.compare import study
+
+    def forbidden(*a, **k):
+        raise AssertionError("the reference was rendered")
+    monkeypatch.setattr(study, "References", forbidden)
+
+
+def test_study_with_nothing_rendered_is_an_error(tmp_path, capsys, monkeypatch):
+    _no_reference(monkeypatch)
     line = _one_error_line(*_cli(["study", "whitted", "--quick", "--size", "16x12", "--out", tmp_path / "s",
                                   "--methods", "radiosity"], capsys)[::2])
     assert "nothing to study" in line and "no emitters" in line
     assert not (tmp_path / "s" / "study.json").exists()
+
+
+def test_study_with_an_unknown_reference_fails_before_any_render(tmp_path, capsys, monkeypatch):
+    from workbench.compare import study
+
+    def forbidden(*a, **k):
+        raise AssertionError("a sweep point was rendered")
+    monkeypatch.setattr(study, "timed_run", forbidden)
+    _no_reference(monkeypatch)
+    line = _one_error_line(*_cli(["study", "whitted", "--quick", "--size", "16x12", "--out", tmp_path / "s",
+                                  "--methods", "flat", "--reference", "nosuch"], capsys)[::2])
+    assert "nosuch" in line
+    assert not (tmp_path / "s").exists() or not any((tmp_path / "s").iterdir())
 
 
 @pytest.mark.parametrize("args, kwargs, expect", [

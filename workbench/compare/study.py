@@ -133,19 +133,13 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
     repeat = (2 if quick else 5) if repeat is None else int(repeat)
     if repeat < 1:
         raise WorkbenchError(f"a study needs at least one warm run per point, got repeat={repeat}")
-    refs = None
+    if reference is not None:
+        get_renderer(reference)  # an unknown --reference fails now, not after the sweep
     if reference_image is not None:
-        ref_img = np.asarray(reference_image[0], dtype=np.float32)
-        h, w = ref_img.shape[:2]
-        ref_info = {"method": "given", "options": {}, "reason": reference_image[1]}
+        h, w = np.asarray(reference_image[0]).shape[:2]
     else:
         w, h = size if size else ((160, max(1, round(160 / scene.camera.aspect))) if quick
                                   else (scene.camera.width, scene.camera.height))
-        if progress:
-            print(f"study {scene.name}: rendering the reference (cached after the first run)", flush=True)
-        refs = References(scene, w, h, reference)
-        ref_img = refs.full.image
-        ref_info = refs.full.describe()
     load = machine_info()
 
     plan = []
@@ -178,18 +172,29 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
         if run.status == "ok":
             p.update(time_s=run.time, warm_s=run.warm, cold_s=run.cold, compile_s=run.compile,
                      nonfinite_pixels=run.result.stats.get("nonfinite_pixels", 0),
-                     features_used=run.result.features_used, left_out=run.result.left_out,
-                     is_reference=(m == ref_info["method"] and {knob: value} == ref_info["options"]))
+                     features_used=run.result.features_used, left_out=run.result.left_out)
             images.append((len(points), run.image))
         points.append(p)
     bar.close()
+    ok = [p for p in points if p["status"] == "ok"]
+    if not ok:  # said before the reference is rendered: it may take minutes
+        why = sorted({f"{p['method']}: {p['status']} ({p['reason']})" for p in points})
+        raise WorkbenchError(f"nothing to study on {scene.name}: no setting rendered ({'; '.join(why)})")
+    refs = None
+    if reference_image is not None:
+        ref_img = np.asarray(reference_image[0], dtype=np.float32)
+        ref_info = {"method": "given", "options": {}, "reason": reference_image[1]}
+    else:
+        if progress:
+            print(f"study {scene.name}: rendering the reference (cached after the first run)", flush=True)
+        refs = References(scene, w, h, reference)
+        ref_img = refs.full.image
+        ref_info = refs.full.describe()
+    for p in ok:
+        p["is_reference"] = p["method"] == ref_info["method"] and {p["knob"]: p["value"]} == ref_info["options"]
     for (i, _), mt in zip(images, evaluate([im for _, im in images], ref_img, jobs)):
         points[i].update(mt)
     matched = _matched_errors(refs, points, images, jobs) if refs is not None else {}
-    ok = [p for p in points if p["status"] == "ok"]
-    if not ok:
-        why = sorted({f"{p['method']}: {p['status']} ({p['reason']})" for p in points})
-        raise WorkbenchError(f"nothing to study on {scene.name}: no setting rendered ({'; '.join(why)})")
     front = [p for p in ok if not p["is_reference"]]
     for key in ("rmse", "flip"):
         for p in ok:
