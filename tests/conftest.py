@@ -1,10 +1,12 @@
 """Shared fixtures: the headless GL context with an error-state check around each GL test, and
-the private X server (Xvfb) of the UI tests."""
+the private X server (Xvfb) of the UI tests; on a cold numba cache, the kernels' warm-up beside
+a full run (``tests/warm_kernels.py``)."""
 from __future__ import annotations
 
 import os
 import shutil
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -83,3 +85,32 @@ def xvfb():
     yield f":{n}"
     proc.terminate()
     proc.wait(10)
+
+
+WARM_MIN_ITEMS = 200
+"""A run of at least this many tests starts the kernel warm-up (a single file's run does not)."""
+WARM_CACHED_FILES = 60
+"""Fewer cached functions (``*.nbi``) than this for the current code: the cache counts as cold
+(a full run leaves about 95)."""
+_WARMER = pytest.StashKey()
+
+
+def pytest_collection_finish(session):
+    """On a cold numba cache, compile the kernels in a niced process beside the run
+    (``tests/warm_kernels.py``); ``WORKBENCH_TEST_WARM=0`` turns it off."""
+    if os.environ.get("WORKBENCH_TEST_WARM", "1") == "0" or len(session.items) < WARM_MIN_ITEMS:
+        return
+    from workbench.core.jit_cache import use_code_keyed_cache
+    if sum(1 for _ in use_code_keyed_cache().rglob("*.nbi")) >= WARM_CACHED_FILES:
+        return
+    script = Path(__file__).with_name("warm_kernels.py")
+    session.config.stash[_WARMER] = subprocess.Popen(
+        [sys.executable, str(script)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        preexec_fn=lambda: os.nice(10))
+
+
+def pytest_sessionfinish(session):
+    proc = session.config.stash.get(_WARMER, None)
+    if proc is not None and proc.poll() is None:
+        proc.terminate()  # numba renames each cache file into place: nothing is left half-written
+        proc.wait(30)
