@@ -103,10 +103,13 @@ def pytest_collection_finish(session):
     from workbench.core.jit_cache import use_code_keyed_cache
     if sum(1 for _ in use_code_keyed_cache().rglob("*.nbi")) >= WARM_CACHED_FILES:
         return
-    script = Path(__file__).with_name("warm_kernels.py")
+    root = Path(__file__).resolve().parents[1]
+    # the sources the tests import (numba names its cache folders by the source file's path)
+    path = os.pathsep.join([str(root)] + [p for p in [os.environ.get("PYTHONPATH")] if p])
     session.config.stash[_WARMER] = subprocess.Popen(
-        [sys.executable, str(script)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-        preexec_fn=lambda: os.nice(10))
+        [sys.executable, str(root / "tests" / "warm_kernels.py")], cwd=root,
+        env={**os.environ, "PYTHONPATH": path}, stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL, preexec_fn=lambda: os.nice(10))
 
 
 def pytest_sessionfinish(session):
