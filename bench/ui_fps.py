@@ -1,7 +1,7 @@
 """Frames per second of the UI with three GL panels (flat, Gouraud, Phong) at 512 x 512 on a
 bundled scene while a ray trace runs in the background, under Xvfb (llvmpipe).
 
-Each case runs ``python -m workbench.app.ui.main --test-script fps|fps_static`` in a
+Each case runs ``workbench ui --script fps|fps_static`` (the console script) in a
 subprocess on a fresh Xvfb display (``scripts.Fps`` counts frames for 10 s after 10 warm-up
 frames) and the results go to ``bench/results/ui_fps.json``:
 
@@ -90,9 +90,9 @@ def measure(scene: str, size: int, window: str, cpu: bool, script: str) -> dict:
         methods = "flat,gouraud,phong" + (",raytrace" if cpu else "")
         with tempfile.TemporaryDirectory() as out:
             load = os.getloadavg()
-            subprocess.run([sys.executable, "-m", "workbench.app.ui.main", scene, "--methods",
+            subprocess.run([str(Path(sys.executable).with_name("workbench")), "ui", scene, "--methods",
                             methods, "--size", str(size), "--window", window,
-                            "--test-script", script, "--out", out],
+                            "--script", script, "--out", out],
                            cwd=ROOT, env={**os.environ, "DISPLAY": f":{n}"}, check=True,
                            timeout=900)
             summary = json.loads(Path(out, "summary.json").read_text())

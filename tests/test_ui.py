@@ -12,6 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ui_command import ui_command
+
 from workbench.app.ui import camera as cam
 from workbench.scene.io import load_scene
 
@@ -26,9 +28,9 @@ def session(xvfb, tmp_path_factory):
     """Run the check script once; returns (out folder, summary, completed process)."""
     out = tmp_path_factory.mktemp("ui")
     env = {**os.environ, "DISPLAY": xvfb}
-    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", "whitted",
+    p = subprocess.run([*ui_command(), "whitted",
                         "--methods", ",".join(METHODS), "--size", "128",
-                        "--test-script", "check", "--out", str(out), "--frames", "2000"],
+                        "--script", "check", "--out", str(out), "--frames", "2000"],
                        cwd=ROOT, env=env, capture_output=True, text=True, timeout=400)
     summary = json.loads((out / "summary.json").read_text()) if (out / "summary.json").exists() else None
     return out, summary, p  # (the README's screenshot comes from test_ui_screens.py)
@@ -164,9 +166,9 @@ def test_radiosity_panels_in_the_window(xvfb, tmp_path):
     """Radiosity and hybrid (no tiles: they finish in the background) restart with each change
     and end with non-empty images; no thread left."""
     env = {**os.environ, "DISPLAY": xvfb}
-    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", "cornell",
+    p = subprocess.run([*ui_command(), "cornell",
                         "--methods", "phong,radiosity,hybrid", "--size", "64",
-                        "--test-script", "check", "--out", str(tmp_path)],
+                        "--script", "check", "--out", str(tmp_path)],
                        cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
     assert p.returncode == 0, p.stderr[-2000:]
     summary = json.loads((tmp_path / "summary.json").read_text())
@@ -198,11 +200,13 @@ def test_docking_layout_and_status_bar(session):
         assert f"| {m} " in status and status.split(f"| {m} ")[1].split(" ms")[0].isdigit(), m
 
 
-@pytest.mark.parametrize("argv", [["whitted", "--methods", "nosuch"], ["nosuchscene"]])
-def test_the_window_module_refuses_bad_input_with_one_line(argv):
-    """``python -m workbench.app.ui.main`` (the tests' and benchmarks' entry) says what is wrong
-    in one line and exits 2 before opening a window, as ``workbench ui`` does."""
-    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", *argv], cwd=ROOT,
+@pytest.mark.parametrize("argv", [["whitted", "--methods", "nosuch"], ["nosuchscene"],
+                                  ["whitted", "--size", "4"], ["whitted", "--frames", "0"],
+                                  ["whitted", "--script", "nosuch"],
+                                  ["whitted", "--window", "0x600"]])
+def test_workbench_ui_refuses_bad_input_with_one_line(argv, xvfb):
+    """``workbench ui`` says what is wrong in one line and exits 2 before opening a window."""
+    p = subprocess.run([*ui_command(), *argv], cwd=ROOT, env={**os.environ, "DISPLAY": xvfb},
                        capture_output=True, text=True, timeout=120)
     assert p.returncode == 2
     lines = p.stderr.strip().splitlines()

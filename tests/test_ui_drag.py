@@ -16,6 +16,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ui_command import ui_command
+
 from workbench.app.ui.display_modes import LUT_SHIFT, ModeDisplay, clut_table, encoded8
 from workbench.core.display import apply_display_mode, display_mode, nearest
 from workbench.core.imageio import to_srgb8
@@ -86,9 +88,9 @@ def test_gpu_indexed_drag_view_uses_the_clut_within_one_cell(gl_ctx):
 
 @pytest.mark.gl
 def test_drag_with_an_indexed_mode_and_a_ray_traced_panel(xvfb, tmp_path):
-    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", "whitted",
+    p = subprocess.run([*ui_command(), "whitted",
                         "--methods", "flat,phong,raytrace", "--size", "96",
-                        "--test-script", "drag_check", "--out", str(tmp_path)],
+                        "--script", "drag_check", "--out", str(tmp_path)],
                        cwd=ROOT, env={**os.environ, "DISPLAY": xvfb}, capture_output=True,
                        text=True, timeout=400)
     assert p.returncode == 0, p.stderr[-2000:]

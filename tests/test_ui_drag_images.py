@@ -20,6 +20,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ui_command import ui_command
+
 import workbench
 from workbench.app.ui import camera as cam
 from workbench.app.ui.colours import colour_scale
@@ -40,9 +42,9 @@ pytestmark = pytest.mark.gl
 @pytest.fixture(scope="module")
 def drag(xvfb, tmp_path_factory):
     out = tmp_path_factory.mktemp("ui_drag_rest")
-    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", "whitted",
+    p = subprocess.run([*ui_command(), "whitted",
                         "--methods", ",".join(RASTER), "--size", str(SIZE),
-                        "--test-script", "drag_rest", "--out", str(out), "--frames", "100"],
+                        "--script", "drag_rest", "--out", str(out), "--frames", "100"],
                        cwd=ROOT, env={**os.environ, "DISPLAY": xvfb}, capture_output=True,
                        text=True, timeout=300)
     assert p.returncode == 0, p.stderr[-2000:]

@@ -15,6 +15,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
+from ui_command import ui_command
 from PIL import Image
 
 from workbench.app.ui.export import toml_text
@@ -27,9 +29,9 @@ ROOT = Path(__file__).resolve().parents[1]
 @pytest.fixture(scope="module")
 def exported(xvfb, tmp_path_factory):
     out = tmp_path_factory.mktemp("export")
-    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", "whitted",
+    p = subprocess.run([*ui_command(), "whitted",
                         "--methods", "phong,raytrace,radiosity", "--size", "64",
-                        "--test-script", "export_check", "--out", str(out)],
+                        "--script", "export_check", "--out", str(out)],
                        cwd=ROOT, env={**os.environ, "DISPLAY": xvfb}, capture_output=True,
                        text=True, timeout=400)
     assert p.returncode == 0, p.stderr[-2000:]

@@ -15,6 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ui_command import ui_command
+
 import workbench
 from workbench.app.ui.file_browser import go_to, listing, open_scene
 from workbench.app.ui.state import new_state
@@ -116,9 +118,9 @@ def features(xvfb, tmp_path_factory):
     workbench.render(workbench.load_scene("whitted"), "raytrace", width=8, height=8)
     _scene_folder((out / "scenes").mkdir() or out / "scenes")
     env = {**os.environ, "DISPLAY": xvfb}
-    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", "whitted",
+    p = subprocess.run([*ui_command(), "whitted",
                         "--methods", "flat,phong,raytrace", "--size", "96",
-                        "--test-script", "features", "--out", str(out), "--frames", "3000"],
+                        "--script", "features", "--out", str(out), "--frames", "3000"],
                        cwd=ROOT, env=env, capture_output=True, text=True, timeout=400)
     summary = json.loads((out / "summary.json").read_text()) if (out / "summary.json").exists() else None
     return out, summary, p
@@ -251,9 +253,9 @@ def radiosity_session(xvfb, tmp_path_factory):
     """Run the ``radiosity`` script once on the Cornell box; (out folder, summary, process)."""
     out = tmp_path_factory.mktemp("ui_radiosity")
     env = {**os.environ, "DISPLAY": xvfb}
-    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", "cornell",
+    p = subprocess.run([*ui_command(), "cornell",
                         "--methods", "phong,radiosity", "--size", "64",
-                        "--test-script", "radiosity", "--out", str(out), "--frames", "3000"],
+                        "--script", "radiosity", "--out", str(out), "--frames", "3000"],
                        cwd=ROOT, env=env, capture_output=True, text=True, timeout=400)
     summary = json.loads((out / "summary.json").read_text()) if (out / "summary.json").exists() else None
     return out, summary, p
@@ -275,9 +277,9 @@ def pyrender_session(xvfb, tmp_path_factory):
     """Run the ``pyrender`` script once on whitted; (out folder, summary, process)."""
     out = tmp_path_factory.mktemp("ui_pyrender")
     env = {**os.environ, "DISPLAY": xvfb}
-    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", "whitted",
+    p = subprocess.run([*ui_command(), "whitted",
                         "--methods", "phong,pyrender", "--size", "96",
-                        "--test-script", "pyrender", "--out", str(out), "--frames", "5000"],
+                        "--script", "pyrender", "--out", str(out), "--frames", "5000"],
                        cwd=ROOT, env=env, capture_output=True, text=True, timeout=400)
     summary = json.loads((out / "summary.json").read_text()) if (out / "summary.json").exists() else None
     return out, summary, p

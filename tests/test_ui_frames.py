@@ -15,6 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ui_command import ui_command
+
 import workbench
 from workbench.app.ui import camera as cam
 from workbench.app.ui.images import PanelImages
@@ -29,9 +31,9 @@ SIZE = 96
 @pytest.fixture(scope="module")
 def gpu_session(xvfb, tmp_path_factory):
     out = tmp_path_factory.mktemp("ui_frames")
-    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", "whitted",
+    p = subprocess.run([*ui_command(), "whitted",
                         "--methods", "flat,gouraud,phong,raycast", "--size", str(SIZE),
-                        "--test-script", "gpu_panels", "--out", str(out), "--frames", "200"],
+                        "--script", "gpu_panels", "--out", str(out), "--frames", "200"],
                        cwd=ROOT, env={**os.environ, "DISPLAY": xvfb}, capture_output=True,
                        text=True, timeout=300)
     assert p.returncode == 0, p.stderr[-2000:]

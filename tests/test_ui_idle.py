@@ -12,6 +12,8 @@ from pathlib import Path
 
 import pytest
 
+from ui_command import ui_command
+
 from workbench.app.ui.main import IDLE_FPS
 
 pytestmark = pytest.mark.gl
@@ -19,8 +21,8 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def _run(xvfb, out: Path, script: str, methods: str, size: int = 96) -> dict:
-    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", "whitted",
-                        "--methods", methods, "--size", str(size), "--test-script", script,
+    p = subprocess.run([*ui_command(), "whitted",
+                        "--methods", methods, "--size", str(size), "--script", script,
                         "--out", str(out)],
                        cwd=ROOT, env={**os.environ, "DISPLAY": xvfb}, capture_output=True,
                        text=True, timeout=500)
@@ -63,8 +65,8 @@ def test_long_session_keeps_jobs_and_gl_objects_bounded(xvfb, tmp_path):
 def test_nothing_is_cut_off_and_panels_fit(xvfb, tmp_path, window):
     """Before at 1280 x 720: the Difference window's B selector and kind, the knob labels and
     the method names ran past their windows' right edges (FLIP could not be chosen)."""
-    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", "cornell_spheres",
-                        "--window", window, "--test-script", "layout", "--out", str(tmp_path)],
+    p = subprocess.run([*ui_command(), "cornell_spheres",
+                        "--window", window, "--script", "layout", "--out", str(tmp_path)],
                        cwd=ROOT, env={**os.environ, "DISPLAY": xvfb}, capture_output=True,
                        text=True, timeout=300)
     assert p.returncode == 0, p.stderr[-2000:]

@@ -14,6 +14,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
+from ui_command import ui_command
 from PIL import Image
 
 from workbench.app.ui.screenshot import read_xwd
@@ -34,8 +36,8 @@ def screen(xvfb, tmp_path_factory):
     # 128 px panels (shown scaled up) keep the ray trace and the plot's reference short; the
     # README's screenshot is the real default (256 px)
     size = [] if update else ["--size", "128"]
-    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", "whitted",
-                        "--window", f"{WINDOW[0]}x{WINDOW[1]}", "--test-script", "screens",
+    p = subprocess.run([*ui_command(), "whitted",
+                        "--window", f"{WINDOW[0]}x{WINDOW[1]}", "--script", "screens",
                         "--out", str(out), *size],
                        cwd=ROOT, env={**os.environ, "DISPLAY": xvfb}, capture_output=True,
                        text=True, timeout=400)

@@ -17,6 +17,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ui_command import ui_command
+
 import workbench
 from workbench.app.ui.scripts import slider_step
 from workbench.app.ui.state import new_state
@@ -32,9 +34,9 @@ pytestmark = pytest.mark.gl
 @pytest.fixture(scope="module")
 def slider_session(xvfb, tmp_path_factory):
     out = tmp_path_factory.mktemp("ui_sliders")
-    p = subprocess.run([sys.executable, "-m", "workbench.app.ui.main", "whitted",
+    p = subprocess.run([*ui_command(), "whitted",
                         "--methods", ",".join(RASTER), "--size", str(SIZE),
-                        "--test-script", "slider_frames", "--out", str(out), "--frames", "2000"],
+                        "--script", "slider_frames", "--out", str(out), "--frames", "2000"],
                        cwd=ROOT, env={**os.environ, "DISPLAY": xvfb}, capture_output=True,
                        text=True, timeout=300)
     assert p.returncode == 0, p.stderr[-2000:]

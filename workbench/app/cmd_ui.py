@@ -1,31 +1,78 @@
-"""``workbench ui [SCENE]``: the interactive comparison window (imgui-bundle, GLFW)."""
+"""``workbench ui [SCENE]``: the interactive comparison window (imgui-bundle, GLFW).
+
+The one way to start the window: users, tests and benchmarks all run this command.  ``--script``
+drives the window from a named scripted session (:mod:`.ui.scripts`: the tests' and benchmarks'
+drivers) and ``--out`` receives its outputs: each recorded panel image, ``summary.json`` and
+``ui.png`` (the last frame).
+"""
 from __future__ import annotations
 
-from .args import methods_list
+import os
+import sys
+import threading
+from pathlib import Path
+
+from .args import methods_list, size
+from .ui import WINDOW_SIZE
+
+PANEL_SIZE_RANGE = (8, 4096)
+"""Allowed ``--size``: pixels along the panels' longer side."""
 
 
 def add_parser(sub) -> None:
+    # (the help names ui.state's FIRST_VIEW, EMITTER_VIEW and MAX_PANELS without importing the
+    # window's modules for every command; tests/test_ui_command.py checks that they agree)
     p = sub.add_parser("ui", help="interactive side-by-side comparison window",
                        description="Open a window comparing the methods live on one camera: "
                                    "mouse orbit (left drag), pan (right drag), zoom (wheel).")
     p.add_argument("scene", nargs="?", default="whitted", help="bundled scene name or file")
-    p.add_argument("--methods", type=methods_list, default=[], help="comma-separated methods, 1 to 6 "
-                                                 "(default: flat,gouraud,phong)")
-    p.add_argument("--size", type=int, default=256, help="panel width and height in pixels")
+    p.add_argument("--methods", type=methods_list, default=[],
+                   help="comma-separated methods, 1 to 6 (default: phong,raytrace, plus "
+                        "radiosity,pathtrace on a scene with emitters)")
+    p.add_argument("--size", type=int, default=256,
+                   help="panel resolution: pixels along the longer side, the other side keeps the "
+                        "scene camera's aspect (default %%(default)s; %d to %d)" % PANEL_SIZE_RANGE)
+    p.add_argument("--window", type=size, default=WINDOW_SIZE, metavar="WxH",
+                   help="window size in pixels (default %dx%d)" % WINDOW_SIZE)
+    p.add_argument("--frames", type=int, default=None, metavar="N",
+                   help="close the window after N frames")
+    p.add_argument("--script", default=None, metavar="NAME",
+                   help="drive the window with a scripted session (for tests and benchmarks: "
+                        "check, features, fps, ...; see workbench/app/ui/scripts.py)")
+    p.add_argument("--out", type=Path, default=None, metavar="DIR",
+                   help="write the last frame (ui.png), summary.json and the script's outputs here")
     p.set_defaults(run=run)
 
 
 def run(args) -> int:
     from ..core.errors import WorkbenchError
-    if not 16 <= args.size <= 2048:
-        raise WorkbenchError(f"--size must be in [16, 2048], got {args.size}")
-    import os
+    lo, hi = PANEL_SIZE_RANGE
+    if not lo <= args.size <= hi:
+        raise WorkbenchError(f"--size must be in [{lo}, {hi}] pixels, got {args.size}")
+    if args.frames is not None and args.frames < 1:
+        raise WorkbenchError(f"--frames must be at least 1, got {args.frames}")
+    from .ui.scripts import SCRIPTS
+    if args.script is not None and args.script not in SCRIPTS:
+        raise WorkbenchError(f"--script {args.script!r}: unknown script, expected one of "
+                             f"{', '.join(sorted(SCRIPTS))}")
     if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
         raise WorkbenchError("no display (DISPLAY is not set): the UI needs a window; "
                              "under no screen run it inside `xvfb-run -s '-screen 0 1280x800x24'`")
-    from .ui.main import run as run_ui
+    out = args.out if args.out is not None or args.script is None else Path("out/ui")
+    if out is not None:
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+        except OSError as e:
+            raise WorkbenchError(f"--out {out}: cannot create the folder ({e.strerror})") from None
     from .ui.state import new_state
-    state = new_state(args.scene, args.methods or None,
-                      (args.size, args.size))
-    run_ui(state)
-    return 0
+    from .ui.main import run
+    state = new_state(args.scene, args.methods or None, args.size)
+    script = SCRIPTS[args.script](out) if args.script is not None else None
+    code = run(state, frames=args.frames, script=script, window=args.window, out=out)
+    if code and threading.active_count() > 1:
+        # a signal closed the window while a CPU job was still inside a numba compile (which
+        # cannot be interrupted): its children are gone, so end without waiting for it
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    return code

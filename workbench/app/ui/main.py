@@ -1,25 +1,25 @@
-"""The window loop (hello_imgui through ``immapp.run``).
+"""The window loop (hello_imgui through ``immapp.run``), started by ``workbench ui``
+(:mod:`workbench.app.cmd_ui`).
 
-``python -m workbench.app.ui.main [SCENE] --test-script check --out DIR`` runs a scripted
-session (see :mod:`.scripts`) and writes the panel images, ``summary.json`` (frames, GL
-renderer, threads alive after exit) and ``ui.png`` (the last frame) into DIR.
+With an output folder the loop writes ``ui.png`` (the last frame) and ``summary.json`` (frames,
+GL renderer, threads and child processes alive after exit, the script's log) into it.  SIGTERM
+and SIGINT close the window as its close button does: background jobs, the error plot's worker
+process and the pyrender child end before the process does.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import multiprocessing
-import sys
+import signal
 import threading
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
-from ...core.errors import WorkbenchError
-from ..args import size
+from . import WINDOW_SIZE
 from .glfw_title import glfw_library, window_title
-from .state import AppState, new_state
+from .state import AppState
 
-WINDOW_SIZE = (1280, 760)
 IDLE_FPS = 2.0
 """Frames per second while nothing changes and no input comes (hello_imgui's idling: it sleeps
 between frames; an input event, :func:`hello_imgui.request_refresh` from a background job that
@@ -35,11 +35,67 @@ def frame_rest(last: float | None, now: float, cap: float, job_running: bool) ->
     return max(0.0, last + 1.0 / cap - now)
 
 
-def run(state: AppState, max_frames: int | None = None, script=None,
-        window: tuple[int, int] = WINDOW_SIZE) -> None:
+def run(state: AppState, frames: int | None = None, script=None,
+        window: tuple[int, int] = WINDOW_SIZE, out: Path | None = None) -> int:
     """Open the window (``window`` = (width, height) pixels) and loop until it is closed,
-    ``max_frames`` frames were shown or the script sets ``state.quit``.  Background jobs are
-    joined before returning."""
+    ``frames`` frames were shown, the script sets ``state.quit`` or SIGTERM/SIGINT comes.
+    Background jobs and child processes are ended and joined before returning (after a signal,
+    CPU jobs get :data:`SIGNAL_GRACE_SECONDS`: one inside a numba compile cannot stop sooner);
+    with ``out``, the last frame and the summary are written there.  Returns 0, or 128 + the
+    signal's number when a signal closed the window."""
+    t0 = time.perf_counter()
+    with quit_on_signals(state):
+        try:
+            _loop(state, frames, script, window)
+        finally:
+            stop_background(state)
+    if out is not None:
+        write_outputs(state, script, out, time.perf_counter() - t0)
+    return 128 + state.quit_signal if state.quit_signal else 0
+
+
+SIGNAL_GRACE_SECONDS = 2.0
+"""After SIGTERM or SIGINT, how long the CPU jobs' threads get to see their cancel flag."""
+
+
+@contextmanager
+def quit_on_signals(state: AppState):
+    """While the window runs, SIGTERM and SIGINT set ``state.quit`` and ``state.quit_signal``
+    (the loop ends at its next frame, as by the close button) instead of killing the process
+    past its children; a second signal before then ends the process at once (after the
+    ``finally`` clean-ups)."""
+    def handler(signum, _frame):
+        if state.quit_signal:
+            raise SystemExit(128 + signum)
+        state.quit, state.quit_signal = True, signum
+    old = {s: signal.signal(s, handler) for s in (signal.SIGTERM, signal.SIGINT)}
+    try:
+        yield
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)
+
+
+def write_outputs(state: AppState, script, out: Path, seconds: float) -> None:
+    """``out/ui.png`` (the last frame, when hello_imgui kept one) and ``out/summary.json``."""
+    from imgui_bundle import hello_imgui
+    from PIL import Image
+    shot = hello_imgui.final_app_window_screenshot()
+    if shot is not None and shot.size:
+        Image.fromarray(shot[..., :3]).save(out / "ui.png")
+    summary = {"frames": state.frame, "seconds": seconds,
+               "gl_renderer": state.gl_renderer, "methods": state.methods,
+               "scene": state.scene_path.stem,
+               "panel_size": [state.camera.width, state.camera.height],
+               "timings": state.timings,
+               "threads": [t.name for t in threading.enumerate()],
+               "child_processes": [c.name for c in multiprocessing.active_children()],
+               "script": getattr(script, "log", {})}
+    (out / "summary.json").write_text(json.dumps(summary, indent=1, default=str))
+
+
+def _loop(state: AppState, max_frames: int | None, script, window: tuple[int, int]) -> None:
+    """hello_imgui's runner with the workbench's callbacks (returns when the window closes)."""
     import moderngl
     from imgui_bundle import hello_imgui, immapp
 
@@ -115,66 +171,15 @@ def run(state: AppState, max_frames: int | None = None, script=None,
     params.callbacks.show_status = lambda: status_bar(state)
     params.callbacks.before_exit = before_exit
     immapp.run(params, immapp.AddOnsParams(with_implot=True))
-    stop_background(state)
 
 
 def stop_background(state: AppState) -> None:
-    """End everything that runs beside the window (joined): the CPU jobs, the error plot's
-    reference render and worker, the pyrender child process."""
-    state.jobs.join_all()
-    state.errors.shutdown()
+    """End everything that runs beside the window: the CPU jobs, the error plot's reference
+    render and worker, the pyrender child process (child processes always joined; threads
+    joined, or given :data:`SIGNAL_GRACE_SECONDS` after a signal)."""
+    grace = SIGNAL_GRACE_SECONDS if state.quit_signal else None
+    state.jobs.join_all(grace)
+    state.errors.shutdown(grace)
     if state.pyrender is not None:
         state.pyrender.close()
         state.pyrender = None
-
-
-def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m workbench.app.ui.main")
-    p.add_argument("scene", nargs="?", default="whitted")
-    p.add_argument("--methods", default="", help="comma-separated, 1 to 6")
-    p.add_argument("--size", type=int, default=256,
-                   help="panel resolution: pixels along the longer side (the other side keeps "
-                        "the scene camera's aspect)")
-    p.add_argument("--frames", type=int, default=None, help="stop after this many frames")
-    p.add_argument("--window", type=size, default=WINDOW_SIZE, metavar="WxH",
-                   help="window size in pixels (default %(default)s)")
-    p.add_argument("--test-script", default=None, help="check or fps (see scripts.py)")
-    p.add_argument("--out", type=Path, default=None, help="folder for the script's outputs")
-    args = p.parse_args(argv)
-    if not 8 <= args.size <= 4096:
-        p.error(f"--size {args.size}: the panels' resolution must be 8 to 4096 pixels")
-    from .scripts import SCRIPTS
-    try:
-        state = new_state(args.scene, [m for m in args.methods.split(",") if m] or None,
-                          args.size)
-    except WorkbenchError as e:  # a bad scene or method list: one line, as `workbench ui` says it
-        print(f"workbench: error: {e}", file=sys.stderr)
-        return 2
-    script = None
-    if args.test_script:
-        args.out = args.out or Path("out/ui")
-    if args.out is not None:  # also without a script: the last frame and the summary
-        args.out.mkdir(parents=True, exist_ok=True)
-    if args.test_script:
-        script = SCRIPTS[args.test_script](args.out)
-    t0 = time.perf_counter()
-    run(state, args.frames, script, args.window)
-    if args.out is not None:
-        from imgui_bundle import hello_imgui
-        from PIL import Image
-        shot = hello_imgui.final_app_window_screenshot()
-        if shot is not None and shot.size:
-            Image.fromarray(shot[..., :3]).save(args.out / "ui.png")
-        summary = {"frames": state.frame, "seconds": time.perf_counter() - t0,
-                   "gl_renderer": state.gl_renderer, "methods": state.methods,
-                   "scene": state.scene_path.stem, "panel_size": [state.camera.width, state.camera.height],
-                   "timings": state.timings,
-                   "threads": [t.name for t in threading.enumerate()],
-                   "child_processes": [c.name for c in multiprocessing.active_children()],
-                   "script": getattr(script, "log", {})}
-        (args.out / "summary.json").write_text(json.dumps(summary, indent=1, default=str))
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -105,10 +105,11 @@ class ErrorPlot:
         """The boards rendering references: the full one's and the matched ones'."""
         return [b for b in (self.board, *self.matched_boards.values()) if b is not None]
 
-    def shutdown(self) -> None:
-        """Cancel the reference renders and end the worker process (joined)."""
+    def shutdown(self, timeout: float | None = None) -> None:
+        """Cancel the reference renders (their threads joined, within ``timeout`` seconds
+        each when given) and end the worker process (joined)."""
         for board in self.boards():
-            board.join_all()
+            board.join_all(timeout)
         if self.pool is not None:
             self.pool.shutdown(wait=True, cancel_futures=True)
             self.pool = None
@@ -177,6 +178,9 @@ class AppState:
     cut: set = field(default_factory=set)
     """Widgets that ran past their window's right edge in the last frame (``panels.check_fits``)."""
     quit: bool = False
+    """Close the window at the end of this frame (scripts; SIGTERM and SIGINT)."""
+    quit_signal: int = 0
+    """The signal that closed the window (0: none)."""
 
 
 def choosable_methods() -> list[str]:

@@ -1,0 +1,14 @@
+"""How the tests start the window: the console script ``workbench ui``, as the README tells
+users to (the ``workbench`` next to the running interpreter, i.e. the venv's)."""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+WORKBENCH = str(Path(sys.executable).with_name("workbench"))
+"""The console script installed with the package."""
+
+
+def ui_command(*args: str) -> list[str]:
+    """``workbench ui ARGS...`` as a subprocess argument list."""
+    return [WORKBENCH, "ui", *args]
