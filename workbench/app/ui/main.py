@@ -46,11 +46,11 @@ def run(state: AppState, frames: int | None = None, script=None,
     t0 = time.perf_counter()
     with quit_on_signals(state):
         try:
-            _loop(state, frames, script, window)
+            shown = _loop(state, frames, script, window)
         finally:
             stop_background(state)
     if out is not None:
-        write_outputs(state, script, out, time.perf_counter() - t0)
+        write_outputs(state, script, out, time.perf_counter() - t0, shown)
     return 128 + state.quit_signal if state.quit_signal else 0
 
 
@@ -76,8 +76,10 @@ def quit_on_signals(state: AppState):
             signal.signal(s, h)
 
 
-def write_outputs(state: AppState, script, out: Path, seconds: float) -> None:
-    """``out/ui.png`` (the last frame, when hello_imgui kept one) and ``out/summary.json``."""
+def write_outputs(state: AppState, script, out: Path, seconds: float, shown: list) -> None:
+    """``out/ui.png`` (the last frame, when hello_imgui kept one) and ``out/summary.json``;
+    ``shown`` lists (panel name, (x0, y0, x1, y1) window pixels) of the images in the last
+    frame."""
     from imgui_bundle import hello_imgui
     from PIL import Image
     shot = hello_imgui.final_app_window_screenshot()
@@ -87,15 +89,16 @@ def write_outputs(state: AppState, script, out: Path, seconds: float) -> None:
                "gl_renderer": state.gl_renderer, "methods": state.methods,
                "scene": state.scene_path.stem,
                "panel_size": [state.camera.width, state.camera.height],
-               "timings": state.timings,
+               "timings": state.timings, "shown": [[m, list(r)] for m, r in shown],
                "threads": [t.name for t in threading.enumerate()],
                "child_processes": [c.name for c in multiprocessing.active_children()],
                "script": getattr(script, "log", {})}
     (out / "summary.json").write_text(json.dumps(summary, indent=1, default=str))
 
 
-def _loop(state: AppState, max_frames: int | None, script, window: tuple[int, int]) -> None:
-    """hello_imgui's runner with the workbench's callbacks (returns when the window closes)."""
+def _loop(state: AppState, max_frames: int | None, script, window: tuple[int, int]) -> list:
+    """hello_imgui's runner with the workbench's callbacks; returns when the window closes,
+    with the images' rectangles of the last frame (:attr:`.frames.ScreenBlits.last`)."""
     import moderngl
     from imgui_bundle import hello_imgui, immapp
 
@@ -106,6 +109,7 @@ def _loop(state: AppState, max_frames: int | None, script, window: tuple[int, in
     from .panels import status_bar
     from .plot import track
     clock = {"t": None, "title": window_title(state)}
+    shown = []
 
     def post_init():
         state.ctx = moderngl.create_context()  # the window's current GLFW context
@@ -140,6 +144,8 @@ def _loop(state: AppState, max_frames: int | None, script, window: tuple[int, in
             hello_imgui.get_runner_params().app_shall_exit = True
 
     def before_exit():
+        if state.gpu is not None:
+            shown.extend(state.gpu.blits.last)
         stop_background(state)
         release_gl(state)
 
@@ -171,6 +177,7 @@ def _loop(state: AppState, max_frames: int | None, script, window: tuple[int, in
     params.callbacks.show_status = lambda: status_bar(state)
     params.callbacks.before_exit = before_exit
     immapp.run(params, immapp.AddOnsParams(with_implot=True))
+    return shown
 
 
 def stop_background(state: AppState) -> None:
