@@ -110,12 +110,17 @@ class _Uniforms:
         self.prog, self.items = prog, []
 
     def set(self, name: str, value) -> None:
+        """Record ``value`` for the uniform ``name`` (an int, or floats written as raw bytes).
+        An array uniform whose tail the compiler dropped (it keeps an array up to its last
+        element read, e.g. one light's shadow range of two when only the first is used) takes
+        the leading elements it kept."""
         if name in self.prog:
             u = self.prog[name]
             if isinstance(value, int):
                 self.items.append((u, value, False))
             else:
-                self.items.append((u, np.ascontiguousarray(value, dtype="f4").tobytes(), True))
+                data = np.ascontiguousarray(value, dtype="f4").tobytes()
+                self.items.append((u, data[:4 * u.dimension * u.array_length], True))
 
     def apply(self) -> None:
         for u, v, raw in self.items:
@@ -462,12 +467,11 @@ class RasterSession:
     @staticmethod
     def _shadow_uniforms(u: _Uniforms, layout: sti.ShadowLayout, live: bool) -> None:
         """The shadow layout's uniforms: the tiles' clip matrices (only directional lights'
-        tiles are read: the compiler keeps the array up to the last one, whose length the data
-        must match) and, in a live-lights program (``SHADOW_LIVE``), the lights' positions and
-        cube ranges."""
+        tiles are read: the compiler keeps the array up to the last one, :meth:`_Uniforms.set`)
+        and, in a live-lights program (``SHADOW_LIVE``), the lights' positions and cube
+        ranges."""
         if "u_shadow_clip" in u.prog:
-            n = u.prog["u_shadow_clip"].array_length
-            u.set("u_shadow_clip", sti.mat4_array(layout.clips[:n]))
+            u.set("u_shadow_clip", sti.mat4_array(layout.clips))
         if live:
             u.set("u_shadow_pos", np.array(layout.pos, dtype=np.float64).reshape(-1, 3))
             u.set("u_shadow_range", np.array(layout.ranges, dtype=np.float64).reshape(-1, 2))

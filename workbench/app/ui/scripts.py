@@ -14,6 +14,7 @@ from .frames import shown_texture
 from .inspect import select_ray_tree
 from .layout import window_report
 from .panels import status_text
+from .script_controls import Controls
 from .state import AppState, method_kind, set_display, set_material_value, set_option, shown_image
 
 CPU_WAIT_SECONDS = 120.0
@@ -789,7 +790,7 @@ def gl_object_counts(state: AppState, names: int = 4096) -> dict:
     return out
 
 
-SCRIPTS = {"check": Check, "features": Features, "radiosity": Radiosity, "pyrender": Pyrender,
+SCRIPTS = {"check": Check, "controls": Controls, "features": Features, "radiosity": Radiosity, "pyrender": Pyrender,
            "fps": Fps,
            "fps_indexed": lambda out: Fps(out, display="indexed16-kmeans-fs"),
            "fps_bare": lambda out: Fps(out, standins="off"),
