@@ -89,7 +89,7 @@ def _mean_part(a, b, s2, keep) -> dict:
 
 
 def noise_agreement(a, se_a, dof_a: float, b, se_b, dof_b: float, *, block: int = 4,
-                    exclude: np.ndarray | None = None) -> dict:
+                    exclude: np.ndarray | None = None, band_sd: float = BAND_SD) -> dict:
     """The statistics of the module docstring.
 
     Parameters
@@ -100,6 +100,8 @@ def noise_agreement(a, se_a, dof_a: float, b, se_b, dof_b: float, *, block: int 
     block : block edge in pixels for the block test (H and W are cut to multiples of it).
     exclude : (H, W) bool or None, pixels left out of the ``mean_off`` part (e.g.
         :func:`light_pixels`); every other statistic uses all pixels.
+    band_sd : width of the ratio's and the block chi-square's acceptance bands in standard
+        deviations (a caller with a false-failure budget derives it from a normal quantile).
 
     Returns
     -------
@@ -137,7 +139,7 @@ def noise_agreement(a, se_a, dof_a: float, b, se_b, dof_b: float, *, block: int 
         var_R = (2.0 * float((s2[ok] ** 2).sum()) + 2.0 * float((va ** 2).sum()) / (dof_a + 2.0)
                  + 2.0 * float((vb ** 2).sum()) / (dof_b + 2.0)) / S ** 2
         z = d[ok] / np.sqrt(s2[ok])
-        out.update(ratio=R, ratio_sd=math.sqrt(var_R), ratio_ok=bool(abs(R - 1.0) <= BAND_SD * math.sqrt(var_R)),
+        out.update(ratio=R, ratio_sd=math.sqrt(var_R), ratio_ok=bool(abs(R - 1.0) <= band_sd * math.sqrt(var_R)),
                    n_eff=S ** 2 / float((s2[ok] ** 2).sum()), frac_abs_z_gt_3=float(np.mean(np.abs(z) > 3.0)))
     Hb, Wb = H // block, W // block
     db = d[:Hb * block, :Wb * block].reshape(Hb, block, Wb, block, 3).sum((1, 3))
@@ -147,7 +149,7 @@ def noise_agreement(a, se_a, dof_a: float, b, se_b, dof_b: float, *, block: int 
         zb = db[live] / np.sqrt(vbk[live])
         K = int(live.any(axis=2).sum())
         Q = float(np.mean(zb ** 2))
-        band = BAND_SD * math.sqrt(2.0 / K)
+        band = band_sd * math.sqrt(2.0 / K)
         out.update(block=block, block_count=K, block_chi2=Q, block_chi2_band=band,
                    block_chi2_ok=bool(abs(Q - 1.0) <= band), block_frac_abs_z_gt_3=float(np.mean(np.abs(zb) > 3.0)))
     out["mean"] = _mean_part(a, b, s2, np.ones((H, W), bool))

@@ -1,0 +1,20 @@
+"""The registered false-failure probabilities (tests/statistics_budget.py) add up to at most the
+suite's budget, and the bands derived from them are what a normal distribution gives."""
+from __future__ import annotations
+
+import math
+
+from statistics_budget import ALPHA, SUITE_BUDGET, band
+
+
+def test_the_suite_total_is_within_budget():
+    assert sum(ALPHA.values()) <= SUITE_BUDGET
+    assert all(0.0 < a < SUITE_BUDGET for a in ALPHA.values())
+
+
+def test_band_is_the_two_sided_normal_quantile():
+    for test in ALPHA:
+        for checks in (1, 4):
+            z = band(test, checks)
+            tail = math.erfc(z / math.sqrt(2.0))  # P(|Z| > z)
+            assert abs(tail * checks - ALPHA[test]) <= 1e-9 * ALPHA[test] + 1e-15
