@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...core.tol import tol
-from ...scene.kinds import BOX, MESH, POLYGON, RECT
+from ...scene.kinds import BOX, KINDS, MESH, POLYGON, RECT
 from ..raytrace.flatten import SceneData
 
 _BOX_QUADS = ((0, 2, 6, 4), (1, 5, 7, 3), (0, 4, 5, 1), (2, 3, 7, 6), (0, 1, 3, 2), (4, 6, 7, 5))
@@ -95,6 +95,10 @@ def _prim_triangles(sd: SceneData, k: int):
         return np.stack(out)
     return None
 
+KIND_NAMES = {k.PTYPE: k.TYPE for k in KINDS.values()}
+"""ptype -> the kind's name in scene files (every registered kind: an emissive blob, lathe,
+prism or isosurface named a ptype past a hand-written list of six and raised IndexError)."""
+
 
 def build_emitters(sd: SceneData) -> Emitters:
     """The emitter table of a flattened scene (see the module docstring)."""
@@ -109,7 +113,7 @@ def build_emitters(sd: SceneData) -> Emitters:
         t = _prim_triangles(sd, k)
         if t is None:
             unsampled.append(f"primitive {k} (object {sd.obj[k]}): an emissive "
-                             f"{('sphere', 'rectangle', 'box', 'concave polygon', 'quadric', 'CSG solid')[sd.ptype[k]]} "
+                             f"{KIND_NAMES.get(int(sd.ptype[k]), 'primitive')} "
                              "is found by BSDF sampling only (no next-event estimation)")
             continue
         tris.append(t)
