@@ -192,17 +192,19 @@ def _same(a, b) -> bool:
 _PARTS: OrderedDict = OrderedDict()
 
 
-def _parts(scene: Scene, level: int) -> list[Part]:
-    """Tessellated parts, cached by the scene's objects (identity) and level: flat, Gouraud
-    and Phong sessions of the same scene share one tessellation."""
+def _parts(scene: Scene, level: int) -> tuple[list[Part], list[str]]:
+    """Tessellated parts and the names of the objects that gave none, cached by the scene's
+    objects (identity) and level: flat, Gouraud and Phong sessions of the same scene share one
+    tessellation."""
     key = (id(scene.objects), level)
     hit = _PARTS.get(key)
     if hit is None or hit[0] is not scene.objects:
-        hit = (scene.objects, tessellate_scene(scene, level))
+        empty: list[str] = []
+        hit = (scene.objects, tessellate_scene(scene, level, empty), empty)
         _PARTS[key] = hit
         if len(_PARTS) > 8:
             _PARTS.popitem(last=False)
-    return hit[1]
+    return hit[1], hit[2]
 
 
 class RasterSession:
@@ -256,15 +258,19 @@ class RasterSession:
         self.programs = ProgramCache(self.ctx)
         self.timings: dict[str, float] = {}
         t0 = time.perf_counter()
+        parts, empty = _parts(scene, tessellation)
+        #: objects whose surface tessellates to nothing (a blob's threshold above its field's
+        #: maximum): not drawn, as the ray methods find no surface there; said in left_out
+        self.empty_objects = empty
         pairs = [(with_normal_rule(p, normals), scene.materials[p.material], p.material)
-                 for p in _parts(scene, tessellation)]
+                 for p in parts]
         #: bounds, clip planes and area lights (.scene.prepared), built once per session
         self.prepared = prepare(scene)
         pairs += [(p, m, None) for p, m in area_light_parts(self.prepared.area_lights)]
         self.timings["tessellate"] = time.perf_counter() - t0
         self.n_triangles = sum(p.n_triangles for p, _, _ in pairs)
         #: (K, 2, 3) world box of every part: what the stand-ins' maps cover
-        self.part_boxes = np.array([[p.positions.min(0), p.positions.max(0)] for p, _, _ in pairs])
+        self.part_boxes = np.array([[p.positions.min(0), p.positions.max(0)] for p, _, _ in pairs]).reshape(-1, 2, 3)
         self.lights = scene.point_lights()
         self._light_values = light_uniforms(self.lights)
         self._needs = ft.scene_needs(scene)  # its texture entry does not change with update()
@@ -547,6 +553,9 @@ class RasterSession:
         for f, why in NOT_RASTER.items():
             if f in needs and f not in covered:
                 left.append(f"{f}: {why}" + ("" if enabled[f] else f" ({self.plan.off_reason})"))
+        if self.empty_objects:
+            left.append(f"objects: {', '.join(self.empty_objects)} tessellate(s) to no triangle "
+                        "(no surface: not drawn)")
         used = sorted(f for f in needs if (f not in NOT_RASTER or f in covered)
                       and not (f == ft.BUMP and self.mode != "phong"))
         self._covered = covered
