@@ -63,7 +63,7 @@ def test_render_every_method_and_compare(scene, tmp_path, capsys):
     _render_all(scene, tmp_path, capsys, cheapest=True)
     out = tmp_path / "cmp"
     code, stdout = _check(["compare", scene, "--size", SIZE, "--out", out, "--methods", "raycast,raytrace",
-                           "--reference", "raytrace", "--repeat", "0"], capsys)
+                           "--reference", "raytrace", "--repeat", "1"], capsys)
     assert code == 0
     rep = _compare_report_is_sound(out, stdout)
     exact = [e for e in rep["methods"] if e["metrics"]["rmse"] == 0.0]
@@ -79,7 +79,7 @@ def test_real_process_compare_with_an_exact_method(tmp_path):
     """The same through a real process (argv parsing, os._exit, stdout flushing)."""
     r = subprocess.run([sys.executable, "-m", "workbench.app.cli", "compare", "globe", "--size", SIZE,
                         "--out", str(tmp_path / "c"), "--methods", "raytrace", "--reference", "raytrace",
-                        "--repeat", "0"], capture_output=True, text=True, timeout=600)
+                        "--repeat", "1"], capture_output=True, text=True, timeout=600)
     assert r.returncode == 0 and "Traceback" not in r.stderr, r.stderr
     assert "PSNR inf dB" in r.stdout
     _compare_report_is_sound(tmp_path / "c", r.stdout)

@@ -207,7 +207,7 @@ def test_compare_and_study_take_glsl_methods(tmp_path):
     study sweeps its knob.  (Reference phong: no numba compile in the default run.)"""
     out = tmp_path / "cmp"
     r = _cli("compare", "whitted", "--out", out, "--methods", f"phong,glsl:{TOON},glsl:{OREN_NAYAR}",
-             "--size", "64x48", "--reference", "phong", "--repeat", "0")
+             "--size", "64x48", "--reference", "phong", "--repeat", "1")
     assert r.returncode == 0, r.stderr
     rep = json.loads((out / "report.json").read_text())
     entries = {e["method"]: e for e in rep["methods"]}
@@ -228,7 +228,7 @@ def test_compare_stops_on_a_compile_error(tmp_path):
     f.write_text("vec3 shade(vec3 P, vec3 N, vec3 V, vec3 L, Material m) {\n  return m.color\n}\n")
     out = tmp_path / "cmp"
     err = _one_error_line(_cli("compare", "whitted", "--out", out, "--methods", f"phong,glsl:{f}",
-                               "--size", "32x24", "--reference", "phong", "--repeat", "0"))
+                               "--size", "32x24", "--reference", "phong", "--repeat", "1"))
     assert err.startswith(f"workbench: error: {f}:3:")
     assert not (out / "report.json").exists()
 

@@ -26,3 +26,28 @@ def key_value(text: str) -> tuple[str, str]:
 def methods_list(text: str) -> list[str]:
     """``"phong,raytrace"`` -> ``["phong", "raytrace"]`` (names checked when running)."""
     return [m.strip() for m in text.split(",") if m.strip()]
+
+
+def at_least_one(text: str) -> int:
+    """A count that must be >= 1 (``--repeat``)."""
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {n}")
+    return n
+
+
+def value_after_option(argv: list[str]) -> list[str]:
+    """``["--size", "-5x5"]`` -> ``["--size=-5x5"]``: a value that starts with a minus and a
+    digit is the option's value (argparse takes it for an option and says "expected one
+    argument"), so that the converter can say what is wrong with it."""
+    out: list[str] = []
+    for tok in argv:
+        if out and out[-1].startswith("--") and "=" not in out[-1] and len(tok) > 1 \
+                and tok[0] == "-" and (tok[1].isdigit() or tok[1] == "."):
+            out[-1] = f"{out[-1]}={tok}"
+        else:
+            out.append(tok)
+    return out

@@ -69,7 +69,8 @@ def main(argv: list[str] | None = None) -> int:
 def _run(argv: list[str] | None) -> int:
     from ..core.errors import WorkbenchError
     try:
-        args = build_parser().parse_args(argv)
+        from .args import value_after_option
+        args = build_parser().parse_args(value_after_option(sys.argv[1:] if argv is None else list(argv)))
         if args.max_memory is not None:  # one limit for this process and its children
             from ..core.memory import ENV, parse_size
             os.environ[ENV] = str(parse_size(args.max_memory, "--max-memory"))

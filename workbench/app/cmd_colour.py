@@ -71,6 +71,10 @@ def _load_source(source: str, method: str):
                 raise WorkbenchError(f"{source}: cannot read the image ({e})") from None
         if img.ndim != 3 or img.shape[-1] != 3:
             raise WorkbenchError(f"{source}: expected an (H, W, 3) image, got shape {img.shape}")
+        if not np.issubdtype(img.dtype, np.number) or not np.isfinite(img).all():
+            bad = int(img.size - np.isfinite(img).sum()) if np.issubdtype(img.dtype, np.number) else img.size
+            raise WorkbenchError(f"{source}: {bad} value(s) are NaN or infinite (or not numbers): "
+                                 "an image must be finite")
         return img, f"image {p.name}"
     from ..renderers.base import render
     from ..scene.io import load_scene

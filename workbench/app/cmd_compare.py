@@ -1,7 +1,7 @@
 """``workbench compare SCENE --out DIR``: every method side by side, timed, against a reference."""
 from __future__ import annotations
 
-from .args import methods_list, size
+from .args import at_least_one, methods_list, size
 
 
 def add_parser(sub):
@@ -11,7 +11,7 @@ def add_parser(sub):
     p.add_argument("--methods", type=methods_list, help="comma-separated methods (default: every registered one except mitsuba)")
     p.add_argument("--size", type=size, help="WIDTHxHEIGHT (default: the scene camera's)")
     p.add_argument("--reference", help="force the reference method (default: the documented rule)")
-    p.add_argument("--repeat", type=int, default=1, help="warm timed runs per method after the cold one (default 1)")
+    p.add_argument("--repeat", type=at_least_one, default=1, help="warm timed runs per method after the cold one, at least 1: the time reported is a warm run's (default 1)")
     p.set_defaults(run=run)
 
 

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import argparse
 
-from .args import methods_list, size
+from .args import at_least_one, methods_list, size
 
 
 def _sweep(text: str) -> tuple[str, tuple[str, list[str]]]:
@@ -64,7 +64,7 @@ def add_parser(sub):
     p.add_argument("--methods", type=methods_list, help="comma-separated methods (default: every registered one except mitsuba)")
     p.add_argument("--size", type=size, help="WIDTHxHEIGHT (default: 160 wide with --quick, else the camera's)")
     p.add_argument("--quick", action="store_true", help="small sweep: at most 4 knob values, 2 warm runs, 160 px wide")
-    p.add_argument("--repeat", type=int, help="warm runs per point (default 2 quick, 5 otherwise)")
+    p.add_argument("--repeat", type=at_least_one, help="warm runs per point (default 2 quick, 5 otherwise)")
     p.add_argument("--reference", help="force the reference method (default: the documented rule)")
     p.add_argument("--sweep", type=_sweep, action="append", default=[], metavar="[METHOD:]OPTION=V1,V2,...",
                    help="sweep this option instead of the method's knob (repeatable; without METHOD: every "

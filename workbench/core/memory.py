@@ -56,9 +56,10 @@ def memory_limit(max_memory=None) -> int:
 
 
 def gib(nbytes: float) -> str:
-    """``nbytes`` for a message: ``"412.0 MiB"``, ``"53.9 GiB"``, ``"1.8e+09 TiB"``."""
-    for unit, power in (("TiB", 40), ("GiB", 30)):
+    """``nbytes`` for a message in the largest unit it fills: ``"412.0 MiB"``, ``"53.9 GiB"``,
+    ``"1.8e+09 TiB"``, ``"1.0 KiB"``, ``"12 bytes"`` (a small limit is not shown as 0.0 MiB)."""
+    for unit, power in (("TiB", 40), ("GiB", 30), ("MiB", 20), ("KiB", 10)):
         if nbytes >= 2 ** power:
             value = nbytes / 2 ** power
             return f"{value:.1f} {unit}" if value < 1e6 else f"{value:.2g} {unit}"
-    return f"{nbytes / 2 ** 20:.1f} MiB"
+    return f"{int(nbytes)} bytes"

@@ -45,12 +45,14 @@ class Knob:
 @dataclass(frozen=True)
 class Option:
     """An accepted option: converter (``int``, ``float``, ``bool``, ``str`` or a callable that
-    raises ``ValueError``), default, help text and, for strings, the allowed choices."""
+    raises ``ValueError``), default, help text, for strings the allowed choices, and for numbers
+    the smallest value allowed (``low``; None: any)."""
 
     kind: Callable
     default: Any
     help: str = ""
     choices: tuple | None = None
+    low: float | None = None
 
 
 @dataclass
@@ -200,6 +202,8 @@ def convert_options(r: Renderer, options: dict) -> dict:
                                  f" ({o.help}), got {v!r}") from None
         if isinstance(val, float) and not np.isfinite(val):
             raise WorkbenchError(f"method {r.name!r}: option {k!r} must be a finite number, got {v!r}")
+        if o.low is not None and val < o.low:
+            raise WorkbenchError(f"method {r.name!r}: option {k!r} must be >= {o.low:g} ({o.help}), got {v!r}")
         if o.choices is not None and val not in o.choices:
             raise WorkbenchError(f"method {r.name!r}: option {k!r} must be one of {', '.join(map(str, o.choices))}, got {v!r}")
         out[k] = val

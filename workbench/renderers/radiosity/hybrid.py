@@ -70,7 +70,7 @@ class HybridRenderer:
                 "largest patch edge / scene diagonal")
     options = {**common_options(),
                "max_depth": Option(int, 5, "ray tracer: maximum ray generations per path"),
-               "threshold": Option(float, 1e-3, "ray tracer: weight below which a child ray is not traced"),
+               "threshold": Option(float, 1e-3, "ray tracer: weight below which a child ray is not traced", low=0.0),
                "spp": Option(int, 1, "ray tracer: samples per pixel"),
                "fresnel": Option(str, "none", "ray tracer: reflection/transmission split",
                                  ("none", "schlick", "exact"))}

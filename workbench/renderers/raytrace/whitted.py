@@ -669,7 +669,7 @@ class RaytraceRenderer(_WhittedBase):
                 "maximum number of ray generations in a path (primary = 1)")
     options = {**_COMMON,
                "max_depth": Option(int, 5, "maximum ray generations per path (primary = 1), >= 1"),
-               "threshold": Option(float, 1e-3, "perceptual threshold: a child ray whose accumulated weight (max RGB) is at most this is not traced")}
+               "threshold": Option(float, 1e-3, "perceptual threshold: a child ray whose accumulated weight (max RGB) is at most this is not traced", low=0.0)}
     memory_options = ("max_depth", "threshold", "spp")
 
     def estimate_bytes(self, scene, width, height, **o):

@@ -1,0 +1,48 @@
+"""Bad arguments found in a new user's trial, each answered by the console script with one line
+``workbench: error: ...`` naming what is wrong, exit 2, no traceback, no numpy repr and no output
+file."""
+from __future__ import annotations
+
+import subprocess
+
+import numpy as np
+import pytest
+
+from ui_command import WORKBENCH
+
+CASES = {  # id -> (argv after "workbench", words the one line must hold); {tmp} is the test folder
+    "size negative, space form": (["render", "whitted", "-m", "phong", "--size", "-5x5", "-o", "{tmp}/x.png"],
+                                  ["--size", "-5x5", "1..16384"]),
+    "size negative, = form": (["render", "whitted", "-m", "phong", "--size=-5x5", "-o", "{tmp}/x.png"],
+                              ["--size", "-5x5"]),
+    "tiny memory limit shown in its unit": (["render", "whitted", "-m", "phong", "--size", "32x24",
+                                             "--max-memory", "1K", "-o", "{tmp}/x.png"], ["1.0 KiB"]),
+    "compare --repeat 0": (["compare", "whitted", "--repeat", "0", "--out", "{tmp}/c"], ["--repeat", "at least 1"]),
+    "study --repeat -1": (["study", "whitted", "--repeat", "-1", "--out", "{tmp}/s"], ["--repeat", "at least 1"]),
+    "raytrace threshold -1": (["render", "whitted", "-m", "raytrace", "--set", "threshold=-1",
+                               "-o", "{tmp}/x.png"], ["threshold", ">= 0"]),
+    "hybrid threshold -1": (["render", "cornell", "-m", "hybrid", "--set", "threshold=-1",
+                             "-o", "{tmp}/x.png"], ["threshold", ">= 0"]),
+    "NaN image to colour": (["colour", "display", "{tmp}/nan.npy", "-o", "{tmp}/x.png"], ["NaN", "nan.npy"]),
+}
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_one_line_and_exit_2(case, tmp_path):
+    np.save(tmp_path / "nan.npy", np.full((4, 4, 3), np.nan, np.float32))
+    argv, words = CASES[case]
+    p = subprocess.run([WORKBENCH, *(a.format(tmp=tmp_path) for a in argv)], cwd=tmp_path,
+                       capture_output=True, text=True, timeout=300)
+    lines = [ln for ln in p.stderr.splitlines() if ln.strip()]
+    assert p.returncode == 2, p.stderr[-2000:]
+    assert len(lines) == 1 and lines[0].startswith("workbench: error: "), p.stderr[-2000:]
+    assert "np." not in lines[0]
+    for w in words:
+        assert w in lines[0], (w, lines[0])
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_sizes_below_a_mebibyte_keep_their_value():
+    from workbench.core.memory import gib
+    assert gib(1024) == "1.0 KiB" and gib(12) == "12 bytes" and gib(3 * 2 ** 20) == "3.0 MiB"
+    assert gib(2 ** 30) == "1.0 GiB"
