@@ -46,3 +46,14 @@ def test_sizes_below_a_mebibyte_keep_their_value():
     from workbench.core.memory import gib
     assert gib(1024) == "1.0 KiB" and gib(12) == "12 bytes" and gib(3 * 2 ** 20) == "3.0 MiB"
     assert gib(2 ** 30) == "1.0 GiB"
+
+
+def test_study_with_a_failed_point_exits_1(tmp_path):
+    """Phong at tessellations 12 and 32 needs more than 100 MiB at 32x24, 1 and 4 less: the
+    study is written with the points that rendered, and the exit status says it is not whole."""
+    p = subprocess.run([WORKBENCH, "study", "whitted", "--quick", "--methods", "phong", "--size", "32x24",
+                        "--max-memory", "100M", "--out", str(tmp_path / "s")], cwd=tmp_path,
+                       capture_output=True, text=True, timeout=600)
+    assert p.returncode == 1, p.stderr[-2000:]
+    assert "study points failed" in p.stderr and "Traceback" not in p.stderr
+    assert (tmp_path / "s" / "study.csv").stat().st_size > 0

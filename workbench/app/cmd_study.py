@@ -105,4 +105,9 @@ def run(args) -> int:
         else:
             print(f"  {p['method']:<10} {p['knob']}={p['value']}: {p['status']}: {p['reason']}")
     print(f"study: {(Path(args.out) / 'study.png').resolve()}")
+    failed = [p for p in res["points"] if p["status"] == "failed"]
+    if failed:  # the study is written, but not whole: say so and exit 1 (as snapshot check)
+        print(f"workbench: {len(failed)} of {len(res['points'])} study points failed (listed above)",
+              file=sys.stderr)
+        return 1
     return 0
