@@ -57,3 +57,23 @@ def test_study_with_a_failed_point_exits_1(tmp_path):
     assert p.returncode == 1, p.stderr[-2000:]
     assert "study points failed" in p.stderr and "Traceback" not in p.stderr
     assert (tmp_path / "s" / "study.csv").stat().st_size > 0
+
+
+def test_snapshot_record_keeps_another_scene_stored_under_the_same_name(tmp_path):
+    """Recording the same scene again replaces its snapshot; a different scene file with the
+    same scene name is refused before rendering, and the stored snapshot is left as it was."""
+    from workbench.scene.library import resolve
+    other = tmp_path / "whitted.toml"  # another file whose scene is also named whitted
+    other.write_text(resolve("whitted").read_text().replace("fov_y =", "fov_y = 30.0\n#", 1))
+    snap = tmp_path / "snap"
+    opts = ["--methods", "phong", "--size", "16x12", "--dir", str(snap)]
+    for scene in ("whitted", "whitted"):
+        done = subprocess.run([WORKBENCH, "snapshot", "record", scene, *opts], capture_output=True,
+                              text=True, timeout=300)
+        assert done.returncode == 0, done.stderr
+    before = (snap / "whitted.phong.npy").read_bytes()
+    p = subprocess.run([WORKBENCH, "snapshot", "record", str(other), *opts], capture_output=True,
+                       text=True, timeout=300)
+    lines = [ln for ln in p.stderr.splitlines() if ln.strip()]
+    assert p.returncode == 2 and len(lines) == 1 and "holds scene 'whitted'" in lines[0], p.stderr
+    assert (snap / "whitted.phong.npy").read_bytes() == before

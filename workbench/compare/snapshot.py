@@ -120,9 +120,21 @@ def _write(stored: Path, scene: Scene, method: str, result) -> list[Path]:
 
 def record(scene: Scene, method: str, directory: str | Path, *, size: tuple[int, int] | None = None,
            name: str | None = None, options: dict | None = None) -> Outcome:
-    """Render ``scene`` with ``method`` and store it as a snapshot (replacing any)."""
+    """Render ``scene`` with ``method`` and store it as a snapshot, replacing one of the same
+    scene file; a snapshot of another scene file stored under the same name is refused
+    (:class:`WorkbenchError`, before rendering): two scenes named alike would overwrite each
+    other's snapshots."""
     check_methods([method])
     stored = stored_path(directory, scene, method, name)
+    meta = _sibling(stored, ".json")
+    if stored.exists() and meta.exists():
+        try:
+            held = json.loads(meta.read_text()).get("scene_source", "")
+        except (OSError, ValueError):
+            held = ""
+        if held and scene.source and Path(held).resolve() != Path(scene.source).resolve():
+            raise WorkbenchError(f"snapshot {stored} holds scene {scene.name!r} from {held}, not from "
+                                 f"{scene.source}: record into another --dir (or remove it)")
     result = _render(scene, method, size, options or {})
     h, w = result.image.shape[:2]
     written = _write(stored, scene, method, result)
