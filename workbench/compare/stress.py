@@ -94,15 +94,42 @@ _GEOMETRIC = {"position", "look_at", "center", "radius", "point", "size", "verti
 
 
 def scale_scene_dict(d, factor: float):
-    """A copy of a scene dictionary with every length multiplied by ``factor`` (camera, lights,
-    object positions and sizes).  Rendering must not change: lights without falloff, same
-    field of view."""
+    """A copy of a scene dictionary with every length multiplied by ``factor``.  The camera,
+    lights and other scene-level lengths (:data:`_GEOMETRIC` keys) are multiplied; each object
+    is scaled through its transform (:func:`scaled_transform`), so every kind scales whole,
+    whatever its parameters are (a lathe's profile, a prism's polygon and heights, an
+    isosurface's bounds and field), CSG children with their parent.  Rendering must not change:
+    lights without falloff, same field of view."""
     if isinstance(d, dict):
-        return {k: (np.multiply(v, factor).tolist() if k in _GEOMETRIC else scale_scene_dict(v, factor))
+        return {k: (np.multiply(v, factor).tolist() if k in _GEOMETRIC
+                    else [scale_object_dict(o, factor) for o in v] if k == "objects" and isinstance(v, list)
+                    else scale_scene_dict(v, factor))
                 for k, v in d.items()}
     if isinstance(d, list):
         return [scale_scene_dict(v, factor) for v in d]
     return d
+
+
+def scale_object_dict(obj, factor: float):
+    """An object table scaled by ``factor`` about the world origin (its transform's)."""
+    if not isinstance(obj, dict):
+        return obj
+    return {**obj, "transform": scaled_transform(obj.get("transform"), factor)}
+
+
+def scaled_transform(t, factor: float) -> dict:
+    """The transform table (``translate``/``rotate``/``scale`` or ``matrix``; None: identity)
+    followed by a uniform scale ``factor`` about the origin.  ``T = Tr(t) R S(s)`` gives
+    ``factor T = Tr(factor t) R S(factor s)`` (a uniform scale commutes with ``R``)."""
+    t = dict(t or {})
+    if "matrix" in t:
+        M = np.asarray(t["matrix"], dtype=float)
+        return {"matrix": (np.diag([factor, factor, factor, 1.0]) @ M).tolist()}
+    sc = t.get("scale", 1.0)
+    t["scale"] = np.multiply(sc, factor).tolist()
+    if "translate" in t:
+        t["translate"] = np.multiply(t["translate"], factor).tolist()
+    return t
 
 
 class Catalogue:
