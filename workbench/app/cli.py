@@ -16,6 +16,7 @@ import argparse
 import atexit
 import importlib
 import os
+import warnings
 import sys
 
 COMMANDS = ["cmd_scenes", "cmd_info", "cmd_methods", "cmd_render", "cmd_colour", "cmd_compare", "cmd_study", "cmd_stress", "cmd_snapshot", "cmd_ui"]
@@ -66,8 +67,21 @@ def main(argv: list[str] | None = None) -> int:
     os._exit(code)
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A :class:`SceneWarning` as one ``workbench: warning:`` line; others as Python shows them."""
+    from ..core.errors import SceneWarning
+    if issubclass(category, SceneWarning):
+        print(f"workbench: warning: {message}", file=sys.stderr)
+    else:
+        _PYTHON_SHOWWARNING(message, category, filename, lineno, file, line)
+
+
+_PYTHON_SHOWWARNING = warnings.showwarning
+
+
 def _run(argv: list[str] | None) -> int:
     from ..core.errors import WorkbenchError
+    warnings.showwarning = _show_warning
     try:
         from .args import value_after_option
         args = build_parser().parse_args(value_after_option(sys.argv[1:] if argv is None else list(argv)))

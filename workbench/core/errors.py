@@ -12,3 +12,8 @@ class NotApplicable(WorkbenchError):
 class ShaderSourceError(WorkbenchError):
     """A user's shader code does not compile: the message is one line naming the user's file
     and line.  Bad input, not a method's failure: comparisons stop on it rather than list it."""
+
+
+class SceneWarning(UserWarning):
+    """A scene that loads but likely does not show what its author meant (an area light that
+    faces away from every object).  The CLI prints it as one ``workbench: warning:`` line."""

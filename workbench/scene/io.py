@@ -7,14 +7,16 @@ yields a half-loaded scene.
 from __future__ import annotations
 
 import tomllib
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 from ..core import transform as tf
+from ..core.errors import SceneWarning
 from ..core.tol import tol
 from . import model as m
-from .kinds import KINDS, kind_of
+from .kinds import KINDS, kind_of, world_bounds
 from .readers import (FLOAT32_MAX, Ctx, SceneError, boolean, check_keys, file_path, matrix, num,
                       parallel, polygon_vertices, rgb, string, vec)
 
@@ -267,6 +269,30 @@ def _environment(ctx, t):
 
 
 # --------------------------------------------------------------------------- entry points
+def unlit_area_lights(lights, objects) -> list[int]:
+    """Indices of the area lights with no object's world bounding box in front of them (on the
+    side of their normal, :attr:`AreaLight.normal`)."""
+    boxes = [world_bounds(o, np.eye(4)) for o in objects]
+    out = []
+    for k, light in enumerate(lights):
+        if not isinstance(light, m.AreaLight):
+            continue
+        c, n = light.vertices.mean(0), light.normal
+        reach = float(np.ptp(light.vertices, axis=0).max())
+        ahead = False
+        for lo, hi in boxes:
+            if not (np.isfinite(lo).all() and np.isfinite(hi).all()):
+                ahead = True
+                break
+            corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+            if ((corners - c) @ n > tol.zero * max(1.0, reach)).any():
+                ahead = True
+                break
+        if not ahead:
+            out.append(k)
+    return out
+
+
 def scene_from_dict(data: dict, source: str = "<dict>", base_dir: Path | str = ".") -> m.Scene:
     """Build a validated :class:`Scene` from a parsed TOML dictionary."""
     ctx = Ctx(source, Path(base_dir))
@@ -289,6 +315,11 @@ def scene_from_dict(data: dict, source: str = "<dict>", base_dir: Path | str = "
         ctx.fail("objects", "expected at least one [[objects]] table")
     objects = tuple(_object(ctx, ot, f"[[objects]] #{i + 1}", materials) for i, ot in enumerate(objs_t))
     env = _environment(ctx, data["environment"]) if "environment" in data else None
+    for k in unlit_area_lights(lights, objects):
+        warnings.warn(SceneWarning(
+            f"{source}: lights #{k + 1} (area) faces away from every object and lights nothing: an "
+            "area light emits from its front face, the side from which its vertices turn "
+            "counter-clockwise (reverse them to turn it)"), stacklevel=2)
     return m.Scene(
         name=string(ctx, st, "[scene]", "name", Path(source).stem), camera=camera, materials=materials,
         objects=objects, lights=lights, description=string(ctx, st, "[scene]", "description", ""),
