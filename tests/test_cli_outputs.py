@@ -121,7 +121,7 @@ def test_write_together_is_all_or_nothing(tmp_path):
     (["render", "whitted", "-o", "x.png", "--bogus"], "unrecognized arguments: --bogus"),
     (["frobnicate"], "invalid choice: 'frobnicate'"),
     ([], "required: COMMAND"),
-    (["compare", "whitted", "--out", "d", "--repeat", "x"], "argument --repeat: invalid int value"),
+    (["compare", "whitted", "--out", "d", "--repeat", "x"], "argument --repeat: expected a whole number"),
 ])
 def test_argparse_errors_are_one_line(argv, expect, tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)

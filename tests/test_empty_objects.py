@@ -1,5 +1,5 @@
 """An object with no surface (a blob whose threshold is above its field's maximum, an
-isosurface whose field never reaches its threshold, a CSG intersection of disjoint solids) gets
+isosurface whose field stays above its threshold (the solid is f < threshold), a CSG intersection of disjoint solids) gets
 the same answer from every method: the scene as if it were not there, and the raster methods
 say so in ``left_out`` (the raster crashed on a zero-size reduction, the ray methods dropped it
 silently)."""
@@ -22,7 +22,7 @@ right = { type = "sphere", center = [3.0, 0.5, 0.0], radius = 0.4 }
 '''
 CASES = {  # name -> (bundled scene, edit making one object empty, the object's name)
     "blob": ("kinds", lambda t: t.replace("threshold = 0.3", "threshold = 50.0", 1), "metaballs"),
-    "isosurface": ("kinds", lambda t: t.replace("threshold = 0.0\nmax_gradient", "threshold = 100.0\nmax_gradient", 1),
+    "isosurface": ("kinds", lambda t: t.replace("threshold = 0.0\nmax_gradient", "threshold = -100.0\nmax_gradient", 1),
                    "gyroid"),
     "csg": ("csg", lambda t: t + DISJOINT, "nothing"),
 }
@@ -52,9 +52,9 @@ def test_an_empty_object_renders_as_if_absent_in_every_method(kind, tmp_path):
         a = workbench.render(with_empty, m, width=32, height=24)
         b = workbench.render(without, m, width=32, height=24)
         assert np.isfinite(a.image).all(), m
-        # the same image; the empty CSG's leaves still widen the scene's bounds, so the raster's
-        # depth range (near/far) differs and a few pixels of depth ties may too
+        # the same image: an empty object's declared bounds widen neither the raster's depth
+        # range nor its stand-ins' maps (they did: 4 % of the flat pixels moved)
         same = np.abs(a.image - b.image).max(-1) <= 1e-5
-        assert same.mean() >= 0.99, (m, same.mean())
+        assert same.all(), (m, same.mean())
         if m in ("flat", "phong"):
             assert any(obj in x and "no triangle" in x for x in a.left_out), (m, a.left_out)

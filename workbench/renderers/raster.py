@@ -192,14 +192,14 @@ def _same(a, b) -> bool:
 _PARTS: OrderedDict = OrderedDict()
 
 
-def _parts(scene: Scene, level: int) -> tuple[list[Part], list[str]]:
-    """Tessellated parts and the names of the objects that gave none, cached by the scene's
+def _parts(scene: Scene, level: int) -> tuple[list[Part], list]:
+    """Tessellated parts and the objects that gave none, cached by the scene's
     objects (identity) and level: flat, Gouraud and Phong sessions of the same scene share one
     tessellation."""
     key = (id(scene.objects), level)
     hit = _PARTS.get(key)
     if hit is None or hit[0] is not scene.objects:
-        empty: list[str] = []
+        empty: list = []
         hit = (scene.objects, tessellate_scene(scene, level, empty), empty)
         _PARTS[key] = hit
         if len(_PARTS) > 8:
@@ -261,11 +261,14 @@ class RasterSession:
         parts, empty = _parts(scene, tessellation)
         #: objects whose surface tessellates to nothing (a blob's threshold above its field's
         #: maximum): not drawn, as the ray methods find no surface there; said in left_out
-        self.empty_objects = empty
+        self.empty_objects = [o.name or o.kind for o in empty]
         pairs = [(with_normal_rule(p, normals), scene.materials[p.material], p.material)
                  for p in parts]
-        #: bounds, clip planes and area lights (.scene.prepared), built once per session
-        self.prepared = prepare(scene)
+        #: bounds, clip planes and area lights (.scene.prepared) of what is drawn (an empty
+        #: object's declared bounds would widen the depth range and the stand-ins' maps), built
+        #: once per session
+        drawn = [o for o in scene.objects if not any(o is e for e in empty)]
+        self.prepared = prepare(replace(scene, objects=type(scene.objects)(drawn)) if empty else scene)
         pairs += [(p, m, None) for p, m in area_light_parts(self.prepared.area_lights)]
         self.timings["tessellate"] = time.perf_counter() - t0
         self.n_triangles = sum(p.n_triangles for p, _, _ in pairs)

@@ -83,15 +83,15 @@ def tessellate_object(obj: m.SceneObject, level: int = DEFAULT_LEVEL,
 
 
 def tessellate_scene(scene: m.Scene, level: int = DEFAULT_LEVEL,
-                     empty: list[str] | None = None) -> list[Part]:
+                     empty: list[m.SceneObject] | None = None) -> list[Part]:
     """Parts of every object of the scene, in scene order, each with at least one triangle: an
     object with no surface (a blob whose threshold is above its field's maximum) gives none, as
-    the ray methods find none; its name (or kind) is appended to ``empty`` when given."""
+    the ray methods find none; the object is appended to ``empty`` when given."""
     parts: list[Part] = []
     for obj in scene.objects:
         mine = [p for p in tessellate_object(obj, level) if len(p.faces) > 0]
         if not mine and empty is not None:
-            empty.append(obj.name or obj.kind)
+            empty.append(obj)
         parts.extend(mine)
     return parts
 

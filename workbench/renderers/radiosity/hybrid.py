@@ -22,7 +22,7 @@ from ...scene import features as ft
 from ...scene import model as m
 from ..base import Knob, Option, RenderResult
 from ..base import render as render_method
-from .method import common_options, estimate_solve_bytes, solve_scene
+from .method import check_camera_outside, common_options, estimate_solve_bytes, solve_scene
 
 RAYTRACE_OPTIONS = ("max_depth", "threshold", "spp", "fresnel")
 
@@ -82,6 +82,7 @@ class HybridRenderer:
         plus the ray tracer on the derived scene (two triangles per patch,
         :func:`..raytrace.whitted.estimate_trace_bytes`)."""
         from ..raytrace.whitted import estimate_trace_bytes
+        check_camera_outside(scene, self.name)  # refused before any estimate
         solve, P = estimate_solve_bytes(scene, opts)
         return solve + estimate_trace_bytes(scene, width, height, opts, True, extra_triangles=2 * P)
 

@@ -13,6 +13,7 @@ import numpy as np
 
 from ...core.errors import NotApplicable, WorkbenchError
 from ...scene import features as ft
+from ...scene.kinds import containing, kind_of
 from ...scene.model import Scene
 from ...scene.prepared import prepare
 from ..base import Knob, Option, RenderResult
@@ -173,8 +174,22 @@ def _shoot_raycast(geom, E, R, opts, stats, timings, tol, cap) -> solvers.SolveR
     return res
 
 
+def check_camera_outside(scene: Scene, method: str) -> None:
+    """Refuse (:class:`NotApplicable`) a camera inside a closed object: patches are lit on their
+    outer side only, so the image would be their unlit backs, all black."""
+    eye = np.asarray(scene.camera.position, dtype=np.float64)
+    for obj in scene.objects:
+        if containing(obj, np.eye(4), eye) is not None:
+            raise NotApplicable(f"{method}: the camera is inside the closed object "
+                                f"{obj.name or kind_of(obj).TYPE!r} ({kind_of(obj).TYPE}): radiosity lights "
+                                "the outer side of its patches only and would show their unlit backs "
+                                "(move the camera out, or use pathtrace)")
+
+
 def solve_scene(scene: Scene, opts: dict, method: str) -> Solution:
-    """Patches, form factors and solution of ``scene`` with the ``common_options``."""
+    """Patches, form factors and solution of ``scene`` with the ``common_options``
+    (:func:`check_camera_outside` first)."""
+    check_camera_outside(scene, method)
     if opts["max_iterations"] < 0:
         raise WorkbenchError(f"{method}: max_iterations must be >= 0 (0: automatic), got {opts['max_iterations']}")
     if opts["row_cache_mb"] < 0:
@@ -234,7 +249,9 @@ class RadiosityRenderer:
     memory_options = ("patch_size", "hemicube_resolution", "solver", "row_cache_mb")
 
     def estimate_bytes(self, scene: Scene, width: int, height: int, **opts) -> int:
-        """:func:`estimate_solve_bytes` plus the Gouraud display's image and buffers."""
+        """:func:`estimate_solve_bytes` plus the Gouraud display's image and buffers (a camera
+        inside a closed object is refused first: :func:`check_camera_outside`)."""
+        check_camera_outside(scene, self.name)
         return estimate_solve_bytes(scene, opts)[0] + _DISPLAY_BYTES_PER_PIXEL * width * height
 
     def render(self, scene: Scene, width: int, height: int, **opts) -> RenderResult:
