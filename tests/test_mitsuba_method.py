@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import workbench
+from statistics_budget import band
 from workbench.core.errors import WorkbenchError
 from workbench.renderers import mitsuba_method as mm
 from workbench.renderers.base import get_renderer
@@ -52,23 +53,33 @@ def _light_pixels(scene: m.Scene, width: int, height: int) -> np.ndarray:
     return mask
 
 
-def test_cornell_mean_radiance_agrees_with_radiosity_and_reports_its_noise():
+def test_cornell_mean_radiance_agrees_with_radiosity_and_reports_its_noise(tmp_path):
+    check_cornell_mean(0, tmp_path)
+
+
+#: radiosity's discretisation at 48x48 (about 1 %) and the box filter's blur near the light
+BIAS_ALLOWANCE = 0.02
+
+
+def check_cornell_mean(seed: int, tmp_path) -> None:
     """Off the light's own pixels (where a box-filtered and a pixel-centre image differ most),
-    the mean radiance of Mitsuba's path tracing and of the workbench's radiosity agree within 3 %
-    (radiosity's discretisation at 48x48 is about 1 %; the noise of a 2,300-pixel mean at 64 spp
-    is far below that)."""
+    the mean radiance of Mitsuba's path tracing (one pinned variant, seeded) and of the
+    workbench's radiosity agree within :data:`BIAS_ALLOWANCE` plus the normal band of the
+    mean's standard error (from Mitsuba's per-pixel estimate, 2,300 pixels at 256 spp)."""
     s = workbench.load_scene("cornell")
-    mit = workbench.render(s, "mitsuba", width=48, height=48, spp=64)
+    mit = workbench.render(s, "mitsuba", width=48, height=48, spp=256, seed=seed, variant=mm.FALLBACK_VARIANT)
     rad = workbench.render(s, "radiosity", width=48, height=48)
     keep = ~_light_pixels(s, 48, 48)
     a, b = mit.image[keep].mean(0), rad.image[keep].mean(0)
-    assert np.all(np.abs(a / b - 1.0) < 0.03), (a, b)
     assert np.isfinite(mit.image).all() and mit.stats["nonfinite_pixels"] == 0
-    assert mit.stats["variant"] in (mm.FALLBACK_VARIANT, mm.FAST_VARIANT) and mit.stats["variant_reason"]
+    assert mit.stats["variant"] == mm.FALLBACK_VARIANT and mit.stats["variant_reason"]
     err = mit.stats["stderr"]
     assert err.shape == mit.image.shape and np.isfinite(err).all()
-    # the standard error of the whole mean from the per-pixel estimate is small beside 3 %
-    assert np.all(np.sqrt((err[keep] ** 2).sum(0)) / keep.sum() < 0.005 * a)
+    se = np.sqrt((err[keep].astype(np.float64) ** 2).sum(0)) / keep.sum()
+    # the noise is small beside the bias allowance: the check is about the means, not the noise
+    z = band("test_mitsuba_method::cornell_mean", 3)
+    assert np.all(z * se < 0.01 * a), (z * se / a)
+    assert np.all(np.abs(a - b) <= BIAS_ALLOWANCE * b + z * se), (a, b, se)
     assert mit.left_out == [] and "area_lights" in mit.features_used
 
 

@@ -53,7 +53,11 @@ def test_hemicube_parallel_squares(gl_ctx, c, n, res, rel):
 
 
 def test_raycast_parallel_squares():
-    ff = radiosity.form_factors(squares(1.0, 2), "raycast", rays=16384)
+    check_raycast(0)
+
+
+def check_raycast(seed: int, tmp_path=None) -> None:
+    ff = radiosity.form_factors(squares(1.0, 2), "raycast", rays=16384, seed=seed)
     # 4 x 16384 rays, F = 0.2: binomial standard deviation sqrt(F (1 - F) / 65536) = 0.0016;
     # the band from the test's false-failure probability (tests/statistics_budget.py)
     sd = (0.2 * 0.8 / (4 * 16384)) ** 0.5

@@ -18,3 +18,14 @@ def test_band_is_the_two_sided_normal_quantile():
             z = band(test, checks)
             tail = math.erfc(z / math.sqrt(2.0))  # P(|Z| > z)
             assert abs(tail * checks - ALPHA[test]) <= 1e-9 * ALPHA[test] + 1e-15
+
+
+def test_band_with_estimated_errors_is_students_t():
+    """With the standard error estimated from dof + 1 samples the band is Student's t quantile:
+    wider than the normal one, and its tail is the test's share."""
+    from scipy.stats import t
+    test = "test_pathtrace::furnace"
+    for dof in (7, 63, 4095):
+        z = band(test, 100, dof=dof)
+        assert z > band(test, 100)
+        assert abs(2.0 * t.sf(z, dof) * 100 - ALPHA[test]) <= 1e-9 * ALPHA[test]
