@@ -31,7 +31,7 @@ import pytest
 import workbench
 from workbench.compare import agreement as ag
 from workbench.renderers.mitsuba_export import export_scene
-from statistics_budget import ALPHA, band
+from statistics_budget import band
 from workbench.renderers.mitsuba_method import mitsuba_installed
 
 pytestmark = pytest.mark.skipif(not mitsuba_installed(), reason="Mitsuba 3 not installed (extra 'reference')")
