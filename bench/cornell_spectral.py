@@ -22,7 +22,7 @@ sys.path.insert(0, str(ROOT))
 
 from workbench.core import color, spectral  # noqa: E402
 
-DEFAULT_REFS = ROOT.parent / "shared" / "references" / "published_references.json"
+DEFAULT_REFS = ROOT / "references" / "published_references.json"
 
 
 def describe(rgb) -> dict:

@@ -1,8 +1,6 @@
 """Spectral -> RGB conversion: bundled CMF table, white point, Cornell data and scene file."""
 from __future__ import annotations
 
-import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -10,17 +8,15 @@ import pytest
 import workbench
 from workbench.core import spectral
 from workbench.core.color import luminance
+from published import entry
 from workbench.core.errors import WorkbenchError
 
 colour = pytest.importorskip("colour")
-REFS = Path(__file__).resolve().parents[2] / "shared" / "references" / "published_references.json"
 CMFS = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
 
 
 def _refs(rid):
-    if not REFS.is_file():
-        pytest.skip(f"published references not found at {REFS}")
-    return next(e for e in json.loads(REFS.read_text()) if e["id"] == rid)["expected"]
+    return entry(rid)["expected"]
 
 
 def test_bundled_cmf_table_is_colour_science_cie1931():

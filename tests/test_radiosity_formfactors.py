@@ -2,13 +2,13 @@
 hemicube's convergence with resolution, closure of a cube, reciprocity, degenerate patches."""
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from published import entry
 from statistics_budget import band
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -18,9 +18,6 @@ from workbench import radiosity  # noqa: E402
 from workbench.core.errors import WorkbenchError  # noqa: E402
 from workbench.renderers.radiosity.formfactors import point_polygon  # noqa: E402
 
-REFS = {e["id"]: e for e in json.loads(
-    (Path(__file__).resolve().parents[2] / "shared/references/published_references.json").read_text())} \
-    if (Path(__file__).resolve().parents[2] / "shared/references/published_references.json").exists() else {}
 
 
 def squares(c, n_emit=1):
@@ -37,9 +34,7 @@ def aggregate(ff, n_emit):
 @pytest.mark.parametrize("c", [0.1, 1.0, 10.0])
 def test_closed_form_parallel_squares(c):
     exact = parallel_squares_F(c)
-    ref = REFS.get(f"VF-C11-square-c{c}")
-    if ref:
-        assert exact == pytest.approx(ref["expected"], abs=1e-9)
+    assert exact == pytest.approx(entry(f"VF-C11-square-c{c}")["expected"], abs=1e-9)
     ff = radiosity.form_factors(squares(c), "analytic", order=32)
     assert ff[0, 1] == pytest.approx(exact, rel=1e-8)
     assert ff.reciprocity_error < 1e-9

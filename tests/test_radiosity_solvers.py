@@ -2,27 +2,21 @@
 furnace (B = E / (1 - rho)) up to rho = 0.999, and honest non-convergence."""
 from __future__ import annotations
 
-import json
 from fractions import Fraction
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from workbench import radiosity
+from published import entry
 from workbench.core.errors import WorkbenchError
 
 SOLVERS = ["direct", "jacobi", "gauss_seidel", "progressive"]
-REF = Path(__file__).resolve().parents[2] / "shared/references/published_references.json"
 
 
 def _two_plates():
-    if REF.exists():
-        for e in json.loads(REF.read_text()):
-            if e["id"] == "RAD-plates-E10-r0.5-0.8":
-                return e["inputs"], e["expected"]
-    inp = {"E1": 1, "E2": 0, "rho1": 0.5, "rho2": 0.8}
-    return inp, {"B1": 1 / 0.6, "B2": 0.8 / 0.6}
+    e = entry("RAD-plates-E10-r0.5-0.8")
+    return e["inputs"], e["expected"]
 
 
 @pytest.mark.parametrize("method", SOLVERS)
