@@ -46,12 +46,23 @@ def build_parser() -> argparse.ArgumentParser:
     sub.required = True
     for name in COMMANDS:
         importlib.import_module(f"workbench.app.{name}").add_parser(sub)
-    for command in {id(c): c for c in sub.choices.values()}.values():  # aliases share a parser
+    for command in _leaf_parsers(sub):
         command.add_argument("--max-memory", metavar="SIZE", default=None,
                              help="memory limit of each render, e.g. 8G or 512M (sets "
                                   "WORKBENCH_MAX_MEMORY for this command; default: that variable, "
                                   "else half the physical memory)")
     return p
+
+
+def _leaf_parsers(sub) -> list[argparse.ArgumentParser]:
+    """The parsers that take a command's options: each command's, or its subcommands' when it
+    has some (``colour wheel``, ``snapshot record``); aliases share a parser, listed once."""
+    leaves = {}
+    for command in sub.choices.values():
+        nested = [a for a in command._actions if isinstance(a, argparse._SubParsersAction)]
+        for parser in ([c for n in nested for c in n.choices.values()] if nested else [command]):
+            leaves[id(parser)] = parser
+    return list(leaves.values())
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -85,7 +96,7 @@ def _run(argv: list[str] | None) -> int:
     try:
         from .args import value_after_option
         args = build_parser().parse_args(value_after_option(sys.argv[1:] if argv is None else list(argv)))
-        if args.max_memory is not None:  # one limit for this process and its children
+        if getattr(args, "max_memory", None) is not None:  # one limit for this process and its children
             from ..core.memory import ENV, parse_size
             os.environ[ENV] = str(parse_size(args.max_memory, "--max-memory"))
         return int(args.run(args) or 0)

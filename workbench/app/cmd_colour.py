@@ -50,17 +50,35 @@ def run_wheel(args) -> int:
     return 0
 
 
-def _load_source(source: str, method: str):
-    """Linear (H, W, 3) image from an image file, or from a scene rendered with ``method``."""
+def _image_size(p) -> tuple[int, int]:
+    """``(height, width)`` of an image file from its header, without reading its pixels."""
+    import numpy as np
+
+    from ..core.errors import WorkbenchError
+    from PIL import Image
+    try:
+        if p.suffix.lower() == ".npy":
+            return np.load(p, mmap_mode="r", allow_pickle=False).shape[:2]
+        with Image.open(p) as im:
+            return im.size[1], im.size[0]
+    except (OSError, ValueError, Image.DecompressionBombError) as e:
+        raise WorkbenchError(f"{p}: cannot read the image ({e})") from None
+
+
+def _load_source(source: str, method: str, mode: str):
+    """Linear (H, W, 3) image from an image file, or from a scene rendered with ``method``;
+    the memory of showing it through ``mode`` is checked before either."""
     from pathlib import Path
 
     import numpy as np
 
+    from ..core.display import check_display_memory
     from ..core.errors import WorkbenchError
     p = Path(source)
     if p.suffix.lower() in _IMAGE_SUFFIXES:
         if not p.is_file():
             raise WorkbenchError(f"{source}: no such image file")
+        check_display_memory(*_image_size(p), mode)
         if p.suffix.lower() == ".npy":
             img = np.load(p, allow_pickle=False)
         else:
@@ -79,6 +97,7 @@ def _load_source(source: str, method: str):
     from ..renderers.base import render
     from ..scene.io import load_scene
     scene = load_scene(source)
+    check_display_memory(scene.camera.height, scene.camera.width, mode)
     result = render(scene, method)
     return result.image, f"{scene.name} / {result.method}"
 
@@ -91,7 +110,7 @@ def run_display(args) -> int:
     from ..core.imageio import save_png
     _png_output(args.output)
     mode = display_mode(args.mode)                       # a bad mode fails before any rendering
-    image, what = _load_source(args.source, args.method)
+    image, what = _load_source(args.source, args.method, mode)
     image = np.nan_to_num(np.asarray(image, dtype=np.float32), nan=0.0, posinf=1.0, neginf=0.0)
     ref = apply_display_mode(image, "direct24")
     shown = apply_display_mode(image, mode)

@@ -33,10 +33,12 @@ def run(args) -> int:
         if target:
             check_output_file(target, opt)
     check_distinct({"-o": args.output, "--npy": args.npy, "--json": args.json})
-    from ..core.display import apply_display_mode, display_mode
+    from ..core.display import apply_display_mode, check_display_memory, display_mode
     display_mode(args.display)  # refuse a bad mode before rendering
     scene = load_scene(args.scene)
     w, h = args.size if args.size else (None, None)
+    if args.display != "direct24":  # the post-process's memory, before the render's
+        check_display_memory(h or scene.camera.height, w or scene.camera.width, args.display)
     options = dict(args.set)
     if "progress" in _accepted(args.method):
         options.setdefault("progress", "true")

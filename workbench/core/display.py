@@ -31,6 +31,7 @@ import numpy as np
 
 from .errors import WorkbenchError
 from .imageio import srgb_decode, srgb_encode
+from .memory import check_limit
 
 PALETTES = ("median_cut", "kmeans")
 DITHERS = ("none", "ordered", "floyd_steinberg")
@@ -42,6 +43,15 @@ _SYNTAX = ("direct24 | direct16[-555|-565] | indexedN[-mediancut|-kmeans] (N = 2
            "each optionally followed by -bayer or -fs")
 #: Lloyd iterations of the k-means palette, and pixels sampled (seeded) to fit it.
 KMEANS_ITERATIONS = 12
+KNOLL_CANDIDATES = 16
+"""Palette colours mixed per pixel by the ordered dithering of an indexed mode (:func:`knoll_ordered`)."""
+WORK_BYTES_PER_PIXEL = 192
+"""Working memory per pixel of :func:`apply_display_mode` (six float64 RGB copies: the image,
+its 24-bit encoding, the shown colours and the sRGB conversions' temporaries, with the
+palette's or the dithering's indices), besides the input image."""
+KNOLL_BYTES_PER_CANDIDATE = 48
+"""Per pixel and candidate of :func:`knoll_ordered`: the candidate (float64 RGB), its luminance,
+its rank (int64) and the accumulated error's update."""
 KMEANS_SAMPLES = 32768
 
 
@@ -124,18 +134,44 @@ def display_mode(mode: str | DisplayMode = "direct24", *, entries: int | None = 
     return replace(base, **changes)
 
 
-def apply_display_mode(image, mode: str | DisplayMode = "direct24", **fields) -> np.ndarray:
+def estimate_display_bytes(height: int, width: int, mode: str | DisplayMode = "direct24") -> int:
+    """Bytes :func:`apply_display_mode` allocates on an ``height x width`` image (an upper
+    bound: :data:`WORK_BYTES_PER_PIXEL`, plus the candidates of an indexed mode's ordered
+    dithering)."""
+    spec = display_mode(mode)
+    per_pixel = WORK_BYTES_PER_PIXEL
+    if spec.kind == "indexed" and spec.dither == "ordered":
+        per_pixel += KNOLL_CANDIDATES * KNOLL_BYTES_PER_CANDIDATE
+    return int(height) * int(width) * per_pixel
+
+
+def check_display_memory(height: int, width: int, mode: str | DisplayMode, max_memory=None) -> None:
+    """Refuse (one line) before rendering or loading what showing an ``height x width`` image
+    through ``mode`` beside its 24-bit reference would need above the memory limit: the image,
+    the reference and the shown image (float32 RGB each), and the larger of the two modes'
+    work (:func:`estimate_display_bytes`)."""
+    work = max(estimate_display_bytes(height, width, "direct24"), estimate_display_bytes(height, width, mode))
+    check_limit(3 * 12 * int(height) * int(width) + work,
+                f"display mode {display_mode(mode)} on {int(width)}x{int(height)}", max_memory)
+
+
+def apply_display_mode(image, mode: str | DisplayMode = "direct24", *, max_memory=None, **fields) -> np.ndarray:
     """Show a linear ``(H, W, 3)`` image through a display mode; returns linear float32 ``(H, W, 3)``.
 
     ``mode`` and ``fields`` as in :func:`display_mode`, e.g.
     ``apply_display_mode(img, "indexed", entries=16, palette="median_cut",
     dither="floyd_steinberg")`` or ``apply_display_mode(img, "indexed16-kmeans-fs")``.
-    Deterministic (k-means samples pixels with a fixed seed).
+    Deterministic (k-means samples pixels with a fixed seed).  The work is estimated
+    (:func:`estimate_display_bytes`) and checked against the memory limit (``max_memory``, see
+    :func:`workbench.core.memory.memory_limit`) first.
     """
     spec = display_mode(mode, **fields)
+    shape = np.shape(image)
+    if len(shape) != 3 or shape[-1] != 3 or shape[0] == 0 or shape[1] == 0:
+        raise WorkbenchError(f"a display mode applies to an (H, W, 3) image, got shape {shape}")
+    check_limit(estimate_display_bytes(shape[0], shape[1], spec), f"display mode {spec} on {shape[1]}x{shape[0]}",
+                max_memory)
     img = np.asarray(image, dtype=np.float64)
-    if img.ndim != 3 or img.shape[-1] != 3 or img.shape[0] == 0 or img.shape[1] == 0:
-        raise WorkbenchError(f"a display mode applies to an (H, W, 3) image, got shape {img.shape}")
     e = np.round(srgb_encode(img) * 255.0) / 255.0          # the 24-bit frame buffer
     if spec.kind == "direct":
         levels = np.array([2.0 ** b - 1.0 for b in spec.bits])
@@ -160,7 +196,7 @@ def _show(e: np.ndarray, palette: np.ndarray, levels: np.ndarray, dither: str) -
     flat = e.reshape(-1, 3)
     if dither == "ordered":
         t = np.tile(bayer_matrix(8), (h // 8 + 1, w // 8 + 1))[:h, :w].ravel()
-        return knoll_ordered(flat, palette, t).reshape(e.shape)
+        return knoll_ordered(flat, palette, t, KNOLL_CANDIDATES).reshape(e.shape)
     return palette[nearest(flat, palette)].reshape(e.shape)
 
 

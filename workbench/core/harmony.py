@@ -19,6 +19,7 @@ import numpy as np
 from .color import clip_to_gamut, hsv_to_rgb
 from .errors import WorkbenchError
 from .imageio import srgb_decode
+from .memory import check_limit
 
 #: Harmony name -> number of colours.
 HARMONIES = {"complementary": 2, "triad": 3, "square": 4, "hexagon": 6}
@@ -46,20 +47,28 @@ def harmony_colors(base_hue: float, kind: str, saturation: float = 1.0,
     return srgb_decode(clip_to_gamut(hsv_to_rgb(hsv)))
 
 
+WHEEL_BYTES_PER_PIXEL = 320
+"""Working memory per pixel of :func:`wheel_image`: the pixel grid and its distances (five
+float64 planes), the HSV and RGB images and the compositing's temporaries (float64 RGB each)."""
+
+
 def wheel_image(base_hue: float = 0.0, kind: str = "triad", size: int = 256,
-                value: float = 1.0) -> np.ndarray:
+                value: float = 1.0, *, max_memory=None) -> np.ndarray:
     """The HSV chromatic circle with a harmony marked: linear float32 ``(size, size, 3)``.
 
     Pixel at angle a (degrees, counter-clockwise from the +x axis, y up) and distance r from the
     centre, inside the wheel of radius R, has hue a, saturation r / R and the given value;
     outside is mid grey.  Each harmony colour is a disk of that colour (outlined black on white)
     on the ring at 0.72 R, and the disks are joined by black lines (a diameter, a triangle, a
-    square, a hexagon).  Edges are anti-aliased by pixel coverage.
+    square, a hexagon).  Edges are anti-aliased by pixel coverage.  The work
+    (:data:`WHEEL_BYTES_PER_PIXEL`) is checked against the memory limit (``max_memory``,
+    :func:`.memory.memory_limit`) first.
     """
     hues = harmony_hues(base_hue, kind)
     if not (16 <= int(size) <= 8192):
         raise WorkbenchError(f"wheel size must be within 16..8192 pixels, got {size!r}")
     size = int(size)
+    check_limit(size * size * WHEEL_BYTES_PER_PIXEL, f"a {size}x{size} colour wheel", max_memory)
     c = (size - 1) / 2.0
     radius = 0.47 * size
     yy, xx = np.mgrid[0:size, 0:size].astype(np.float64)

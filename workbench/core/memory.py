@@ -55,6 +55,15 @@ def memory_limit(max_memory=None) -> int:
     return int(DEFAULT_FRACTION * physical_memory())
 
 
+def check_limit(need: int, what: str, max_memory=None) -> None:
+    """Refuse (one :class:`WorkbenchError` line) work estimated at ``need`` bytes above the limit
+    (:func:`memory_limit` of ``max_memory``), before it allocates; ``what`` names the work."""
+    limit = memory_limit(max_memory)
+    if need > limit:
+        raise WorkbenchError(f"{what} needs about {gib(need)} of memory, above the limit of {gib(limit)}: "
+                             f"use a smaller image, or raise the limit (--max-memory, {ENV} or max_memory=)")
+
+
 def gib(nbytes: float) -> str:
     """``nbytes`` for a message in the largest unit it fills: ``"412.0 MiB"``, ``"53.9 GiB"``,
     ``"1.8e+09 TiB"``, ``"1.0 KiB"``, ``"12 bytes"`` (a small limit is not shown as 0.0 MiB)."""
