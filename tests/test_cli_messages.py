@@ -25,11 +25,30 @@ CASES = {  # id -> (argv after "workbench", words the one line must hold); {tmp}
                              "-o", "{tmp}/x.png"], ["threshold", ">= 0"]),
     "NaN image to colour": (["colour", "display", "{tmp}/nan.npy", "-o", "{tmp}/x.png"], ["NaN", "nan.npy"]),
 }
+# every command that writes, its output under a regular file ({tmp}/afile): refused before any
+# work (snapshot record rendered first and then failed on "Not a directory")
+UNWRITABLE = {
+    "render -o": ["render", "whitted", "-m", "flat", "--size", "16x12", "-o", "{tmp}/afile/x.png"],
+    "render --json": ["render", "whitted", "-m", "flat", "--size", "16x12", "-o", "{tmp}/x.png",
+                      "--json", "{tmp}/afile/x.json"],
+    "compare --out": ["compare", "whitted", "--methods", "flat", "--size", "16x12", "--out", "{tmp}/afile/c"],
+    "study --out": ["study", "whitted", "--methods", "flat", "--quick", "--size", "16x12", "--out", "{tmp}/afile/s"],
+    "stress --out": ["stress", "--out", "{tmp}/afile/st"],
+    "snapshot record --dir": ["snapshot", "record", "--dir", "{tmp}/afile/snap", "--methods", "flat", "whitted"],
+    "snapshot check --update --dir": ["snapshot", "check", "whitted", "--update", "--dir", "{tmp}/afile/snap",
+                                      "--methods", "flat"],
+    "colour wheel -o": ["colour", "wheel", "-o", "{tmp}/afile/w.png"],
+    "colour display -o": ["colour", "display", "whitted", "-o", "{tmp}/afile/d.png"],
+    "ui --out": ["ui", "whitted", "--frames", "1", "--out", "{tmp}/afile/u"],
+}
+for _name, _argv in UNWRITABLE.items():
+    CASES[f"unwritable {_name}"] = (_argv, ["afile is a file, not a folder"])
 
 
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_one_line_and_exit_2(case, tmp_path):
     np.save(tmp_path / "nan.npy", np.full((4, 4, 3), np.nan, np.float32))
+    (tmp_path / "afile").write_text("a file where a folder is expected")
     argv, words = CASES[case]
     p = subprocess.run([WORKBENCH, *(a.format(tmp=tmp_path) for a in argv)], cwd=tmp_path,
                        capture_output=True, text=True, timeout=300)
@@ -39,7 +58,7 @@ def test_one_line_and_exit_2(case, tmp_path):
     assert "np." not in lines[0]
     for w in words:
         assert w in lines[0], (w, lines[0])
-    assert not (tmp_path / "x.png").exists()
+    assert not (tmp_path / "x.png").exists() and p.stdout == "", p.stdout  # refused before any work
 
 
 def test_sizes_below_a_mebibyte_keep_their_value():
@@ -77,3 +96,16 @@ def test_snapshot_record_keeps_another_scene_stored_under_the_same_name(tmp_path
     lines = [ln for ln in p.stderr.splitlines() if ln.strip()]
     assert p.returncode == 2 and len(lines) == 1 and "holds scene 'whitted'" in lines[0], p.stderr
     assert (snap / "whitted.phong.npy").read_bytes() == before
+
+
+def test_snapshot_scenes_may_follow_the_options(tmp_path):
+    """``snapshot record --dir D --methods M SCENE`` (the scenes after the options) records, as
+    ``snapshot record SCENE --dir D ...`` does (it failed: unrecognized arguments: SCENE)."""
+    for action in ("record", "check"):
+        p = subprocess.run([WORKBENCH, "snapshot", action, "--dir", str(tmp_path / "snap"), "--methods", "flat",
+                            "--size", "16x12", "whitted"], capture_output=True, text=True, timeout=300)
+        assert p.returncode == 0, p.stderr
+    assert (tmp_path / "snap" / "whitted.flat.npy").is_file()
+    p = subprocess.run([WORKBENCH, "snapshot", "check", "--dir", str(tmp_path / "snap"), "whitted", "--bogus"],
+                       capture_output=True, text=True, timeout=300)
+    assert p.returncode == 2 and "unrecognized arguments: --bogus" in p.stderr

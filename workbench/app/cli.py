@@ -95,7 +95,14 @@ def _run(argv: list[str] | None) -> int:
     warnings.showwarning = _show_warning
     try:
         from .args import value_after_option
-        args = build_parser().parse_args(value_after_option(sys.argv[1:] if argv is None else list(argv)))
+        parser = build_parser()
+        args, extra = parser.parse_known_args(value_after_option(sys.argv[1:] if argv is None else list(argv)))
+        trailing = getattr(args, "trailing_positionals", None)
+        if trailing:                                # `snapshot record --dir D SCENE`
+            getattr(args, trailing).extend(w for w in extra if not w.startswith("-"))
+            extra = [w for w in extra if w.startswith("-")]
+        if extra:
+            parser.error(f"unrecognized arguments: {' '.join(extra)}")
         if getattr(args, "max_memory", None) is not None:  # one limit for this process and its children
             from ..core.memory import ENV, parse_size
             os.environ[ENV] = str(parse_size(args.max_memory, "--max-memory"))

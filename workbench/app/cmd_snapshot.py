@@ -17,6 +17,9 @@ def add_parser(sub):
     p = sub.add_parser("snapshot", help="record or check stored images of scenes x methods (snapshot tests)")
     p.add_argument("action", metavar="record|check", help="record: store the images; check: compare with them")
     p.add_argument("scenes", nargs="*", metavar="SCENE", help="scene files or bundled scene names")
+    # scenes may also follow the options (argparse gives a "*" positional the empty list when
+    # options come first): the CLI appends the leftover words to this list
+    p.set_defaults(trailing_positionals="scenes")
     p.add_argument("--methods", default="", help="comma-separated methods (registered, or glsl:FILE)")
     p.add_argument("--dir", default="", help="folder of the stored snapshots")
     p.add_argument("--size", default="", help="WIDTHxHEIGHT (record: default the scene camera's; "
@@ -47,6 +50,13 @@ def run(args) -> int:
         raise WorkbenchError("snapshot: --methods needs at least one method")
     if not args.dir:
         raise WorkbenchError("snapshot: --dir is required (the folder of the stored snapshots)")
+    from pathlib import Path
+
+    from ..core.output_paths import check_output_dir
+    if args.action == "record" or args.update:   # it will write: writable, before any render
+        check_output_dir(args.dir, "--dir")
+    elif Path(args.dir).exists() and not Path(args.dir).is_dir():
+        raise WorkbenchError(f"--dir: {args.dir} is not a folder")
     try:
         size = parse_size(args.size) if args.size else None
     except argparse.ArgumentTypeError as e:

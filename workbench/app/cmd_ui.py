@@ -55,10 +55,13 @@ def run(args) -> int:
     if args.script is not None and args.script not in SCRIPTS:
         raise WorkbenchError(f"--script {args.script!r}: unknown script, expected one of "
                              f"{', '.join(sorted(SCRIPTS))}")
+    out = args.out if args.out is not None or args.script is None else Path("out/ui")
+    if out is not None:
+        from ..core.output_paths import check_output_dir
+        check_output_dir(out, "--out")
     if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
         raise WorkbenchError("no display (DISPLAY is not set): the UI needs a window; "
                              "under no screen run it inside `xvfb-run -s '-screen 0 1280x800x24'`")
-    out = args.out if args.out is not None or args.script is None else Path("out/ui")
     if out is not None:
         try:
             out.mkdir(parents=True, exist_ok=True)
