@@ -112,7 +112,7 @@ def read(t: dict, where: str, common: dict) -> Lathe:
         return _read_smooth(P, spline, where, common)
     if (P[:, 0] < 0).any():
         i = int(np.argmax(P[:, 0] < 0))
-        val.fail(f"{where}.points[{i}]", f"radius must be >= 0, got {P[i, 0]!r}")
+        val.fail(f"{where}.points[{i}]", f"radius must be >= 0, got {float(P[i, 0])!r}")
     seg = np.diff(P, axis=0)
     if ((seg == 0).all(1)).any():
         i = int(np.argmax((seg == 0).all(1)))
