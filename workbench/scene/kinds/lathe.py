@@ -282,7 +282,8 @@ def mesh(la: Lathe, steps: int):
     segments are cut in ``steps * PROFILE_STEPS / LEVEL_STEPS`` pieces each (at least 1) with
     the curve's normals (:func:`.lathe_spline.mesh`)."""
     if la.smooth:
-        return spl.mesh(la.segments, la.orientation, steps, max(1, steps * spl.PROFILE_STEPS // LEVEL_STEPS))
+        return spl.mesh(la.segments, spl.ends(la.points, la.spline)[1], la.orientation, steps,
+                        max(1, steps * spl.PROFILE_STEPS // LEVEL_STEPS))
     ang = np.linspace(0.0, 2.0 * np.pi, steps + 1)
     c, s = np.cos(ang), np.sin(ang)
     c[-1], s[-1] = 1.0, 0.0          # the seam's two copies at exactly the same place
