@@ -14,7 +14,8 @@ mathematics and POV-Ray)::
 Functions: the one-argument ones in :data:`UNARY` (``sin cos tan asin acos atan sinh cosh tanh
 sqrt exp log abs floor``), ``atan2(y, x)``, ``pow(a, b)``, and ``min``/``max`` of two or more
 arguments.  A value outside a function's domain (``sqrt(-1)``, ``log(0)``) is NaN or an
-infinity, as IEEE 754 says; the isosurface counts such points as outside.
+infinity, as IEEE 754 says; the isosurface refuses a function that is not finite at one of
+the points where it samples it at load, and counts such points elsewhere as outside.
 
 Program format (:func:`compile_expression`): a flat float64 array of ``(opcode, argument)``
 pairs, the argument used by ``CONST`` only, so that it travels in a kind's aux array with the

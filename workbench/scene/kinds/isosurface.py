@@ -49,7 +49,12 @@ work per ray by 2^16 steps)."""
 BISECTIONS = 200
 """Bisection steps cap: enough to reach adjacent floats from any bracket of finite width."""
 GRADIENT_CHECK = 17
-"""Samples per axis of the grid on which the declared ``max_gradient`` is checked at load."""
+"""Samples per axis of the grid on which the function and its declared ``max_gradient`` are
+checked at load (:func:`check_samples`)."""
+SLOPE_MARGIN = 1e-9
+"""Relative margin of the finite-difference check of ``max_gradient`` (:func:`check_samples`):
+far above the rounding of a few float64 operations (about 1e-16 each), far below any
+meaningful excess."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -75,11 +80,8 @@ MODEL = Isosurface
 
 # --------------------------------------------------------------------------- parse
 def read(t: dict, where: str, common: dict) -> Isosurface:
-    """Read ``{function = "...", threshold = T, max_gradient = L, bounds = {min, max}}``.
-
-    The declared ``max_gradient`` is checked against |grad f| on a ``GRADIENT_CHECK^3`` grid
-    over the bounds: a bound below a sampled gradient is refused (the root search would step
-    over surfaces), naming the point."""
+    """Read ``{function = "...", threshold = T, max_gradient = L, bounds = {min, max}}``; the
+    function is sampled over the bounds at load (:func:`check_samples`)."""
     val.check_keys(t, where, val.COMMON | KEYS, REQUIRED)
     if not isinstance(t.get("function"), str):
         val.fail(f"{where}.function", f"expected an expression of x, y, z as a string, got {t.get('function')!r}")
@@ -90,18 +92,58 @@ def read(t: dict, where: str, common: dict) -> Isosurface:
     threshold = val.number(t, where, "threshold", 0.0)
     L = val.number(t, where, "max_gradient", lo=0.0, lo_open=True)
     lo, hi = val.box(t, where, "bounds")
+    check_samples(prog, L, lo, hi, where)
+    return Isosurface(function=t["function"], threshold=threshold, max_gradient=L,
+                      bounds_min=lo, bounds_max=hi, program=prog, **common)
+
+
+def _point(axes, index) -> list:
+    return [float(f"{float(a[i]):.6g}") for a, i in zip(axes, index)]
+
+
+def check_samples(prog: Program, L: float, lo, hi, where: str):
+    """Sample f on a ``GRADIENT_CHECK^3`` grid over the bounds and refuse (one line, naming the
+    key and a sample point):
+
+    - a non-finite value (``x/0``, ``sqrt(-1 - x^2)``, ``log(0*x)``): the solid would be
+      silently empty or everywhere;
+    - a declared Lipschitz bound ``L`` below |grad f| at a sample (the exact gradient; a
+      sample where it is not finite, as at the apex of a cone, is left to the next test);
+    - ``L`` below the slope between two neighbouring samples a, b along an axis: by the mean
+      value theorem a field with |grad f| <= L has |f(a) - f(b)| <= L |a - b|, so a larger
+      difference means a steeper or discontinuous field (``floor``).  Refused only beyond
+      ``L |a - b| (1 + SLOPE_MARGIN) + SLOPE_MARGIN max(|f(a)|, |f(b)|)``, which covers the
+      rounding of f's evaluation and of ``a - b``.
+    """
     axes = [np.linspace(a, b, GRADIENT_CHECK) for a, b in zip(lo, hi)]
     X, Y, Z = np.meshgrid(*axes, indexing="ij")
-    _, g = gradient_numpy(prog, X, Y, Z)
+    f, g = gradient_numpy(prog, X, Y, Z)
+    bad = ~np.isfinite(f)
+    if bad.any():
+        i = np.unravel_index(np.argmax(bad), bad.shape)
+        val.fail(f"{where}.function", f"{prog.text!r} is {f[i]} at {_point(axes, i)} (sampled over the "
+                 "bounds): the function must be finite in its bounds")
     norm = np.linalg.norm(g, axis=-1)
     norm = np.where(np.isfinite(norm), norm, 0.0)
     worst = np.unravel_index(np.argmax(norm), norm.shape)
     if norm[worst] > L:
-        p = [float(a[i]) for a, i in zip(axes, worst)]
         val.fail(f"{where}.max_gradient", f"{L:g} is below |grad f| = {norm[worst]:.6g} found at "
-                 f"{[round(c, 6) for c in p]}: the root search could step over the surface")
-    return Isosurface(function=t["function"], threshold=threshold, max_gradient=L,
-                      bounds_min=lo, bounds_max=hi, program=prog, **common)
+                 f"{_point(axes, worst)}: the root search could step over the surface")
+    for axis in range(3):
+        shape = [1, 1, 1]
+        shape[axis] = GRADIENT_CHECK - 1
+        h = np.diff(axes[axis]).reshape(shape)
+        fa, fb = np.delete(f, -1, axis), np.delete(f, 0, axis)
+        df = np.abs(fb - fa)
+        over = df > L * h * (1.0 + SLOPE_MARGIN) + SLOPE_MARGIN * np.maximum(np.abs(fa), np.abs(fb))
+        if over.any():
+            slope = np.where(over, df / h, 0.0)
+            i = np.unravel_index(np.argmax(slope), slope.shape)
+            j = list(i)
+            j[axis] += 1
+            val.fail(f"{where}.max_gradient", f"{L:g} is below |f(a) - f(b)| / |a - b| = {slope[i]:.6g} "
+                     f"between the samples a = {_point(axes, i)} and b = {_point(axes, j)}: the function "
+                     "is steeper than declared (or jumps) and the root search could step over the surface")
 
 
 def parse(ctx, t: dict, where: str, common: dict) -> Isosurface:

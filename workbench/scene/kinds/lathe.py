@@ -40,6 +40,7 @@ from . import lathe_spline as spl
 from . import values as val
 from .aux_rows import flatten_aux
 from .crossing_events import alternate
+from .outline import first_crossing
 
 TYPE = "lathe"
 FEATURE = "lathes"
@@ -102,7 +103,9 @@ MODEL = Lathe
 # --------------------------------------------------------------------------- parse
 def read(t: dict, where: str, common: dict) -> Lathe:
     """Read ``{points = [[r, y], ...], spline = "linear"}`` (linear: at least 2 points, r >= 0,
-    no zero-length segment; smooth: :func:`_read_smooth`)."""
+    no zero-length segment, no two segments meeting but at the point consecutive ones share
+    (:func:`.outline.first_crossing`: a self-crossing profile has no consistent inside);
+    smooth: :func:`_read_smooth`)."""
     val.check_keys(t, where, val.COMMON | KEYS, REQUIRED)
     spline = t.get("spline", "linear")
     if spline not in spl.SPLINES:
@@ -119,6 +122,12 @@ def read(t: dict, where: str, common: dict) -> Lathe:
         val.fail(f"{where}.points[{i + 1}]", "repeats the previous point (a zero-length segment)")
     if (P[:, 0] == 0.0).all():
         val.fail(f"{where}.points", "every point is on the axis (r = 0): the profile sweeps no surface")
+    repeat = (P[0] == P[-1]).all()
+    crossing = first_crossing(P[:-1] if repeat else P, loop=bool(repeat))
+    if crossing is not None:
+        i, j = crossing
+        val.fail(f"{where}.points", f"the profile crosses itself: segment {i} ({P[i].tolist()} -> "
+                 f"{P[i + 1].tolist()}) meets segment {j} ({P[j].tolist()} -> {P[j + 1].tolist()})")
     return Lathe(points=P, **common)
 
 
@@ -282,7 +291,8 @@ def mesh(la: Lathe, steps: int):
     segments are cut in ``steps * PROFILE_STEPS / LEVEL_STEPS`` pieces each (at least 1) with
     the curve's normals (:func:`.lathe_spline.mesh`)."""
     if la.smooth:
-        return spl.mesh(la.segments, la.orientation, steps, max(1, steps * spl.PROFILE_STEPS // LEVEL_STEPS))
+        return spl.mesh(la.segments, spl.ends(la.points, la.spline)[1], la.orientation, steps,
+                        max(1, steps * spl.PROFILE_STEPS // LEVEL_STEPS))
     ang = np.linspace(0.0, 2.0 * np.pi, steps + 1)
     c, s = np.cos(ang), np.sin(ang)
     c[-1], s[-1] = 1.0, 0.0          # the seam's two copies at exactly the same place

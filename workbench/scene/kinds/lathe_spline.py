@@ -304,17 +304,24 @@ def signed_area2(segs: np.ndarray, per_seg: int = 64) -> float:
 
 
 # --------------------------------------------------------------------------- tessellation
-def mesh(segs: np.ndarray, orientation: float, steps: int, per_seg: int):
+def mesh(segs: np.ndarray, end: np.ndarray, orientation: float, steps: int, per_seg: int):
     """The surface swept in ``steps`` angular steps, each segment cut in ``per_seg`` pieces:
     ``(P (V, 3), N (V, 3), F (F, 3))`` with the curve's own normals on the vertices (smooth
-    along the curve within a segment)."""
+    along the curve within a segment).
+
+    Each segment's last ring is placed at the next segment's first point (``D``, exact) and
+    the curve's at ``end`` (its last control point on the curve, :func:`ends`), not at
+    ``A + B + C + D``, whose rounding would leave the rings a joint apart by an ulp (so the
+    welded mesh of a closed profile would not be closed) and an end on the axis at r ~ 1e-17
+    instead of 0."""
     ang = np.linspace(0.0, 2.0 * np.pi, steps + 1)
     c, s = np.cos(ang), np.sin(ang)
     c[-1], s[-1] = 1.0, 0.0
     Ps, Ns, Fs, base = [], [], [], 0
     a = np.arange(steps)
-    for seg in segs:
+    for i, seg in enumerate(segs):
         pts, tan = sample(seg, per_seg)
+        pts[-1] = segs[i + 1][:, 0] if i + 1 < len(segs) else end
         nr, ny = orientation * tan[:, 1], -orientation * tan[:, 0]
         ln = np.hypot(nr, ny)
         ln[ln == 0.0] = 1.0

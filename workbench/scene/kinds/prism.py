@@ -26,6 +26,7 @@ from . import values as val
 from .aux_rows import flatten_aux
 from .crossing_events import alternate
 from .lathe import weld
+from .outline import first_crossing
 
 TYPE = "prism"
 FEATURE = "prisms"
@@ -61,19 +62,6 @@ MODEL = Prism
 
 
 # --------------------------------------------------------------------------- parse
-def _segments_cross(a, b, c, d) -> bool:
-    """Closed segments ab and cd share a point (orientation tests)."""
-    def orient(p, q, r):
-        return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
-    o1, o2, o3, o4 = orient(a, b, c), orient(a, b, d), orient(c, d, a), orient(c, d, b)
-    if o1 * o2 < 0 and o3 * o4 < 0:
-        return True
-    def on(p, q, r):   # r on segment pq, given collinear
-        return min(p[0], q[0]) <= r[0] <= max(p[0], q[0]) and min(p[1], q[1]) <= r[1] <= max(p[1], q[1])
-    return ((o1 == 0 and on(a, b, c)) or (o2 == 0 and on(a, b, d)) or (o3 == 0 and on(c, d, a))
-            or (o4 == 0 and on(c, d, b)))
-
-
 def read(t: dict, where: str, common: dict) -> Prism:
     """Read ``{polygon = [[x, z], ...], heights = [y0, y1]}``: at least 3 vertices, a simple
     polygon (no two non-adjacent edges meet, no repeated vertex), ``y0 < y1``."""
@@ -86,13 +74,11 @@ def read(t: dict, where: str, common: dict) -> Prism:
     for i in range(k):
         if (P[i] == P[(i + 1) % k]).all():
             val.fail(f"{where}.polygon[{(i + 1) % k}]", "repeats the previous vertex")
-    for i in range(k):
-        for j in range(i + 2, k):
-            if i == 0 and j == k - 1:
-                continue
-            if _segments_cross(P[i], P[(i + 1) % k], P[j], P[(j + 1) % k]):
-                val.fail(f"{where}.polygon", f"not simple: edge {i} ({P[i].tolist()} -> {P[(i + 1) % k].tolist()}) "
-                         f"meets edge {j} ({P[j].tolist()} -> {P[(j + 1) % k].tolist()})")
+    crossing = first_crossing(P, loop=True)
+    if crossing is not None:
+        i, j = crossing
+        val.fail(f"{where}.polygon", f"not simple: edge {i} ({P[i].tolist()} -> {P[(i + 1) % k].tolist()}) "
+                 f"meets edge {j} ({P[j].tolist()} -> {P[(j + 1) % k].tolist()})")
     area2 = float(np.sum(P[:, 0] * np.roll(P[:, 1], -1) - np.roll(P[:, 0], -1) * P[:, 1]))
     diam = float(np.ptp(P, axis=0).max())
     if abs(area2) <= tol.degenerate * diam * max(diam, float(np.abs(P).max())):
