@@ -8,23 +8,25 @@ import time
 import numpy as np
 
 from ...core.resources import data_dir
-from ...core.tol import tol
+from ...scene.clip_planes import auto_near_far
 from ...scene.model import Camera
 from .. import gl
 from .patches import PatchSet
 
 SHADERS = data_dir("shaders")
-NEAR_FRACTION = 1e-3    # near plane as a fraction of the farthest vertex depth
 
 
-def clip_planes(camera: Camera, points: np.ndarray) -> tuple[float, float]:
-    """(near, far): the camera's own, else from the depths of ``points`` (N, 3)."""
-    if camera.near is not None and camera.far is not None:
-        return camera.near, camera.far
-    _, depth = camera.project(points)
-    far = float(max(depth.max(), tol.zero)) * 1.01 if len(depth) else 1.0
-    near = max(float(depth[depth > 0].min()) * 0.5 if (depth > 0).any() else far, far * NEAR_FRACTION)
-    return (camera.near or min(near, far * 0.5)), (camera.far or far)
+def clip_planes(camera: Camera, patches: PatchSet) -> tuple[float, float]:
+    """(near, far): the raster's automatic rule (:func:`workbench.scene.clip_planes.auto_near_far`)
+    over each surface's box of patch corners.  Boxes, not vertices: a surface can pass closer
+    to the camera than any of its corners (a camera just above a floor cut into large patches)."""
+    corners = patches.vertices[patches.vertex_ids]                   # (P, 4, 3)
+    _, owner = np.unique(patches.surface, return_inverse=True)
+    lo = np.full((owner.max(initial=-1) + 1, 3), np.inf)
+    hi = np.full_like(lo, -np.inf)
+    np.minimum.at(lo, owner, corners.min(1))
+    np.maximum.at(hi, owner, corners.max(1))
+    return auto_near_far(camera, np.stack([lo, hi], 1))
 
 
 def draw(patches: PatchSet, radiance: np.ndarray, camera: Camera, background) -> tuple[np.ndarray, dict]:
@@ -40,7 +42,7 @@ def draw(patches: PatchSet, radiance: np.ndarray, camera: Camera, background) ->
     vcol = patches.vertex_values(radiance)
     ids = patches.vertex_ids
     tris = np.concatenate([ids[:, [0, 1, 2]], ids[:, [0, 2, 3]]]).astype("u4")
-    near, far = clip_planes(camera, patches.vertices)
+    near, far = clip_planes(camera, patches)
     M = camera.clip_from_camera(near, far) @ camera.camera_from_world()
     data = np.concatenate([patches.vertices, vcol], 1).astype("f4")
     W, H = camera.width, camera.height
