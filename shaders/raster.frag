@@ -73,6 +73,7 @@ void main() {
 #ifdef BUMP_KIND
     N = bump_normal(v_obj, N);
 #endif
+    bool inside = dot(v_normal, S) < 0.0;  // the viewer on the inner side (outward normals)
     N = face_viewer(N, S);
 #endif
 #if defined(USER_MODEL)
@@ -101,7 +102,7 @@ void main() {
 #if defined(ENV_CUBE) && defined(MODE_GOURAUD)
     color += v_env;  // stand-in environment map, per vertex
 #elif defined(ENV_CUBE)
-    color += env_terms(v_world, N, S, C);  // stand-in environment map (standins.glsl)
+    color += env_terms(v_world, N, S, C, inside);  // stand-in environment map (standins.glsl)
 #elif defined(ENV_MAP) && defined(ENV_KIND)
     color += MAT_KR * environment(2.0 * dot(N, S) * N - S);
 #endif

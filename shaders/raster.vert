@@ -74,6 +74,7 @@ void main() {
 #endif
     vec3 S = safe_normalize(u_eye - P);
     vec3 N = face_viewer(safe_normalize(in_normal), S);
+    bool inside = dot(in_normal, S) < 0.0;  // the viewer on the inner side (outward normals)
     local_terms(P, N, S, v_diffuse, v_specular);
 #if defined(MODE_GOURAUD) && defined(SHADOW_MAPS)
     v_diffuse = MAT_KA * SCENE_AMBIENT;
@@ -81,7 +82,7 @@ void main() {
     light_terms(P, N, S, v_light_d, v_light_s);
 #endif
 #if defined(MODE_GOURAUD) && defined(ENV_CUBE)
-    v_env = env_terms(P, N, S, MAT_COLOR);
+    v_env = env_terms(P, N, S, MAT_COLOR, inside);
 #endif
 #endif
     gl_Position = u_clip_from_world * vec4(in_position, 1.0);

@@ -107,10 +107,18 @@ vec3 exit_direction(vec3 P, vec3 T1) {
 // The stand-in's global terms at a surface point P seen along -S with unit normal N (facing
 // the viewer): kr env(R), R = 2 (N.S) N - S (the mirror direction); ENV_KT: kt C env(T2), T2
 // the direction leaving the object after refracting in at P (T1 = refract(-S, N, 1 / ior);
-// entering a denser medium never reflects totally) and out again (exit_direction).
-vec3 env_terms(vec3 P, vec3 N, vec3 S, vec3 C) {
+// entering a denser medium never reflects totally) and out again (exit_direction).  Seen
+// from inside (inside: the viewer is on the inner side of the surface, the object's outward
+// normal points away from it) the ray leaves the object at P: T = refract(-S, N, ior), or
+// the mirror direction on total internal reflection (DESIGN errata 5).
+vec3 env_terms(vec3 P, vec3 N, vec3 S, vec3 C, bool inside) {
     vec3 g = MAT_KR * env_ray(P, 2.0 * dot(N, S) * N - S);
 #ifdef ENV_KT
+    if (inside) {
+        vec3 T = refract(-S, N, MAT_IOR);
+        g += MAT_KT * C * env_ray(P, dot(T, T) > 0.0 ? T : 2.0 * dot(N, S) * N - S);
+        return g;
+    }
     vec3 T1 = refract(-S, N, 1.0 / MAT_IOR);
     if (dot(T1, T1) > 0.0) {
         vec3 Q = P - 2.0 * dot(T1, P - u_env_centre) * T1;

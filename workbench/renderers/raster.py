@@ -97,6 +97,22 @@ def _set(prog, name: str, value) -> None:
         prog[name].value = value
 
 
+def _box_corners(P: np.ndarray) -> list:
+    """The 8 corners of the axis-aligned bounding box of points ``P`` (N, 3)."""
+    lo, hi = P.min(0), P.max(0)
+    return [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
+
+
+def _beyond_near(camera: Camera, boxes, near: float) -> np.ndarray:
+    """Per box (G, 8, 3 corners): True when the whole box lies beyond the near plane, so the
+    camera is outside the solid within it and no front face is clipped open."""
+    boxes = np.asarray(boxes, dtype=np.float64)
+    if len(boxes) == 0:
+        return np.zeros(0, dtype=bool)
+    depth = camera.project(boxes.reshape(-1, 3))[1].reshape(-1, 8)
+    return (depth > near).all(1)
+
+
 def _write(prog, name: str, array: np.ndarray) -> None:
     if name in prog:
         prog[name].write(np.ascontiguousarray(array, dtype="f4").tobytes())
@@ -527,8 +543,7 @@ class RasterSession:
             F = np.vstack([d.part.faces + o for d, o in zip(draws, offsets)])
             if not closed_outward(P, F):
                 continue
-            lo, hi = P.min(0), P.max(0)
-            boxes.append([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+            boxes.append(_box_corners(P))
             for d in draws:
                 d.cull = len(boxes) - 1
         return np.array(boxes, dtype=np.float64).reshape(-1, 8, 3)
@@ -536,10 +551,7 @@ class RasterSession:
     def _cull_flags(self, camera: Camera, near: float) -> np.ndarray:
         """Per cull group: True when its whole bounding box lies beyond the near plane (so the
         camera is outside the solid and no front face is clipped open): back faces hidden."""
-        if len(self.cull_boxes) == 0:
-            return np.zeros(0, dtype=bool)
-        depth = camera.project(self.cull_boxes.reshape(-1, 3))[1].reshape(-1, 8)
-        return (depth > near).all(1)
+        return _beyond_near(camera, self.cull_boxes, near)
 
     def _report(self) -> tuple[list[str], list[str]]:
         needs = ft.scene_needs(self.scene)
@@ -860,8 +872,9 @@ class RasterSession:
             ctx.enable(moderngl.BLEND)
             fbo.depth_mask = False
             for d in blended:
-                # closed solids: only their front faces (the back ones would blend in twice)
-                if d.part.kind in CLOSED_KINDS:
+                # closed solids seen from outside their box: only their front faces (the back
+                # ones would blend in twice); from inside, the inner (back) faces are the surface
+                if d.part.kind in CLOSED_KINDS and _beyond_near(camera, [_box_corners(d.part.positions)], near)[0]:
                     ctx.enable(moderngl.CULL_FACE)
                 if d.tint is not None:
                     # stand-in transparency: behind *= kt C, then + the surface's own light

@@ -74,5 +74,5 @@ def geometry_from_polygons(polygons) -> Geometry:
     tsum = np.zeros(n)
     np.add.at(tsum, owner_a, ta)
     plain = np.array([p.mean(0) for p in polys])
-    cen = np.where(tsum[:, None] > 0, cen / np.maximum(tsum, tol.zero)[:, None], plain)
+    cen = np.where(tsum[:, None] > 0, cen / np.where(tsum > 0, tsum, 1.0)[:, None], plain)
     return Geometry(tris_a, owner_a, cen, normals, areas, polys)

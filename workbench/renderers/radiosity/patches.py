@@ -145,7 +145,7 @@ class PatchSet:
         for k in range(4):
             np.add.at(cnt, self.vertex_ids[:, k], 1.0)
             np.add.at(plain, self.vertex_ids[:, k], values)
-        return np.where(den[:, None] > 0, num / np.maximum(den, tol.zero)[:, None],
+        return np.where(den[:, None] > 0, num / np.where(den > 0, den, 1.0)[:, None],
                         plain / np.maximum(cnt, 1.0)[:, None])
 
 
