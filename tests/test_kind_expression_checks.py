@@ -12,29 +12,14 @@ import pytest
 
 import workbench
 from ui_command import WORKBENCH
+from one_object import scene_text
 from workbench.core.errors import WorkbenchError
 from workbench.scene.kinds import isosurface as I
 from workbench.scene.kinds.expression import compile_expression
 
-SCENE = """[camera]
-position = [0, 0, 6]
-look_at = [0, 0, 0]
-fov_y = 40.0
-resolution = [32, 24]
-
-[materials.m]
-color = [0.8, 0.8, 0.8]
-
-[[lights]]
-type = "point"
-position = [2, 3, 6]
-
-[[objects]]
-{object}
-"""
-ISO = 'type = "isosurface"\nmaterial = "m"\nfunction = "{f}"\nthreshold = 0.5\nmax_gradient = {L}\n' \
+ISO = 'type = "isosurface"\nfunction = "{f}"\nthreshold = 0.5\nmax_gradient = {L}\n' \
       'bounds = {{ min = [-1, -1, -1], max = [1, 1, 1] }}'
-CSG = 'type = "csg"\nop = "union"\nmaterial = "m"\n' \
+CSG = 'type = "csg"\nop = "union"\n' \
       'left = {{ type = "sphere", material = "m", center = [2, 0, 0], radius = 0.5 }}\n' \
       'right = {{ type = "isosurface", material = "m", function = "{f}", threshold = 0.5, ' \
       'max_gradient = {L}, bounds = {{ min = [-1, -1, -1], max = [1, 1, 1] }} }}'
@@ -61,7 +46,7 @@ GOOD = {  # functions at their exact Lipschitz bound: the float margin must let 
 
 def _write(tmp_path, f, L, template=ISO):
     p = tmp_path / "s.toml"
-    p.write_text(SCENE.format(object=template.format(f=f, L=L)), encoding="utf-8")
+    p.write_text(scene_text(template.format(f=f, L=L)), encoding="utf-8")
     return p
 
 

@@ -9,25 +9,10 @@ import subprocess
 import pytest
 
 import workbench
+from one_object import scene_text
 from ui_command import WORKBENCH
 from workbench.core.errors import WorkbenchError
 
-HEAD = """[camera]
-position = [0, 0, 6]
-look_at = [0, 0, 0]
-fov_y = 40.0
-resolution = [32, 24]
-
-[materials.m]
-color = [0.8, 0.8, 0.8]
-
-[[lights]]
-type = "point"
-position = [2, 3, 6]
-
-[[objects]]
-material = "m"
-"""
 BAD = {  # id -> (object keys, the words the line must hold)
     "lathe open, crossing": ('type = "lathe"\npoints = [[0.5, 0], [1, 1], [0.5, 1], [1, 0]]',
                              ["points", "segment 0 ([0.5, 0.0] -> [1.0, 1.0]) meets segment 2"]),
@@ -49,7 +34,7 @@ GOOD = {
 
 def _write(tmp_path, obj):
     p = tmp_path / "s.toml"
-    p.write_text(HEAD + obj + "\n", encoding="utf-8")
+    p.write_text(scene_text(obj), encoding="utf-8")
     return p
 
 
