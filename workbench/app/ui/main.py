@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import multiprocessing
+import os
 import signal
 import threading
 import time
@@ -44,10 +45,11 @@ def run(state: AppState, frames: int | None = None, script=None,
     with ``out``, the last frame and the summary are written there.  Returns 0, or 128 + the
     signal's number when a signal closed the window."""
     t0 = time.perf_counter()
-    with quit_on_signals(state):
+    with quit_on_signals(state) as closing:
         try:
             shown = _loop(state, frames, script, window)
         finally:
+            closing.set()
             stop_background(state)
     if out is not None:
         write_outputs(state, script, out, time.perf_counter() - t0, shown)
@@ -56,6 +58,9 @@ def run(state: AppState, frames: int | None = None, script=None,
 
 SIGNAL_GRACE_SECONDS = 2.0
 """After SIGTERM or SIGINT, how long the CPU jobs' threads get to see their cancel flag."""
+SIGNAL_EXIT_SECONDS = 4.0
+"""After SIGTERM or SIGINT, how long the window's loop gets to end (its clean-up then takes
+its own bounded time) before the process ends its child processes and itself."""
 
 
 @contextmanager
@@ -63,17 +68,49 @@ def quit_on_signals(state: AppState):
     """While the window runs, SIGTERM and SIGINT set ``state.quit`` and ``state.quit_signal``
     (the loop ends at its next frame, as by the close button) instead of killing the process
     past its children; a second signal before then ends the process at once (after the
-    ``finally`` clean-ups)."""
+    ``finally`` clean-ups).
+
+    A Python handler runs only when the main thread returns to the interpreter, which a long
+    call (a GL draw or a compile under load) can delay: so the signal's number is also written
+    to a pipe by the interpreter's C handler (:func:`signal.set_wakeup_fd`), and a watcher
+    thread, woken by it, sets the flags itself and, if the loop has not ended (the event this
+    yields, which the caller sets when it has) :data:`SIGNAL_EXIT_SECONDS` later, terminates the
+    child processes and ends the process (status 128 + the signal's number)."""
+    handled = []  # the signals the Python handler saw (the watcher may set the flags first)
+
     def handler(signum, _frame):
-        if state.quit_signal:
+        if handled:
             raise SystemExit(128 + signum)
-        state.quit, state.quit_signal = True, signum
+        handled.append(signum)
+        state.quit, state.quit_signal = True, state.quit_signal or signum
+    read_end, write_end = os.pipe()
+    os.set_blocking(write_end, False)
+    closing = threading.Event()
+
+    def watch():
+        data = os.read(read_end, 1)
+        if not data or closing.is_set():
+            return
+        state.quit_signal = state.quit_signal or data[0]
+        state.quit = True
+        if not closing.wait(SIGNAL_EXIT_SECONDS):
+            for child in multiprocessing.active_children():
+                child.terminate()
+            os._exit(128 + data[0])
     old = {s: signal.signal(s, handler) for s in (signal.SIGTERM, signal.SIGINT)}
+    old_fd = signal.set_wakeup_fd(write_end, warn_on_full_buffer=False)
+    watcher = threading.Thread(target=watch, name="ui-signal-watch", daemon=True)
+    watcher.start()
     try:
-        yield
+        yield closing
     finally:
+        closing.set()
+        signal.set_wakeup_fd(old_fd)
         for s, h in old.items():
             signal.signal(s, h)
+        os.close(write_end)          # wakes the watcher if no signal came
+        watcher.join()
+        os.close(read_end)
 
 
 def write_outputs(state: AppState, script, out: Path, seconds: float, shown: list) -> None:
