@@ -33,7 +33,7 @@ COMMANDS = {
     "render radiosity": [["render", "cornell", "-m", "radiosity", "--size", SIZE, "-o", "{out}/r.png",
                           "--json", "{out}/r.json"]],
     "render raytrace": [["render", "whitted", "-m", "raytrace", "--size", SIZE, "-o", "{out}/t.png",
-                         "--json", "{out}/t.json", "--set", "traversal_stats=true"]],
+                         "--json", "{out}/t.json"]],
     "render pathtrace": [["render", "furnace", "-m", "pathtrace", "--size", SIZE, "-o", "{out}/p.png",
                           "--json", "{out}/p.json", "--set", "spp=2"]],
     "colour": [["colour", "wheel", "--size", "32", "-o", "{out}/w.png"],
