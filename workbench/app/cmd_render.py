@@ -24,6 +24,7 @@ def add_parser(sub):
 def run(args) -> int:
     import json
 
+    from ..compare.outputs import jsonable
     from ..core.imageio import npy_writer, png_writer, text_writer
     from ..core.output_paths import check_distinct, check_output_file, write_together
     from ..renderers.base import render, stats_for_display
@@ -55,11 +56,11 @@ def run(args) -> int:
     if args.npy:
         files.append((args.npy, npy_writer(result.image)))
     if args.json:
-        files.append((args.json, text_writer(json.dumps({
+        files.append((args.json, text_writer(json.dumps(jsonable({
             "scene": scene.name, "method": result.method, "timings": result.timings,
             "stats": stats, "features_used": result.features_used,
-            "left_out": result.left_out, "options": {k: str(v) for k, v in result.options.items()}},
-            indent=2, default=str))))
+            "left_out": result.left_out, "options": {k: str(v) for k, v in result.options.items()}}),
+            indent=2, allow_nan=False))))
     write_together(files)                                 # all of them or none
     t = ", ".join(f"{k} {v:.3f} s" for k, v in result.timings.items())
     print(f"{scene.name} / {result.method}: {result.image.shape[1]}x{result.image.shape[0]} -> {args.output}")

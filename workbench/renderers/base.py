@@ -114,8 +114,10 @@ _instances: dict[str, Renderer] = {}
 
 def stats_for_display(stats: dict) -> dict:
     """``stats`` with every array (e.g. a per-pixel noise image) replaced by a one-line summary
-    ``"array (H, W, 3) float32, RMS x"``: what reports and the CLI print and write to JSON
-    (the arrays themselves stay in ``RenderResult.stats``)."""
+    ``"array (H, W, 3) float32, RMS x"`` and every numpy scalar (also inside lists, tuples and
+    dicts, and a one-element array) by the Python number it holds: what reports and the CLI print
+    and write to JSON (the arrays themselves stay in ``RenderResult.stats``).  A numpy scalar
+    printed inside a list shows as ``np.float32(0.1)`` under numpy 2, and json writes it as text."""
     out = {}
     for k, v in stats.items():
         if isinstance(v, np.ndarray) and v.size > 1:
@@ -123,8 +125,20 @@ def stats_for_display(stats: dict) -> dict:
             rms = float(np.sqrt(np.mean(a * a))) if a.size and np.isfinite(a).all() else float("nan")
             out[k] = f"array {tuple(v.shape)} {v.dtype}, RMS {rms:.4g}"
         else:
-            out[k] = v
+            out[k] = _plain(v)
     return out
+
+
+def _plain(v):
+    """``v`` with numpy scalars and one-element arrays turned into Python numbers, recursively
+    through lists, tuples and dicts (a tuple stays a tuple); anything else unchanged."""
+    if isinstance(v, dict):
+        return {k: _plain(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return (tuple if isinstance(v, tuple) else list)(_plain(x) for x in v)
+    if isinstance(v, (np.generic, np.ndarray)):
+        return v.item() if v.size == 1 else v.tolist()
+    return v
 
 
 def available() -> list[str]:
