@@ -79,3 +79,12 @@ def test_bad_numbers_give_one_clean_line(kind):
                     msg = str(e)
                     assert "\n" not in msg and "np." not in msg and "Traceback" not in msg, (path, bad, msg)
     assert refused > 0, f"{kind}: no bad value of {tried} was refused"
+
+
+def test_a_loaded_scene_holds_python_numbers():
+    """The scene model holds plain floats (a texture's pole and equator were numpy scalars, shown
+    as np.float64(...) in any repr or message that quoted a material)."""
+    from workbench.scene.library import resolve
+    from workbench.scene.io import load_scene
+    for path in bundled():
+        assert "np." not in repr(load_scene(resolve(path.stem))), path.stem
