@@ -116,7 +116,7 @@ def _light(ctx, t, i):
                             string(ctx, t, w, "falloff", "none", choices=("none", "inverse_square")))
     if kind == "directional":
         check_keys(ctx, t, w, common | {"direction"}, {"direction"})
-        return m.DirectionalLight(tuple(float(c) for c in tf.normalize(vec(ctx, t, w, "direction", nonzero=True))),
+        return m.DirectionalLight(tuple(tf.normalize(vec(ctx, t, w, "direction", nonzero=True)).tolist()),
                                   rgb(ctx, t, w, "color", (1.0, 1.0, 1.0)),
                                   num(ctx, t, w, "intensity", 1.0, lo=0.0))
     check_keys(ctx, t, w, common | {"vertices", "stand_in"}, {"vertices"})
@@ -133,8 +133,8 @@ _MAP_KEYS = {"projection", "scale", "path", "center", "pole", "equator"}
 def _mapping(ctx, t, w, default_projection):
     proj = string(ctx, t, w, "projection", default_projection,
                 choices=("uv", "planar", "cylindrical", "spherical", "solid"))
-    pole = tuple(float(c) for c in tf.normalize(vec(ctx, t, w, "pole", (0.0, 1.0, 0.0), nonzero=True)))
-    equator = tuple(float(c) for c in tf.normalize(vec(ctx, t, w, "equator", (1.0, 0.0, 0.0), nonzero=True)))
+    pole = tuple(tf.normalize(vec(ctx, t, w, "pole", (0.0, 1.0, 0.0), nonzero=True)).tolist())
+    equator = tuple(tf.normalize(vec(ctx, t, w, "equator", (1.0, 0.0, 0.0), nonzero=True)).tolist())
     if proj in ("spherical", "cylindrical") and parallel(pole, equator):
         ctx.fail(f"{w}.equator", "must not be parallel to the pole")
     return dict(projection=proj, scale=num(ctx, t, w, "scale", 1.0, lo=0.0, lo_open=True),

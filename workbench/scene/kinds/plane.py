@@ -24,7 +24,7 @@ def parse(ctx: rd.Ctx, t: dict, w: str, common: dict) -> m.Plane:
     if min(size) <= 0:
         ctx.fail(f"{w}.size", f"expected two positive numbers [width, height], got {list(size)}")
     return m.Plane(**common, point=rd.vec(ctx, t, w, "point", (0.0, 0.0, 0.0)),
-                   normal=tuple(float(c) for c in tf.normalize(rd.vec(ctx, t, w, "normal", nonzero=True))),
+                   normal=tuple(tf.normalize(rd.vec(ctx, t, w, "normal", nonzero=True)).tolist()),
                    size=size, u_axis=rd.vec(ctx, t, w, "u_axis", (1.0, 0.0, 0.0), nonzero=True))
 
 
