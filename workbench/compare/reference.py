@@ -43,7 +43,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.errors import NotApplicable, WorkbenchError
+from ..core.errors import NotApplicable, OverMemory, WorkbenchError
 from ..renderers.base import available, default_methods, get_renderer
 from ..scene import features as F
 from ..scene.model import Scene
@@ -160,6 +160,9 @@ def _cached_run(scene: Scene, method: str, width: int, height: int, options: dic
         res = reference_cache.cached_render(scene, method, width, height, **options)
     except NotApplicable as e:
         run.status, run.reason = "not_applicable", str(e)
+        return run
+    except OverMemory as e:
+        run.status, run.reason = "over_memory", str(e)
         return run
     except WorkbenchError as e:
         run.status, run.reason = "failed", str(e)

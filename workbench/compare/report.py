@@ -211,7 +211,7 @@ def render_html(report: dict, stage: Path, out_dir: Path) -> str:
         if e["status"] != "ok":
             rows.append([e["method"], ("raw", f"<b>{esc(e['status'])}</b>: {esc(e['reason'])}"),
                          "", "", "", "", "", "", "", "", "", ""])
-            cls.append("warn" if e["status"] == "not_applicable" else "bad")
+            cls.append("warn" if e["status"] in ("not_applicable", "over_memory") else "bad")
             continue
         mt, mm = e["metrics"], e["matched"]
         if "metrics" in mm:

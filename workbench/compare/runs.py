@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.errors import NotApplicable, ShaderSourceError
+from ..core.errors import NotApplicable, OverMemory, ShaderSourceError
 from ..renderers.base import RenderResult, render
 from ..scene.model import Scene
 
@@ -22,8 +22,9 @@ from ..scene.model import Scene
 class MethodRun:
     """Outcome of timing one method at one setting.
 
-    status : "ok", "not_applicable" (``reason`` says why) or "failed" (``reason`` holds the
-        exception, ``trace`` the traceback).
+    status : "ok", "not_applicable" (``reason`` says why), "over_memory" (refused before it
+        allocated: its estimate is above the memory limit, ``reason`` says by how much) or
+        "failed" (``reason`` holds the exception, ``trace`` the traceback).
     cold : wall time of the first call (s), includes ``compile``.
     compile : shader / JIT compile time reported by the first call (s).
     warm : wall times of the warm calls (s); ``time`` is their median (``cold - compile`` when
@@ -55,7 +56,8 @@ def timed_run(scene: Scene, method: str, width: int, height: int, repeat: int = 
               options: dict | None = None) -> MethodRun:
     """Render ``repeat + 1`` times (first call = warm-up); never raises for a method's failure.
 
-    A :class:`NotApplicable` gives ``status = "not_applicable"``; a :class:`ShaderSourceError`
+    A :class:`NotApplicable` gives ``status = "not_applicable"``, an :class:`OverMemory`
+    ``status = "over_memory"``; a :class:`ShaderSourceError`
     (a user's GLSL does not compile) is raised: it is bad input.  Any other exception inside the
     method gives ``status = "failed"`` with its message (the report lists it instead of dying:
     a comparison of many methods must survive one broken method).
@@ -71,6 +73,8 @@ def timed_run(scene: Scene, method: str, width: int, height: int, repeat: int = 
         run.result = res
     except NotApplicable as e:
         run.status, run.reason = "not_applicable", str(e)
+    except OverMemory as e:
+        run.status, run.reason = "over_memory", str(e)
     except ShaderSourceError:  # the user's shader code: bad input, not a method's failure
         raise
     except Exception as e:  # noqa: BLE001 -- a method's bug is reported, not fatal

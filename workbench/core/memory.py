@@ -17,7 +17,7 @@ import math
 import os
 import re
 
-from .errors import WorkbenchError
+from .errors import OverMemory, WorkbenchError
 
 ENV = "WORKBENCH_MAX_MEMORY"
 DEFAULT_FRACTION = 0.5
@@ -60,7 +60,7 @@ def check_limit(need: int, what: str, max_memory=None) -> None:
     (:func:`memory_limit` of ``max_memory``), before it allocates; ``what`` names the work."""
     limit = memory_limit(max_memory)
     if need > limit:
-        raise WorkbenchError(f"{what} needs about {gib(need)} of memory, above the limit of {gib(limit)}: "
+        raise OverMemory(f"{what} needs about {gib(need)} of memory, above the limit of {gib(limit)}: "
                              f"use a smaller image, or raise the limit (--max-memory, {ENV} or max_memory=)")
 
 

@@ -24,7 +24,7 @@ from typing import Any, Callable, Protocol
 
 import numpy as np
 
-from ..core.errors import WorkbenchError
+from ..core.errors import OverMemory, WorkbenchError
 from ..core.memory import ENV as MEMORY_ENV
 from ..core.memory import gib, memory_limit
 from ..scene.model import Scene
@@ -252,7 +252,7 @@ def check_memory(r: Renderer, scene: Scene, width: int, height: int, options: di
         raise TypeError(f"{type(r).__name__}.estimate_bytes returned {est!r}, not a positive int")
     if est > limit:
         knobs = "".join(f"{k}={options[k]!r}, " for k in r.memory_options) + ("or " if r.memory_options else "")
-        raise WorkbenchError(
+        raise OverMemory(
             f"method {r.name!r}: {width}x{height} needs about {gib(est)} of memory, above the limit "
             f"of {gib(limit)}: change {knobs}the image size, or raise the limit "
             f"(--max-memory, {MEMORY_ENV} or max_memory=)")
