@@ -5,6 +5,7 @@ methods have landed.  ``install(monkeypatch)`` registers them in place of the re
   the exact sphere silhouette, but each pixel shaded with its facet's normal (the direction of
   the facet's centre).  Theory: the shading error falls like the facet's angular size, 1/n.
 * ``never``: raises ``NotApplicable`` for every scene.
+* ``broken``: the facets, but a bug (``RuntimeError``) at ``n = 64``: a method's failure.
 """
 from __future__ import annotations
 
@@ -69,7 +70,16 @@ class Never:
         raise NotApplicable("this fake applies to no scene")
 
 
-FAKES = {"facets": "compare_fakes:Facets", "never": "compare_fakes:Never"}
+class Broken(Facets):
+    name = "broken"
+
+    def render(self, scene, width, height, n=8):
+        if n == 64:
+            raise RuntimeError("a bug of this fake at n = 64")
+        return super().render(scene, width, height, n=n)
+
+
+FAKES = {"facets": "compare_fakes:Facets", "never": "compare_fakes:Never", "broken": "compare_fakes:Broken"}
 
 
 def install(monkeypatch, extra: dict | None = None):

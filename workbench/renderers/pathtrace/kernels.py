@@ -63,8 +63,8 @@ import math
 
 import numba as nb
 import numpy as np
-from numba import prange
 
+from ..kernels.tasks import run_tasks
 from ..raytrace.kernels import (MAX_TASKS, NO_REFCOUNT, _feeler, _light_dir, _normalize, bvh_hit,
                                 checker_color, closest, fresnel_reflectance, scratch, surface)
 
@@ -175,7 +175,6 @@ def hit_rows():
             np.zeros(4, np.int64))
 
 
-@nb.njit(cache=True, error_model="numpy", parallel=True)
 def render_samples(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq, counts):
     """Add samples ``s0 .. s0 + nsamp - 1`` of every pixel to its running sums.
 
@@ -197,18 +196,23 @@ def render_samples(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sum
     sums, sumsq : (H*W, 3) float64, updated: sum and sum of squares of the sample radiances.
     counts : (NCOUNTS,) int64, updated (see ``NCOUNTS``).
     """
-    npix = sums.shape[0]
-    nblocks = (npix + BLOCK - 1) // BLOCK
+    nblocks = (sums.shape[0] + BLOCK - 1) // BLOCK
     nit = max(1, min(nblocks, MAX_TASKS))
     part = np.zeros((nit, 8), np.int64)
-    for c in prange(nit):
-        scr, rows = scratch(), hit_rows()
-        for b in range(c, nblocks, nit):
-            pixel_block(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq, part[c],
-                        b * BLOCK, min(npix, (b + 1) * BLOCK), scr, rows)
-    for c in range(nit):
-        for q in range(NCOUNTS):
-            counts[q] += part[c, q]
+    run_tasks(samples_task, nit, geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq, part)
+    counts += part[:, :NCOUNTS].sum(axis=0)
+
+
+@nb.njit(cache=True, error_model="numpy", nogil=True)
+def samples_task(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq, part, c, nit):
+    """Task ``c`` of ``nit`` of :func:`render_samples`: pixel blocks ``c, c + nit, ...``; its
+    counts go to ``part[c]``."""
+    npix = sums.shape[0]
+    nblocks = (npix + BLOCK - 1) // BLOCK
+    scr, rows = scratch(), hit_rows()
+    for b in range(c, nblocks, nit):
+        pixel_block(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq, part[c],
+                    b * BLOCK, min(npix, (b + 1) * BLOCK), scr, rows)
 
 
 @nb.njit(**NO_REFCOUNT)
@@ -243,7 +247,7 @@ def cast_all(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr):
     """:func:`..raytrace.kernels.closest` over every primitive (area lights included), compiled
     once here (not inlined: its call sites share one copy)."""
     stack, st, sp_, sf, sn = scr
-    return closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, False, any_hit, zero, eps, stack, st,
+    return closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, np.bool_(False), np.bool_(any_hit), zero, eps, stack, st,
                    sp_, sf, sn)
 
 
@@ -270,10 +274,10 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
     module docstring.  Random dimensions: 0, 1 pixel jitter; then 8 per bounce."""
     mat_of, mat_tab, tex_tab, lights = shading
     em_tri, em_n, em_prim, em_mtri, em_cdf, lpdf_prim, lpdf_tri = emitters
-    solid = geo[5]
-    tri_e = geo[12]
-    tri_prim = geo[13]
-    bvh = (geo[14], geo[15], geo[16], geo[17], geo[18])
+    solid = geo.solid
+    tri_e = geo.tri_e
+    tri_prim = geo.tri_prim
+    bvh = (geo.bvh_node, geo.bvh_child, geo.bvh_leaf, geo.bvh_first, geo.bvh_tv4)
     only_tris = opts[20] > 0.5
     h_ng, h_ns, h_uv, h_po, h_ev, stk = rows
     fres = int(opts[0])

@@ -147,8 +147,6 @@ class PathTraceSession:
     def _ensure_compiled(self) -> float:
         """First-call JIT (or numba disk-cache load) of the kernel, on an empty image."""
         k = _kernels()
-        if k.render_samples.signatures:
-            return 0.0
         t0 = time.perf_counter()
         k.render_samples(self.geo, self.shading, self.emitters.arrays(), self.cam, self.opts, 0, 0, 0,
                          np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(k.NCOUNTS, np.int64))

@@ -32,7 +32,10 @@ import numpy as np
 from ...core.tol import tol
 from ...scene import model as m
 from ...scene.kinds import kind_of
+from ...scene.kinds import blob, isosurface, lathe, prism
+from ...scene.kinds.csg import CSGNODE
 from ...scene.prepared import PreparedScene, prepare
+from ..kernels.layout import Geometry, kinds_marker
 
 if TYPE_CHECKING:
     from .accel import PrimTree
@@ -46,6 +49,11 @@ SHADOW_CROSSINGS = 32
 """Surfaces a shadow feeler goes on through (transmissive with ``transmissive_shadows``, cut out
 or partly opaque by an opacity map) before it stops with the visibility gathered so far."""
 NPAR = 20
+_KERNEL_KINDS = (("blob", blob.PTYPE), ("isosurface", isosurface.PTYPE), ("lathe", lathe.PTYPE),
+                 ("prism", prism.PTYPE))
+"""The kinds with kernels of their own, by feature name (:data:`..kernels.layout.FEATURES`)."""
+EXTENDED_PTYPES = frozenset([code for _, code in _KERNEL_KINDS] + [CSGNODE])
+"""Rows that make a scene compile the extended kinds' kernels (:meth:`SceneData.features`)."""
 _IDENTITY_ROWS = np.eye(4)[:3].reshape(-1)
 
 
@@ -86,11 +94,27 @@ class SceneData:
     """Variable-length data of the kinds that have it (blob components, an isosurface's
     program, lathe profiles, prism polygons), flat float64; each row holds its offset."""
 
-    def kernel_args(self) -> tuple:
-        """The geometry tuple passed to every numba kernel."""
-        return (self.ptype, self.top, self.xf, self.nm, self.par, self.solid, self.shadow,
-                self.poly_v, self.csg_prog, self.tri_v, self.tri_n, self.tri_uv, self.tri_e,
-                self.tri_prim, *self.bvh, self.ident, self.aux, *self.prims)
+    def features(self) -> tuple[str, ...]:
+        """What the kernels compile for this scene (:data:`..kernels.layout.FEATURES`), in
+        two groups, so that all scenes together need at most four compiled variants of each
+        kernel: the extended kinds (blob, isosurface, lathe, prism, CSG: all five if the scene
+        has any of them among its rows, CSG leaves included) and the triangles' tree (if the
+        scene has triangles).  The analytic primitives' tree walk is always compiled."""
+        present = {int(p) for p in np.unique(self.ptype)}
+        out = []
+        if present & EXTENDED_PTYPES:
+            out += [name for name, _ in _KERNEL_KINDS] + ["csg"]
+        if len(self.tri_v):
+            out.append("triangles")
+        return tuple(out) + ("prim_tree",)
+
+    def kernel_args(self) -> Geometry:
+        """The geometry record passed to every numba kernel, its kind marker naming
+        :meth:`features` (kernels compiled for this set of features only)."""
+        return Geometry(self.ptype, self.top, self.xf, self.nm, self.par, self.solid, self.shadow,
+                        self.poly_v, self.csg_prog, self.tri_v, self.tri_n, self.tri_uv, self.tri_e,
+                        self.tri_prim, *self.bvh, self.ident, self.aux, *self.prims,
+                        kinds_marker(self.features()))
 
 
 def _material_row(mat: m.Material, front_only: bool = False) -> np.ndarray:

@@ -4,16 +4,22 @@ spawning step of a hit (:func:`shade_hit`), and the two drivers: the fused kerne
 (:func:`trace_batch`, :func:`shade_batch`: each generation of rays is traced, then shaded, then
 its reflected and refracted children form the next generation).
 
-Everything is scalar code over flat arrays (:mod:`.flatten`), but for the BVH traversal, which
-tests four boxes and four triangles side by side (:func:`bvh_hit`); the drivers are ``parallel=True``
-over chunks of rays or blocks of pixels (``prange``), each with its own scratch arrays (BVH
-stack, CSG interval stacks, ray stack), and hand each chunk to a worker compiled without
-reference counting (:data:`NO_REFCOUNT`).  Helpers marked ``inline="always"`` are inlined into
-their callers, which are cached, so they are not cached themselves (one dispatcher cache less
-to set up per helper at import).  ``error_model="numpy"``: float divisions follow IEEE (no
-zero-divisor check and exception path on every division; the results are the same wherever
-the default Python model would not raise).  ``cache=True``: compiled code is kept on disk
-(``NUMBA_CACHE_DIR``), so a warm cache compiles nothing.
+Everything is scalar code over flat arrays (:mod:`.flatten`; the geometry as the named record
+:class:`..kernels.layout.Geometry`), but for the BVH traversal, which tests four boxes and four
+triangles side by side (:func:`bvh_hit`).  The drivers run blocks of pixels or chunks of rays
+on several threads: the fused one as ``nogil`` tasks on a thread pool
+(:mod:`..kernels.tasks`), the wavefront ones with ``prange``; each task has its own scratch
+arrays (BVH stack, CSG interval stacks, ray stack) and hands its work to functions compiled
+without reference counting (:data:`NO_REFCOUNT`).  Helpers marked ``inline="always"`` are
+inlined into their callers by numba, at the IR level, and are not cached themselves: that
+copying is most of a first render's compile time, but making them calls slows warm renders
+(``docs/kernels.md``).
+The kernels are compiled per set of kinds present (:mod:`..kernels.specialise`): the
+geometry's kind marker makes the blob, isosurface, lathe and prism kernels, CSG programs and
+the two trees' walks compile only for a scene that has them.  ``error_model="numpy"``: float
+divisions follow IEEE (no zero-divisor check and exception path on every division; the
+results are the same wherever the default Python model would not raise).  ``cache=True``:
+compiled code is kept on disk (``NUMBA_CACHE_DIR``), so a warm cache compiles nothing.
 
 The readable version of the same algorithm is :mod:`.reference`; the two are tested against
 each other.  Equations: see the docstrings of the reference's functions.
@@ -25,13 +31,15 @@ import math
 import numba as nb
 import numpy as np
 from numba import prange
+from numba.extending import overload
 
 from ...core.tol import tol
 from ...scene.kinds import BOX, CSGNODE, POLYGON, QUADRIC, RECT, SPHERE
 from ...scene.kinds import blob, isosurface, lathe, prism
-from ...scene.kinds import blob_kernels as kb, isosurface_kernels as ki, lathe_kernels as kl, prism_kernels as kp
 from ...scene.kinds.csg import CSG_DEPTH, CSG_DIFFERENCE, CSG_INTERSECTION, CSG_UNION
 from ...scene.kinds.expression import MAX_STACK
+from ..kernels.tasks import run_tasks
+from ..kernels.specialise import exotic_events, exotic_first, exotic_normal, has
 from .bvh import MAX_DEPTH
 from .flatten import SHADOW_CROSSINGS
 
@@ -237,8 +245,8 @@ def _quadric_hit(k, par, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
 
 
 @nb.njit(error_model="numpy", inline="always")
-def prim_hit(k, ptype, par, poly_v, aux, ox, oy, oz, dx, dy, dz, ux, uy, uz, inv_s, tmin, tmax, zero,
-             out_t, out_f, stack):
+def prim_hit(kinds, k, ptype, par, poly_v, aux, ox, oy, oz, dx, dy, dz, ux, uy, uz, inv_s, tmin, tmax,
+             zero, out_t, out_f, stack):
     """Closest hit ``tmin < t < tmax`` of analytic primitive ``k`` (object-space ray with
     direction ``d``; spheres use its unit direction ``u`` and ``inv_s = 1 / |d|``).  The
     kinds with variable-length data (blob, isosurface, lathe, prism: :mod:`workbench.scene.kinds`)
@@ -277,19 +285,12 @@ def prim_hit(k, ptype, par, poly_v, aux, ox, oy, oz, dx, dy, dz, ux, uy, uz, inv
         return _polygon_hit(k, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax)
     if kind == QUADRIC:
         return _quadric_hit(k, par, ox, oy, oz, dx, dy, dz, tmin, tmax, zero)
-    if kind == BLOB:
-        return kb.blob_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack)
-    if kind == ISOSURFACE:
-        return ki.iso_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack)
-    if kind == LATHE:
-        return kl.lathe_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack)
-    if kind == PRISM:
-        return kp.prism_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack)
-    return np.inf, 0
+    # blob, isosurface, lathe, prism: compiled only for a scene that has them
+    return exotic_first(kinds, kind, par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack)
 
 
 @nb.njit(**NO_REFCOUNT)
-def leaf_events(k, ptype, par, aux, ox, oy, oz, dx, dy, dz, zero, et, ep, ef, stack):
+def leaf_events(kinds, k, ptype, par, aux, ox, oy, oz, dx, dy, dz, zero, et, ep, ef, stack):
     """Interval list (entering / leaving events along the whole line) of solid leaf ``k``:
     sphere, box, or quadric inside ``P^T Q P < 0`` intersected with its bounds box.
     Writes ``et`` (t), ``ep`` (signed primitive code ``k + 1``), ``ef`` (face); returns the count."""
@@ -352,14 +353,7 @@ def leaf_events(k, ptype, par, aux, ox, oy, oz, dx, dy, dz, zero, et, ep, ef, st
         return m
     m = 0
     cap = et.shape[0]
-    if kind == BLOB:
-        m = kb.blob_events(par, k, aux, ox, oy, oz, dx, dy, dz, et, ef, cap, stack)
-    elif kind == ISOSURFACE:
-        m = ki.iso_events(par, k, aux, ox, oy, oz, dx, dy, dz, et, ef, cap, stack)
-    elif kind == LATHE:
-        m = kl.lathe_events(par, k, aux, ox, oy, oz, dx, dy, dz, et, ef, cap, stack)
-    elif kind == PRISM:
-        m = kp.prism_events(par, k, aux, ox, oy, oz, dx, dy, dz, et, ef, cap, stack)
+    m = exotic_events(kinds, kind, par, k, aux, ox, oy, oz, dx, dy, dz, et, ef, cap, stack)
     m -= m % 2            # a list cut at the capacity ends inside: close the last interval
     for i in range(m):
         ep[i] = k + 1
@@ -418,8 +412,8 @@ def combine(op, ta, pa, fa, na, tb, pb, fb, nb_, to, po, fo, eps):
 
 
 @nb.njit(**NO_REFCOUNT)
-def csg_hit(start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps,
-            st, sp_, sf, sn, stack):
+def csg_hit(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, zero,
+            eps, st, sp_, sf, sn, stack):
     """Evaluate a CSG postfix program along a ray (the course's recursive ``intersect``, made
     iterative).  Returns ``(t, code, face)`` of the first boundary in ``(tmin, tmax)``."""
     top = 0
@@ -427,7 +421,7 @@ def csg_hit(start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy, dz, tm
         c = prog[q]
         if c >= 0:
             lo = _to_object(xf, c, ox, oy, oz, dx, dy, dz)
-            sn[top] = leaf_events(c, ptype, par, aux, lo[0], lo[1], lo[2], lo[3], lo[4], lo[5], zero,
+            sn[top] = leaf_events(kinds, c, ptype, par, aux, lo[0], lo[1], lo[2], lo[3], lo[4], lo[5], zero,
                                   st[top], sp_[top], sf[top], stack)
             top += 1
         else:
@@ -685,20 +679,18 @@ def row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, zero, eps, stack,
     """Closest hit ``tmin < t < tmax`` of top-level analytic primitive row ``k`` (a CSG node
     evaluates its program) for the world ray.  Returns ``(t, prim, face)``: ``prim`` the row
     hit (a CSG leaf's own row), ``face + 16`` for a flipped CSG normal; ``t = inf`` on a miss."""
-    (ptype, top, xf, nm, par, solid, shadow, poly_v, prog, tri_v, tri_n, tri_uv, tri_e,
-     tri_prim, bvh_node, bvh_child, bvh_leaf, bvh_first, bvh_tv4, bvh_bounds, ident, aux,
-     pfree, pnode, pchild, pleaf, pref, pbounds) = geo
-    if ident[k]:  # object space is world space: no transform, the world unit direction
+    ptype, xf, par, aux = geo.ptype, geo.xf, geo.par, geo.aux
+    if geo.ident[k]:  # object space is world space: no transform, the world unit direction
         lo = (ox, oy, oz, dx, dy, dz)
         inv_s = inv_w
     else:
         lo = _to_object(xf, k, ox, oy, oz, dx, dy, dz)
         inv_s = 1.0 / math.sqrt(lo[3] * lo[3] + lo[4] * lo[4] + lo[5] * lo[5])
     if ptype[k] == CSGNODE:
-        t, code, f = csg_hit(int(par[k, 0]), int(par[k, 1]), prog, ptype, xf, par, aux, ox, oy, oz,
-                             dx, dy, dz, tmin, tmax, zero, eps, st, sp_, sf, sn, stack)
+        t, code, f = csg_gate(geo.kinds, int(par[k, 0]), int(par[k, 1]), geo.prog, ptype, xf, par, aux,
+                              ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps, st, sp_, sf, sn, stack)
         return t, abs(code) - 1, f + (16 if code < 0 else 0)
-    t, f = prim_hit(k, ptype, par, poly_v, aux, lo[0], lo[1], lo[2], lo[3], lo[4], lo[5],
+    t, f = prim_hit(geo.kinds, k, ptype, par, geo.poly_v, aux, lo[0], lo[1], lo[2], lo[3], lo[4], lo[5],
                     lo[3] * inv_s, lo[4] * inv_s, lo[5] * inv_s, inv_s, tmin, tmax, zero,
                     st[0], sf[0], stack)
     return t, k, f
@@ -722,15 +714,75 @@ def prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_o
                           eps, stack, st, sp_, sf, sn, False, sn)
 
 
+# ----------------------------------------------------------------------------- gates
+# The walks below compile only for a scene that needs them (see ..kernels.specialise): CSG
+# programs, the analytic primitives' tree, the triangles' tree.  A gate whose feature is absent
+# is never reached (its caller tests the same data first) and compiles to a miss.
+
+def csg_gate(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, zero,
+             eps, st, sp_, sf, sn, stack):
+    """:func:`csg_hit` if the scene has CSG nodes."""
+    raise TypeError("csg_gate is callable from numba-compiled code only")
+
+
+@overload(csg_gate, jit_options=dict(error_model="numpy"))
+def _csg_gate(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, zero,
+              eps, st, sp_, sf, sn, stack):
+    on = has(kinds, "csg")
+
+    def impl(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, zero,
+             eps, st, sp_, sf, sn, stack):
+        if on:
+            return csg_hit(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy, dz, tmin,
+                           tmax, zero, eps, st, sp_, sf, sn, stack)
+        return np.inf, 0, 0
+    return impl
+
+
+def prim_tree_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero, eps,
+                   stack, st, sp_, sf, sn):
+    """:func:`prim_tree_hit` if the scene has bounded analytic primitives."""
+    raise TypeError("prim_tree_gate is callable from numba-compiled code only")
+
+
+@overload(prim_tree_gate, jit_options=dict(error_model="numpy"))
+def _prim_tree_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero, eps,
+                    stack, st, sp_, sf, sn):
+    on = has(geo.types[-1], "prim_tree")  # geo.kinds' type
+
+    def impl(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero, eps,
+             stack, st, sp_, sf, sn):
+        if on:
+            return prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only,
+                                 any_hit, zero, eps, stack, st, sp_, sf, sn)
+        return best, -1, 0, -1
+    return impl
+
+
+def triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
+    """:func:`bvh_hit` over the scene's triangles if it has any."""
+    raise TypeError("triangles_gate is callable from numba-compiled code only")
+
+
+@overload(triangles_gate, jit_options=dict(error_model="numpy"))
+def _triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
+    on = has(geo.types[-1], "triangles")
+
+    def impl(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
+        if on:
+            return bvh_hit((geo.bvh_node, geo.bvh_child, geo.bvh_leaf, geo.bvh_first, geo.bvh_tv4),
+                           ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack)
+        return np.inf, -1, 0.0, 0.0
+    return impl
+
+
 @nb.njit(error_model="numpy", inline="always")
 def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero, eps,
                    stack, st, sp_, sf, sn, count, cnt):
     """:func:`prim_tree_hit`; with ``count`` (the traversal statistics' pass,
     :mod:`.traversal_stats`) it adds the 4-wide nodes visited to ``cnt[0]`` and the primitive
     tests to ``cnt[1]`` (the rendering kernels pass ``False``: no counting)."""
-    (ptype, top, xf, nm, par, solid, shadow, poly_v, prog, tri_v, tri_n, tri_uv, tri_e,
-     tri_prim, bvh_node, bvh_child, bvh_leaf, bvh_first, bvh_tv4, bvh_bounds, ident, aux,
-     pfree, pnode, pchild, pleaf, pref, pbounds) = geo
+    shadow, pnode, pchild, pleaf, pref = geo.shadow, geo.pnode, geo.pchild, geo.pleaf, geo.pref
     ray = node_ray(ox, oy, oz, dx, dy, dz, tmin)
     bp, bf, found = -1, 0, -1
     base = PRIM_STACK_BASE
@@ -774,9 +826,7 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
     one by one, then the analytic primitives' structure, then the triangles' (see
     :mod:`.accel`).  Returns ``(t, prim, face, tri, b1, b2)``; ``prim = -1`` on a miss,
     negative ``face`` is never returned (a flipped CSG normal is ``face + 16``)."""
-    (ptype, top, xf, nm, par, solid, shadow, poly_v, prog, tri_v, tri_n, tri_uv, tri_e,
-     tri_prim, bvh_node, bvh_child, bvh_leaf, bvh_first, bvh_tv4, bvh_bounds, ident, aux,
-     pfree, pnode, pchild, pleaf, pref, pbounds) = geo
+    pfree, shadow = geo.pfree, geo.shadow
     best, bp, bf, btri, bb1, bb2 = tmax, -1, 0, -1, 0.0, 0.0
     brow = -1
     inv_w = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
@@ -789,40 +839,29 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
             best, bp, bf, brow = t, p, f, k
         if any_hit and bp >= 0:
             return best, bp, bf, btri, bb1, bb2
-    if pref.shape[0] > 0 and _bounds_hit(pbounds, ox, oy, oz, dx, dy, dz, tmin, best):
-        # np.int64, np.bool_: runtime values, not literals (-1, True, False) from the inlined
-        # callers: one compiled prim_tree_hit for all (six specializations, ~20 s of JIT each)
-        t, p, f, row = prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, np.int64(brow),
-                                     np.bool_(shadow_only), np.bool_(any_hit), zero, eps, stack, st,
-                                     sp_, sf, sn)
+    if geo.pref.shape[0] > 0 and _bounds_hit(geo.pbounds, ox, oy, oz, dx, dy, dz, tmin, best):
+        t, p, f, row = prim_tree_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, np.int64(brow),
+                                      np.bool_(shadow_only), np.bool_(any_hit), zero, eps, stack, st,
+                                      sp_, sf, sn)
         if row >= 0:
             best, bp, bf = t, p, f
             if any_hit:
                 return best, bp, bf, btri, bb1, bb2
-    if tri_v.shape[0] > 0 and _bounds_hit(bvh_bounds, ox, oy, oz, dx, dy, dz, tmin, best):
-        # np.bool_: a runtime flag, not a literal True/False (one compiled bvh_hit for all)
-        t, tri, b1, b2 = bvh_hit((bvh_node, bvh_child, bvh_leaf, bvh_first, bvh_tv4),
-                                 ox, oy, oz, dx, dy, dz, tmin, best,
-                                 np.bool_(any_hit), stack)
+    if geo.tri_v.shape[0] > 0 and _bounds_hit(geo.bvh_bounds, ox, oy, oz, dx, dy, dz, tmin, best):
+        t, tri, b1, b2 = triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, best, np.bool_(any_hit), stack)
         if tri >= 0:
-            best, bp, bf, btri, bb1, bb2 = t, tri_prim[tri], 0, tri, b1, b2
+            best, bp, bf, btri, bb1, bb2 = t, geo.tri_prim[tri], 0, tri, b1, b2
     if bp < 0:
         return np.inf, -1, 0, -1, 0.0, 0.0
     return best, bp, bf, btri, bb1, bb2
 
 
 @nb.njit(error_model="numpy", inline="always")
-def object_normal(k, face, ptype, par, aux, x, y, z, stack):
+def object_normal(kinds, k, face, ptype, par, aux, x, y, z, stack):
     """Outward normal (unnormalised) of primitive ``k`` at object-space point, by face."""
     kind = ptype[k]
-    if kind == BLOB:
-        return kb.blob_normal(par, k, aux, face, x, y, z, stack)
-    if kind == ISOSURFACE:
-        return ki.iso_normal(par, k, aux, face, x, y, z, stack)
-    if kind == LATHE:
-        return kl.lathe_normal(par, k, aux, face, x, y, z, stack)
-    if kind == PRISM:
-        return kp.prism_normal(par, k, aux, face, x, y, z, stack)
+    if kind == BLOB or kind == ISOSURFACE or kind == LATHE or kind == PRISM:
+        return exotic_normal(kinds, kind, par, k, aux, face, x, y, z, stack)
     if face >= 1 and (kind == BOX or kind == QUADRIC):
         a = (face - 1) // 2
         s = 1.0 if (face - 1) % 2 == 1 else -1.0
@@ -853,9 +892,7 @@ def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_
     """Geometric (outward) normal, shading normal, uv (meshes; analytic primitives leave the
     mapping to the texturing module), object-space point and vertex emission at a hit, written
     to row ``i`` of the output arrays (``stack``: scratch of an isosurface's gradient)."""
-    (ptype, top, xf, nm, par, solid, shadow, poly_v, prog, tri_v, tri_n, tri_uv, tri_e,
-     tri_prim, bvh_node, bvh_child, bvh_leaf, bvh_first, bvh_tv4, bvh_bounds, ident, aux,
-     pfree, pnode, pchild, pleaf, pref, pbounds) = geo
+    xf, nm, tri_v, tri_n, tri_uv, tri_e = geo.xf, geo.nm, geo.tri_v, geo.tri_n, geo.tri_uv, geo.tri_e
     x = xf[k, 0] * px + xf[k, 1] * py + xf[k, 2] * pz + xf[k, 3]
     y = xf[k, 4] * px + xf[k, 5] * py + xf[k, 6] * pz + xf[k, 7]
     z = xf[k, 8] * px + xf[k, 9] * py + xf[k, 10] * pz + xf[k, 11]
@@ -884,7 +921,7 @@ def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_
         return
     f = face - 16 if face >= 16 else face
     sgn = -1.0 if face >= 16 else 1.0
-    ux, uy, uz = object_normal(k, f, ptype, par, aux, x, y, z, stack)
+    ux, uy, uz = object_normal(geo.kinds, k, f, geo.ptype, geo.par, geo.aux, x, y, z, stack)
     wx = sgn * (nm[k, 0] * ux + nm[k, 1] * uy + nm[k, 2] * uz)
     wy = sgn * (nm[k, 3] * ux + nm[k, 4] * uy + nm[k, 5] * uz)
     wz = sgn * (nm[k, 6] * ux + nm[k, 7] * uy + nm[k, 8] * uz)
@@ -894,7 +931,7 @@ def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_
 
 
 # ----------------------------------------------------------------------------- batch kernels
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(error_model="numpy")
 def scratch():
     """Per-thread work arrays of :func:`closest`: the traversal stack (rows: entry distance,
     child code: a 4-wide node or a leaf; the triangles' traversal uses it from row 0, the
@@ -943,7 +980,8 @@ def trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_on
         ox, oy, oz = O[i, 0], O[i, 1], O[i, 2]
         eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
         t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, D[i, 0], D[i, 1], D[i, 2], tmin[i],
-                                       tmax[i], shadow_only, False, zero, eps, stack, st, sp_, sf, sn)
+                                       tmax[i], np.bool_(shadow_only), np.bool_(False), zero, eps, stack, st,
+                                       sp_, sf, sn)
         t_out[i], prim_out[i] = t, k
         if k >= 0:
             surface(geo, k, f, tri, b1, b2, ox + t * D[i, 0], oy + t * D[i, 1],
@@ -959,7 +997,7 @@ def _transmittance(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmin, tmax, tra
     v = 1.0
     t0 = tmin
     for _ in range(SHADOW_CROSSINGS):
-        t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, t0, tmax, True, not transmissive,
+        t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, t0, tmax, np.bool_(True), np.bool_(not transmissive),
                                        zero, eps, stack, st, sp_, sf, sn)
         if k < 0:
             return v
@@ -1107,7 +1145,7 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
     ray_off, t_min, zero, extent = opts[8], opts[9], opts[10], opts[11]
     add_bg = opts[12] > 0.5
     nl = lights.shape[0]
-    solid = geo[5]
+    solid = geo.solid
     out_kind[s0], out_kind[s0 + 1] = 0, 0
     for q in range(7):
         counts[i, q] = 0
@@ -1348,41 +1386,48 @@ def checker_color(tex_tab, mi, x, y, z):
             tex_tab[mi, 13] * (1.0 - a) + tex_tab[mi, 16] * a)
 
 
-@nb.njit(cache=True, error_model="numpy", parallel=True)
 def render_pixels(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts, O, D, spp,
                   fwd, cam, first, ncancel, image, depth_map, counts):
-    """Whole ray trees of every pixel in one kernel (the fused path): each pixel's ``spp``
-    primary rays (``O, D`` rows ``p spp ... p spp + spp - 1``; with ``O`` empty and ``spp = 1``,
-    the centre ray of image pixel ``first + p`` of the camera ``cam``, see
-    ``whitted.camera_frame``) and their reflected and refracted descendants are traced depth
-    first (:func:`pixel_block`), so no array crosses back to Python between ray generations.
+    """Whole ray trees of every pixel (the fused path): each pixel's ``spp`` primary rays
+    (``O, D`` rows ``p spp ... p spp + spp - 1``; with ``O`` empty and ``spp = 1``, the centre
+    ray of image pixel ``first + p`` of the camera ``cam``, see ``whitted.camera_frame``) and
+    their reflected and refracted descendants are traced depth first (:func:`pixel_block`), so
+    no array crosses back to Python between ray generations.
 
     Writes ``image[p]`` (mean over the samples), ``depth_map[p]`` (camera-space depth of the
     first sample's primary hit, ``fwd`` the unit view axis, ``inf`` on a miss) and adds the
     ray counts of :func:`shade_hit` to ``counts`` (7,).  Blocks of ``PIXEL_BLOCK`` pixels are
-    dealt to a few tasks per thread in a scrambled order, so that the static split of
-    ``prange`` between threads gives each a fair share of the expensive parts of the image.
+    dealt to a few tasks per thread in a scrambled order (:func:`pixels_task`, run on threads
+    by :func:`..kernels.tasks.run_tasks`), so that each thread gets a fair share of the
+    expensive parts of the image.
     """
-    npix = image.shape[0]
-    nblocks = (npix + PIXEL_BLOCK - 1) // PIXEL_BLOCK
+    nblocks = (image.shape[0] + PIXEL_BLOCK - 1) // PIXEL_BLOCK
     stride = 1
     if nblocks > 2:  # a stride coprime with nblocks: c -> c * stride % nblocks is a permutation
         stride = nblocks // 2 + 1
         while math.gcd(stride, nblocks) != 1:
             stride += 1
-    cap = 2 * int(opts[0]) + 2
-    nit = _tasks(nblocks)
+    nit = max(1, min(nblocks, MAX_TASKS))
     part = np.zeros((nit, 8), np.int64)  # a row per task (8: rows a cache line apart)
-    for c in prange(nit):
-        scr, bufs = scratch(), ray_stack(cap)
-        for k in range(c, nblocks, nit):
-            b = (k * stride) % nblocks
-            pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts, O, D, spp,
-                        fwd, cam, first, ncancel, image, depth_map, part[c], b * PIXEL_BLOCK,
-                        min(npix, (b + 1) * PIXEL_BLOCK), scr, bufs)
-    for c in range(nit):
-        for q in range(7):
-            counts[q] += part[c, q]
+    run_tasks(pixels_task, nit, geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts, O, D,
+              spp, fwd, cam, first, ncancel, image, depth_map, part, stride)
+    counts += part[:, :7].sum(axis=0)
+
+
+@nb.njit(cache=True, error_model="numpy", nogil=True)
+def pixels_task(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts, O, D, spp, fwd, cam,
+                first, ncancel, image, depth_map, part, stride, c, nit):
+    """Task ``c`` of ``nit`` of :func:`render_pixels`: blocks ``c, c + nit, ...`` in the
+    scrambled order ``b = k stride mod nblocks``; its ray counts go to ``part[c]``."""
+    npix = image.shape[0]
+    nblocks = (npix + PIXEL_BLOCK - 1) // PIXEL_BLOCK
+    cap = 2 * int(opts[0]) + 2
+    scr, bufs = scratch(), ray_stack(cap)
+    for k in range(c, nblocks, nit):
+        b = (k * stride) % nblocks
+        pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts, O, D, spp,
+                    fwd, cam, first, ncancel, image, depth_map, part[c], b * PIXEL_BLOCK,
+                    min(npix, (b + 1) * PIXEL_BLOCK), scr, bufs)
 
 
 @nb.njit(error_model="numpy", inline="always")
@@ -1460,7 +1505,7 @@ def pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts
                 dx, dy, dz = c_d[0, 0], c_d[0, 1], c_d[0, 2]
                 eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
                 t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, r_tmin[top], np.inf,
-                                               False, False, zero, eps, stack, st, sp_, sf, sn)
+                                               np.bool_(False), np.bool_(False), zero, eps, stack, st, sp_, sf, sn)
                 h_t[0], h_p[0] = t, k
                 if c_gen[0] == 0 and s == 0:
                     depth_map[p] = t * (dx * fwd[0] + dy * fwd[1] + dz * fwd[2]) if k >= 0 else np.inf

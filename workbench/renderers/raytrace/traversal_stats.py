@@ -92,7 +92,7 @@ def count_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, stack, cnt):
 @nb.njit(**NO_REFCOUNT)
 def _count_chunk(geo_analytic, bvh, bounds, has_tri, O, D, zero, rel_eps, extent, counts, i0, i1, scr):
     stack, st, sp_, sf, sn = scr
-    free, pref, pbounds = geo_analytic[22], geo_analytic[26], geo_analytic[27]
+    free, pref, pbounds = geo_analytic.pfree, geo_analytic.pref, geo_analytic.pbounds
     for i in range(i0, i1):
         ox, oy, oz, dx, dy, dz = O[i, 0], O[i, 1], O[i, 2], D[i, 0], D[i, 1], D[i, 2]
         eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
@@ -138,11 +138,10 @@ def ray_counts(sd, O: np.ndarray, D: np.ndarray) -> np.ndarray:
     """(N, 4) int64 per ray ``O + t D``, t >= 0, of the flattened scene ``sd``
     (:class:`.flatten.SceneData`): nodes visited and tests in the triangles' structure, then
     in the analytic primitives' (the list's primitives counted as tests)."""
-    geo = list(sd.kernel_args())
-    geo[9] = np.zeros((0, 9))  # tri_v: no triangles, the analytic primitives only
+    geo = sd.kernel_args()._replace(tri_v=np.zeros((0, 9)))  # the analytic primitives only
     b = sd.bvh
     counts = np.zeros((len(O), 4), dtype=np.int64)
-    count_rays(tuple(geo), (b.node, b.child, b.leaf, b.first, b.tv4), b.bounds, len(sd.tri_v) > 0,
+    count_rays(geo, (b.node, b.child, b.leaf, b.first, b.tv4), b.bounds, len(sd.tri_v) > 0,
                np.ascontiguousarray(O, dtype=np.float64), np.ascontiguousarray(D, dtype=np.float64),
                tol.zero, tol.ray_offset, sd.extent, counts)
     return counts

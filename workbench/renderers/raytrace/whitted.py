@@ -264,12 +264,10 @@ def _kernels():
 def ensure_compiled(sd: SceneData, fused: bool = False) -> float:
     """Run the kernels a render needs once on one ray (first-call JIT, or a load from the numba
     disk cache): :func:`.kernels.render_pixels` for the fused path, the wavefront kernels
-    otherwise.  Returns the seconds spent (0 if already compiled in this process)."""
+    otherwise.  Returns the seconds spent (a fraction of a millisecond once compiled for this
+    scene's kinds in this process: the kernels are specialised to them, see
+    :mod:`..kernels.specialise`)."""
     k = _kernels()
-    needed = (k.render_pixels,) if fused else (k.trace_batch, k.shade_batch, k.accumulate, k.compact,
-                                               k.column_sums, k.feeler_batch)
-    if all(f.signatures for f in needed):
-        return 0.0
     t0 = time.perf_counter()
     O = np.zeros((1, 3))
     D = np.array([[0.0, 0.0, 1.0]])

@@ -1,8 +1,10 @@
 """Object kinds as plugins (pbrt-v4's ``Shape::Create``, Mitsuba 3's plugins): one module per
 kind of ``[[objects]]`` table, and :data:`KINDS`, the registry by scene-file ``type`` name.
 
-Adding a kind = one new module here + one line in :data:`KINDS` (+ its case in the ray tracer's
-numba dispatch over ``ptype``, :mod:`workbench.renderers.raytrace.kernels`).  Renderers ask the
+Adding a kind = one new module here + one line in :data:`KINDS` (+ its case in the kernels'
+dispatch over ``ptype``: :mod:`workbench.renderers.kernels.specialise` for a kind with kernels
+of its own, compiled only for scenes that have it, and the feature name that marks it,
+:data:`workbench.renderers.kernels.layout.FEATURES`).  Renderers ask the
 registry (:func:`kind_of`) instead of testing classes.  Kind modules are in the scene layer:
 they import ``workbench.core``, the scene's :mod:`..model`, :mod:`..readers`, :mod:`..parts`,
 other kind modules, numpy and numba, never ``workbench.renderers`` nor this registry (a

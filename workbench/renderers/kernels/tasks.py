@@ -1,0 +1,28 @@
+"""Running a kernel's work items on several threads without numba's ``parallel=True``.
+
+A driver compiled with ``parallel=True`` pays numba's parallel-loop passes and compiles its
+loop body twice, for seconds of a first render; the drivers here are ordinary kernels compiled
+with ``nogil=True`` that do work items ``c, c + n, c + 2 n, ...`` of ``n`` (a task), and
+:func:`run_tasks` calls one per task on a pool of ``numba.get_num_threads()`` Python threads,
+which run concurrently since the kernels release the GIL.  Each work item writes its own
+pixels, so the result does not depend on the thread that ran it.
+"""
+from __future__ import annotations
+
+from concurrent.futures import ThreadPoolExecutor
+
+
+def run_tasks(kernel, ntasks: int, *args) -> None:
+    """Call ``kernel(*args, c, ntasks)`` for ``c = 0 .. ntasks - 1``, on as many threads as
+    numba is set to use (``numba.set_num_threads``), and wait for all; an exception of any
+    call is raised here."""
+    import numba
+
+    threads = max(1, min(ntasks, numba.get_num_threads()))
+    if threads == 1:
+        for c in range(ntasks):
+            kernel(*args, c, ntasks)
+        return
+    with ThreadPoolExecutor(max_workers=threads) as pool:
+        for f in [pool.submit(kernel, *args, c, ntasks) for c in range(ntasks)]:
+            f.result()
