@@ -79,7 +79,9 @@ class Broken(Facets):
         return super().render(scene, width, height, n=n)
 
 
-FAKES = {"facets": "compare_fakes:Facets", "never": "compare_fakes:Never", "broken": "compare_fakes:Broken"}
+FAKES = {"facets": "compare_fakes:Facets", "never": "compare_fakes:Never"}
+BROKEN = {"broken": "compare_fakes:Broken"}
+"""Registered only by the tests that want a failing method (``install(monkeypatch, BROKEN)``)."""
 
 
 def install(monkeypatch, extra: dict | None = None):

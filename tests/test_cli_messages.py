@@ -105,7 +105,7 @@ def test_study_with_a_failed_point_exits_1(tmp_path, monkeypatch, capsys):
     bundled method fails on purpose) is listed and makes the study exit 1, once written."""
     import compare_fakes
     from workbench.app.cli import main
-    compare_fakes.install(monkeypatch)
+    compare_fakes.install(monkeypatch, compare_fakes.BROKEN)
     scene = tmp_path / "ball.toml"
     scene.write_text(BALL)
     code = main(["study", str(scene), "--methods", "broken", "--reference", "facets", "--size", "24x18",
