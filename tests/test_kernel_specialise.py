@@ -29,11 +29,11 @@ from workbench.renderers.raytrace import kernels as k
 from workbench.renderers.raytrace.flatten import flatten
 from workbench.scene.kinds import blob_kernels, isosurface_kernels, lathe_kernels, prism_kernels
 
-@nb.njit
+@nb.njit(error_model="numpy")  # IEEE divisions, as the kernels it inlines
 def first_hit(geo, scr):
     stack, st, sp_, sf, sn = scr
-    return k.closest(geo, 0.0, 0.0, 10.0, 0.0, 0.0, -1.0, 0.0, np.inf, np.bool_(False), np.bool_(False),
-                     1e-12, 1e-9, stack, st, sp_, sf, sn)
+    return k.row_hit(geo, 0, 0.0, 0.0, 10.0, 0.0, 0.0, -1.0, 1.0, 0.0, np.inf, 1e-12, 1e-9, stack, st, sp_,
+                     sf, sn)
 
 geo = flatten(workbench.load_scene("whitted")).kernel_args()
 if sys.argv[1] == "blob":
