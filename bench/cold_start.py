@@ -49,6 +49,7 @@ def main() -> int:
                       "renders": [f"{s} -m {m}" for s, m in runs]}
         print(name, rows[name], flush=True)
     report = {"machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} CPUs",
+              "load_average_at_end": [round(x, 2) for x in os.getloadavg()],
               "python": platform.python_version(), "size": "64x48", "cases": rows}
     RESULTS.mkdir(parents=True, exist_ok=True)
     (RESULTS / "cold_start.json").write_text(json.dumps(report, indent=1) + "\n")
