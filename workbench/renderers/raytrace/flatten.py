@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...core.tol import tol
+from ...core.transform import transform_normals
 from ...scene import model as m
 from ...scene.kinds import kind_of
 from ...scene.kinds import blob, isosurface, lathe, prism
@@ -227,9 +228,11 @@ def _triangles(meshes):
         F = np.asarray(mesh.faces, dtype=np.int64)
         tv.append(V[F].reshape(-1, 9))
         if mesh.normals is not None:
-            nrm = np.asarray(mesh.normals, dtype=np.float64) @ np.linalg.inv(W[:3, :3])
-            ln = np.linalg.norm(nrm, axis=1, keepdims=True)
-            nrm = np.divide(nrm, ln, out=np.zeros_like(nrm), where=ln > tol.normal_cancel)
+            # a cancelled normal is judged in object space, where normals are unit: the
+            # inverse transpose scales them by 1 / scale (1e-6 at scale 1e6)
+            n_obj = np.asarray(mesh.normals, dtype=np.float64)
+            live = np.linalg.norm(n_obj, axis=1, keepdims=True) > tol.normal_cancel
+            nrm = np.where(live, transform_normals(W, n_obj), 0.0)
             tn.append(nrm[F].reshape(-1, 9))
         else:
             tn.append(np.zeros((len(F), 9)))

@@ -707,8 +707,8 @@ def prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_o
                   stack, st, sp_, sf, sn):
     """Closest hit through the analytic primitives' 4-wide tree (:class:`.accel.PrimTree`;
     traversal as :func:`bvh_hit`'s, one primitive row per leaf item).  ``best``: the nearest
-    hit so far (of row ``brow``, ``-1`` for none); a hit replaces it if nearer, or as near
-    and of a lower row (the brute-force loop's order).  Returns ``(t, prim, face, row)``,
+    hit so far (of row ``brow``, ``-1`` for none); a hit replaces it as :func:`nearer`
+    says.  Returns ``(t, prim, face, row)``,
     ``row = -1`` if nothing replaced ``best``."""
     return prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero,
                           eps, stack, st, sp_, sf, sn, False, sn)
@@ -784,6 +784,8 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_
     tests to ``cnt[1]`` (the rendering kernels pass ``False``: no counting)."""
     shadow, pnode, pchild, pleaf, pref = geo.shadow, geo.pnode, geo.pchild, geo.pleaf, geo.pref
     ray = node_ray(ox, oy, oz, dx, dy, dz, tmin)
+    w = eps * inv_w  # coincidence window in ray parameter units (see :func:`nearer`)
+    reach = best + w if brow >= 0 else best
     bp, bf, found = -1, 0, -1
     base = PRIM_STACK_BASE
     top_ = stack.shape[0] - 1
@@ -792,7 +794,7 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_
         while code >= 0:
             if count:
                 cnt[0] += 1
-            sp, code = open_node((pnode, pchild), code, ray, best, stack, sp, top_)
+            sp, code = open_node((pnode, pchild), code, ray, reach, stack, sp, top_)
         if code < -1:
             lf = -2 - code
             for q in range(pleaf[lf, 0], pleaf[lf, 0] + pleaf[lf, 1]):
@@ -801,22 +803,35 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_
                     continue
                 if count:
                     cnt[1] += 1
-                # up to and including best: a tie goes to the lower row
-                t, p, f = row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, np.nextafter(best, np.inf),
+                # up to best and its window: a coincident surface of a lower row wins
+                t, p, f = row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, np.nextafter(reach, np.inf),
                                   zero, eps, stack, st, sp_, sf, sn)
-                if t < best or (t == best and k < brow):
+                if nearer(t, k, best, brow, w):
                     best, bp, bf, brow, found = t, p, f, k, k
+                    reach = best + w
                     if any_hit:
                         return best, bp, bf, found
         code = -1
         while sp > base:
             sp -= 1
-            if stack[sp, 0] <= best:
+            if stack[sp, 0] <= reach:
                 code = int(stack[sp, 1])
                 break
         if code == -1:
             break
     return best, bp, bf, found
+
+
+@nb.njit(error_model="numpy", inline="always")
+def nearer(t, k, best, brow, w):
+    """Whether a hit at ``t`` of row ``k`` replaces the nearest so far (``best`` of row
+    ``brow``, ``-1`` for none).  Two surfaces closer along the ray than ``w`` (the secondary
+    rays' offset, relative to the scene's size: no ray can tell them apart) are coincident,
+    such as a box's face resting on a floor: the lower row wins whatever the rounding says,
+    so that the choice does not change with the scene's scale or the traversal's order."""
+    if brow < 0:
+        return t < best
+    return t < best - w or (t <= best + w and k < brow)
 
 
 @nb.njit(error_model="numpy", inline="always")
@@ -830,12 +845,14 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
     best, bp, bf, btri, bb1, bb2 = tmax, -1, 0, -1, 0.0, 0.0
     brow = -1
     inv_w = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
+    w = eps * inv_w
     for q in range(pfree.shape[0]):
         k = pfree[q]
         if shadow_only and not shadow[k]:
             continue
-        t, p, f = row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, zero, eps, stack, st, sp_, sf, sn)
-        if t < best:
+        t, p, f = row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, best + w if brow >= 0 else best,
+                          zero, eps, stack, st, sp_, sf, sn)
+        if nearer(t, k, best, brow, w):
             best, bp, bf, brow = t, p, f, k
         if any_hit and bp >= 0:
             return best, bp, bf, btri, bb1, bb2
@@ -844,12 +861,13 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
                                       np.bool_(shadow_only), np.bool_(any_hit), zero, eps, stack, st,
                                       sp_, sf, sn)
         if row >= 0:
-            best, bp, bf = t, p, f
+            best, bp, bf, brow = t, p, f, row
             if any_hit:
                 return best, bp, bf, btri, bb1, bb2
     if geo.tri_v.shape[0] > 0 and _bounds_hit(geo.bvh_bounds, ox, oy, oz, dx, dy, dz, tmin, best):
-        t, tri, b1, b2 = triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, best, np.bool_(any_hit), stack)
-        if tri >= 0:
+        t, tri, b1, b2 = triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, best + w if brow >= 0 else best,
+                                        np.bool_(any_hit), stack)
+        if tri >= 0 and nearer(t, geo.tri_prim[tri], best, brow, w):
             best, bp, bf, btri, bb1, bb2 = t, geo.tri_prim[tri], 0, tri, b1, b2
     if bp < 0:
         return np.inf, -1, 0, -1, 0.0, 0.0

@@ -110,18 +110,21 @@ def _mesh_hit(ctx, item, O, D, tmin, tmax):
 
 
 def closest(ctx: Context, O, D, tmin, tmax=np.inf, shadow=False) -> Hit | None:
-    """The nearest hit in ``(tmin, tmax)`` over every object ("find_closest")."""
+    """The nearest hit in ``(tmin, tmax)`` over every object ("find_closest").  Surfaces
+    closer along the ray than the secondary rays' offset are coincident: the object listed
+    first wins (a later one must be nearer by more than that), as in the kernels' ``nearer``."""
     best = None
     eps = tol.ray_offset * max(float(np.abs(O).max()), ctx.extent)
+    w = eps / float(np.linalg.norm(D))
     for item in ctx.items:
         if shadow and not item.shadow:
             continue
         if kind_of(item.obj).PTYPE == MESH:  # world triangles (a BVH in the kernels)
-            h = _mesh_hit(ctx, item, O, D, tmin, best.t if best else tmax)
+            h = _mesh_hit(ctx, item, O, D, tmin, best.t - w if best else tmax)
             best = h or best
             continue
         for c in crossings(item.obj, np.eye(4), O, D, eps):
-            if tmin < c.t < (best.t if best else tmax):
+            if tmin < c.t < (best.t - w if best else tmax):
                 leaf, Wl = c.leaf
                 P = O + c.t * D
                 inv = np.linalg.inv(Wl)

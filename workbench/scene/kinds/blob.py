@@ -225,7 +225,8 @@ def mesh(b: Blob, resolution: int):
     n = grid_cells(lo, hi, resolution + 2, f"blob {b.name!r}")
     xs, ys, zs = (np.linspace(a, c, k + 1) for a, c, k in zip(lo, hi, n))
     G = np.stack(np.meshgrid(xs, ys, zs, indexing="ij"), -1)
-    P, F = marching_cubes(b.threshold - field_value(b, G), xs, ys, zs)
+    P, F = marching_cubes(b.threshold - field_value(b, G), xs, ys, zs,
+                          field=lambda X: b.threshold - field_value(b, X))
     return shade_normals(P, F, lambda X: gradient(b, X), lo, hi)
 
 

@@ -119,6 +119,18 @@ def _leaf_normals(leaf: m.SceneObject, M: np.ndarray, Pw: np.ndarray, tri_n: np.
     return np.where(ok[:, None], N, flat)
 
 
+def _canonical_order(Pw: np.ndarray, Ml: np.ndarray) -> np.ndarray:
+    """An order of triangles ``Pw`` (T, 3, 3) that does not depend on the scene's scale:
+    manifold3d returns a boolean's triangles in an order of its own, which changes when the
+    world is scaled (the radiosity patches cut from them, one per triangle, came out
+    permuted); sorted by their centroids in the leaf's object space (unscaled), rounded to
+    1e-9 of its size so that rounding does not reorder them."""
+    c = tf.transform_points(np.linalg.inv(Ml), Pw.mean(1))
+    size = max(float(np.abs(c).max(initial=0.0)), 1e-300)
+    q = np.round(c / size * 1e9)
+    return np.lexsort((q[:, 2], q[:, 1], q[:, 0]))
+
+
 def tessellate(node: m.CSG, level: int, parent: np.ndarray, kind_of) -> list[Part]:
     """Parts of a CSG node (one per leaf whose surface survives the boolean).
 
@@ -142,6 +154,7 @@ def tessellate(node: m.CSG, level: int, parent: np.ndarray, kind_of) -> list[Par
         if len(Fi) == 0:
             continue
         Pw = props[Fi][:, :, :3]  # (T, 3, 3), unwelded
+        Pw = Pw[_canonical_order(Pw, Ml)]
         tri_n = triangle_normals(Pw.reshape(-1, 3), np.arange(3 * len(Fi)).reshape(-1, 3))
         N = _leaf_normals(leaf, Ml, Pw, tri_n, kind_of)
         P = Pw.reshape(-1, 3)

@@ -272,7 +272,8 @@ def _closed_mesh(s: Isosurface, resolution: int) -> tuple[np.ndarray, np.ndarray
     lo, hi = bounds(s)
     xs, ys, zs = closed_grid(lo, hi, grid_cells(lo, hi, resolution, f"isosurface {s.name!r}"))
     X, Y, Z = np.meshgrid(xs[1:-1], ys[1:-1], zs[1:-1], indexing="ij")
-    return marching_cubes(pad_outside(evaluate_numpy(s.program, X, Y, Z) - s.threshold), xs, ys, zs)
+    return marching_cubes(pad_outside(evaluate_numpy(s.program, X, Y, Z) - s.threshold), xs, ys, zs,
+                          field=lambda Q: evaluate_numpy(s.program, Q[:, 0], Q[:, 1], Q[:, 2]) - s.threshold)
 
 
 def solid_mesh(s: Isosurface, level: int) -> tuple[np.ndarray, np.ndarray]:
