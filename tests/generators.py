@@ -10,9 +10,8 @@ Each object is built about its object-space origin, which is inside every closed
 generators make (an inside camera is put at an object's ``translate``), with a size about
 ``r`` (1 at scale 1).
 
-Cases left out: glass touching the floor (objects float above it: a box's bottom face on the
-floor and a mesh at scale 1e6 still differ across scales, tests/test_raytrace_scale_floor.py
-holds them as strict xfails); isosurface fields are polynomials and square roots of sums of
+Cases left out: glass touching the floor (objects float above it; every kind resting on a
+floor at scales 1e-6, 1 and 1e6 is tests/test_raytrace_scale_floor.py); isosurface fields are polynomials and square roots of sums of
 squares (a field with NaN values or a jump is refused at load, tests/test_kind_expression_checks.py).
 """
 from __future__ import annotations
