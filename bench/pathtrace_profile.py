@@ -58,7 +58,8 @@ def main() -> None:
     import workbench
     from workbench.renderers.pathtrace import kernels as K
     from workbench.renderers.pathtrace.session import PathTraceSession
-    from workbench.renderers.raytrace.kernels import NO_REFCOUNT, scratch, surface
+    from workbench.renderers.kernels.flags import NO_REFCOUNT
+    from workbench.renderers.kernels.intersect import scratch, surface
 
     @nb.njit(**NO_REFCOUNT)
     def record(geo, cam, em_tri, nsamp, scr, rows, O, D, TM, AH):

@@ -111,7 +111,7 @@ def mesh_intersection(repeats: int = 3) -> dict:
     from workbench.core.tol import tol
     from workbench.renderers.raytrace import kernels as K
     from workbench.renderers.raytrace.flatten import flatten
-    from workbench.renderers.raytrace.whitted import _alloc, camera_rays
+    from workbench.renderers.raytrace.whitted import _alloc, camera_rays, kernel_options
     numba.set_num_threads(1)
     scene = workbench.load_scene("mesh")
     r = min((workbench.render(scene, "raytrace", width=W, height=H, threshold=1.0 / 255.0, max_depth=5)
@@ -123,8 +123,7 @@ def mesh_intersection(repeats: int = 3) -> dict:
     h = _alloc(n)
     K.trace_batch(geo, O, D, np.zeros(n), np.full(n, np.inf), tol.zero, tol.ray_offset, sd.extent,
                   tol.normal_cancel, False, h["t"], h["prim"], h["ng"], h["ns"], h["uv"], h["po"], h["ev"])
-    kopts = np.zeros(18)
-    kopts[8], kopts[9], kopts[11] = tol.ray_offset, tol.t_min, sd.extent
+    kopts = kernel_options(1, extent=sd.extent)
     nl = len(sd.lights)
     fo, fd = np.empty((n * nl, 3)), np.empty((n * nl, 3))
     ftmin, ftmax, want = np.empty(n * nl), np.empty(n * nl), np.empty(n * nl, np.bool_)

@@ -25,7 +25,7 @@ import numba as nb
 import numpy as np
 import workbench
 from workbench.renderers.kernels.layout import kinds_marker
-from workbench.renderers.raytrace import kernels as k
+from workbench.renderers.kernels import intersect as k
 from workbench.renderers.raytrace.flatten import flatten
 from workbench.scene.kinds import blob_kernels, isosurface_kernels, lathe_kernels, prism_kernels
 

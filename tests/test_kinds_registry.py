@@ -32,11 +32,11 @@ def test_every_kind_provides_the_interface(name):
 
 
 def test_ptypes_are_unique_and_match_the_kernels():
-    from workbench.renderers.raytrace import kernels
+    from workbench.renderers.kernels import intersect, shapes
     ptypes = {k.PTYPE for k in KINDS.values()}
     assert len(ptypes) == len(KINDS)
-    assert (kernels.SPHERE, kernels.RECT, kernels.BOX, kernels.POLYGON, kernels.QUADRIC,
-            kernels.CSGNODE) == tuple(KINDS[n].PTYPE for n in ("sphere", "plane", "box", "polygon",
+    assert (shapes.SPHERE, shapes.RECT, shapes.BOX, shapes.POLYGON, shapes.QUADRIC,
+            intersect.CSGNODE) == tuple(KINDS[n].PTYPE for n in ("sphere", "plane", "box", "polygon",
                                                                  "quadric", "csg"))
 
 
@@ -67,6 +67,7 @@ def test_a_sheet_in_a_csg_tree_is_refused_by_its_kind():
 def test_area_light_is_one_polygon_in_every_method():
     from workbench.renderers.radiosity.patches import patches_from_scene
     from workbench.scene.tessellate import area_light_parts
+    from workbench.renderers.kernels.columns import Mat
     from workbench.renderers.raytrace.flatten import flatten
     from workbench.renderers.raytrace.reference import Context
     from workbench.scene.prepared import prepare
@@ -76,7 +77,7 @@ def test_area_light_is_one_polygon_in_every_method():
     assert mat.emission == (2.0, 1.0, 0.5) and mat.name not in scene.materials
     sd = flatten(scene)                                   # ray tracer: last row, front-only
     assert sd.obj[-1] == len(scene.objects) and not sd.shadow[-1]
-    assert sd.materials[sd.mat[-1]] == mat and sd.mat_tab[sd.mat[-1], 14] == 1.0
+    assert sd.materials[sd.mat[-1]] == mat and sd.mat_tab[sd.mat[-1], Mat.EMISSION + 1] == 1.0
     ctx = Context(scene)                                  # readable reference tracer
     assert np.array_equal(ctx.items[-1].obj.vertices, poly.vertices) and ctx.materials[mat.name] == mat
     ((part, pmat),) = area_light_parts(prepare(scene).area_lights)  # raster, zbuffer

@@ -92,12 +92,12 @@ def _structures(tri):
 
 
 def test_counting_traversal_finds_the_kernels_hits_and_brute_force_counts_are_exact():
-    from workbench.renderers.raytrace import kernels
+    from workbench.renderers.kernels import walks
     from workbench.renderers.raytrace.traversal_stats import count_hit
     rng = np.random.default_rng(7)
     c = rng.uniform(-3, 3, size=(500, 1, 3))
     tri = (c + rng.normal(scale=0.4, size=(500, 3, 3))).reshape(-1, 9)
-    stack = np.empty((kernels.BVH_STACK, 2))
+    stack = np.empty((walks.BVH_STACK, 2))
     O = rng.uniform(-6, 6, size=(300, 3))
     D = rng.normal(size=(300, 3))
     D /= np.linalg.norm(D, axis=1, keepdims=True)
@@ -107,7 +107,7 @@ def test_counting_traversal_finds_the_kernels_hits_and_brute_force_counts_are_ex
         arrays = (tree.node, tree.child, tree.leaf, tree.first, tree.tv4)
         ts = []
         for o, d in zip(O, D):
-            t, tr, _, _ = kernels.bvh_hit(arrays, *o, *d, 0.0, np.inf, np.bool_(False), stack)
+            t, tr, _, _ = walks.bvh_hit(arrays, *o, *d, 0.0, np.inf, np.bool_(False), stack)
             cnt = np.zeros(2, np.int64)
             t2, tr2 = count_hit(arrays, *o, *d, 0.0, np.inf, stack, cnt)
             assert (t2, tr2) == (t, tr)
@@ -180,16 +180,16 @@ def test_a_bad_accel_value_is_one_line_and_exit_2(tmp_path):
 def test_octree_of_coincident_triangles_stays_within_its_reference_budget():
     # 600 copies of one triangle: every cut would copy them all into one octant, level after
     # level; the depth and the reference budget end it, and rays still find the triangle
-    from workbench.renderers.raytrace import kernels
+    from workbench.renderers.kernels import walks
     from workbench.renderers.raytrace.octree import REF_FACTOR, build_octree
     tri = np.tile([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], (600, 1))
     tri[:300, 2] = tri[:300, 5] = tri[:300, 8] = 0.5  # and 300 copies of a parallel one, 0.5 behind
     refs, _ = build_octree(tri)
     assert len(tri) <= len(refs) <= REF_FACTOR * len(tri)
-    stack = np.empty((kernels.BVH_STACK, 2))
+    stack = np.empty((walks.BVH_STACK, 2))
     for a, order, tree in _structures(tri):
         arrays = (tree.node, tree.child, tree.leaf, tree.first, tree.tv4)
-        t, k, _, _ = kernels.bvh_hit(arrays, 0.2, 0.2, -1.0, 0.0, 0.0, 1.0, 0.0, np.inf, np.bool_(False), stack)
+        t, k, _, _ = walks.bvh_hit(arrays, 0.2, 0.2, -1.0, 0.0, 0.0, 1.0, 0.0, np.inf, np.bool_(False), stack)
         assert abs(t - 1.0) <= 1e-12 and k >= 0 and tri[order[k], 2] == 0.0, a
-        t, k, _, _ = kernels.bvh_hit(arrays, 0.2, 0.2, 2.0, 0.0, 0.0, -1.0, 0.0, np.inf, np.bool_(False), stack)
+        t, k, _, _ = walks.bvh_hit(arrays, 0.2, 0.2, 2.0, 0.0, 0.0, -1.0, 0.0, np.inf, np.bool_(False), stack)
         assert abs(t - 1.5) <= 1e-12 and tri[order[k], 2] == 0.5, a

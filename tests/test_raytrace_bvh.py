@@ -9,7 +9,8 @@ import pytest
 def test_a_degenerate_tree_stops_at_max_depth_and_is_traversed_exactly():
     # triangles at x = 100 * 2^-k: every SAH split peels one off; the tree stops at MAX_DEPTH
     # with a large leaf, so that no traversal stack ever overflows, and every hit is found
-    from workbench.renderers.raytrace import kernels, shapes
+    from workbench.renderers.kernels import walks
+    from workbench.renderers.raytrace import shapes
     from workbench.renderers.raytrace.bvh import MAX_DEPTH, build_bvh, build_bvh4
     n = 1200
     x = 100.0 * 2.0 ** -np.arange(n)
@@ -26,13 +27,13 @@ def test_a_degenerate_tree_stops_at_max_depth_and_is_traversed_exactly():
     assert meta[meta[:, 2] == -1, 1].sum() == n
     order, bvh = build_bvh4(tri.reshape(n, 9))
     tvo = np.ascontiguousarray(tri.reshape(n, 9)[order])
-    stack = np.empty((kernels.BVH_STACK, 2))
+    stack = np.empty((walks.BVH_STACK, 2))
     arrays = (bvh.node, bvh.child, bvh.leaf, bvh.first, bvh.tv4)
     for k in (0, 5, 59, 61, 300, 1000):  # along the x axis through the triangles, from afar
         o = np.array([-1.0, 2e-4, 2e-4])
         d = np.array([1.0, 0.0, 0.0])
         tb = shapes.triangles(tvo.reshape(-1, 3, 3), o, d)[0]
-        t = kernels.bvh_hit(arrays, *o, *d, x[k] + 1.0 - 1e-12, np.inf, np.bool_(False), stack)[0]
+        t = walks.bvh_hit(arrays, *o, *d, x[k] + 1.0 - 1e-12, np.inf, np.bool_(False), stack)[0]
         expected = np.where(tb > x[k] + 1.0 - 1e-12, tb, np.inf).min()
         assert t == pytest.approx(expected, rel=1e-12)
 
@@ -89,7 +90,8 @@ def test_4wide_tree_holds_each_triangle_once_inside_its_boxes(n):
 
 
 def test_4wide_traversal_equals_brute_force_closest_and_any_hit():
-    from workbench.renderers.raytrace import kernels, shapes
+    from workbench.renderers.kernels import walks
+    from workbench.renderers.raytrace import shapes
     from workbench.renderers.raytrace.bvh import build_bvh4
     tv = _soup(2, 400)
     order, bvh = build_bvh4(tv)
@@ -98,13 +100,13 @@ def test_4wide_traversal_equals_brute_force_closest_and_any_hit():
     O = rng.uniform(-8, 8, size=(300, 3))
     D = rng.uniform(-3, 3, size=(300, 3)) - O
     D[:20] = [0.1, 0.05, 1.0] - O[:20]  # at the eight stacked triangles
-    stack = np.empty((kernels.BVH_STACK, 2))
+    stack = np.empty((walks.BVH_STACK, 2))
     arrays = (bvh.node, bvh.child, bvh.leaf, bvh.first, bvh.tv4)
     hits = 0
     for o, d in zip(O, D):
         tb, _, _ = shapes.triangles(tvo.reshape(-1, 3, 3), o, d)
         tb = np.where(tb > 1e-9, tb, np.inf)
-        t, tri, b1, b2 = kernels.bvh_hit(arrays, *o, *d, 1e-9, np.inf, np.bool_(False), stack)
+        t, tri, b1, b2 = walks.bvh_hit(arrays, *o, *d, 1e-9, np.inf, np.bool_(False), stack)
         if np.isfinite(tb.min()):
             hits += 1
             assert t == pytest.approx(tb.min(), rel=1e-9)
@@ -115,7 +117,7 @@ def test_4wide_traversal_equals_brute_force_closest_and_any_hit():
         else:
             assert tri == -1 and np.isinf(t)
         # any hit: some triangle within [tmin, tmax] iff brute force has one
-        ta, tria, _, _ = kernels.bvh_hit(arrays, *o, *d, 1e-9, 0.5, np.bool_(True), stack)
+        ta, tria, _, _ = walks.bvh_hit(arrays, *o, *d, 1e-9, 0.5, np.bool_(True), stack)
         assert (tria >= 0) == bool((tb < 0.5).any())
         if tria >= 0:
             assert ta < 0.5 and tb[tria] == pytest.approx(ta, rel=1e-9)

@@ -5,7 +5,7 @@ relative (``tol.ray_offset``, ``tol.t_min`` times the larger of the hit point's 
 the scene's extent), so the three images agree; the bound allows 4 of the 48 x 36 pixels to
 differ by more than 0.05 (a grazing ray at a silhouette, where the last bit decides).  A box's
 bottom face coincides with the floor: surfaces closer than the ray offset are one, the object
-listed first wins (``kernels.nearer``), whatever the rounding at each scale says.  A mesh's
+listed first wins (``renderers.kernels.intersect.nearer``), whatever the rounding at each scale says.  A mesh's
 vertex normals are judged cancelled in object space (at scale 1e6 the inverse transpose makes
 them 1e-6 long, and half of them were taken for cancelled).
 """

@@ -13,6 +13,13 @@ from typing import NamedTuple
 
 import numpy as np
 
+MAX_DEPTH = 60
+"""Deepest binary level of a BVH build (``raytrace.bvh``): a node there is a leaf whatever its
+size (only degenerate input, e.g. triangles at geometrically shrinking spacing, reaches it).
+It bounds the traversal stacks: radiosity's visibility test keeps one pending child per
+level, the 4-wide walks at most three per level (``walks.BVH_STACK``), so neither ever drops
+a node."""
+
 FEATURES = ("blob", "isosurface", "lathe", "prism", "csg", "triangles", "prim_tree")
 """What a kernel compiles only when the scene has it: the kinds with kernels of their own
 (``workbench.scene.kinds.*_kernels``), CSG programs, the triangles' BVH walk and the analytic

@@ -11,7 +11,7 @@ code only.
 
 The kinds with kernels of their own are blob, isosurface, lathe and prism
 (``workbench.scene.kinds.*_kernels``); the rest (sphere, rectangle, box, polygon, quadric) are a
-few lines each and stay inline in :mod:`workbench.renderers.raytrace.kernels`.
+few lines each and stay inline in :mod:`workbench.renderers.kernels.shapes`.
 """
 from __future__ import annotations
 

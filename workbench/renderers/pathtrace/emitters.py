@@ -20,6 +20,7 @@ import numpy as np
 
 from ...core.tol import tol
 from ...scene.kinds import BOX, KINDS, MESH, POLYGON, RECT
+from ..kernels.columns import Mat
 from ..raytrace.flatten import SceneData
 
 _BOX_QUADS = ((0, 2, 6, 4), (1, 5, 7, 3), (0, 4, 5, 1), (2, 3, 7, 6), (0, 1, 3, 2), (4, 6, 7, 5))
@@ -103,7 +104,7 @@ prism or isosurface named a ptype past a hand-written list of six and raised Ind
 def build_emitters(sd: SceneData) -> Emitters:
     """The emitter table of a flattened scene (see the module docstring)."""
     tris, prims, mtris, lums, unsampled = [], [], [], [], []
-    emission = sd.mat_tab[:, 13:16]
+    emission = sd.mat_tab[:, Mat.EMISSION:Mat.EMISSION + 3]
     for k in range(len(sd.ptype)):
         if sd.ptype[k] == MESH or not sd.top[k]:
             continue

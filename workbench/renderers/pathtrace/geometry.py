@@ -1,7 +1,7 @@
 """The scene as the path tracer traces it: flat opaque polygons and rectangles become
 triangle meshes, so that they are intersected through the ray tracer's 4-wide BVH
-(:func:`..raytrace.kernels.bvh_hit`, watertight triangle tests four at a time) instead of one
-by one in :func:`..raytrace.kernels.closest`'s linear loop over analytic primitives: the
+(:func:`..kernels.walks.bvh_hit`, watertight triangle tests four at a time) instead of one
+by one in :func:`..kernels.intersect.closest`'s linear loop over analytic primitives: the
 Cornell box's 15 quadrilaterals cost a BVH descent instead of 15 polygon tests per ray.
 
 Only what a triangle mesh describes identically is converted: convex polygons and rectangles

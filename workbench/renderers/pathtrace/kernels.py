@@ -1,6 +1,6 @@
 """Numba kernels of the path tracer: unbiased Monte Carlo estimation of the rendering equation
 (Kajiya, "The rendering equation", SIGGRAPH 1986) on the ray tracer's arrays, BVH and
-intersection kernels (:func:`..raytrace.kernels.closest`, :func:`..raytrace.kernels.surface`).
+intersection kernels (:func:`..kernels.intersect.closest`, :func:`..kernels.intersect.surface`).
 
 One path per sample, from the camera (uniform jitter in the pixel: the box-filtered pixel):
 
@@ -26,7 +26,7 @@ One path per sample, from the camera (uniform jitter in the pixel: the box-filte
   ``q = min(0.95, max(beta))``, ``beta /= q``; a path stops for good at ``max_bounces``
   (``0.95^k``: unreachable in practice, a guard against endless loops).
 
-Transport (``opts[18]``), for the matched references of other methods (DESIGN.md, "Ground
+Transport (``opts[PathOpt.TRANSPORT]``), for the matched references of other methods (DESIGN.md, "Ground
 truth and the error split"):
 
 * ``full`` (0): all of the above;
@@ -47,7 +47,7 @@ truth and the error split"):
   that difference is missing physics); from the first non-delta bounce on, ``diffuse`` transport
   (no caustics: a mirror or glass surface is Lambertian ``kd C`` there).
 
-Pixel filter (``opts[19]``): 0 box (uniform jitter over the pixel's square: the workbench's ideal
+Pixel filter (``opts[PathOpt.PIXEL_FILTER]``): 0 box (uniform jitter over the pixel's square: the workbench's ideal
 image), 1 centre (every sample through the pixel's centre: the point-sampled image of the
 raster and radiosity methods; the estimate converges to the radiance seen at the centre).
 
@@ -64,9 +64,14 @@ import math
 import numba as nb
 import numpy as np
 
+from ..kernels.columns import Light, Mat, PathOpt
 from ..kernels.tasks import run_tasks
-from ..raytrace.kernels import (MAX_TASKS, NO_REFCOUNT, _feeler, _light_dir, _normalize, bvh_hit,
-                                checker_color, closest, fresnel_reflectance, scratch, surface)
+from ..kernels.flags import NO_REFCOUNT
+from ..kernels.intersect import closest, scratch, surface
+from ..kernels.optics import _feeler, _light_dir, checker_color, fresnel_reflectance
+from ..kernels.shapes import _normalize
+from ..kernels.walks import bvh_hit
+from ..raytrace.kernels import MAX_TASKS
 
 BLOCK = 32
 """Pixels per work item of :func:`render_samples`."""
@@ -124,7 +129,7 @@ def _around(nx, ny, nz, cos_t, phi):
 @nb.njit(error_model="numpy", inline="always")
 def camera_ray_at(cam, i, j, u, v):
     """Unit direction of the ray through point ``(j + u, i + v)`` of the image plane (pixel
-    ``(i, j)``, ``u, v`` in [0, 1); ``u = v = 1/2`` is :func:`..raytrace.kernels.camera_ray`'s
+    ``(i, j)``, ``u, v`` in [0, 1); ``u = v = 1/2`` is :func:`..kernels.optics.camera_ray`'s
     centre ray) of the camera ``cam`` (``raytrace.whitted.camera_frame``)."""
     x = ((j + u) / cam[14] * 2.0 - 1.0) * cam[12] * cam[13]
     y = (1.0 - (i + v) / cam[15] * 2.0) * cam[12]
@@ -169,7 +174,7 @@ def pick_emitter(cdf, u):
 
 @nb.njit(cache=True, error_model="numpy")
 def hit_rows():
-    """One row per hit record of :func:`..raytrace.kernels.surface`: geometric normal, shading
+    """One row per hit record of :func:`..kernels.intersect.surface`: geometric normal, shading
     normal, uv, object-space point, vertex emission; then the media stack (4)."""
     return (np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 2)), np.empty((1, 3)), np.empty((1, 3)),
             np.zeros(4, np.int64))
@@ -220,7 +225,7 @@ def pixel_block(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq,
                 scr, rows):
     """Pixels ``p0 .. p1 - 1`` of :func:`render_samples`, each sample's path in turn."""
     width = int(cam[14])
-    centre = opts[19] > 0.5
+    centre = opts[PathOpt.PIXEL_FILTER] > 0.5
     for p in range(p0, p1):
         i, j = p // width, p % width
         for s in range(s0, s0 + nsamp):
@@ -244,7 +249,7 @@ def pixel_block(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq,
 
 @nb.njit(**NO_REFCOUNT)
 def cast_all(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr):
-    """:func:`..raytrace.kernels.closest` over every primitive (area lights included), compiled
+    """:func:`..kernels.intersect.closest` over every primitive (area lights included), compiled
     once here (not inlined: its call sites share one copy)."""
     stack, st, sp_, sf, sn = scr
     return closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, np.bool_(False), np.bool_(any_hit), zero, eps, stack, st,
@@ -254,10 +259,10 @@ def cast_all(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr):
 @nb.njit(error_model="numpy", inline="always")
 def cast(geo, bvh, tri_prim, only_tris, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr):
     """The hit of every ray of a path (camera, extension and shadow rays), as
-    :func:`..raytrace.kernels.closest` returns it.  ``only_tris`` (``opts[20]``: every
+    :func:`..kernels.intersect.closest` returns it.  ``only_tris`` (``opts[PathOpt.ONLY_TRIANGLES]``: every
     primitive a BVH triangle, no top-level analytic primitive, as the Cornell box once its
     polygons and area light are triangles, :mod:`.geometry`): straight to
-    :func:`..raytrace.kernels.bvh_hit`, which is all ``closest`` would do (its loop over analytic
+    :func:`..kernels.walks.bvh_hit`, which is all ``closest`` would do (its loop over analytic
     primitives is empty and its box test the BVH root's); the call then passes the BVH's five
     arrays instead of the geometry's 21 (measured: 30-40 % of a ray's time in this scene)."""
     if only_tris:
@@ -278,16 +283,17 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
     tri_e = geo.tri_e
     tri_prim = geo.tri_prim
     bvh = (geo.bvh_node, geo.bvh_child, geo.bvh_leaf, geo.bvh_first, geo.bvh_tv4)
-    only_tris = opts[20] > 0.5
+    only_tris = opts[PathOpt.ONLY_TRIANGLES] > 0.5
     h_ng, h_ns, h_uv, h_po, h_ev, stk = rows
-    fres = int(opts[0])
-    ray_off, t_min, zero, extent, ncancel = opts[1], opts[2], opts[3], opts[4], opts[5]
-    rr_start, max_bounces = int(opts[6]), int(opts[7])
-    use_tex, beta_mis = opts[8] > 0.5, opts[9]
-    nstk = int(opts[13])
-    transport = int(opts[18])
+    fres = int(opts[PathOpt.FRESNEL])
+    ray_off, t_min, zero = opts[PathOpt.RAY_OFFSET], opts[PathOpt.T_MIN], opts[PathOpt.ZERO]
+    extent, ncancel = opts[PathOpt.EXTENT], opts[PathOpt.NORMAL_CANCEL]
+    rr_start, max_bounces = int(opts[PathOpt.RR_START]), int(opts[PathOpt.MAX_BOUNCES])
+    use_tex, beta_mis = opts[PathOpt.TEXTURED] > 0.5, opts[PathOpt.MIS_BETA]
+    nstk = int(opts[PathOpt.N_MEDIA])
+    transport = int(opts[PathOpt.TRANSPORT])
     for q in range(4):
-        stk[q] = int(opts[14 + q])
+        stk[q] = int(opts[PathOpt.MEDIA + q])
     n_em = em_cdf.shape[0]
     nl = lights.shape[0]
     br, bg_, bb = 1.0, 1.0, 1.0           # path throughput beta
@@ -304,15 +310,15 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
         if k < 0:
             counts[4] += 1
             if transport == 0 or eye:  # diffuse transport: the background is seen, it lights nothing
-                Lr += br * opts[10]
-                Lg += bg_ * opts[11]
-                Lb += bb * opts[12]
+                Lr += br * opts[PathOpt.BACKGROUND]
+                Lg += bg_ * opts[PathOpt.BACKGROUND + 1]
+                Lb += bb * opts[PathOpt.BACKGROUND + 2]
             return Lr, Lg, Lb
         if nstk > 0:  # Beer-Lambert absorption of the medium the segment crossed
             ma = stk[nstk - 1]
-            br *= math.exp(-mat_tab[ma, 10] * t)
-            bg_ *= math.exp(-mat_tab[ma, 11] * t)
-            bb *= math.exp(-mat_tab[ma, 12] * t)
+            br *= math.exp(-mat_tab[ma, Mat.ABSORPTION] * t)
+            bg_ *= math.exp(-mat_tab[ma, Mat.ABSORPTION + 1] * t)
+            bb *= math.exp(-mat_tab[ma, Mat.ABSORPTION + 2] * t)
         px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
         surface(geo, k, f, tri, b1, b2, px, py, pz, ncancel, h_ng, h_ns, h_uv, h_po, h_ev, 0, scr[0])
         mi = mat_of[k]
@@ -323,7 +329,8 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
         nx, ny, nz = h_ns[0, 0], h_ns[0, 1], h_ns[0, 2]
         if nx * dx + ny * dy + nz * dz > 0.0:
             nx, ny, nz = -nx, -ny, -nz                              # shading normal, incident side
-        kd, ks, shin, kr, kt = mat_tab[mi, 4], mat_tab[mi, 5], mat_tab[mi, 6], mat_tab[mi, 7], mat_tab[mi, 8]
+        kd, ks, shin = mat_tab[mi, Mat.KD], mat_tab[mi, Mat.KS], mat_tab[mi, Mat.SHININESS]
+        kr, kt = mat_tab[mi, Mat.KR], mat_tab[mi, Mat.KT]
         if transport > 0:
             if transport == 2 and eye and (kr > 0.0 or kt > 0.0):
                 ks = 0.0                   # eye-path mirror / glass: its delta lobes and kd C
@@ -341,10 +348,10 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
         er, eg, eb = 0.0, 0.0, 0.0
         if transport == 0:
             er, eg, eb = h_ev[0, 0], h_ev[0, 1], h_ev[0, 2]
-        if front or (transport == 0 and mat_tab[mi, 16] < 0.5):
-            er += mat_tab[mi, 13]
-            eg += mat_tab[mi, 14]
-            eb += mat_tab[mi, 15]
+        if front or (transport == 0 and mat_tab[mi, Mat.FRONT_ONLY] < 0.5):
+            er += mat_tab[mi, Mat.EMISSION]
+            eg += mat_tab[mi, Mat.EMISSION + 1]
+            eb += mat_tab[mi, Mat.EMISSION + 2]
         if er > 0.0 or eg > 0.0 or eb > 0.0:
             w = 1.0
             if not delta_before:
@@ -355,8 +362,8 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
             Lg += bg_ * eg * w
             Lb += bb * eb * w
         # ---- lobes
-        cr, cg, cb = mat_tab[mi, 0], mat_tab[mi, 1], mat_tab[mi, 2]
-        if use_tex and mat_tab[mi, 17] > 0.5:
+        cr, cg, cb = mat_tab[mi, Mat.COLOR], mat_tab[mi, Mat.COLOR + 1], mat_tab[mi, Mat.COLOR + 2]
+        if use_tex and mat_tab[mi, Mat.TEXTURED] > 0.5:
             tr_, tg_, tb_ = checker_color(tex_tab, mi, h_po[0, 0], h_po[0, 1], h_po[0, 2])
             cr, cg, cb = cr * tr_, cg * tg_, cb * tb_
         total = kd * max(cr, cg, cb) + ks + kr + kt
@@ -380,11 +387,11 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
         if a_t > 0.0 and solid[k]:
             cf = -(dx * fx + dy * fy + dz * fz)
             if front:
-                n1 = mat_tab[stk[nstk - 1], 9] if nstk > 0 else 1.0
-                n2 = mat_tab[mi, 9]
+                n1 = mat_tab[stk[nstk - 1], Mat.IOR] if nstk > 0 else 1.0
+                n2 = mat_tab[mi, Mat.IOR]
                 push = True
             else:
-                n1 = mat_tab[mi, 9]
+                n1 = mat_tab[mi, Mat.IOR]
                 jj = nstk - 1
                 while jj >= 0 and stk[jj] != mi:
                     jj -= 1
@@ -396,9 +403,9 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                         if q != jj:
                             top_ = stk[q]
                             break
-                    n2 = mat_tab[top_, 9] if top_ >= 0 else 1.0
+                    n2 = mat_tab[top_, Mat.IOR] if top_ >= 0 else 1.0
                 elif nstk > 0:
-                    n2 = mat_tab[stk[nstk - 1], 9]
+                    n2 = mat_tab[stk[nstk - 1], Mat.IOR]
             eta = n1 / n2
             kk = 1.0 - eta * eta * (1.0 - cf * cf)
             if kk <= 0.0:  # total internal reflection: the transmitted share is reflected
@@ -434,8 +441,10 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                     cos_l = -(lx * em_n[e, 0] + ly * em_n[e, 1] + lz * em_n[e, 2])
                     emi = mat_of[em_prim[e]]
                     ler, leg, leb = 0.0, 0.0, 0.0
-                    if cos_l > 0.0 or (transport == 0 and mat_tab[emi, 16] < 0.5):
-                        ler, leg, leb = mat_tab[emi, 13], mat_tab[emi, 14], mat_tab[emi, 15]
+                    if cos_l > 0.0 or (transport == 0 and mat_tab[emi, Mat.FRONT_ONLY] < 0.5):
+                        ler = mat_tab[emi, Mat.EMISSION]
+                        leg = mat_tab[emi, Mat.EMISSION + 1]
+                        leb = mat_tab[emi, Mat.EMISSION + 2]
                     mt = em_mtri[e]
                     if mt >= 0 and transport == 0:
                         for q in range(3):
@@ -483,9 +492,9 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                     continue
                 fs, _ = phong_lobe(a_s, shin, rx, ry, rz, lx, ly, lz)
                 e_ = math.pi * sc * cos_s  # irradiance per unit light value
-                Lr += br * (adr * INV_PI + fs) * lights[li, 4] * e_
-                Lg += bg_ * (adg * INV_PI + fs) * lights[li, 5] * e_
-                Lb += bb * (adb * INV_PI + fs) * lights[li, 6] * e_
+                Lr += br * (adr * INV_PI + fs) * lights[li, Light.POWER] * e_
+                Lg += bg_ * (adg * INV_PI + fs) * lights[li, Light.POWER + 1] * e_
+                Lb += bb * (adb * INV_PI + fs) * lights[li, Light.POWER + 2] * e_
         # ---- Russian roulette
         if bounce + 1 >= rr_start:
             q_rr = min(0.95, max(br, bg_, bb))

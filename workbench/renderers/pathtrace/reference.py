@@ -21,6 +21,7 @@ from ...core.tol import tol
 from ...scene import model as m
 from ...scene.kinds import MESH
 from .. import local_model
+from ..kernels.columns import Mat
 from ..raytrace import reference as rt
 from ..raytrace.flatten import flatten
 from ..raytrace.whitted import camera_frame
@@ -54,7 +55,8 @@ class Tracer:
         self.full = options.transport == "full"
         self.ctx = rt.Context(self.scene, fresnel=options.fresnel)
         sd = flatten(self.scene, prepared=self.ctx.prepared)
-        if (sd.tri_e > 0).any() or any(sd.mat_tab[sd.mat[k], 13:16].max() > 0 for k in np.flatnonzero(sd.ptype == MESH)):
+        emission = sd.mat_tab[:, Mat.EMISSION:Mat.EMISSION + 3]
+        if (sd.tri_e > 0).any() or any(emission[sd.mat[k]].max() > 0 for k in np.flatnonzero(sd.ptype == MESH)):
             raise WorkbenchError("pathtrace reference: emissive meshes are not covered")
         self.em = build_emitters(sd)
         self.em_material = [sd.materials[sd.mat[k]] for k in self.em.prim]

@@ -21,7 +21,8 @@ from ...core.tol import tol
 from ...scene import model as m
 from ...scene.prepared import prepare
 from ..raytrace.flatten import flatten, light_rows
-from ..raytrace.whitted import TEX_COLS, camera_frame, fused_textures
+from ..kernels.columns import LIGHT_COLS, TEX_COLS, Mat, PathOpt, pack
+from ..raytrace.whitted import camera_frame, fused_textures
 from .emitters import build_emitters
 from .geometry import FRONT_ONLY, triangulated
 
@@ -68,7 +69,7 @@ class PathTraceSession:
     max_bounces : hard stop of a path (>= 1).  mis : ``power`` (exponent 2) or ``balance``.
     triangulate : trace plain opaque polygons and rectangles, and convex area lights, as
     triangles through the BVH (:mod:`.geometry`; the same surfaces, faster: a scene of triangles
-    only casts every ray straight into the BVH, ``opts[20]``), else as the ray tracer's polygons.
+    only casts every ray straight into the BVH, ``PathOpt.ONLY_TRIANGLES``), else as the ray tracer's polygons.
     transport : ``full`` | ``diffuse`` | ``eye_specular`` (:data:`TRANSPORT`; the latter two
     ignore point and directional lights, textures and vertex emission).
     pixel_filter : ``box`` | ``center`` (:data:`PIXEL_FILTER`).
@@ -104,13 +105,13 @@ class PathTraceSession:
         sd = flatten(traced, accel, prepared=prepared)
         for i, mt in enumerate(sd.materials):  # area lights as triangles: still front-face emitters
             if mt.name.startswith(FRONT_ONLY):
-                sd.mat_tab[i, 16] = 1.0
+                sd.mat_tab[i, Mat.FRONT_ONLY] = 1.0
         self.sd = sd
         self.emitters = build_emitters(sd)
         full = transport == "full"
         point = [lt for lt in scene.lights if not isinstance(lt, m.AreaLight)] if full else []
-        lights = np.ascontiguousarray(light_rows(point).reshape(-1, 14))
-        surfaces_emit = bool((sd.mat_tab[sd.mat, 13:16] > 0).any())
+        lights = np.ascontiguousarray(light_rows(point).reshape(-1, LIGHT_COLS))
+        surfaces_emit = bool((sd.mat_tab[sd.mat, Mat.EMISSION:Mat.EMISSION + 3] > 0).any())
         emissive = surfaces_emit or bool((sd.tri_e > 0).any())
         background = np.asarray(scene.background, dtype=np.float64)
         if full and not (emissive or len(point) or (background > 0).any()):
@@ -127,11 +128,12 @@ class PathTraceSession:
         media = [names.index(mt.name) for mt in prepared.camera_media][-4:]
         if transport == "diffuse":  # every surface opaque: no medium
             media = []
-        self.opts = np.array([FRESNEL[fresnel], tol.ray_offset, tol.t_min, tol.zero, sd.extent,
-                              tol.normal_cancel, rr_start, max_bounces, float(self.textured), MIS[mis],
-                              *background, len(media), *(media + [0] * (4 - len(media))),
-                              TRANSPORT[transport], PIXEL_FILTER[pixel_filter],
-                              float(len(sd.tri_v) > 0 and not sd.top.any())])
+        self.opts = pack(PathOpt, fresnel=FRESNEL[fresnel], ray_offset=tol.ray_offset, t_min=tol.t_min,
+                         zero=tol.zero, extent=sd.extent, normal_cancel=tol.normal_cancel, rr_start=rr_start,
+                         max_bounces=max_bounces, textured=self.textured, mis_beta=MIS[mis],
+                         background=background, n_media=len(media), media=media + [0] * (4 - len(media)),
+                         transport=TRANSPORT[transport], pixel_filter=PIXEL_FILTER[pixel_filter],
+                         only_triangles=len(sd.tri_v) > 0 and not sd.top.any())
         self.shading = (sd.mat, sd.mat_tab, np.ascontiguousarray(tex), lights)
         self.geo = sd.kernel_args()
         self.cam = camera_frame(self.scene.camera, self.width, self.height)

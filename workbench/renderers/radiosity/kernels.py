@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ..raytrace.bvh import MAX_DEPTH
+from ..kernels.layout import MAX_DEPTH
 
 TWO_PI = 2.0 * np.pi
 

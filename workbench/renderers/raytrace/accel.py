@@ -6,7 +6,7 @@
   (one leaf holding them all).
 
 All three are laid out as :class:`.bvh.Bvh4` (4-wide nodes, leaves of triangles packed by
-four), so the one traversal :func:`.kernels.bvh_hit` serves them: they differ only in which
+four), so the one traversal :func:`..kernels.walks.bvh_hit` serves them: they differ only in which
 boxes a ray tests and which triangles it tests.  They find the same closest hit; where two
 triangles have exactly the same ``t`` (a ray through a shared edge or vertex), the first
 tested wins, and the order of the tests is the structure's.  The octree references a triangle
@@ -18,7 +18,7 @@ every top-level primitive with finite world bounds is an item of a second tree o
 kind (:class:`PrimTree`, built over their padded world boxes: :func:`build_prim_tree`), its
 leaves listing primitive rows; the unbounded ones (a quadric without bounds, a CSG node with
 one among its operands) stay in a short list tested by every ray.  With ``none`` every
-primitive is in that list (the brute force of before).  :func:`.kernels.closest` tests the
+primitive is in that list (the brute force of before).  :func:`..kernels.intersect.closest` tests the
 list, then the primitives' tree, then the triangles' tree: all three find the closest hit,
 and equal ``t`` goes to the lowest primitive row (as the brute-force loop in row order
 does), then to the analytic primitive before a triangle, so the images are the same.

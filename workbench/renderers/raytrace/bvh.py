@@ -24,15 +24,12 @@ from typing import NamedTuple
 import numba as nb
 import numpy as np
 
+from ..kernels.layout import MAX_DEPTH
+
 N_BINS = 16
 BIN_SAMPLES = 256
 """Items binned per node, about: a node of more bins a regular sample of them (see :func:`_build`)."""
 MAX_LEAF = 4
-MAX_DEPTH = 60
-"""Deepest binary level: a node there is a leaf whatever its size (only degenerate input, e.g.
-triangles at geometrically shrinking spacing, reaches it).  It bounds the traversal stacks:
-radiosity's visibility test keeps one pending child per level, the ray tracer's 4-wide
-traversal at most three per level (``kernels.BVH_STACK``), so neither ever drops a node."""
 # SAH cost of a traversal step relative to one triangle test (pbrt-v4 uses 1/2 as well).
 TRAVERSAL_COST = 0.5
 

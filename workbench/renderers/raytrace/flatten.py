@@ -36,6 +36,7 @@ from ...scene.kinds import kind_of
 from ...scene.kinds import blob, isosurface, lathe, prism
 from ...scene.kinds.csg import CSGNODE
 from ...scene.prepared import PreparedScene, prepare
+from ..kernels.columns import LIGHT_COLS, Light, Mat, pack
 from ..kernels.layout import Geometry, kinds_marker
 
 if TYPE_CHECKING:
@@ -86,8 +87,8 @@ class SceneData:
     bvh: Bvh4                   # 4-wide BVH over the triangles (see .bvh)
     prims: PrimTree             # the analytic primitives' list and structure (see .accel)
     materials: list             # Material objects, index = mat
-    mat_tab: np.ndarray         # (M, 24) numeric material table (see _material_row)
-    lights: np.ndarray          # (L, 14) light table (see _light_rows)
+    mat_tab: np.ndarray         # (M, MAT_COLS) material table, columns ``kernels.columns.Mat``
+    lights: np.ndarray          # (L, LIGHT_COLS) light table, columns ``kernels.columns.Light``
     extent: float               # diagonal of the scene's bounds (PreparedScene.extent)
     n_objects: int
     bvh_build_time: float = 0.0
@@ -119,27 +120,25 @@ class SceneData:
 
 
 def _material_row(mat: m.Material, front_only: bool = False) -> np.ndarray:
-    """color(3) ka kd ks shininess kr kt ior absorption(3) emission(3) front_only_emitter
-    has_texture has_bump has_opacity environment."""
-    return np.array([*mat.color, mat.ka, mat.kd, mat.ks, mat.shininess, mat.kr, mat.kt, mat.ior,
-                     *mat.absorption, *mat.emission, float(front_only), float(mat.texture is not None),
-                     float(mat.bump is not None), float(mat.opacity is not None),
-                     float(mat.environment), 0.0, 0.0], dtype=np.float64)
+    """The material's row of the material table (columns :class:`..kernels.columns.Mat`)."""
+    return pack(Mat, color=mat.color, ka=mat.ka, kd=mat.kd, ks=mat.ks, shininess=mat.shininess,
+                kr=mat.kr, kt=mat.kt, ior=mat.ior, absorption=mat.absorption, emission=mat.emission,
+                front_only=front_only, textured=mat.texture is not None, bumped=mat.bump is not None,
+                opacity=mat.opacity is not None, environment=mat.environment)
 
 
 def light_rows(lights) -> np.ndarray:
-    """(L, 14): kind (0 point, 1 directional), position or direction (3), colour*intensity (3),
-    inverse-square flag, cosine flag, cosine normal (3), spare."""
-    rows = np.zeros((len(lights), 14))
+    """(L, LIGHT_COLS) table of point and directional lights (columns
+    :class:`..kernels.columns.Light`)."""
+    rows = np.zeros((len(lights), LIGHT_COLS))
     for i, lt in enumerate(lights):
-        if isinstance(lt, m.DirectionalLight):
-            rows[i, 0], rows[i, 1:4] = 1.0, lt.direction
-        else:
-            rows[i, 1:4] = lt.position
-            rows[i, 7] = float(lt.falloff == "inverse_square")
-            if lt.cosine_normal is not None:
-                rows[i, 8], rows[i, 9:12] = 1.0, lt.cosine_normal
-        rows[i, 4:7] = np.asarray(lt.color) * lt.intensity
+        directional = isinstance(lt, m.DirectionalLight)
+        cosine = not directional and lt.cosine_normal is not None
+        rows[i] = pack(Light, kind=float(directional),
+                       position=lt.direction if directional else lt.position,
+                       power=np.asarray(lt.color) * lt.intensity,
+                       inverse_square=not directional and lt.falloff == "inverse_square",
+                       cosine=cosine, cosine_normal=lt.cosine_normal if cosine else (0.0, 0.0, 0.0))
     return rows
 
 
@@ -328,6 +327,6 @@ def flatten(scene: m.Scene, accel: str = "bvh", prepared: PreparedScene | None =
         tri_v=tri_v, tri_n=tri_n, tri_uv=tri_uv, tri_e=tri_e, tri_prim=tri_p, tri_src=tri_src,
         bvh=bvh, prims=prims,
         materials=b.materials, mat_tab=np.ascontiguousarray(mat_tab),
-        lights=np.ascontiguousarray(light_rows(scene.point_lights()).reshape(-1, 14)),
+        lights=np.ascontiguousarray(light_rows(scene.point_lights()).reshape(-1, LIGHT_COLS)),
         extent=prepared.extent, n_objects=len(scene.objects), bvh_build_time=bvh_time,
         aux=np.ascontiguousarray(np.concatenate(b.aux) if b.aux else np.zeros(1)))

@@ -1,5 +1,5 @@
 """The course's octree ("arbre octal : intersection avec le cube courant") over triangles, laid
-out as the ray tracer's 4-wide tree so that :func:`.kernels.bvh_hit` traverses it unchanged.
+out as the ray tracer's 4-wide tree so that :func:`..kernels.walks.bvh_hit` traverses it unchanged.
 
 Build (Glassner, "Space subdivision for fast ray tracing", IEEE CG&A 1984): the root is the cube
 of side ``max(extent)`` at the triangles' lower bounds corner (stretched, exactly, to their
@@ -27,7 +27,7 @@ MAX_LEAF = 8
 """A cell with more triangles than this is cut (if depth and budget allow)."""
 MAX_DEPTH = 16
 """Deepest cell level (the root is 0).  A level costs the traversal stack at most four pending
-children (one half, three octants): ``4 MAX_DEPTH`` stays within ``kernels.BVH_STACK``."""
+children (one half, three octants): ``4 MAX_DEPTH`` stays within ``..kernels.walks.BVH_STACK``."""
 REF_FACTOR = 4
 """Triangle references the octree may hold, per triangle: the bound of its memory estimate."""
 

@@ -4,13 +4,13 @@ nodes visited and primitives tested per camera ray, counted in a pass of their o
 the rendering kernels carry no counters (their speed is untouched; the pass costs about one
 more trace of the pixel centres and is timed apart, ``timings["traversal_stats"]``).
 
-:func:`count_hit` is :func:`.kernels.bvh_hit` (closest hit) step for step with two counters:
+:func:`count_hit` is :func:`..kernels.walks.bvh_hit` (closest hit) step for step with two counters:
 the same box and triangle tests in the same order, so it returns the same hit (tested) and
 its counts are the real traversal's; the analytic primitives' tree is walked by the rendering
-kernels' own :func:`.kernels.prim_tree_walk` with its counting switched on.  Counting rules,
+kernels' own :func:`..kernels.intersect.prim_tree_walk` with its counting switched on.  Counting rules,
 per ray and per structure (the triangles', the analytic primitives'):
 
-* nodes: 1 for the structure's root box (:func:`.kernels.closest`'s bounds test), plus one
+* nodes: 1 for the structure's root box (:func:`..kernels.intersect.closest`'s bounds test), plus one
   per further 4-wide node whose children's boxes the ray tests (the root's own visit is the
   bounds test's: a ray that misses the root box visits 1 node, one that enters it visits the
   root and the nodes it goes on to).  Rays that meet no box are counted too.  A scene without
@@ -31,13 +31,15 @@ import numpy as np
 from numba import prange
 
 from ...core.tol import tol
-from .kernels import (CHUNK, NO_REFCOUNT, _bounds_hit, _tasks, node_ray, open_node, prim_tree_walk, row_hit,
-                      scratch, tri_lane)
+from ..kernels.flags import NO_REFCOUNT
+from ..kernels.intersect import prim_tree_walk, row_hit, scratch
+from ..kernels.walks import _bounds_hit, node_ray, open_node, tri_lane
+from .kernels import CHUNK, _tasks
 
 
 @nb.njit(**NO_REFCOUNT)
 def count_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, stack, cnt):
-    """:func:`.kernels.bvh_hit`'s closest-hit traversal, adding the 4-wide nodes visited to
+    """:func:`..kernels.walks.bvh_hit`'s closest-hit traversal, adding the 4-wide nodes visited to
     ``cnt[0]`` and the triangle tests to ``cnt[1]``.  Returns ``(t, tri)``."""
     node, child, leaf, first, tv4 = bvh
     ray = node_ray(ox, oy, oz, dx, dy, dz, tmin)

@@ -43,6 +43,7 @@ from ...scene import features as F
 from ...scene.model import Mesh, Scene
 from ...scene.prepared import prepare
 from ..base import Knob, Option, RenderResult
+from ..kernels.columns import CHECKER_PLANAR, CHECKER_SOLID, TEX_COLS, Mat, Tex, WhittedOpt, pack
 from .accel import ACCELS, accel_extra_bytes
 from .flatten import MAX_CUTOUTS, OPACITY_CUT, SHADOW_CROSSINGS, SceneData, flatten, flatten_bytes
 
@@ -203,7 +204,7 @@ class _Colorizer:
 
     def __init__(self, scene: Scene, sd: SceneData):
         self.scene, self.sd = scene, sd
-        self.base = sd.mat_tab[:, 0:3]
+        self.base = sd.mat_tab[:, Mat.COLOR:Mat.COLOR + 3]
         needs = F.scene_needs(scene)
         self.tex = None
         self.missing: list[str] = []
@@ -272,8 +273,7 @@ def ensure_compiled(sd: SceneData, fused: bool = False) -> float:
     O = np.zeros((1, 3))
     D = np.array([[0.0, 0.0, 1.0]])
     geo = sd.kernel_args()
-    kopts = np.zeros(18)
-    kopts[0] = 1.0
+    kopts = kernel_options(1, extent=sd.extent)
     if fused:
         k.render_pixels(geo, sd.mat, sd.mat_tab, np.zeros((len(sd.mat_tab), TEX_COLS)), sd.lights,
                         np.zeros(3), np.zeros(3), kopts, O, D, 1, np.array([0.0, 0.0, 1.0]),
@@ -301,8 +301,19 @@ def ensure_compiled(sd: SceneData, fused: bool = False) -> float:
     return time.perf_counter() - t0
 
 
-TEX_COLS = 17
-"""Columns of the fused kernel's texture table (see :func:`.kernels.checker_color`)."""
+def kernel_options(generations: int, *, threshold: float = 0.0, fresnel: int = 0,
+                   transmissive_shadows: bool = False, blinn: bool = False, shadows: bool = False,
+                   reflection: bool = False, refraction: bool = False, extent: float = 1.0,
+                   background: bool = True, media=()) -> np.ndarray:
+    """The Whitted kernels' options (columns :class:`..kernels.columns.WhittedOpt`): the
+    tolerances from ``tol``, the media around the camera (material rows, innermost last, at
+    most four)."""
+    media = list(media)[-4:]
+    return pack(WhittedOpt, generations=generations, threshold=threshold, fresnel=fresnel,
+                transmissive_shadows=transmissive_shadows, blinn=blinn, shadows=shadows,
+                reflection=reflection, refraction=refraction, ray_offset=tol.ray_offset, t_min=tol.t_min,
+                zero=tol.zero, extent=extent, background=background, n_media=len(media),
+                media=media + [0] * (4 - len(media)))
 
 
 def fusable(scene: Scene, materials) -> bool:
@@ -328,11 +339,8 @@ def fused_textures(scene: Scene, sd: SceneData):
             continue
         from ..texturing import frame
         _, se, w = frame(tx.pole, tx.equator)
-        tab[i, 0] = _kernels().CHECKER_PLANAR if tx.projection == "planar" else _kernels().CHECKER_SOLID
-        tab[i, 1] = tx.scale
-        tab[i, 2:5] = tx.center
-        tab[i, 5:8], tab[i, 8:11] = se, w
-        tab[i, 11:14], tab[i, 14:17] = tx.colors[0], tx.colors[1]
+        tab[i] = pack(Tex, kind=CHECKER_PLANAR if tx.projection == "planar" else CHECKER_SOLID,
+                      scale=tx.scale, center=tx.center, se=se, w=w, color0=tx.colors[0], color1=tx.colors[1])
     return tab
 
 
@@ -371,13 +379,12 @@ class _Tracer:
         self.G = generation_bound(scene, opts["max_depth"], opts.get("threshold", 0.0), recursive)
         self.ray_cap = wavefront_cap(scene, scene.camera.width, scene.camera.height, opts["spp"], self.G,
                                      opts.get("threshold", 0.0), recursive)
-        self.kopts = np.array([self.G, opts.get("threshold", 0.0), fres,
-                               float(opts["transmissive_shadows"]), float(opts["blinn"]),
-                               float(self.do_shadow), float(refl), float(refr), tol.ray_offset,
-                               tol.t_min, tol.zero, sd.extent, float(not self.env)])
         names = [mt.name for mt in sd.materials]
         self.media = [names.index(mt.name) for mt in media][-4:]
-        self.kopts = np.r_[self.kopts, len(self.media), self.media + [0] * (4 - len(self.media))]
+        self.kopts = kernel_options(self.G, threshold=opts.get("threshold", 0.0), fresnel=fres,
+                                    transmissive_shadows=opts["transmissive_shadows"], blinn=opts["blinn"],
+                                    shadows=self.do_shadow, reflection=refl, refraction=refr,
+                                    extent=sd.extent, background=not self.env, media=self.media)
         self.ambient = np.asarray(scene.ambient, dtype=np.float64)
         self.geo = sd.kernel_args()
         self.stats = dict(primary_rays=0, shadow_rays=0, reflected_rays=0, refracted_rays=0,
@@ -477,7 +484,7 @@ class _Tracer:
         tmin, tmax, want = np.empty(n * nl), np.empty(n * nl), np.empty(n * nl, np.bool_)
         k.feeler_batch(sd.lights, O, D, h["t"], h["prim"], h["ng"], ns, self.kopts, fo, fd, tmin, tmax, want)
         vis = np.ones(n * nl)
-        kt = sd.mat_tab[sd.mat, 8] if self.kopts[3] > 0.5 else np.zeros(len(sd.mat))
+        kt = sd.mat_tab[sd.mat, Mat.KT] if self.kopts[WhittedOpt.TRANSMISSIVE_SHADOWS] > 0.5 else np.zeros(len(sd.mat))
         todo = np.flatnonzero(want)
         for _ in range(SHADOW_CROSSINGS):
             if not len(todo):

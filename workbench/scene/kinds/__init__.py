@@ -75,7 +75,7 @@ Functions (``W`` and ``M`` are (4, 4) ``world_from_object`` including any CSG pa
     exported (noted).
 
 The numba functions (intersection and normal by ``par`` row) live in
-:mod:`workbench.renderers.raytrace.kernels`, which imports the ``PTYPE`` constants from here.
+:mod:`workbench.renderers.kernels.shapes`, which imports the ``PTYPE`` constants from here.
 
 Composite kinds (``COMPOSITE = True``: CSG) take the dispatch as an argument instead of
 importing it: ``parse(ctx, t, w, common, child, kind_of)``, ``children(obj)``,

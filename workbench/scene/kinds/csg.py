@@ -10,7 +10,7 @@ Combining two solids sweeps both lists in order and keeps a crossing wherever th
 (coincident surfaces: ``A - A`` is empty, ``A n A = A u A = A``), and intervals shorter than
 ``eps`` are dropped.  A difference turns the right solid inside out: its surfaces' normals are
 flipped.  Readable version here (lists of :class:`Crossing`);
-:func:`workbench.renderers.raytrace.kernels.combine` is the numba twin, over the postfix
+:func:`workbench.renderers.kernels.shapes.combine` is the numba twin, over the postfix
 program :func:`flatten` writes.
 
 Raster by real mesh booleans (manifold3d): each leaf is tessellated as a closed, welded solid

@@ -1,0 +1,13 @@
+"""Compile options shared by the numba kernels."""
+from __future__ import annotations
+
+FAST_MATH = {"nsz", "arcp"}
+"""The fast-math flags of the hot kernels: signed zeros may be ignored, a division may become a
+multiplication by a reciprocal.  Not ``nnan``/``ninf``: misses are ``inf`` and the tests look
+for NaN, so the compiler may not assume either away.  Not ``contract``: a fused multiply-add
+breaks the watertight triangle test (the two triangles of a shared edge must round its edge
+function the same way, or a ray through the edge misses both)."""
+NO_REFCOUNT = dict(cache=True, error_model="numpy", _nrt=False, fastmath=FAST_MATH)
+"""Options of the kernels that allocate nothing: compiled without numba's reference counting
+(no atomic increments and decrements of every array they touch, which cost the fused kernel
+40 % of its time); the arrays they use belong to their (reference-counted) callers."""

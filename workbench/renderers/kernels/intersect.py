@@ -1,0 +1,277 @@
+"""The one intersector: the closest (or any) hit of a world ray over every primitive (the
+unbounded ones one by one, the analytic primitives' tree, the triangles' BVH), coincident
+surfaces resolved by :func:`nearer`, and the surface record of a hit (:func:`surface`).  Used
+by the Whitted drivers, the path tracer and the traversal statistics.
+"""
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+from numba.extending import overload
+
+from ...scene.kinds import CSGNODE
+from ...scene.kinds.csg import CSG_DEPTH
+from ...scene.kinds.expression import MAX_STACK
+from .flags import NO_REFCOUNT
+from .shapes import CSG_EVENTS, _normalize, _to_object, csg_hit, object_normal, prim_hit
+from .specialise import has
+from .walks import BVH_STACK, _bounds_hit, bvh_hit, node_ray, open_node
+
+
+@nb.njit(error_model="numpy", inline="always")
+def row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, zero, eps, stack, st, sp_, sf, sn):
+    """Closest hit ``tmin < t < tmax`` of top-level analytic primitive row ``k`` (a CSG node
+    evaluates its program) for the world ray.  Returns ``(t, prim, face)``: ``prim`` the row
+    hit (a CSG leaf's own row), ``face + 16`` for a flipped CSG normal; ``t = inf`` on a miss."""
+    ptype, xf, par, aux = geo.ptype, geo.xf, geo.par, geo.aux
+    if geo.ident[k]:  # object space is world space: no transform, the world unit direction
+        lo = (ox, oy, oz, dx, dy, dz)
+        inv_s = inv_w
+    else:
+        lo = _to_object(xf, k, ox, oy, oz, dx, dy, dz)
+        inv_s = 1.0 / math.sqrt(lo[3] * lo[3] + lo[4] * lo[4] + lo[5] * lo[5])
+    if ptype[k] == CSGNODE:
+        t, code, f = csg_gate(geo.kinds, int(par[k, 0]), int(par[k, 1]), geo.prog, ptype, xf, par, aux,
+                              ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps, st, sp_, sf, sn, stack)
+        return t, abs(code) - 1, f + (16 if code < 0 else 0)
+    t, f = prim_hit(geo.kinds, k, ptype, par, geo.poly_v, aux, lo[0], lo[1], lo[2], lo[3], lo[4], lo[5],
+                    lo[3] * inv_s, lo[4] * inv_s, lo[5] * inv_s, inv_s, tmin, tmax, zero,
+                    st[0], sf[0], stack)
+    return t, k, f
+
+
+PRIM_STACK_BASE = max(BVH_STACK, MAX_STACK)
+"""First row of the scratch stack used by the analytic primitives' traversal
+(:func:`prim_tree_hit`): rows below it stay free for an isosurface's expression evaluator,
+which runs inside that traversal."""
+
+
+@nb.njit(**NO_REFCOUNT)
+def prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero, eps,
+                  stack, st, sp_, sf, sn):
+    """Closest hit through the analytic primitives' 4-wide tree (:class:`.accel.PrimTree`;
+    traversal as :func:`bvh_hit`'s, one primitive row per leaf item).  ``best``: the nearest
+    hit so far (of row ``brow``, ``-1`` for none); a hit replaces it as :func:`nearer`
+    says.  Returns ``(t, prim, face, row)``,
+    ``row = -1`` if nothing replaced ``best``."""
+    return prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero,
+                          eps, stack, st, sp_, sf, sn, False, sn)
+
+
+# ----------------------------------------------------------------------------- gates
+# The walks below compile only for a scene that needs them (see ..kernels.specialise): CSG
+# programs, the analytic primitives' tree, the triangles' tree.  A gate whose feature is absent
+# is never reached (its caller tests the same data first) and compiles to a miss.
+
+def csg_gate(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, zero,
+             eps, st, sp_, sf, sn, stack):
+    """:func:`csg_hit` if the scene has CSG nodes."""
+    raise TypeError("csg_gate is callable from numba-compiled code only")
+
+
+@overload(csg_gate, jit_options=dict(error_model="numpy"))
+def _csg_gate(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, zero,
+              eps, st, sp_, sf, sn, stack):
+    on = has(kinds, "csg")
+
+    def impl(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, zero,
+             eps, st, sp_, sf, sn, stack):
+        if on:
+            return csg_hit(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy, dz, tmin,
+                           tmax, zero, eps, st, sp_, sf, sn, stack)
+        return np.inf, 0, 0
+    return impl
+
+
+def prim_tree_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero, eps,
+                   stack, st, sp_, sf, sn):
+    """:func:`prim_tree_hit` if the scene has bounded analytic primitives."""
+    raise TypeError("prim_tree_gate is callable from numba-compiled code only")
+
+
+@overload(prim_tree_gate, jit_options=dict(error_model="numpy"))
+def _prim_tree_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero, eps,
+                    stack, st, sp_, sf, sn):
+    on = has(geo.types[-1], "prim_tree")  # geo.kinds' type
+
+    def impl(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero, eps,
+             stack, st, sp_, sf, sn):
+        if on:
+            return prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only,
+                                 any_hit, zero, eps, stack, st, sp_, sf, sn)
+        return best, -1, 0, -1
+    return impl
+
+
+def triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
+    """:func:`bvh_hit` over the scene's triangles if it has any."""
+    raise TypeError("triangles_gate is callable from numba-compiled code only")
+
+
+@overload(triangles_gate, jit_options=dict(error_model="numpy"))
+def _triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
+    on = has(geo.types[-1], "triangles")
+
+    def impl(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
+        if on:
+            return bvh_hit((geo.bvh_node, geo.bvh_child, geo.bvh_leaf, geo.bvh_first, geo.bvh_tv4),
+                           ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack)
+        return np.inf, -1, 0.0, 0.0
+    return impl
+
+
+@nb.njit(error_model="numpy", inline="always")
+def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero, eps,
+                   stack, st, sp_, sf, sn, count, cnt):
+    """:func:`prim_tree_hit`; with ``count`` (the traversal statistics' pass,
+    :mod:`.traversal_stats`) it adds the 4-wide nodes visited to ``cnt[0]`` and the primitive
+    tests to ``cnt[1]`` (the rendering kernels pass ``False``: no counting)."""
+    shadow, pnode, pchild, pleaf, pref = geo.shadow, geo.pnode, geo.pchild, geo.pleaf, geo.pref
+    ray = node_ray(ox, oy, oz, dx, dy, dz, tmin)
+    w = eps * inv_w  # coincidence window in ray parameter units (see :func:`nearer`)
+    reach = best + w if brow >= 0 else best
+    bp, bf, found = -1, 0, -1
+    base = PRIM_STACK_BASE
+    top_ = stack.shape[0] - 1
+    code, sp = 0, base
+    while True:
+        while code >= 0:
+            if count:
+                cnt[0] += 1
+            sp, code = open_node((pnode, pchild), code, ray, reach, stack, sp, top_)
+        if code < -1:
+            lf = -2 - code
+            for q in range(pleaf[lf, 0], pleaf[lf, 0] + pleaf[lf, 1]):
+                k = pref[q]
+                if shadow_only and not shadow[k]:
+                    continue
+                if count:
+                    cnt[1] += 1
+                # up to best and its window: a coincident surface of a lower row wins
+                t, p, f = row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, np.nextafter(reach, np.inf),
+                                  zero, eps, stack, st, sp_, sf, sn)
+                if nearer(t, k, best, brow, w):
+                    best, bp, bf, brow, found = t, p, f, k, k
+                    reach = best + w
+                    if any_hit:
+                        return best, bp, bf, found
+        code = -1
+        while sp > base:
+            sp -= 1
+            if stack[sp, 0] <= reach:
+                code = int(stack[sp, 1])
+                break
+        if code == -1:
+            break
+    return best, bp, bf, found
+
+
+@nb.njit(error_model="numpy", inline="always")
+def nearer(t, k, best, brow, w):
+    """Whether a hit at ``t`` of row ``k`` replaces the nearest so far (``best`` of row
+    ``brow``, ``-1`` for none).  Two surfaces closer along the ray than ``w`` (the secondary
+    rays' offset, relative to the scene's size: no ray can tell them apart) are coincident,
+    such as a box's face resting on a floor: the lower row wins whatever the rounding says,
+    so that the choice does not change with the scene's scale or the traversal's order."""
+    if brow < 0:
+        return t < best
+    return t < best - w or (t <= best + w and k < brow)
+
+
+@nb.njit(error_model="numpy", inline="always")
+def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
+            st, sp_, sf, sn):
+    """Nearest hit of a world ray over all primitives: the list of analytic primitives tested
+    one by one, then the analytic primitives' structure, then the triangles' (see
+    :mod:`.accel`).  Returns ``(t, prim, face, tri, b1, b2)``; ``prim = -1`` on a miss,
+    negative ``face`` is never returned (a flipped CSG normal is ``face + 16``)."""
+    pfree, shadow = geo.pfree, geo.shadow
+    best, bp, bf, btri, bb1, bb2 = tmax, -1, 0, -1, 0.0, 0.0
+    brow = -1
+    inv_w = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
+    w = eps * inv_w
+    for q in range(pfree.shape[0]):
+        k = pfree[q]
+        if shadow_only and not shadow[k]:
+            continue
+        t, p, f = row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, best + w if brow >= 0 else best,
+                          zero, eps, stack, st, sp_, sf, sn)
+        if nearer(t, k, best, brow, w):
+            best, bp, bf, brow = t, p, f, k
+        if any_hit and bp >= 0:
+            return best, bp, bf, btri, bb1, bb2
+    if geo.pref.shape[0] > 0 and _bounds_hit(geo.pbounds, ox, oy, oz, dx, dy, dz, tmin, best):
+        t, p, f, row = prim_tree_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, np.int64(brow),
+                                      np.bool_(shadow_only), np.bool_(any_hit), zero, eps, stack, st,
+                                      sp_, sf, sn)
+        if row >= 0:
+            best, bp, bf, brow = t, p, f, row
+            if any_hit:
+                return best, bp, bf, btri, bb1, bb2
+    if geo.tri_v.shape[0] > 0 and _bounds_hit(geo.bvh_bounds, ox, oy, oz, dx, dy, dz, tmin, best):
+        t, tri, b1, b2 = triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, best + w if brow >= 0 else best,
+                                        np.bool_(any_hit), stack)
+        if tri >= 0 and nearer(t, geo.tri_prim[tri], best, brow, w):
+            best, bp, bf, btri, bb1, bb2 = t, geo.tri_prim[tri], 0, tri, b1, b2
+    if bp < 0:
+        return np.inf, -1, 0, -1, 0.0, 0.0
+    return best, bp, bf, btri, bb1, bb2
+
+
+@nb.njit(error_model="numpy", inline="always")
+def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_uv, out_po, out_e, i,
+            stack):
+    """Geometric (outward) normal, shading normal, uv (meshes; analytic primitives leave the
+    mapping to the texturing module), object-space point and vertex emission at a hit, written
+    to row ``i`` of the output arrays (``stack``: scratch of an isosurface's gradient)."""
+    xf, nm, tri_v, tri_n, tri_uv, tri_e = geo.xf, geo.nm, geo.tri_v, geo.tri_n, geo.tri_uv, geo.tri_e
+    x = xf[k, 0] * px + xf[k, 1] * py + xf[k, 2] * pz + xf[k, 3]
+    y = xf[k, 4] * px + xf[k, 5] * py + xf[k, 6] * pz + xf[k, 7]
+    z = xf[k, 8] * px + xf[k, 9] * py + xf[k, 10] * pz + xf[k, 11]
+    out_po[i, 0], out_po[i, 1], out_po[i, 2] = x, y, z
+    out_uv[i, 0], out_uv[i, 1] = 0.0, 0.0
+    out_e[i, 0], out_e[i, 1], out_e[i, 2] = 0.0, 0.0, 0.0
+    if tri >= 0:
+        e1x, e1y, e1z = tri_v[tri, 3] - tri_v[tri, 0], tri_v[tri, 4] - tri_v[tri, 1], tri_v[tri, 5] - tri_v[tri, 2]
+        e2x, e2y, e2z = tri_v[tri, 6] - tri_v[tri, 0], tri_v[tri, 7] - tri_v[tri, 1], tri_v[tri, 8] - tri_v[tri, 2]
+        gx, gy, gz = _normalize(e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x)
+        b0 = 1.0 - b1 - b2
+        sx = b0 * tri_n[tri, 0] + b1 * tri_n[tri, 3] + b2 * tri_n[tri, 6]
+        sy = b0 * tri_n[tri, 1] + b1 * tri_n[tri, 4] + b2 * tri_n[tri, 7]
+        sz = b0 * tri_n[tri, 2] + b1 * tri_n[tri, 5] + b2 * tri_n[tri, 8]
+        ln = math.sqrt(sx * sx + sy * sy + sz * sz)
+        if ln > ncancel:  # a cancelled interpolated normal falls back to Ng
+            sx, sy, sz = sx / ln, sy / ln, sz / ln
+        else:
+            sx, sy, sz = gx, gy, gz
+        out_uv[i, 0] = b0 * tri_uv[tri, 0] + b1 * tri_uv[tri, 2] + b2 * tri_uv[tri, 4]
+        out_uv[i, 1] = b0 * tri_uv[tri, 1] + b1 * tri_uv[tri, 3] + b2 * tri_uv[tri, 5]
+        for c in range(3):
+            out_e[i, c] = b0 * tri_e[tri, c] + b1 * tri_e[tri, 3 + c] + b2 * tri_e[tri, 6 + c]
+        out_ng[i, 0], out_ng[i, 1], out_ng[i, 2] = gx, gy, gz
+        out_ns[i, 0], out_ns[i, 1], out_ns[i, 2] = sx, sy, sz
+        return
+    f = face - 16 if face >= 16 else face
+    sgn = -1.0 if face >= 16 else 1.0
+    ux, uy, uz = object_normal(geo.kinds, k, f, geo.ptype, geo.par, geo.aux, x, y, z, stack)
+    wx = sgn * (nm[k, 0] * ux + nm[k, 1] * uy + nm[k, 2] * uz)
+    wy = sgn * (nm[k, 3] * ux + nm[k, 4] * uy + nm[k, 5] * uz)
+    wz = sgn * (nm[k, 6] * ux + nm[k, 7] * uy + nm[k, 8] * uz)
+    gx, gy, gz = _normalize(wx, wy, wz)
+    out_ng[i, 0], out_ng[i, 1], out_ng[i, 2] = gx, gy, gz
+    out_ns[i, 0], out_ns[i, 1], out_ns[i, 2] = gx, gy, gz
+
+
+@nb.njit(error_model="numpy")
+def scratch():
+    """Per-thread work arrays of :func:`closest`: the traversal stack (rows: entry distance,
+    child code: a 4-wide node or a leaf; the triangles' traversal uses it from row 0, the
+    analytic primitives' from row :data:`PRIM_STACK_BASE`, and the rows below that are also
+    the operand stack (rows: value, gradient) of an isosurface's expression, evaluated inside
+    the primitives' traversal, never inside the triangles') and the CSG stack of interval
+    lists (times, signed primitive codes, faces, counts)."""
+    return (np.empty((PRIM_STACK_BASE + BVH_STACK, 4)), np.empty((CSG_DEPTH, CSG_EVENTS)),
+            np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64),
+            np.empty((CSG_DEPTH, CSG_EVENTS), dtype=np.int64), np.empty(CSG_DEPTH, dtype=np.int64))

@@ -1,0 +1,116 @@
+"""Surface optics shared by Whitted and the path tracer: Fresnel reflectance, the media stack's
+index, the shading normal's side, the direction and falloff of a point or directional light,
+the shadow feeler's origin, the fused checker texture and the camera ray of a pixel.
+"""
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from .columns import CHECKER_PLANAR, Light, Mat, Tex
+from .shapes import _normalize
+
+
+@nb.njit(error_model="numpy", inline="always")
+def _pow(base, n):
+    if n == 0.0:
+        return 1.0
+    return base ** n
+
+
+@nb.njit(error_model="numpy", inline="always")
+def _ior(mat_tab, stk, ns_):
+    return mat_tab[stk[ns_ - 1], Mat.IOR] if ns_ > 0 else 1.0
+
+
+@nb.njit(error_model="numpy", inline="always")
+def fresnel_reflectance(fres, n1, n2, cosi, cost):
+    """Reflected share F of light crossing from index ``n1`` to ``n2`` (``cosi``, ``cost``: the
+    cosines of incidence and refraction): Schlick's approximation for ``fres == 1`` (cosine on the
+    lower-index side; Schlick 1994), else the exact unpolarised Fresnel equations (mean of the
+    s and p reflectances)."""
+    if fres == 1:
+        r0 = (n1 - n2) / (n1 + n2)
+        r0 *= r0
+        cc = cosi if n1 <= n2 else cost
+        return r0 + (1.0 - r0) * (1.0 - cc) ** 5
+    rs = (n1 * cosi - n2 * cost) / (n1 * cosi + n2 * cost)
+    rp = (n2 * cosi - n1 * cost) / (n2 * cosi + n1 * cost)
+    return 0.5 * (rs * rs + rp * rp)
+
+
+@nb.njit(error_model="numpy", inline="always")
+def _facing(nsh, i, dx, dy, dz):
+    """The shading normal of hit ``i``, turned to face the viewer (two-sided shading)."""
+    nx, ny, nz = nsh[i, 0], nsh[i, 1], nsh[i, 2]
+    if nx * dx + ny * dy + nz * dz > 0.0:
+        return -nx, -ny, -nz
+    return nx, ny, nz
+
+
+@nb.njit(error_model="numpy", inline="always")
+def _light_dir(lights, li, px, py, pz):
+    """Unit direction ``l`` from ``P`` to light ``li``, its distance (``inf`` for a directional
+    light) and the light's factor there (1, ``1 / d^2`` when attenuated, times the spot
+    factor).  Returns ``(lx, ly, lz, dist, scale)``."""
+    if lights[li, Light.KIND] > 0.5:
+        return (-lights[li, Light.POSITION], -lights[li, Light.POSITION + 1], -lights[li, Light.POSITION + 2],
+                np.inf, 1.0)
+    vx = lights[li, Light.POSITION] - px
+    vy = lights[li, Light.POSITION + 1] - py
+    vz = lights[li, Light.POSITION + 2] - pz
+    dist = math.sqrt(vx * vx + vy * vy + vz * vz)
+    lx, ly, lz = _normalize(vx, vy, vz)
+    scale = 1.0
+    if lights[li, Light.INVERSE_SQUARE] > 0.5:
+        scale = 1.0 / max(dist * dist, 1e-300)
+    if lights[li, Light.COSINE] > 0.5:
+        scale *= max(0.0, -(lx * lights[li, Light.COSINE_NORMAL] + ly * lights[li, Light.COSINE_NORMAL + 1]
+                            + lz * lights[li, Light.COSINE_NORMAL + 2]))
+    return lx, ly, lz, dist, scale
+
+
+@nb.njit(error_model="numpy", inline="always")
+def _feeler(px, py, pz, gx, gy, gz, lx, ly, lz, dist, off):
+    """The shadow feeler towards ``l``: origin pushed ``off`` off the surface (geometric normal
+    ``g``) on the light's side, and its end short of the light.  Returns ``(qx, qy, qz, tmax)``."""
+    side = 1.0 if gx * lx + gy * ly + gz * lz >= 0.0 else -1.0
+    tmx = dist - 2.0 * off if dist < np.inf else np.inf
+    return px + side * off * gx, py + side * off * gy, pz + side * off * gz, tmx
+
+
+@nb.njit(error_model="numpy", inline="always")
+def checker_color(tex_tab, mi, x, y, z):
+    """Texture factor of material ``mi`` at object-space point ``(x, y, z)``: the
+    ``checker`` pattern of :func:`workbench.renderers.texturing.pattern_value` with the
+    ``planar`` (``s = scale (d.Se, d.W)``) or ``solid`` (``s = scale d``) projection,
+    ``d = P - center``.  ``tex_tab`` row: kind, scale, center (3), Se (3), W (3), colors (6)."""
+    cx, cy, cz = x - tex_tab[mi, Tex.CENTER], y - tex_tab[mi, Tex.CENTER + 1], z - tex_tab[mi, Tex.CENTER + 2]
+    sc = tex_tab[mi, Tex.SCALE]
+    if tex_tab[mi, Tex.KIND] == CHECKER_PLANAR:
+        parity = (math.floor(sc * (cx * tex_tab[mi, Tex.SE] + cy * tex_tab[mi, Tex.SE + 1] + cz * tex_tab[mi, Tex.SE + 2]))
+                  + math.floor(sc * (cx * tex_tab[mi, Tex.W] + cy * tex_tab[mi, Tex.W + 1] + cz * tex_tab[mi, Tex.W + 2])))
+    else:
+        parity = math.floor(sc * cx) + math.floor(sc * cy) + math.floor(sc * cz)
+    a = parity - 2.0 * math.floor(parity / 2.0)
+    return (tex_tab[mi, Tex.COLOR0] * (1.0 - a) + tex_tab[mi, Tex.COLOR1] * a,
+            tex_tab[mi, Tex.COLOR0 + 1] * (1.0 - a) + tex_tab[mi, Tex.COLOR1 + 1] * a,
+            tex_tab[mi, Tex.COLOR0 + 2] * (1.0 - a) + tex_tab[mi, Tex.COLOR1 + 2] * a)
+
+
+@nb.njit(error_model="numpy", inline="always")
+def camera_ray(cam, q, o, d):
+    """Row 0 of ``o, d``: the centre ray of image pixel ``q`` (row-major) of the camera ``cam``
+    (``whitted.camera_frame``: position, rotation, tan(fov_y / 2), aspect, width, height)."""
+    width = int(cam[14])
+    i, j = q // width, q % width
+    x = ((j + 0.5) / cam[14] * 2.0 - 1.0) * cam[12] * cam[13]
+    y = (1.0 - (i + 0.5) / cam[15] * 2.0) * cam[12]
+    dx = x * cam[3] + y * cam[4] - cam[5]
+    dy = x * cam[6] + y * cam[7] - cam[8]
+    dz = x * cam[9] + y * cam[10] - cam[11]
+    n = math.sqrt(dx * dx + dy * dy + dz * dz)
+    o[0, 0], o[0, 1], o[0, 2] = cam[0], cam[1], cam[2]
+    d[0, 0], d[0, 1], d[0, 2] = dx / n, dy / n, dz / n
