@@ -58,6 +58,7 @@ def main() -> None:
     import workbench
     from workbench.renderers.pathtrace import kernels as K
     from workbench.renderers.pathtrace.session import PathTraceSession
+    from workbench.renderers.kernels.columns import PathOpt
     from workbench.renderers.kernels.flags import NO_REFCOUNT
     from workbench.renderers.kernels.intersect import scratch, surface
 
@@ -170,7 +171,8 @@ def main() -> None:
     per_sample = t / nsamp
     cam_r, ext_r, sh_r = st["camera_rays"] / nsamp, st["extension_rays"] / nsamp, st["shadow_rays"] / nsamp
     out["sample"] = {"cpu_ns": per_sample * 1e9, "camera_rays": cam_r, "extension_rays": ext_r, "shadow_rays": sh_r,
-                     "mean_path_length": st["mean_path_length"], "only_bvh_triangles": bool(ses.opts[20] > 0.5)}
+                     "mean_path_length": st["mean_path_length"], "only_bvh_triangles":
+                         bool(ses.opts[PathOpt.ONLY_TRIANGLES] > 0.5)}
 
     scr, rows = work_arrays()
     cap = a.size * a.size * 4 * 7

@@ -100,8 +100,8 @@ def profile(threads: int, repeats: int = 3) -> dict:
 
 def mesh_intersection(repeats: int = 3) -> dict:
     """The mesh scene on one thread: the trace phase of a render against the intersection
-    queries of its rays alone, through :func:`kernels.closest` (analytic primitives, the
-    mesh's box, the 4-wide BVH) and through the BVH alone (box test + :func:`kernels.bvh_hit`):
+    queries of its rays alone, through :func:`intersect.closest` (analytic primitives, the
+    mesh's box, the 4-wide BVH) and through the BVH alone (box test + :func:`walks.bvh_hit`):
     the primary rays' closest hits, then the shadow feelers :func:`kernels.shade_hit` traces
     (:func:`kernels.feeler_batch`, any hit).  Best of ``repeats`` each."""
     import numba
@@ -109,6 +109,8 @@ def mesh_intersection(repeats: int = 3) -> dict:
 
     import workbench
     from workbench.core.tol import tol
+    from workbench.renderers.kernels import intersect, walks
+    from workbench.renderers.kernels.flags import NO_REFCOUNT
     from workbench.renderers.raytrace import kernels as K
     from workbench.renderers.raytrace.flatten import flatten
     from workbench.renderers.raytrace.whitted import _alloc, camera_rays, kernel_options
@@ -131,25 +133,26 @@ def mesh_intersection(repeats: int = 3) -> dict:
     sets = dict(primary=(O, D, np.zeros(n), np.full(n, np.inf), False),
                 shadow=(fo[want], fd[want], ftmin[want], ftmax[want], True))
 
-    @numba.njit(**dict(K.NO_REFCOUNT, cache=False))  # as the kernels: no reference counting
+    @numba.njit(**dict(NO_REFCOUNT, cache=False))  # as the kernels: no reference counting
     def queries(geo, O, D, tmin, tmax, shadow, bvh_only, extent, scr, rel_eps, zero):
         stack, st, sp_, sf, sn = scr
-        (_, _, _, _, _, _, _, _, _, _, _, _, _, _, node, child, leaf, first, tv4, bounds, _) = geo
+        node, child, leaf, first, tv4, bounds = (geo.bvh_node, geo.bvh_child, geo.bvh_leaf, geo.bvh_first,
+                                                 geo.bvh_tv4, geo.bvh_bounds)
         hits = 0
         for i in range(O.shape[0]):
             ox, oy, oz, dx, dy, dz = O[i, 0], O[i, 1], O[i, 2], D[i, 0], D[i, 1], D[i, 2]
             if bvh_only:
-                if K._bounds_hit(bounds, ox, oy, oz, dx, dy, dz, tmin[i], tmax[i]):
-                    t = K.bvh_hit((node, child, leaf, first, tv4), ox, oy, oz, dx, dy, dz, tmin[i],
+                if walks._bounds_hit(bounds, ox, oy, oz, dx, dy, dz, tmin[i], tmax[i]):
+                    t = walks.bvh_hit((node, child, leaf, first, tv4), ox, oy, oz, dx, dy, dz, tmin[i],
                                   tmax[i], shadow, stack)[0]
                     hits += t < np.inf
             else:
                 eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
-                hits += K.closest(geo, ox, oy, oz, dx, dy, dz, tmin[i], tmax[i], shadow, shadow, zero, eps,
+                hits += intersect.closest(geo, ox, oy, oz, dx, dy, dz, tmin[i], tmax[i], shadow, shadow, zero, eps,
                                   stack, st, sp_, sf, sn)[1] >= 0
         return hits
 
-    scr = numba.njit(lambda: K.scratch())()
+    scr = numba.njit(lambda: intersect.scratch())()
     out = dict(triangles=int(len(sd.tri_v)), bvh_4wide_nodes=int(len(sd.bvh.node)),
                bvh_leaves=int(len(sd.bvh.leaf)), trace_s=r.timings["trace"], total_rays=r.stats["total_rays"])
     for name, (o, d, t0, t1, shadow) in sets.items():

@@ -13,6 +13,7 @@ from pathtrace_scenes import PLANE, scene
 from scipy.stats import chi2
 from statistics_budget import ALPHA, band
 from workbench.core.errors import NotApplicable
+from workbench.renderers.kernels.columns import PathOpt
 from workbench.renderers.pathtrace import reference
 from workbench.renderers.pathtrace.session import PathTraceSession
 from workbench.scene.library import bundled
@@ -208,7 +209,7 @@ def check_kernel_reference(seed: int, tmp_path, names=tuple(KERNEL_SCENES)) -> N
     """At a few pixels the numba kernel and the readable twin (the ray tracer's readable
     intersection, numpy random numbers) agree within the t band of their combined standard
     errors (the twin's 159 degrees of freedom).  On ``cornell`` every primitive is a BVH
-    triangle once its polygons and area light are (``opts[20]``: each ray goes to the BVH
+    triangle once its polygons and area light are (``PathOpt.ONLY_TRIANGLES``: each ray goes to the BVH
     alone), while the twin traces the polygons themselves."""
     for name in names:
         _kernel_against_reference(seed, tmp_path, name)
@@ -227,7 +228,7 @@ def _kernel_against_reference(seed: int, tmp_path, name: str) -> None:
         sc, w, h, opts = workbench.load_scene(name), 8, 8, dict(fresnel="schlick")
         pixels = [(1, 4), (5, 2), (5, 5), (3, 0), (7, 4)]
     ses = PathTraceSession(sc, w, h, seed=2 * seed + 7, **opts)
-    assert (ses.opts[20] == 1.0) == (name == "cornell")
+    assert (ses.opts[PathOpt.ONLY_TRIANGLES] == 1.0) == (name == "cornell")
     ses.add_samples(2048)
     km = ses.image.reshape(-1, 3)[[i * w + j for i, j in pixels]]
     ks = ses.std_error.reshape(-1, 3)[[i * w + j for i, j in pixels]]
@@ -257,7 +258,7 @@ def test_area_light_traced_as_triangles_keeps_one_emitting_side(tmp_path):
     up = PathTraceSession(_light_over_plane(tmp_path, True), 16, 12, seed=1, pixel_filter="center")
     down = PathTraceSession(_light_over_plane(tmp_path, False), 16, 12, seed=1, pixel_filter="center")
     for ses in (up, down):
-        assert ses.opts[20] == 1.0 and len(ses.emitters.cdf) == 2 and (ses.emitters.mesh_tri >= 0).all()
+        assert ses.opts[PathOpt.ONLY_TRIANGLES] == 1.0 and len(ses.emitters.cdf) == 2 and (ses.emitters.mesh_tri >= 0).all()
         ses.add_samples(4)
     light = np.float32([3.0, 2.0, 1.0])
     seen = (up.image == light).all(axis=2)        # the front, from above: exactly its radiance
@@ -275,7 +276,7 @@ def check_area_light_triangles(seed: int, tmp_path) -> None:
     sc = _light_over_plane(tmp_path, False)
     tri, poly = (PathTraceSession(sc, 16, 12, seed=s, triangulate=t)
                  for s, t in ((2 * seed, True), (2 * seed + 1, False)))
-    assert poly.opts[20] == 0.0
+    assert poly.opts[PathOpt.ONLY_TRIANGLES] == 0.0
     for ses in (tri, poly):
         ses.add_samples(64)
     se = np.sqrt((tri.std_error.astype(np.float64) ** 2).sum(axis=(0, 1))

@@ -4,7 +4,7 @@ textures, and the Whitted and path-tracing options.
 Each table is a float64 array whose columns are named by an ``IntEnum`` (numba compiles
 ``mat_tab[mi, Mat.KD]`` to the same load as a literal column).  A member names the first
 column of a run where :data:`SPANS` says so (``Mat.COLOR + 1`` is green).  The
-builders (:func:`workbench.renderers.raytrace.flatten.material_row`, ``light_rows``,
+builders (``workbench.renderers.raytrace.flatten``'s ``_material_row`` and ``light_rows``,
 ``whitted.fused_textures``, the sessions' options) write by name through :func:`pack`, which
 refuses a table with a column left unnamed or unset.
 """

@@ -49,14 +49,14 @@ which runs inside that traversal."""
 
 
 @nb.njit(**NO_REFCOUNT)
-def prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero, eps,
+def prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only, any_hit, zero, eps,
                   stack, st, sp_, sf, sn):
     """Closest hit through the analytic primitives' 4-wide tree (:class:`.accel.PrimTree`;
     traversal as :func:`bvh_hit`'s, one primitive row per leaf item).  ``best``: the nearest
     hit so far (of row ``brow``, ``-1`` for none); a hit replaces it as :func:`nearer`
     says.  Returns ``(t, prim, face, row)``,
     ``row = -1`` if nothing replaced ``best``."""
-    return prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero,
+    return prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only, any_hit, zero,
                           eps, stack, st, sp_, sf, sn, False, sn)
 
 
@@ -85,21 +85,21 @@ def _csg_gate(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, d
     return impl
 
 
-def prim_tree_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero, eps,
+def prim_tree_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only, any_hit, zero, eps,
                    stack, st, sp_, sf, sn):
     """:func:`prim_tree_hit` if the scene has bounded analytic primitives."""
     raise TypeError("prim_tree_gate is callable from numba-compiled code only")
 
 
 @overload(prim_tree_gate, jit_options=dict(error_model="numpy"))
-def _prim_tree_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero, eps,
+def _prim_tree_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only, any_hit, zero, eps,
                     stack, st, sp_, sf, sn):
     on = has(geo.types[-1], "prim_tree")  # geo.kinds' type
 
-    def impl(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero, eps,
+    def impl(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only, any_hit, zero, eps,
              stack, st, sp_, sf, sn):
         if on:
-            return prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only,
+            return prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only,
                                  any_hit, zero, eps, stack, st, sp_, sf, sn)
         return best, -1, 0, -1
     return impl
@@ -123,7 +123,7 @@ def _triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
 
 
 @nb.njit(error_model="numpy", inline="always")
-def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_only, any_hit, zero, eps,
+def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only, any_hit, zero, eps,
                    stack, st, sp_, sf, sn, count, cnt):
     """:func:`prim_tree_hit`; with ``count`` (the traversal statistics' pass,
     :mod:`.traversal_stats`) it adds the 4-wide nodes visited to ``cnt[0]`` and the primitive
@@ -131,7 +131,7 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_
     shadow, pnode, pchild, pleaf, pref = geo.shadow, geo.pnode, geo.pchild, geo.pleaf, geo.pref
     ray = node_ray(ox, oy, oz, dx, dy, dz, tmin)
     w = eps * inv_w  # coincidence window in ray parameter units (see :func:`nearer`)
-    reach = best + w if brow >= 0 else best
+    lim = reach(best, brow, w, tmax)
     bp, bf, found = -1, 0, -1
     base = PRIM_STACK_BASE
     top_ = stack.shape[0] - 1
@@ -140,7 +140,7 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_
         while code >= 0:
             if count:
                 cnt[0] += 1
-            sp, code = open_node((pnode, pchild), code, ray, reach, stack, sp, top_)
+            sp, code = open_node((pnode, pchild), code, ray, lim, stack, sp, top_)
         if code < -1:
             lf = -2 - code
             for q in range(pleaf[lf, 0], pleaf[lf, 0] + pleaf[lf, 1]):
@@ -150,17 +150,17 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_
                 if count:
                     cnt[1] += 1
                 # up to best and its window: a coincident surface of a lower row wins
-                t, p, f = row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, np.nextafter(reach, np.inf),
+                t, p, f = row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, np.nextafter(lim, np.inf),
                                   zero, eps, stack, st, sp_, sf, sn)
-                if nearer(t, k, best, brow, w):
+                if nearer(t, k, best, brow, w, tmax):
                     best, bp, bf, brow, found = t, p, f, k, k
-                    reach = best + w
+                    lim = reach(best, brow, w, tmax)
                     if any_hit:
                         return best, bp, bf, found
         code = -1
         while sp > base:
             sp -= 1
-            if stack[sp, 0] <= reach:
+            if stack[sp, 0] <= lim:
                 code = int(stack[sp, 1])
                 break
         if code == -1:
@@ -169,15 +169,25 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, brow, shadow_
 
 
 @nb.njit(error_model="numpy", inline="always")
-def nearer(t, k, best, brow, w):
-    """Whether a hit at ``t`` of row ``k`` replaces the nearest so far (``best`` of row
+def nearer(t, k, best, brow, w, tmax):
+    """Whether a hit at ``t < tmax`` of row ``k`` replaces the nearest so far (``best`` of row
     ``brow``, ``-1`` for none).  Two surfaces closer along the ray than ``w`` (the secondary
     rays' offset, relative to the scene's size: no ray can tell them apart) are coincident,
     such as a box's face resting on a floor: the lower row wins whatever the rounding says,
-    so that the choice does not change with the scene's scale or the traversal's order."""
+    so that the choice of one of two such surfaces does not change with the scene's scale or
+    the traversal's order.  (Three surfaces within ``2 w`` of each other, or two coincident
+    meshes, whose triangles the BVH walk compares by distance alone, are still decided by
+    the order of the tests.)"""
     if brow < 0:
         return t < best
-    return t < best - w or (t <= best + w and k < brow)
+    return t < tmax and (t < best - w or (t <= best + w and k < brow))
+
+
+@nb.njit(error_model="numpy", inline="always")
+def reach(best, brow, w, tmax):
+    """How far a search must look past the nearest hit so far for a coincident surface of a
+    lower row (:func:`nearer`), within ``tmax``."""
+    return min(best + w, tmax) if brow >= 0 else best
 
 
 @nb.njit(error_model="numpy", inline="always")
@@ -196,24 +206,24 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
         k = pfree[q]
         if shadow_only and not shadow[k]:
             continue
-        t, p, f = row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, best + w if brow >= 0 else best,
+        t, p, f = row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, reach(best, brow, w, tmax),
                           zero, eps, stack, st, sp_, sf, sn)
-        if nearer(t, k, best, brow, w):
+        if nearer(t, k, best, brow, w, tmax):
             best, bp, bf, brow = t, p, f, k
         if any_hit and bp >= 0:
             return best, bp, bf, btri, bb1, bb2
-    if geo.pref.shape[0] > 0 and _bounds_hit(geo.pbounds, ox, oy, oz, dx, dy, dz, tmin, best):
-        t, p, f, row = prim_tree_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, best, np.int64(brow),
+    if geo.pref.shape[0] > 0 and _bounds_hit(geo.pbounds, ox, oy, oz, dx, dy, dz, tmin, reach(best, brow, w, tmax)):
+        t, p, f, row = prim_tree_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, np.int64(brow),
                                       np.bool_(shadow_only), np.bool_(any_hit), zero, eps, stack, st,
                                       sp_, sf, sn)
         if row >= 0:
             best, bp, bf, brow = t, p, f, row
             if any_hit:
                 return best, bp, bf, btri, bb1, bb2
-    if geo.tri_v.shape[0] > 0 and _bounds_hit(geo.bvh_bounds, ox, oy, oz, dx, dy, dz, tmin, best):
-        t, tri, b1, b2 = triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, best + w if brow >= 0 else best,
-                                        np.bool_(any_hit), stack)
-        if tri >= 0 and nearer(t, geo.tri_prim[tri], best, brow, w):
+    lim = reach(best, brow, w, tmax)
+    if geo.tri_v.shape[0] > 0 and _bounds_hit(geo.bvh_bounds, ox, oy, oz, dx, dy, dz, tmin, lim):
+        t, tri, b1, b2 = triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, lim, np.bool_(any_hit), stack)
+        if tri >= 0 and nearer(t, geo.tri_prim[tri], best, brow, w, tmax):
             best, bp, bf, btri, bb1, bb2 = t, geo.tri_prim[tri], 0, tri, b1, b2
     if bp < 0:
         return np.inf, -1, 0, -1, 0.0, 0.0

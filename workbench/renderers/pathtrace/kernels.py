@@ -186,7 +186,8 @@ def render_samples(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sum
     Parameters
     ----------
     geo : the ray tracer's geometry tuple (``SceneData.kernel_args()``).
-    shading : ``(mat_of (P,), mat_tab (M, 24), tex_tab (M, 17), lights (L, 14))``: the
+    shading : ``(mat_of (P,), mat_tab (M, MAT_COLS), tex_tab (M, TEX_COLS), lights (L, LIGHT_COLS))`` (the
+        columns of :mod:`..kernels.columns`): the
         flattened materials, the fused checker table (``raytrace.whitted.fused_textures``) and the
         point / directional lights (``flatten.light_rows``, area lights excluded).
     emitters : :meth:`.emitters.Emitters.arrays`.

@@ -20,8 +20,8 @@ leaves listing primitive rows; the unbounded ones (a quadric without bounds, a C
 one among its operands) stay in a short list tested by every ray.  With ``none`` every
 primitive is in that list (the brute force of before).  :func:`..kernels.intersect.closest` tests the
 list, then the primitives' tree, then the triangles' tree: all three find the closest hit,
-and equal ``t`` goes to the lowest primitive row (as the brute-force loop in row order
-does), then to the analytic primitive before a triangle, so the images are the same.
+and two surfaces closer along the ray than the ray offset go to the lower primitive row
+(:func:`..kernels.intersect.nearer`), whatever the order of the tests, so the images are the same.
 """
 from __future__ import annotations
 

@@ -43,15 +43,7 @@ CHUNK = 64
 """Rays of a wavefront chunk."""
 
 
-# ----------------------------------------------------------------------------- small helpers
-
-
-# ----------------------------------------------------------------------------- primitives
-
-
 # ----------------------------------------------------------------------------- batch kernels
-
-
 MAX_TASKS = 64
 """``prange`` tasks of a kernel call: each takes every ``MAX_TASKS``-th chunk of rays or block
 of pixels and allocates its scratch arrays once (an allocation per chunk cost more than the

@@ -32,7 +32,7 @@ from numba import prange
 
 from ...core.tol import tol
 from ..kernels.flags import NO_REFCOUNT
-from ..kernels.intersect import prim_tree_walk, row_hit, scratch
+from ..kernels.intersect import nearer, prim_tree_walk, reach, row_hit, scratch
 from ..kernels.walks import _bounds_hit, node_ray, open_node, tri_lane
 from .kernels import CHUNK, _tasks
 
@@ -101,24 +101,27 @@ def _count_chunk(geo_analytic, bvh, bounds, has_tri, O, D, zero, rel_eps, extent
         inv_w = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
         # the analytic primitives' nearest hit, as closest finds it (the list, then the
         # tree), counted: it is the far end of the triangles' search
-        best, brow = np.inf, -1
+        best, brow, w = np.inf, -1, eps * inv_w
         counts[i, 2], counts[i, 3] = 0, 0
         for q in range(free.shape[0]):
             counts[i, 3] += 1
-            t, p, f = row_hit(geo_analytic, free[q], ox, oy, oz, dx, dy, dz, inv_w, 0.0, best, zero, eps,
-                              stack, st, sp_, sf, sn)
-            if t < best:
+            t, p, f = row_hit(geo_analytic, free[q], ox, oy, oz, dx, dy, dz, inv_w, 0.0,
+                              reach(best, brow, w, np.inf), zero, eps, stack, st, sp_, sf, sn)
+            if nearer(t, free[q], best, brow, w, np.inf):
                 best, brow = t, free[q]
         if pref.shape[0] > 0:
-            if _bounds_hit(pbounds, ox, oy, oz, dx, dy, dz, 0.0, best):
-                best = prim_tree_walk(geo_analytic, ox, oy, oz, dx, dy, dz, inv_w, 0.0, best, brow, False, False,
-                                      zero, eps, stack, st, sp_, sf, sn, True, counts[i, 2:])[0]
+            if _bounds_hit(pbounds, ox, oy, oz, dx, dy, dz, 0.0, reach(best, brow, w, np.inf)):
+                t, _, _, row = prim_tree_walk(geo_analytic, ox, oy, oz, dx, dy, dz, inv_w, 0.0, np.inf, best, brow,
+                                              False, False, zero, eps, stack, st, sp_, sf, sn, True, counts[i, 2:])
+                if row >= 0:
+                    best, brow = t, row
             else:
                 counts[i, 2] = 1
         counts[i, 0], counts[i, 1] = 1, 0
-        if has_tri and _bounds_hit(bounds, ox, oy, oz, dx, dy, dz, 0.0, best):
+        lim = reach(best, brow, w, np.inf)
+        if has_tri and _bounds_hit(bounds, ox, oy, oz, dx, dy, dz, 0.0, lim):
             counts[i, 0] = 0
-            count_hit(bvh, ox, oy, oz, dx, dy, dz, 0.0, best, stack, counts[i])
+            count_hit(bvh, ox, oy, oz, dx, dy, dz, 0.0, lim, stack, counts[i])
 
 
 @nb.njit(cache=True, error_model="numpy", parallel=True)
