@@ -56,11 +56,16 @@ def run(state: AppState, frames: int | None = None, script=None,
     return 128 + state.quit_signal if state.quit_signal else 0
 
 
-SIGNAL_GRACE_SECONDS = 2.0
-"""After SIGTERM or SIGINT, how long the CPU jobs' threads get to see their cancel flag."""
-SIGNAL_EXIT_SECONDS = 4.0
-"""After SIGTERM or SIGINT, how long the window's loop gets to end (its clean-up then takes
-its own bounded time) before the process ends its child processes and itself."""
+SIGNAL_GRACE_SECONDS = 1.0
+"""After SIGTERM or SIGINT, how long the CPU jobs' threads, then the error plot's, get to see
+their cancel flag."""
+SIGNAL_EXIT_SECONDS = 3.0
+"""After SIGTERM or SIGINT, how long the window's loop gets to end before the process ends its
+child processes and itself."""
+SIGNAL_END_SECONDS = 4.0
+"""After SIGTERM or SIGINT, how long the whole exit (the loop, the clean-up and the
+interpreter's own end, which waits for every job thread: one inside a numba compile cannot
+stop) may take before the process ends its child processes and itself."""
 
 
 @contextmanager
@@ -75,7 +80,9 @@ def quit_on_signals(state: AppState):
     to a pipe by the interpreter's C handler (:func:`signal.set_wakeup_fd`), and a watcher
     thread, woken by it, sets the flags itself and, if the loop has not ended (the event this
     yields, which the caller sets when it has) :data:`SIGNAL_EXIT_SECONDS` later, terminates the
-    child processes and ends the process (status 128 + the signal's number)."""
+    child processes and ends the process (status 128 + the signal's number); it does the same
+    if the process has not ended :data:`SIGNAL_END_SECONDS` after the signal (it outlives this
+    context once a signal came)."""
     handled = []  # the signals the Python handler saw (the watcher may set the flags first)
 
     def handler(signum, _frame):
@@ -87,16 +94,22 @@ def quit_on_signals(state: AppState):
     os.set_blocking(write_end, False)
     closing = threading.Event()
 
+    def end(signum):
+        for child in multiprocessing.active_children():
+            child.terminate()
+        os._exit(128 + signum)
+
     def watch():
         data = os.read(read_end, 1)
-        if not data or closing.is_set():
+        if not data:  # the context ended without a signal
             return
+        t_signal = time.monotonic()
         state.quit_signal = state.quit_signal or data[0]
         state.quit = True
         if not closing.wait(SIGNAL_EXIT_SECONDS):
-            for child in multiprocessing.active_children():
-                child.terminate()
-            os._exit(128 + data[0])
+            end(data[0])
+        time.sleep(max(0.0, t_signal + SIGNAL_END_SECONDS - time.monotonic()))
+        end(data[0])
     old = {s: signal.signal(s, handler) for s in (signal.SIGTERM, signal.SIGINT)}
     old_fd = signal.set_wakeup_fd(write_end, warn_on_full_buffer=False)
     watcher = threading.Thread(target=watch, name="ui-signal-watch", daemon=True)
@@ -109,8 +122,9 @@ def quit_on_signals(state: AppState):
         for s, h in old.items():
             signal.signal(s, h)
         os.close(write_end)          # wakes the watcher if no signal came
-        watcher.join()
-        os.close(read_end)
+        if not state.quit_signal:
+            watcher.join()
+            os.close(read_end)
 
 
 def write_outputs(state: AppState, script, out: Path, seconds: float, shown: list) -> None:
