@@ -42,6 +42,16 @@ def _alive(pid: int) -> bool:
         return False
 
 
+def _terminated_after(proc, seconds: float) -> None:
+    """SIGTERM to ``proc``; it must end with 128 + SIGTERM, and not before ``seconds`` (its
+    loop or its exit had that long first)."""
+    t0 = time.monotonic()
+    proc.send_signal(signal.SIGTERM)
+    proc.wait(timeout=seconds + 20)
+    assert proc.returncode == 128 + signal.SIGTERM
+    assert time.monotonic() - t0 >= seconds - 0.5
+
+
 def test_sigterm_ends_a_stuck_window_and_its_children(tmp_path):
     script = tmp_path / "stuck.py"
     script.write_text(STUCK)
@@ -49,11 +59,7 @@ def test_sigterm_ends_a_stuck_window_and_its_children(tmp_path):
     try:
         child = int(proc.stdout.readline())
         assert proc.stdout.readline().strip() == "stuck"
-        t0 = time.monotonic()
-        proc.send_signal(signal.SIGTERM)
-        proc.wait(timeout=SIGNAL_EXIT_SECONDS + 20)
-        assert proc.returncode == 128 + signal.SIGTERM
-        assert time.monotonic() - t0 >= SIGNAL_EXIT_SECONDS - 0.5   # the loop had its time first
+        _terminated_after(proc, SIGNAL_EXIT_SECONDS)
         deadline = time.monotonic() + 5
         while _alive(child) and time.monotonic() < deadline:
             time.sleep(0.1)
@@ -85,11 +91,7 @@ def test_sigterm_ends_the_process_when_a_job_thread_outlives_the_loop(tmp_path):
     proc = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, text=True)
     try:
         assert proc.stdout.readline().strip() == "looping"
-        t0 = time.monotonic()
-        proc.send_signal(signal.SIGTERM)
-        proc.wait(timeout=SIGNAL_END_SECONDS + 20)
-        assert proc.returncode == 128 + signal.SIGTERM
-        assert time.monotonic() - t0 >= SIGNAL_END_SECONDS - 0.5   # the exit had its time first
+        _terminated_after(proc, SIGNAL_END_SECONDS)
     finally:
         if proc.poll() is None:
             proc.kill()
