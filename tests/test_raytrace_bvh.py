@@ -210,3 +210,37 @@ def test_two_thread_build_is_the_one_thread_tree_node_for_node():
     order2, box2, meta2 = B._build(tb.copy())
     assert len(box) > 1000 and (meta[:, 2] == -1).sum() > 500  # a real tree, both subtrees deep
     assert np.array_equal(order2, idx) and np.array_equal(box2, box) and np.array_equal(meta2, meta)
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 4])
+def test_a_tree_of_a_few_boxes_is_the_builders_tree(n):
+    """At most ``MAX_LEAF`` boxes make one leaf at the root without the numba builder
+    (``_root_leaf``): node for node the tree the builder makes of them."""
+    from workbench.renderers.raytrace.bvh import MAX_LEAF, _build, _collapse, build_box_tree
+    assert n <= MAX_LEAF
+    rng = np.random.default_rng(n)
+    lo = rng.normal(size=(n, 3)) * 10.0 ** rng.integers(-6, 7)
+    boxes = np.concatenate([lo, lo + rng.random((n, 3))], axis=1)
+    order, tree = build_box_tree(boxes)
+    b_order, box, meta = _build(boxes.copy())
+    for got, want in zip((order, *tree), (b_order, *_collapse(box, meta))):
+        assert got.dtype == want.dtype and np.array_equal(got, want)
+
+
+@pytest.mark.parametrize("n", [5, 37, 128])
+def test_a_small_build_in_python_is_the_compiled_builds_tree(n, monkeypatch):
+    """Up to ``SMALL_BUILD`` items the builder runs as Python (no compile on a cold cache):
+    node for node, packed group for packed group, the tree of the compiled builder, for boxes
+    (the analytic primitives' tree) and triangles."""
+    from workbench.renderers.raytrace import bvh
+    assert n <= bvh.SMALL_BUILD and max(n - 8, 1) + 8 <= bvh.SMALL_BUILD
+    rng = np.random.default_rng(n)
+    lo = rng.normal(size=(n, 3)) * 10.0 ** rng.integers(-6, 7)
+    boxes = np.concatenate([lo, lo + rng.random((n, 3))], axis=1)
+    tri = _soup(n, max(n - 8, 1))  # at most n triangles
+    small = (bvh.build_box_tree(boxes.copy()), bvh.build_bvh4(tri))
+    monkeypatch.setattr(bvh, "SMALL_BUILD", 0)
+    compiled = (bvh.build_box_tree(boxes.copy()), bvh.build_bvh4(tri))
+    for (o_s, t_s), (o_c, t_c) in zip(small, compiled):
+        for got, want in zip((o_s, *t_s), (o_c, *t_c)):
+            assert got.dtype == want.dtype and np.array_equal(got, want)

@@ -11,3 +11,8 @@ NO_REFCOUNT = dict(cache=True, error_model="numpy", _nrt=False, fastmath=FAST_MA
 """Options of the kernels that allocate nothing: compiled without numba's reference counting
 (no atomic increments and decrements of every array they touch, which cost the fused kernel
 40 % of its time); the arrays they use belong to their (reference-counted) callers."""
+INLINE = dict(NO_REFCOUNT, forceinline=True)
+"""Options of the small helpers: compiled once per signature (and cached) as functions of their
+own, marked ``alwaysinline`` for LLVM, which inlines them into every caller when it links the
+caller's module.  Numba's own ``inline="always"`` copies a helper's IR into each caller and types
+it again there, which cost several times the machine-code generation it saves."""

@@ -14,13 +14,13 @@ from numba.extending import overload
 from ...scene.kinds import CSGNODE
 from ...scene.kinds.csg import CSG_DEPTH
 from ...scene.kinds.expression import MAX_STACK
-from .flags import NO_REFCOUNT
+from .flags import INLINE, NO_REFCOUNT
 from .shapes import CSG_EVENTS, _normalize, _to_object, csg_hit, object_normal, prim_hit
 from .specialise import has
 from .walks import BVH_STACK, _bounds_hit, bvh_hit, node_ray, open_node
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, zero, eps, stack, st, sp_, sf, sn):
     """Closest hit ``tmin < t < tmax`` of top-level analytic primitive row ``k`` (a CSG node
     evaluates its program) for the world ray.  Returns ``(t, prim, face)``: ``prim`` the row
@@ -71,7 +71,7 @@ def csg_gate(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy
     raise TypeError("csg_gate is callable from numba-compiled code only")
 
 
-@overload(csg_gate, jit_options=dict(error_model="numpy"))
+@overload(csg_gate, jit_options=INLINE)
 def _csg_gate(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, zero,
               eps, st, sp_, sf, sn, stack):
     on = has(kinds, "csg")
@@ -91,7 +91,7 @@ def prim_tree_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, s
     raise TypeError("prim_tree_gate is callable from numba-compiled code only")
 
 
-@overload(prim_tree_gate, jit_options=dict(error_model="numpy"))
+@overload(prim_tree_gate, jit_options=INLINE)
 def _prim_tree_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only, any_hit, zero, eps,
                     stack, st, sp_, sf, sn):
     on = has(geo.types[-1], "prim_tree")  # geo.kinds' type
@@ -110,7 +110,7 @@ def triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     raise TypeError("triangles_gate is callable from numba-compiled code only")
 
 
-@overload(triangles_gate, jit_options=dict(error_model="numpy"))
+@overload(triangles_gate, jit_options=INLINE)
 def _triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     on = has(geo.types[-1], "triangles")
 
@@ -122,7 +122,7 @@ def _triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     return impl
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only, any_hit, zero, eps,
                    stack, st, sp_, sf, sn, count, cnt):
     """:func:`prim_tree_hit`; with ``count`` (the traversal statistics' pass,
@@ -168,7 +168,7 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, s
     return best, bp, bf, found
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def nearer(t, k, best, brow, w, tmax):
     """Whether a hit at ``t < tmax`` of row ``k`` replaces the nearest so far (``best`` of row
     ``brow``, ``-1`` for none).  Two surfaces closer along the ray than ``w`` (the secondary
@@ -183,14 +183,14 @@ def nearer(t, k, best, brow, w, tmax):
     return t < tmax and (t < best - w or (t <= best + w and k < brow))
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def reach(best, brow, w, tmax):
     """How far a search must look past the nearest hit so far for a coincident surface of a
     lower row (:func:`nearer`), within ``tmax``."""
     return min(best + w, tmax) if brow >= 0 else best
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
             st, sp_, sf, sn):
     """Nearest hit of a world ray over all primitives: the list of analytic primitives tested
@@ -230,7 +230,7 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
     return best, bp, bf, btri, bb1, bb2
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_uv, out_po, out_e, i,
             stack):
     """Geometric (outward) normal, shading normal, uv (meshes; analytic primitives leave the

@@ -10,22 +10,23 @@ import numba as nb
 import numpy as np
 
 from .columns import CHECKER_PLANAR, Light, Mat, Tex
+from .flags import INLINE
 from .shapes import _normalize
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def _pow(base, n):
     if n == 0.0:
         return 1.0
     return base ** n
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def _ior(mat_tab, stk, ns_):
     return mat_tab[stk[ns_ - 1], Mat.IOR] if ns_ > 0 else 1.0
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def fresnel_reflectance(fres, n1, n2, cosi, cost):
     """Reflected share F of light crossing from index ``n1`` to ``n2`` (``cosi``, ``cost``: the
     cosines of incidence and refraction): Schlick's approximation for ``fres == 1`` (cosine on the
@@ -41,7 +42,7 @@ def fresnel_reflectance(fres, n1, n2, cosi, cost):
     return 0.5 * (rs * rs + rp * rp)
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def _facing(nsh, i, dx, dy, dz):
     """The shading normal of hit ``i``, turned to face the viewer (two-sided shading)."""
     nx, ny, nz = nsh[i, 0], nsh[i, 1], nsh[i, 2]
@@ -50,7 +51,7 @@ def _facing(nsh, i, dx, dy, dz):
     return nx, ny, nz
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def _light_dir(lights, li, px, py, pz):
     """Unit direction ``l`` from ``P`` to light ``li``, its distance (``inf`` for a directional
     light) and the light's factor there (1, ``1 / d^2`` when attenuated, times the spot
@@ -72,7 +73,7 @@ def _light_dir(lights, li, px, py, pz):
     return lx, ly, lz, dist, scale
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def _feeler(px, py, pz, gx, gy, gz, lx, ly, lz, dist, off):
     """The shadow feeler towards ``l``: origin pushed ``off`` off the surface (geometric normal
     ``g``) on the light's side, and its end short of the light.  Returns ``(qx, qy, qz, tmax)``."""
@@ -81,7 +82,7 @@ def _feeler(px, py, pz, gx, gy, gz, lx, ly, lz, dist, off):
     return px + side * off * gx, py + side * off * gy, pz + side * off * gz, tmx
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def checker_color(tex_tab, mi, x, y, z):
     """Texture factor of material ``mi`` at object-space point ``(x, y, z)``: the
     ``checker`` pattern of :func:`workbench.renderers.texturing.pattern_value` with the
@@ -100,7 +101,7 @@ def checker_color(tex_tab, mi, x, y, z):
             tex_tab[mi, Tex.COLOR0 + 2] * (1.0 - a) + tex_tab[mi, Tex.COLOR1 + 2] * a)
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def camera_ray(cam, q, o, d):
     """Row 0 of ``o, d``: the centre ray of image pixel ``q`` (row-major) of the camera ``cam``
     (``whitted.camera_frame``: position, rotation, tan(fov_y / 2), aspect, width, height)."""

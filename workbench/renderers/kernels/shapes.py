@@ -14,7 +14,7 @@ from ...core.tol import tol
 from ...scene.kinds import BOX, POLYGON, QUADRIC, RECT, SPHERE
 from ...scene.kinds import blob, isosurface, lathe, prism
 from ...scene.kinds.csg import CSG_DIFFERENCE, CSG_INTERSECTION, CSG_UNION
-from .flags import NO_REFCOUNT
+from .flags import INLINE, NO_REFCOUNT
 from .specialise import exotic_events, exotic_first, exotic_normal
 
 BLOB, ISOSURFACE, LATHE, PRISM = blob.PTYPE, isosurface.PTYPE, lathe.PTYPE, prism.PTYPE
@@ -24,7 +24,7 @@ TOL_CUT = tol.cut
 """Relative slack of a cut quadric's bounds test (``tol.cut``; a compile-time constant of the kernels)."""
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def _to_object(xf, k, ox, oy, oz, dx, dy, dz):
     return (xf[k, 0] * ox + xf[k, 1] * oy + xf[k, 2] * oz + xf[k, 3], xf[k, 4] * ox + xf[k, 5] * oy + xf[k, 6] * oz + xf[k, 7],
             xf[k, 8] * ox + xf[k, 9] * oy + xf[k, 10] * oz + xf[k, 11],
@@ -54,7 +54,7 @@ def solve_quadratic(A, B, C, zero):
     return 2, t0, t1
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def linear(A, B, C, zero):
     """True when ``A t^2 + B t + C`` is linear for the ray: ``|A C| <= zero B^2``, i.e. the
     second root ``-B/A`` lies beyond ``1/zero`` times the first ``-C/B`` (or ``A = B = 0``).
@@ -64,14 +64,14 @@ def linear(A, B, C, zero):
     return abs(A * C) <= zero * (B * B)
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def sphere_roots(par, k, ox, oy, oz, dx, dy, dz):
     """Roots of the ray / sphere equation in object space (see :func:`sphere_roots_unit`)."""
     inv_s = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
     return sphere_roots_unit(par, k, ox, oy, oz, dx * inv_s, dy * inv_s, dz * inv_s, inv_s)
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def sphere_roots_unit(par, k, ox, oy, oz, ux, uy, uz, inv_s):
     """Roots of the ray / sphere equation in object space, for the unit direction ``u`` of a
     ray direction of length ``1 / inv_s`` (the roots are in units of that direction).
@@ -101,7 +101,7 @@ def sphere_roots_unit(par, k, ox, oy, oz, ux, uy, uz, inv_s):
     return True, t0 * inv_s, t1 * inv_s
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def slab(lo0, lo1, lo2, hi0, hi1, hi2, ox, oy, oz, dx, dy, dz):
     """Ray / axis-aligned box (Kay & Kajiya slabs).  Returns ``(ok, t_near, face_near, t_far,
     face_far)``; faces are ``1 + 2 axis + side`` (side 1 = max face)."""
@@ -133,7 +133,7 @@ def slab(lo0, lo1, lo2, hi0, hi1, hi2, ox, oy, oz, dx, dy, dz):
     return True, tn, fn, tf, ff
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def quadric_coeffs(par, k, ox, oy, oz, dx, dy, dz):
     """``A = D^T Q D``, ``B = 2 D^T Q P0``, ``C = P0^T Q P0`` with D lifted with w = 0 and P0
     with w = 1 (errata 2: the cross terms of C carry their factor 2)."""
@@ -153,7 +153,7 @@ def quadric_coeffs(par, k, ox, oy, oz, dx, dy, dz):
     return A, B, C
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def _in_bounds(par, k, x, y, z, slack):
     return (par[k, 10] - slack <= x <= par[k, 13] + slack and par[k, 11] - slack <= y <= par[k, 14] + slack
             and par[k, 12] - slack <= z <= par[k, 15] + slack)
@@ -201,7 +201,7 @@ def _quadric_hit(k, par, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
     return np.inf, 0
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def prim_hit(kinds, k, ptype, par, poly_v, aux, ox, oy, oz, dx, dy, dz, ux, uy, uz, inv_s, tmin, tmax,
              zero, out_t, out_f, stack):
     """Closest hit ``tmin < t < tmax`` of analytic primitive ``k`` (object-space ray with
@@ -317,7 +317,7 @@ def leaf_events(kinds, k, ptype, par, aux, ox, oy, oz, dx, dy, dz, zero, et, ep,
     return m
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def _op(op, a, b):
     if op == CSG_UNION:
         return a or b
@@ -398,7 +398,7 @@ def csg_hit(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy,
     return np.inf, 0, 0
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def object_normal(kinds, k, face, ptype, par, aux, x, y, z, stack):
     """Outward normal (unnormalised) of primitive ``k`` at object-space point, by face."""
     kind = ptype[k]
@@ -420,7 +420,7 @@ def object_normal(kinds, k, face, ptype, par, aux, x, y, z, stack):
     return 0.0, 1.0, 0.0
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def _normalize(x, y, z):
     n = math.sqrt(x * x + y * y + z * z)
     if n > 0.0:

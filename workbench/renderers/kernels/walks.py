@@ -7,7 +7,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from .flags import NO_REFCOUNT
+from .flags import INLINE, NO_REFCOUNT
 from .layout import MAX_DEPTH
 
 BVH_STACK = 3 * MAX_DEPTH + 4
@@ -17,7 +17,7 @@ BVH_STACK = 3 * MAX_DEPTH + 4
 BOX_GAMMA = 1.0 + 2.0 * 3.0 * 2.0 ** -53 / (1.0 - 3.0 * 2.0 ** -53)
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def _edge_functions(tv4, g, j, pk, okx, oky, okz, sx, sy, sz):
     """The watertight ray / triangle test's edge functions ``U, V, W`` of triangle ``j`` of
     group ``g`` (:func:`.bvh.build_bvh4`) and its vertices' sheared depths (Woop, Benthin &
@@ -34,7 +34,7 @@ def _edge_functions(tv4, g, j, pk, okx, oky, okz, sx, sy, sz):
     return cx * by - cy * bx, ax * cy - ay * cx, bx * ay - by * ax, az, bz, cz
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def tri_lane(tv4, g, j, pk, okx, oky, okz, sx, sy, sz, tmin, tmax):
     """Watertight ray / triangle test of triangle ``j`` of group ``g`` (see
     :func:`_edge_functions`), without branches, so that the four triangles of a group are
@@ -47,7 +47,7 @@ def tri_lane(tv4, g, j, pk, okx, oky, okz, sx, sy, sz, tmin, tmax):
     return t if ((not outside) & (det != 0.0) & (tmin < t) & (t < tmax)) else np.inf
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def _slab_interval(nx, ny, nz, fx, fy, fz):
     """Entry and exit distances of a ray in a box from its three slabs' near and far plane
     distances.  A ray parallel to a slab has ``+-inf`` distances (``1 / 0``), and NaN where it
@@ -62,7 +62,7 @@ def _slab_interval(nx, ny, nz, fx, fy, fz):
     return tn, tf
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def _bounds_hit(b, ox, oy, oz, dx, dy, dz, tmin, tmax):
     """Whether the ray meets the box ``b`` (min xyz, max xyz) within ``[tmin, tmax]``: the
     test before a BVH traversal (the call, and its set-up, cost more than the test; most
@@ -76,7 +76,7 @@ def _bounds_hit(b, ox, oy, oz, dx, dy, dz, tmin, tmax):
     return tn <= tf * BOX_GAMMA and tf >= tmin and tn <= tmax
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def box_lane(node, nd, j, pl, ox, oy, oz, ix, iy, iz, tmin, best):
     """Entry distance of the ray into child ``j``'s box of 4-wide node ``nd``, ``inf`` if it
     misses it or enters beyond ``best``.  ``pl``: the rows of the planes the ray enters by,
@@ -90,7 +90,7 @@ def box_lane(node, nd, j, pl, ox, oy, oz, ix, iy, iz, tmin, best):
     return tn if ((tn <= tf * BOX_GAMMA) & (tf >= tmin) & (tn <= best)) else np.inf
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def _push_sorted(stack, base, sp, t, code):
     """Push ``(t, code)`` on ``stack`` above row ``base``, keeping rows ``base..sp`` sorted
     with the nearest on top.  Returns the new height."""
@@ -102,7 +102,7 @@ def _push_sorted(stack, base, sp, t, code):
     return sp + 1
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def _visit_child(stack, base, sp, top, t, code, near, tnear):
     """One hit child of a node: it becomes the node to visit next if it is the nearest so far
     (the previous nearest waits on the stack), else it waits.  Returns ``(sp, near, tnear)``."""
@@ -115,7 +115,7 @@ def _visit_child(stack, base, sp, top, t, code, near, tnear):
     return sp, near, tnear
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def node_ray(ox, oy, oz, dx, dy, dz, tmin):
     """The ray as :func:`open_node` reads it: ``(pl, ox, oy, oz, ix, iy, iz, tmin)``, its
     origin, inverse direction (``+-inf`` for a zero component: see :func:`_slab_interval`),
@@ -130,7 +130,7 @@ def node_ray(ox, oy, oz, dx, dy, dz, tmin):
     return pl, ox, oy, oz, ix, iy, iz, tmin
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def open_node(tree, code, ray, best, stack, sp, top):
     """Visit of 4-wide node ``code`` of ``tree = (node, child)`` (the layout of
     :func:`.bvh.build_bvh4`: children's boxes ``(N4, 6, 4)``, children ``(N4, 4)``) by

@@ -66,7 +66,7 @@ import numpy as np
 
 from ..kernels.columns import Light, Mat, PathOpt
 from ..kernels.tasks import run_tasks
-from ..kernels.flags import NO_REFCOUNT
+from ..kernels.flags import INLINE, NO_REFCOUNT
 from ..kernels.intersect import closest, scratch, surface
 from ..kernels.optics import _feeler, _light_dir, checker_color, fresnel_reflectance
 from ..kernels.shapes import _normalize
@@ -87,7 +87,7 @@ _M2 = np.uint64(0x94D049BB133111EB)
 _S30, _S27, _S31, _S11 = np.uint64(30), np.uint64(27), np.uint64(31), np.uint64(11)
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def _mix(z):
     """SplitMix64's finaliser (Steele, Lea & Flood, OOPSLA 2014): a bijective 64-bit hash."""
     z = (z ^ (z >> _S30)) * _M1
@@ -95,19 +95,19 @@ def _mix(z):
     return z ^ (z >> _S31)
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def path_key(seed, pixel, sample):
     """The random stream of one path: a hash of (seed, pixel, sample index)."""
     return _mix(_mix(_mix(np.uint64(seed) + _G) + np.uint64(pixel)) + np.uint64(sample))
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def rand(key, dim):
     """Uniform in [0, 1): dimension ``dim`` of the stream ``key`` (53 bits)."""
     return float(_mix(key + np.uint64(dim) * _G) >> _S11) * (1.0 / 9007199254740992.0)
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def _frame(nx, ny, nz):
     """Two unit tangents completing ``n`` (Duff et al., "Building an orthonormal basis,
     revisited", JCGT 2017)."""
@@ -117,7 +117,7 @@ def _frame(nx, ny, nz):
     return 1.0 + s * nx * nx * a, s * b, -s * nx, b, s + ny * ny * a, -ny
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def _around(nx, ny, nz, cos_t, phi):
     """Unit direction at polar angle ``acos(cos_t)`` and azimuth ``phi`` about ``n``."""
     tx, ty, tz, bx, by, bz = _frame(nx, ny, nz)
@@ -126,7 +126,7 @@ def _around(nx, ny, nz, cos_t, phi):
     return c * tx + s * bx + cos_t * nx, c * ty + s * by + cos_t * ny, c * tz + s * bz + cos_t * nz
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def camera_ray_at(cam, i, j, u, v):
     """Unit direction of the ray through point ``(j + u, i + v)`` of the image plane (pixel
     ``(i, j)``, ``u, v`` in [0, 1); ``u = v = 1/2`` is :func:`..kernels.optics.camera_ray`'s
@@ -137,7 +137,7 @@ def camera_ray_at(cam, i, j, u, v):
                  x * cam[9] + y * cam[10] - cam[11])
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def mis_weight(pa, pb, beta):
     """Power heuristic ``pa^beta / (pa^beta + pb^beta)`` (``beta = 1``: balance heuristic)."""
     if beta == 2.0:
@@ -147,7 +147,7 @@ def mis_weight(pa, pb, beta):
     return a / (a + b) if a > 0.0 else 0.0
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def phong_lobe(ks, shin, rx, ry, rz, wx, wy, wz):
     """``(ks cos^n alpha (n + 2) / (2 pi), cos^n alpha (n + 1) / (2 pi))``: the normalised Phong
     lobe's value and its sampling density, ``alpha`` the angle between ``w`` and the mirror
@@ -257,7 +257,7 @@ def cast_all(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr):
                    sp_, sf, sn)
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def cast(geo, bvh, tri_prim, only_tris, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr):
     """The hit of every ray of a path (camera, extension and shadow rays), as
     :func:`..kernels.intersect.closest` returns it.  ``only_tris`` (``opts[PathOpt.ONLY_TRIANGLES]``: every

@@ -17,7 +17,7 @@ from ..kernels.layout import MAX_DEPTH
 TWO_PI = 2.0 * np.pi
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _cross(a0, a1, a2, b0, b1, b2):
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
@@ -332,7 +332,7 @@ def shoot_rows(rows, shooters, areas, rho, B, dB, relax, stop, history, start):
     return len(shooters)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _seg_blocked(tv, box, meta, ox, oy, oz, dx, dy, dz, t0, t1, stack):
     """Whether any triangle (``tv`` (T, 9), BVH ``box``/``meta`` of
     :func:`workbench.renderers.raytrace.bvh.build_bvh`) crosses the segment o + t d,

@@ -215,6 +215,16 @@ def _build_nodes(tb, idx, s0, e0, depth0, bounds0, limit):
 
 PARALLEL_MIN = 4096
 """Items from which the root's two subtrees are built at once (two threads; numba ``nogil``)."""
+SMALL_BUILD = 128
+"""Items up to which :func:`_build` and :func:`_collapse` run as plain Python (the numba
+dispatchers' ``py_func``: the same code, so the same tree): a scene of a few primitives
+(the Cornell box's boxes and rectangles) builds its tree in milliseconds without compiling
+the builder, which costs seconds on an empty numba cache."""
+
+
+def _kernel(fn, n: int):
+    """``fn`` itself, or its Python function for at most :data:`SMALL_BUILD` items."""
+    return fn.py_func if n <= SMALL_BUILD else fn
 
 
 def _build(tb: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -225,9 +235,9 @@ def _build(tb: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     so the tree is the same node for node."""
     T = tb.shape[0]
     idx = np.arange(T)
-    b0 = _root_bounds(tb)
+    b0 = _kernel(_root_bounds, T)(tb)
     if T < PARALLEL_MIN:
-        box, meta, _, _ = _build_nodes(tb, idx, 0, T, 0, b0, 2 * T)
+        box, meta, _, _ = _kernel(_build_nodes, T)(tb, idx, 0, T, 0, b0, 2 * T)
         return idx, box, meta
     rbox, rmeta, pending, pbounds = _build_nodes(tb, idx, 0, T, 0, b0, 1)
     if len(pending) == 0:  # the root is a leaf
@@ -369,11 +379,11 @@ def build_bvh4(tri_v: np.ndarray) -> tuple[np.ndarray, Bvh4]:
     bvh : :class:`Bvh4` over ``tri_v[order]``.
     """
     tri_v = np.ascontiguousarray(tri_v, dtype=np.float64)
-    order, box, meta = _build(triangle_boxes(tri_v))
-    node, child, leaf = _collapse(box, meta)
+    order, box, meta = _build(_kernel(triangle_boxes, len(tri_v))(tri_v))
+    node, child, leaf = _kernel(_collapse, len(box))(box, meta)
     bounds = box[0].copy()
     del box, meta
-    tv4, first, groups = _pack_leaves(tri_v, order, leaf)
+    tv4, first, groups = _kernel(_pack_leaves, len(tri_v))(tri_v, order, leaf)
     return order, Bvh4(node, child, groups, first, tv4, bounds)
 
 
@@ -390,8 +400,22 @@ def build_box_tree(boxes: np.ndarray) -> tuple[np.ndarray, tuple]:
     order : (P,) permutation: leaf ranges index ``boxes[order]``.
     tree : ``(node (N4, 6, 4), child (N4, 4), leaf (L, 2))`` as :func:`_collapse` makes them.
     """
-    order, box, meta = _build(np.array(boxes, dtype=np.float64, order="C"))
-    return order, _collapse(box, meta)
+    boxes = np.array(boxes, dtype=np.float64, order="C")
+    if len(boxes) <= MAX_LEAF:
+        return np.arange(len(boxes), dtype=np.int64), _root_leaf(boxes)
+    order, box, meta = _build(boxes)
+    return order, _kernel(_collapse, len(box))(box, meta)
+
+
+def _root_leaf(boxes: np.ndarray) -> tuple:
+    """The tree :func:`build_box_tree` makes of at most :data:`MAX_LEAF` boxes (one leaf at the
+    root, the items in their order), built without compiling the builder's kernels: a scene
+    of a few spheres pays no compile for them."""
+    node = np.empty((1, 6, 4))
+    node[0, :3, :], node[0, 3:, :] = np.inf, -np.inf  # empty slots
+    node[0, :3, 0], node[0, 3:, 0] = boxes[:, :3].min(axis=0), boxes[:, 3:].max(axis=0)
+    child = np.array([[-2, -1, -1, -1]], dtype=np.int64)
+    return node, child, np.array([[0, len(boxes)]], dtype=np.int64)
 
 
 def empty_bvh4() -> Bvh4:

@@ -11,9 +11,8 @@ drivers run blocks of pixels or chunks of rays on several threads: the fused one
 tasks on a thread pool (:mod:`..kernels.tasks`), the wavefront ones with ``prange``; each task
 has its own scratch arrays (BVH stack, CSG interval stacks, ray stack) and hands its work to
 functions compiled without reference counting (:data:`..kernels.flags.NO_REFCOUNT`).  Helpers
-marked ``inline="always"`` are inlined into their callers by numba, at the IR level, and are
-not cached themselves: that copying is most of a first render's compile time, but making them
-calls slows warm renders (``docs/kernels.md``).  The kernels are compiled per set of kinds
+take :data:`..kernels.flags.INLINE`: each is compiled once (and cached) and LLVM inlines it
+into its callers (``docs/kernels.md``).  The kernels are compiled per set of kinds
 present (:mod:`..kernels.specialise`).  ``error_model="numpy"``: float divisions follow IEEE
 (no zero-divisor check and exception path on every division; the results are the same
 wherever the default Python model would not raise).  ``cache=True``: compiled code is kept on
@@ -31,7 +30,7 @@ import numpy as np
 from numba import prange
 
 from ..kernels.columns import Light, Mat, WhittedOpt
-from ..kernels.flags import NO_REFCOUNT
+from ..kernels.flags import INLINE, NO_REFCOUNT
 from ..kernels.intersect import closest, scratch, surface
 from ..kernels.optics import (_facing, _feeler, _ior, _light_dir, _pow, camera_ray, checker_color,
                               fresnel_reflectance)
@@ -51,7 +50,7 @@ chunk's rays).  Enough for a fair split between threads; a constant, because a k
 asks numba for its thread count cannot be cached."""
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def _tasks(nchunks):
     return max(1, min(nchunks, MAX_TASKS))
 
@@ -88,7 +87,7 @@ def trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_on
                     oz + t * D[i, 2], ncancel, ng, ns, uv, po, ev, i, stack)
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def _transmittance(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmin, tmax, transmissive, zero,
                    eps, stack, st, sp_, sf, sn):
     """Shadow feeler: 1 if nothing blocks the segment, 0 if blocked (any hit ends the search);
@@ -147,7 +146,7 @@ def feeler_batch(lights, O, D, t, prim, ng, nsh, opts, fo, fd, ftmin, ftmax, wan
             want[r] = True
 
 
-@nb.njit(error_model="numpy", inline="always")
+@nb.njit(**INLINE)
 def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, hits, contrib,
               out, s0, counts, scr):
     """Local model with shadow feelers at the hit of ray ``i``, then its reflected and refracted

@@ -11,7 +11,7 @@ import numpy as np
 from .blob import BISECTIONS
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(cache=True, error_model="numpy", forceinline=True)
 def _poly(p0, p1, p2, p3, p4, v):
     return (((p4 * v + p3) * v + p2) * v + p1) * v + p0
 
@@ -103,7 +103,7 @@ def _quartic_change(p0, p1, p2, p3, p4, lo, hi):
     return _first_change(p0, p1, p2, p3, p4, lo, hi, r1, r2, r3)
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(cache=True, error_model="numpy", forceinline=True)
 def _chord_nb(aux, j, ox, oy, oz, ux, uy, uz):
     fx, fy, fz = ox - aux[j], oy - aux[j + 1], oz - aux[j + 2]
     r = aux[j + 3]

@@ -163,12 +163,12 @@ _HITS_S = 84        # and s
 _MAX_HITS = 12
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(cache=True, error_model="numpy", forceinline=True)
 def _get(st, i):
     return st[i >> 2, i & 3]
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(cache=True, error_model="numpy", forceinline=True)
 def _put(st, i, v):
     st[i >> 2, i & 3] = v
 
@@ -238,12 +238,12 @@ def _roots_in(st, deg, lo, hi):
     return nc
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(cache=True, error_model="numpy", forceinline=True)
 def _cubic(aux, j, s):
     return ((aux[j + 3] * s + aux[j + 2]) * s + aux[j + 1]) * s + aux[j]
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
+@nb.njit(cache=True, error_model="numpy", forceinline=True)
 def _dcubic(aux, j, s):
     return (3.0 * aux[j + 3] * s + 2.0 * aux[j + 2]) * s + aux[j + 1]
 
