@@ -16,3 +16,7 @@ INLINE = dict(NO_REFCOUNT, forceinline=True)
 own, marked ``alwaysinline`` for LLVM, which inlines them into every caller when it links the
 caller's module.  Numba's own ``inline="always"`` copies a helper's IR into each caller and types
 it again there, which cost several times the machine-code generation it saves."""
+GATE = dict(error_model="numpy", _nrt=False, fastmath=FAST_MATH)
+"""Options of the kind and feature gates (``@overload`` implementations in :mod:`.specialise`
+and :mod:`.intersect`): ordinary calls, not inlined, so that a scene's rarely used kinds stay
+out of its hot loops."""

@@ -20,11 +20,11 @@ from numba.extending import overload
 
 from ...scene.kinds import blob, isosurface, lathe, prism
 from ...scene.kinds import blob_kernels as kb, isosurface_kernels as ki, lathe_kernels as kl, prism_kernels as kp
-from .flags import INLINE
+from .flags import GATE
 from .layout import marker_features
 
 BLOB, ISOSURFACE, LATHE, PRISM = blob.PTYPE, isosurface.PTYPE, lathe.PTYPE, prism.PTYPE
-JIT = INLINE
+JIT = GATE
 
 
 def has(kinds, feature: str) -> bool:

@@ -140,7 +140,7 @@ def open_node(tree, code, ray, best, stack, sp, top):
     distance, child)``, nearest on top; of equal entries the lower slot is visited first:
     :func:`_visit_child`), no higher than row ``top``.  The one node visit of the triangles'
     traversal (:func:`bvh_hit`), the analytic primitives' (:func:`prim_tree_walk`) and the
-    traversal statistics' (:func:`.traversal_stats.count_hit`).  Returns ``(sp, code)``: the
+    traversal statistics' (:func:`bvh_walk` with counting).  Returns ``(sp, code)``: the
     new stack height and the child to visit next (``>= 0`` a node, ``<= -2`` a leaf, ``-1``
     none hit)."""
     node, child = tree
@@ -190,11 +190,21 @@ def _slp_vectorized(dispatcher):
 @_slp_vectorized
 @nb.njit(**NO_REFCOUNT)
 def bvh_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
+    """Closest (or any) triangle hit through the 4-wide BVH: :func:`bvh_walk` without counting.
+    Returns ``(t, tri, b1, b2)``."""
+    return bvh_walk(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack, False, stack[0])
+
+
+@nb.njit(**INLINE)
+def bvh_walk(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack, count, cnt):
     """Closest (or any) triangle hit through the 4-wide BVH (:func:`.bvh.build_bvh4`): at each
     node the four children's boxes are tested together, the nearest hit child is visited next
     and the others wait on ``stack`` (rows ``(entry distance, child)``, nearest on top), skipped
     when popped if the best hit is now nearer than their box; a leaf's triangles are tested four
-    at a time.  Returns ``(t, tri, b1, b2)``."""
+    at a time.  Returns ``(t, tri, b1, b2)``.  With ``count`` (the traversal statistics' pass,
+    :mod:`..raytrace.traversal_stats`) it adds the 4-wide nodes visited to ``cnt[0]`` and the
+    triangle tests (four per leaf group) to ``cnt[1]``; :func:`bvh_hit` passes ``False``, and
+    the counting compiles away."""
     node, child, leaf, first, tv4 = bvh
     ray = node_ray(ox, oy, oz, dx, dy, dz, tmin)
     # the watertight test's shear
@@ -219,10 +229,14 @@ def bvh_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     code, sp = 0, 0
     while True:
         while code >= 0:  # a 4-wide node
+            if count:
+                cnt[0] += 1
             sp, code = open_node((node, child), code, ray, best, stack, sp, top)
         if code < -1:  # a leaf
             lf = -2 - code
             for g in range(leaf[lf, 0], leaf[lf, 0] + leaf[lf, 1]):
+                if count:
+                    cnt[1] += 4
                 u0 = tri_lane(tv4, g, 0, pk, okx, oky, okz, sx, sy, sz, tmin, best)
                 u1 = tri_lane(tv4, g, 1, pk, okx, oky, okz, sx, sy, sz, tmin, best)
                 u2 = tri_lane(tv4, g, 2, pk, okx, oky, okz, sx, sy, sz, tmin, best)

@@ -1,13 +1,14 @@
 """Traversal statistics of the acceleration structures, the triangles' and the analytic
 primitives' (option ``traversal_stats``):
-nodes visited and primitives tested per camera ray, counted in a pass of their own so that
-the rendering kernels carry no counters (their speed is untouched; the pass costs about one
-more trace of the pixel centres and is timed apart, ``timings["traversal_stats"]``).
+nodes visited and primitives tested per camera ray, counted in a pass of their own by the
+rendering kernels' walks with their counters switched on (switched off in a render, the
+counting compiles away; the pass costs about one more trace of the pixel centres and is timed
+apart, ``timings["traversal_stats"]``).
 
-:func:`count_hit` is :func:`..kernels.walks.bvh_hit` (closest hit) step for step with two counters:
-the same box and triangle tests in the same order, so it returns the same hit (tested) and
-its counts are the real traversal's; the analytic primitives' tree is walked by the rendering
-kernels' own :func:`..kernels.intersect.prim_tree_walk` with its counting switched on.  Counting rules,
+:func:`count_hit` is :func:`..kernels.walks.bvh_hit`'s own walk (:func:`..kernels.walks.bvh_walk`)
+with its two counters switched on: the same box and triangle tests in the same order, so it
+returns the same hit (tested) and its counts are the real traversal's; the analytic
+primitives' tree is walked by :func:`..kernels.intersect.prim_tree_walk`, counting likewise.  Counting rules,
 per ray and per structure (the triangles', the analytic primitives'):
 
 * nodes: 1 for the structure's root box (:func:`..kernels.intersect.closest`'s bounds test), plus one
@@ -33,62 +34,17 @@ from numba import prange
 from ...core.tol import tol
 from ..kernels.flags import NO_REFCOUNT
 from ..kernels.intersect import nearer, prim_tree_walk, reach, row_hit, scratch
-from ..kernels.walks import _bounds_hit, node_ray, open_node, tri_lane
+from ..kernels.walks import _bounds_hit, bvh_walk
 from .kernels import CHUNK, _tasks
 
 
 @nb.njit(**NO_REFCOUNT)
 def count_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, stack, cnt):
-    """:func:`..kernels.walks.bvh_hit`'s closest-hit traversal, adding the 4-wide nodes visited to
-    ``cnt[0]`` and the triangle tests to ``cnt[1]``.  Returns ``(t, tri)``."""
-    node, child, leaf, first, tv4 = bvh
-    ray = node_ray(ox, oy, oz, dx, dy, dz, tmin)
-    ax0, ax1, ax2 = abs(dx), abs(dy), abs(dz)
-    kz = 0
-    if ax1 > ax0 and ax1 >= ax2:
-        kz = 1
-    elif ax2 > ax0 and ax2 > ax1:
-        kz = 2
-    kx = (kz + 1) % 3
-    ky = (kx + 1) % 3
-    d = (dx, dy, dz)
-    if d[kz] < 0.0:
-        kx, ky = ky, kx
-    sx, sy, sz = d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]
-    o = (ox, oy, oz)
-    okx, oky, okz = o[kx], o[ky], o[kz]
-    pk = (np.uint64(kx), np.uint64(ky), np.uint64(kz), np.uint64(3 + kx), np.uint64(3 + ky),
-          np.uint64(3 + kz), np.uint64(6 + kx), np.uint64(6 + ky), np.uint64(6 + kz))
-    best, bg, bl = tmax, -1, 0
-    top = stack.shape[0] - 1
-    code, sp = 0, 0
-    while True:
-        while code >= 0:
-            cnt[0] += 1
-            sp, code = open_node((node, child), code, ray, best, stack, sp, top)
-        if code < -1:
-            lf = -2 - code
-            for g in range(leaf[lf, 0], leaf[lf, 0] + leaf[lf, 1]):
-                cnt[1] += 4
-                u0 = tri_lane(tv4, g, 0, pk, okx, oky, okz, sx, sy, sz, tmin, best)
-                u1 = tri_lane(tv4, g, 1, pk, okx, oky, okz, sx, sy, sz, tmin, best)
-                u2 = tri_lane(tv4, g, 2, pk, okx, oky, okz, sx, sy, sz, tmin, best)
-                u3 = tri_lane(tv4, g, 3, pk, okx, oky, okz, sx, sy, sz, tmin, best)
-                m = min(min(u0, u1), min(u2, u3))
-                if m < best:
-                    best, bg = m, g
-                    bl = 0 if u0 == m else (1 if u1 == m else (2 if u2 == m else 3))
-        code = -1
-        while sp > 0:
-            sp -= 1
-            if stack[sp, 0] <= best:
-                code = int(stack[sp, 1])
-                break
-        if code == -1:
-            break
-    if bg < 0:
-        return np.inf, -1
-    return best, first[bg] + bl
+    """:func:`..kernels.walks.bvh_hit`'s closest-hit traversal (:func:`..kernels.walks.bvh_walk`),
+    adding the 4-wide nodes visited to ``cnt[0]`` and the triangle tests to ``cnt[1]``.
+    Returns ``(t, tri)``."""
+    t, tri, _, _ = bvh_walk(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, False, stack, True, cnt)
+    return t, tri
 
 
 @nb.njit(**NO_REFCOUNT)
