@@ -100,6 +100,24 @@ def _run(args, env, cwd, timeout=600) -> subprocess.CompletedProcess:
     return p
 
 
+def test_the_version_comes_from_pyproject(monkeypatch):
+    """``workbench.__version__`` and ``workbench --version`` give pyproject.toml's version: from the
+    installed metadata, or from pyproject.toml itself in a checkout that is not installed."""
+    import importlib.metadata
+
+    import workbench
+    assert workbench.__version__ == VERSION
+
+    def not_installed(name):
+        raise importlib.metadata.PackageNotFoundError(name)
+    monkeypatch.setattr(importlib.metadata, "version", not_installed)
+    assert workbench._version() == VERSION
+    p = subprocess.run([sys.executable, "-m", "workbench", "--version"], capture_output=True, text=True,
+                       cwd=ROOT, timeout=120)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.strip() == f"workbench {VERSION}"
+
+
 def test_warning_lines_finds_what_setuptools_prints():
     """The filter of the next test sees a setuptools warning, whatever its case."""
     sample = ("running build_py\n"
