@@ -60,6 +60,31 @@ def test_the_site_has_the_generated_pages(site):
         assert (out / page).is_file(), page
 
 
+def test_the_benchmark_index_lists_the_tables_present(tmp_path):
+    """The bench scripts write docs/benchmarks/NAME.md; the index page links those that exist."""
+    import importlib.util
+    from types import SimpleNamespace
+    spec = importlib.util.spec_from_file_location("docs_hooks", ROOT / "tools" / "docs_hooks.py")
+    hooks = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(hooks)
+    folder = tmp_path / "benchmarks"
+    folder.mkdir()
+    for name in ("index.md", "history.md"):
+        (folder / name).write_text("# x\n")
+    page = SimpleNamespace(file=SimpleNamespace(src_uri="benchmarks/index.md"))
+    config = {"docs_dir": str(tmp_path)}
+    text = f"## Tables\n\n{hooks.TABLES_MARKER}\n"
+    empty = hooks.on_page_markdown(text, page, config, None)
+    assert hooks.TABLES_MARKER not in empty and "No benchmark table" in empty
+    (folder / "accel.md").write_text("# accel\n")
+    (folder / "zbuffer.md").write_text("# zbuffer\n")
+    listed = hooks.on_page_markdown(text, page, config, None)
+    assert "- [`accel`](accel.md)\n- [`zbuffer`](zbuffer.md)" in listed
+    assert "history" not in listed and "index.md" not in listed
+    other = SimpleNamespace(file=SimpleNamespace(src_uri="guide/cli.md"))
+    assert hooks.on_page_markdown(text, other, config, None) == text
+
+
 def test_every_scene_kind_is_documented():
     from workbench.scene.kinds import KINDS
     text = (ROOT / "docs" / "guide" / "scenes.md").read_text()
