@@ -56,6 +56,7 @@ def test_the_site_has_the_generated_pages(site):
         assert name in api, name
     render_api = (out / "reference" / "api" / "render.html").read_text()
     assert "RenderResult" in render_api
+    assert ":class:<code>" not in render_api and ":func:<code>" not in render_api  # roles dropped
     for page in ("benchmarks/history.html", "methods/errata.html", "kernels.html", "guide/scenes.html"):
         assert (out / page).is_file(), page
 

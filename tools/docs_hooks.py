@@ -3,6 +3,9 @@
 * ``reference/cli.md`` is generated at every build from the command line's own parser
   (:func:`workbench.app.cli.build_parser`): each command's ``--help`` text, so the page cannot
   fall behind the program.
+* The docstrings cross-reference in Sphinx's roles (``:class:`Scene```); mkdocstrings shows the
+  role's name before the code, so the API pages drop it (``:class:<code>`` -> ``<code>``), and a
+  leading ``~.`` or ``.`` of a relative name.
 * ``benchmarks/index.md`` gets, in place of the line ``<!-- benchmark tables -->``, a list of
   the benchmark tables present in ``docs/benchmarks/`` (each bench script writes its own
   ``NAME.md`` there; which ones exist depends on which scripts have been run).
@@ -11,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -19,7 +23,7 @@ from mkdocs.structure.files import File
 ROOT = Path(__file__).resolve().parents[1]
 CLI_PAGE = "reference/cli.md"
 TABLES_MARKER = "<!-- benchmark tables -->"
-COLUMNS = "100"
+COLUMNS = "78"
 """Width of the help texts on the page (argparse wraps to the terminal's ``COLUMNS``)."""
 
 
@@ -64,6 +68,16 @@ def cli_reference() -> str:
         for sub_name, sub in nested.items():
             lines += [f"### workbench {name} {sub_name}", "", "```text", _help(sub), "```", ""]
     return "\n".join(lines)
+
+
+SPHINX_ROLE = re.compile(r":(?:class|func|meth|mod|data|attr|exc|obj):<code>~?\.?")
+"""A Sphinx role in a docstring as rendered: the role's name, then the name in ``<code>``."""
+
+
+def on_page_content(html, page, config, files):
+    if not page.file.src_uri.startswith("reference/api/"):
+        return html
+    return SPHINX_ROLE.sub("<code>", html)
 
 
 def on_files(files, config):
