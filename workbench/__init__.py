@@ -8,10 +8,35 @@ Public API (stable)::
     workbench.compare.metrics(result.image, reference)
 
 Heavy modules (moderngl, numba, pyrender, matplotlib) load only when a method needs them.
+``workbench.__version__`` is the installed distribution's version (pyproject.toml's
+``[project] version``, the one place it is written).
 """
 from __future__ import annotations
 
 import importlib
+import importlib.metadata
+from pathlib import Path
+
+
+def _version() -> str:
+    """The version of the installed ``workbench`` distribution; in a checkout that is not
+    installed (``PYTHONPATH=checkout``), the ``[project] version`` of its pyproject.toml; else
+    ``"0+unknown"``."""
+    try:
+        return importlib.metadata.version("workbench")
+    except importlib.metadata.PackageNotFoundError:
+        pass
+    import tomllib
+    try:
+        project = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text())["project"]
+        if project.get("name") == "workbench":
+            return str(project["version"])
+    except (OSError, KeyError, tomllib.TOMLDecodeError):
+        pass
+    return "0+unknown"
+
+
+__version__ = _version()
 
 from .core.jit_cache import use_code_keyed_cache
 
@@ -20,7 +45,7 @@ use_code_keyed_cache()  # before any kernel compiles: numba's cache keyed by thi
 from .core.errors import NotApplicable, WorkbenchError  # noqa: E402,F401
 from .scene.io import SceneError, load_scene  # noqa: E402,F401
 
-__all__ = ["load_scene", "render", "available_methods", "SceneError", "WorkbenchError",
+__all__ = ["__version__", "load_scene", "render", "available_methods", "SceneError", "WorkbenchError",
            "NotApplicable", "compare", "raytrace", "radiosity"]
 
 _LAZY = {"compare": "workbench.compare", "raytrace": "workbench.renderers.raytrace",
@@ -34,6 +59,7 @@ def render(scene, method, *, width=None, height=None, **options):
 
 
 def available_methods() -> list[str]:
+    """Names of the registered methods (the built-in ones; ``glsl:FILE`` names a user model)."""
     from .renderers.base import available
     return available()
 

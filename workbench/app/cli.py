@@ -42,6 +42,9 @@ def build_parser() -> argparse.ArgumentParser:
         prog="workbench",
         description="Rendering workbench: classic image-synthesis methods side by side on one "
                     "scene and camera, with run times and errors.")
+    from .. import __version__
+    p.add_argument("--version", action="version", version=f"workbench {__version__}",
+                   help="print the version and exit")
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for name in COMMANDS:
