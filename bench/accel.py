@@ -152,7 +152,10 @@ def st_slow(scene) -> bool:
     return len(scene.objects) > 100
 
 
-def build_before_after(before: str, builds: int = 15, triangles: int = 0):
+def build_before_after(before: str, builds: int = 15, triangles: int = 0, keep: bool = False):
+    """The build before (``before``, a git revision) and after, in one child process.  ``keep``
+    (the smoke run): the exported revision stays in the system's temporary folder and the child
+    uses this process's numba cache, so that a second run loads both builders compiled."""
     import workbench
     from workbench.renderers.raytrace.flatten import _Builder, _triangles
     scene = workbench.load_scene("mesh")
@@ -166,11 +169,15 @@ def build_before_after(before: str, builds: int = 15, triangles: int = 0):
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "tri.npy"
         np.save(path, tri)
-        old = Path(tmp) / "before"
-        old.mkdir()
-        arch = subprocess.run(["git", "archive", before, "workbench"], cwd=ROOT, capture_output=True, check=True)
-        subprocess.run(["tar", "-x", "-C", str(old)], input=arch.stdout, check=True)
-        env = dict(os.environ, PYTHONPATH=str(ROOT), NUMBA_CACHE_DIR=str(Path(tmp) / "cache"))
+        old = Path(tempfile.gettempdir()) / f"workbench-bench-accel-{before}" if keep else Path(tmp) / "before"
+        if not old.exists():
+            part = Path(tempfile.mkdtemp(dir=old.parent, prefix=old.name + "-part-"))
+            arch = subprocess.run(["git", "archive", before, "workbench"], cwd=ROOT, capture_output=True, check=True)
+            subprocess.run(["tar", "-x", "-C", str(part)], input=arch.stdout, check=True)
+            part.rename(old)
+        env = dict(os.environ, PYTHONPATH=str(ROOT))
+        if not keep:
+            env["NUMBA_CACHE_DIR"] = str(Path(tmp) / "cache")
         p = subprocess.run([sys.executable, "-c", BUILD_CHILD, str(path),
                             str(old / "workbench" / "renderers" / "raytrace" / "bvh.py"), str(builds), str(triangles)],
                            capture_output=True, text=True, cwd=tmp, env=env)
@@ -239,7 +246,7 @@ def main(argv=None) -> dict:
                      "many": structures(many_scene(), w, h, args.repeat)}
     for n in (int(x) for x in args.spheres.split(",") if x):
         res["scenes"][f"spheres_{n}"] = structures(spheres_scene(n), w, h, args.repeat)
-    res["bvh_build"] = build_before_after(args.before, builds, triangles)
+    res["bvh_build"] = build_before_after(args.before, builds, triangles, keep=args.smoke)
     res["load_average_end"] = os.getloadavg()
     res["bench_s"] = time.perf_counter() - t0
     print(markdown(res))

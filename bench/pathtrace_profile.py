@@ -119,7 +119,7 @@ def main(argv=None) -> None:
                     if k < 0:
                         break
                     px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
-                    surface(geo, k, f, tri, b1, b2, px, py, pz, 1e-12, h_ng, h_ns, h_uv, h_po, h_ev, 0)
+                    surface(geo, k, f, tri, b1, b2, px, py, pz, 1e-12, h_ng, h_ns, h_uv, h_po, h_ev, 0, scr[0])
                     nx, ny, nz = h_ng[0, 0], h_ng[0, 1], h_ng[0, 2]
                     if nx * dx + ny * dy + nz * dz > 0.0:
                         nx, ny, nz = -nx, -ny, -nz
