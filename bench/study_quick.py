@@ -25,7 +25,7 @@ def tables(res: dict) -> str:
     w, h = res["size"]
     rows = [[p["method"], p["knob"], p["value"], p["status"], p["time_s"], p["compile_s"], p["rmse"], p["flip"],
              p["pareto"]] for p in res["points"]]
-    return (f"`{res['scene']}` at {w} x {h}, {res['repeat']} warm runs per point (median).  The anchor is the "
+    return (f"`{res['scene']}` at {w} x {h}, warm runs per point: {res['repeat']} (their median).  The anchor is the "
             f"study's reference, `{ref['method']}` {ref.get('options', {})} ({ref.get('reason', '')}), "
             f"{ref.get('time_s', 0):.3f} s.  Whole study: **{res['study_wall_s']:.1f} s** of wall time.\n\n"
             + table(["method", "knob", "value", "status", "time (s)", "compile (s)", "RMSE", "FLIP", "Pareto"], rows))

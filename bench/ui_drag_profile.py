@@ -139,7 +139,7 @@ def tables(res: dict) -> str:
     st = res["stages_ms_per_frame"]
     return (f"{res['frames']} frames counted, display `{res['display']}`, {'glFinish after every stage' if res['sync'] else 'no sync'}"
             f"; {fmt(log.get('fps'))} fps, {fmt(log.get('cpu_ms_per_frame'))} CPU ms per frame; {res['gl_renderer']}; "
-            f"load {res.get('load_average_1_5_15_before')}.  No outside anchor: the stages' sum against the frame.\n\n"
+            f"load {[round(x, 2) for x in res.get('load_average_1_5_15_before', [])]}.  No outside anchor: the stages' sum against the frame.\n\n"
             + table(["stage", "wall ms / frame", "CPU ms / frame"],
                     [[k, v["wall_ms"], v["cpu_ms"]] for k, v in st.items()]
                     + [["**sum**", res["sum_wall_ms"], res["sum_cpu_ms"]]]))

@@ -52,8 +52,8 @@ def tables(res: dict) -> str:
     ms = res["ms_per_frame"]
     base = ms.get("encode_blit", {}).get("wall_ms")
     return (f"{res['frames']} frames after 2 warm-up frames; window {res['window'][0]} x {res['window'][1]}, panels "
-            f"{res['panel'][0]} x {res['panel'][1]}; {res['gl_renderer']}; load {res.get('load_average_1_5_15_before')} "
-            f"-> {res.get('load_average_after')}.  No outside anchor: `encode_blit` (the sequence `window_passes` "
+            f"{res['panel'][0]} x {res['panel'][1]}; {res['gl_renderer']}; load {[round(x, 2) for x in res.get('load_average_1_5_15_before', [])]} "
+            f"-> {[round(x, 2) for x in res.get('load_average_after', [])]}.  No outside anchor: `encode_blit` (the sequence `window_passes` "
             "replaced) is the baseline.\n\n"
             + table(["sequence", "wall ms / frame", "CPU ms / frame", "wall: encode_blit / this"],
                     [[k, v["wall_ms"], v["cpu_ms"], ratio(base, v["wall_ms"])] for k, v in ms.items()]))
