@@ -49,6 +49,7 @@ import numpy as np
 from workbench.renderers.raytrace import bvh as after
 spec = importlib.util.spec_from_file_location("bvh_before", sys.argv[2])
 before = importlib.util.module_from_spec(spec)
+sys.modules["bvh_before"] = before  # a named module: numba's cache can load its functions back
 spec.loader.exec_module(before)
 tri = np.load(sys.argv[1])[:int(sys.argv[4]) or None]
 codes = {"before": before.build_bvh4, "after": after.build_bvh4}

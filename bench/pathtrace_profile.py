@@ -95,7 +95,9 @@ def main(argv=None) -> None:
     from workbench.renderers.pathtrace.session import PathTraceSession
     from workbench.renderers.kernels.columns import PathOpt
     from workbench.renderers.kernels.flags import NO_REFCOUNT
-    from workbench.renderers.kernels.intersect import scratch, surface
+    # the module, not its functions: numba's cache key hashes a kernel's closure variables, and a
+    # dispatcher pickles differently in every process (the cache would never hit)
+    from workbench.renderers.kernels import intersect as KI
 
     @nb.njit(**NO_REFCOUNT)
     def record(geo, cam, em_tri, nsamp, scr, rows, O, D, TM, AH):
@@ -119,7 +121,7 @@ def main(argv=None) -> None:
                     if k < 0:
                         break
                     px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
-                    surface(geo, k, f, tri, b1, b2, px, py, pz, 1e-12, h_ng, h_ns, h_uv, h_po, h_ev, 0, scr[0])
+                    KI.surface(geo, k, f, tri, b1, b2, px, py, pz, 1e-12, h_ng, h_ns, h_uv, h_po, h_ev, 0, scr[0])
                     nx, ny, nz = h_ng[0, 0], h_ng[0, 1], h_ng[0, 2]
                     if nx * dx + ny * dy + nz * dz > 0.0:
                         nx, ny, nz = -nx, -ny, -nz
@@ -189,7 +191,7 @@ def main(argv=None) -> None:
 
     @nb.njit
     def work_arrays():
-        return scratch(), K.hit_rows()
+        return KI.scratch(), K.hit_rows()
 
     scene = workbench.load_scene("cornell")
     out = {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "threads": 1, "scene": "cornell",

@@ -139,7 +139,7 @@ def mesh_intersection(repeats: int | None = None) -> dict:
     sets = dict(primary=(O, D, np.zeros(n), np.full(n, np.inf), False),
                 shadow=(fo[want], fd[want], ftmin[want], ftmax[want], True))
 
-    @numba.njit(**dict(NO_REFCOUNT, cache=False))  # as the kernels: no reference counting
+    @numba.njit(**NO_REFCOUNT)  # as the kernels: no reference counting (cached: a smoke run loads it)
     def queries(geo, O, D, tmin, tmax, shadow, bvh_only, extent, scr, rel_eps, zero):
         stack, st, sp_, sf, sn = scr
         node, child, leaf, first, tv4, bounds = (geo.bvh_node, geo.bvh_child, geo.bvh_leaf, geo.bvh_first,
