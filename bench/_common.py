@@ -352,16 +352,16 @@ class Page:
                  f"`--smoke` runs the same code at tiny sizes in seconds and writes elsewhere "
                  f"(`tests/test_bench_smoke.py`); `python bench/{self.name}.py --from-json` renders this page "
                  f"again from the stored JSON.", ""]
+        by = _git_stored(path) if stored else None
         if stored:
             rel = _relative(path)
-            by = _git_stored(path)
             lines += [f"This page was rendered from `{rel}`, the stored result of the last measured run"
                       + (f" (committed in {by})" if by else "") + ": nothing was measured again for it. "
                       "Facts that run did not record are marked \"not recorded\".", ""]
         if res.get("smoke"):
             lines += ["**Smoke run**: tiny sizes and repeats, to check that the script works; its numbers "
                       "are not measurements.", ""]
-        lines += [self._header(res), ""]
+        lines += [self._header(res, by), ""]
         body = self._body(res, path)
         lines.append(body)
         return "\n".join(lines).rstrip() + "\n"
@@ -379,7 +379,7 @@ class Page:
                 parts.append(f"## Variant `{other.stem}` (`{_relative(other)}`)\n\n" + body)
         return "\n".join(parts)
 
-    def _header(self, res: dict) -> str:
+    def _header(self, res: dict, stored_by: str | None = None) -> str:
         env = res.get("environment")
         rows = []
         if env:
@@ -400,7 +400,8 @@ class Page:
             for a in self.anchors:
                 found = {k: v for k, v in env["versions_in_result"].items() if a in k.lower()}
                 rows.append((ANCHORS[a], ", ".join(str(v) for v in found.values()) or "used; version not recorded"))
-            rows.append(("date", env["date"] or "not recorded (see the commit above)"))
+            committed = f"not recorded; the result was committed on {stored_by.split()[-1]}" if stored_by else "not recorded"
+            rows.append(("date", env["date"] or committed))
             rows.append(("load average", env["load"]))
         return kv_table(rows, ("run", ""))
 
