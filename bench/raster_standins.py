@@ -19,8 +19,8 @@ needing none keep their frame rate.
 
 Writes ``bench/results/raster_standins.json`` and ``docs/benchmarks/raster_standins.md`` (and prints
 the table) and the figure ``docs/images/whitted_standins.png`` (``--figure-only``: just the figure).
-``--smoke``: 32 x 24, 0.05 s per rate, one sweep of one value, two scenes for the "unneeded" part;
-the figure goes to the ``--out`` folder.
+``--smoke``: 32 x 24, 0.05 s per rate, the steps "none" and "all", one sweep of one value, two scenes
+for the "unneeded" part; the figure goes to the ``--out`` folder.
 """
 from __future__ import annotations
 
@@ -120,9 +120,10 @@ def main(argv=None):
     ap.add_argument("--height", type=int, default=384)
     ap.add_argument("--figure-only", action="store_true", help="only write docs/images/whitted_standins.png")
     args = PAGE.parse(ap, argv)
-    sweeps_, scenes, unneeded_size = SWEEPS, bundled(), 512
+    steps_, sweeps_, scenes, unneeded_size = STEPS, SWEEPS, bundled(), 512
     if args.smoke:
         args.width, args.height, args.seconds = 32, 24, 0.05
+        steps_ = [st for st in STEPS if st[0] in ("none", "+shadows = all")]
         sweeps_, scenes, unneeded_size = {"envmap_resolution": SWEEPS["envmap_resolution"][:1]}, bundled()[:2], 32
     W, H, sec = args.width, args.height, args.seconds
     load_before = os.getloadavg()
@@ -132,7 +133,7 @@ def main(argv=None):
     if args.figure_only:
         return
     steps = []
-    for label, standins in STEPS:
+    for label, standins in steps_:
         for mode in ("phong", "gouraud") if label in ("none", "+shadows = all") else ("phong",):
             steps.append({"step": label, **measure(scene, mode, ref.image, W, H, sec, standins=standins)})
     sweeps = {k: [measure(scene, "phong", ref.image, W, H, sec / 2, **{k: v}) for v in values]
@@ -194,7 +195,7 @@ def markdown(r: dict) -> str:
 
 
 PAGE = Page("raster_standins", "Raster stand-ins for global effects on `whitted`", first_paragraph(__doc__),
-            "python bench/raster_standins.py", markdown, smoke_note="32 x 24, 0.05 s per rate, one sweep of one value")
+            "python bench/raster_standins.py", markdown, smoke_note="32 x 24, 0.05 s per rate, steps none and all, one sweep of one value")
 
 
 if __name__ == "__main__":
