@@ -21,8 +21,9 @@ last one before the sampled binning, exported with ``git archive`` to a temporar
 after: this checkout) and alternates them, best and median of 15 builds each, wall and CPU
 seconds; the two trees' arrays are compared (``same_tree``) and their SAH costs given.
 
-Writes ``bench/results/accel.json`` and ``accel.md``.  Run:
-``.venv/bin/python bench/accel.py [--size 160x120] [--repeat 3] [--before 7c5be9a]``.
+Writes ``bench/results/accel.json`` and ``docs/benchmarks/accel.md``.  Run:
+``.venv/bin/python bench/accel.py [--size 160x120] [--repeat 3] [--before 7c5be9a]``; ``--smoke``: 32 x 24,
+one run, the mesh scene and 200 spheres (not ``many``), 2 builds of 4,000 triangles.
 The machine is shared: its load average is recorded at the start and the end.
 """
 from __future__ import annotations
@@ -37,9 +38,9 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _common import Page, first_paragraph
 
 ROOT = Path(__file__).resolve().parents[1]
-RESULTS = ROOT / "bench" / "results"
 ACCELS = ("bvh", "octree", "none")
 
 BUILD_CHILD = r"""
@@ -48,14 +49,15 @@ import numpy as np
 from workbench.renderers.raytrace import bvh as after
 spec = importlib.util.spec_from_file_location("bvh_before", sys.argv[2])
 before = importlib.util.module_from_spec(spec)
+sys.modules["bvh_before"] = before  # a named module: numba's cache can load its functions back
 spec.loader.exec_module(before)
-tri = np.load(sys.argv[1])
+tri = np.load(sys.argv[1])[:int(sys.argv[4]) or None]
 codes = {"before": before.build_bvh4, "after": after.build_bvh4}
 for f in codes.values():
     f(tri[:64])  # JIT or cache load, outside the measurement
 wall = {k: [] for k in codes}
 cpu = {k: [] for k in codes}
-for _ in range(15):  # alternating, so that both see the same load
+for _ in range(int(sys.argv[3])):  # alternating, so that both see the same load
     for k, f in codes.items():
         t0, c0 = time.perf_counter(), time.process_time()
         f(tri)
@@ -151,7 +153,10 @@ def st_slow(scene) -> bool:
     return len(scene.objects) > 100
 
 
-def build_before_after(before: str):
+def build_before_after(before: str, builds: int = 15, triangles: int = 0, keep: bool = False):
+    """The build before (``before``, a git revision) and after, in one child process.  ``keep``
+    (the smoke run): the exported revision stays in the system's temporary folder and the child
+    uses this process's numba cache, so that a second run loads both builders compiled."""
     import workbench
     from workbench.renderers.raytrace.flatten import _Builder, _triangles
     scene = workbench.load_scene("mesh")
@@ -159,17 +164,23 @@ def build_before_after(before: str):
     for i, o in enumerate(scene.objects):
         b.leaf(o, i, np.eye(4), top=True)
     tri = np.ascontiguousarray(_triangles(b.meshes)[0])
-    res = {"triangles": int(len(tri)), "before_revision": before}
+    if triangles:
+        tri = tri[:triangles]
+    res = {"triangles": int(len(tri)), "before_revision": before, "builds": builds}
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "tri.npy"
         np.save(path, tri)
-        old = Path(tmp) / "before"
-        old.mkdir()
-        arch = subprocess.run(["git", "archive", before, "workbench"], cwd=ROOT, capture_output=True, check=True)
-        subprocess.run(["tar", "-x", "-C", str(old)], input=arch.stdout, check=True)
-        env = dict(os.environ, PYTHONPATH=str(ROOT), NUMBA_CACHE_DIR=str(Path(tmp) / "cache"))
+        old = Path(tempfile.gettempdir()) / f"workbench-bench-accel-{before}" if keep else Path(tmp) / "before"
+        if not old.exists():
+            part = Path(tempfile.mkdtemp(dir=old.parent, prefix=old.name + "-part-"))
+            arch = subprocess.run(["git", "archive", before, "workbench"], cwd=ROOT, capture_output=True, check=True)
+            subprocess.run(["tar", "-x", "-C", str(part)], input=arch.stdout, check=True)
+            part.rename(old)
+        env = dict(os.environ, PYTHONPATH=str(ROOT))
+        if not keep:
+            env["NUMBA_CACHE_DIR"] = str(Path(tmp) / "cache")
         p = subprocess.run([sys.executable, "-c", BUILD_CHILD, str(path),
-                            str(old / "workbench" / "renderers" / "raytrace" / "bvh.py")],
+                            str(old / "workbench" / "renderers" / "raytrace" / "bvh.py"), str(builds), str(triangles)],
                            capture_output=True, text=True, cwd=tmp, env=env)
         if p.returncode != 0:
             raise RuntimeError(p.stderr[-3000:])
@@ -179,22 +190,26 @@ def build_before_after(before: str):
 
 
 def markdown(res) -> str:
-    lines = [f"# Acceleration structures ({res['size']}, raycast; load average {res['load_average_start'][0]:.1f} "
-             f"at the start, {res['load_average_end'][0]:.1f} at the end, {res['machine']})", ""]
+    lines = [f"Ray casting at {res['size']}; load average {res['load_average_start'][0]:.1f} "
+             f"at the start, {res['load_average_end'][0]:.1f} at the end, {res['machine']}.  No outside anchor: "
+             "the baseline is `none` (every ray against every primitive) and, for the build, the code before "
+             "the sampled binning.", ""]
     for name, rows in res["scenes"].items():
         lines += [f"## {name} ({rows['bvh']['triangles']} triangles, {rows['bvh']['primitives']} analytic primitives)", "",
-                  "| accel | build (ms) | trace (ms) | frame (ms) | nodes / ray (triangles + analytic) | triangle tests / ray | "
-                  "analytic tests / ray | triangle rows | memory estimate (MiB) | same image | statistics pass (ms) |",
-                  "|---|---|---|---|---|---|---|---|---|---|---|"]
+                  "| accel | build (ms) | trace (ms) | trace: none / this | frame (ms) | nodes / ray (triangles + analytic) | "
+                  "triangle tests / ray | analytic tests / ray | triangle rows | memory estimate (MiB) | same image | "
+                  "statistics pass (ms) |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|---|"]
         for a in ACCELS:
             r = rows[a]
-            lines.append(f"| {a} | {1e3 * r['build_s']:.1f} | {1e3 * r['trace_s']:.1f} | {1e3 * r['frame_s']:.1f} | "
+            lines.append(f"| {a} | {1e3 * r['build_s']:.1f} | {1e3 * r['trace_s']:.1f} | "
+                         f"{rows['none']['trace_s'] / r['trace_s']:.1f} | {1e3 * r['frame_s']:.1f} | "
                          f"{r['triangle_nodes_per_ray']:.2f} + {r['analytic_nodes_per_ray']:.2f} | "
                          f"{r['triangle_tests_per_ray']:.1f} | {r['analytic_tests_per_ray']:.1f} | {r['triangle_rows']} | "
                          f"{r['memory_estimate_mb']:.0f} | {'yes' if r['same_image_as_bvh'] else 'NO'} | {1e3 * r['stats_pass_s']:.1f} |")
         lines.append("")
     b = res["bvh_build"]
-    lines += [f"## BVH build, {b['triangles']} triangles (mesh scene), best / median of 15", "",
+    lines += [f"## BVH build, {b['triangles']} triangles (mesh scene), best / median of {b.get('builds', 15)}", "",
               "| code | wall (ms) | CPU (ms) | 4-wide nodes | leaves | SAH cost |", "|---|---|---|---|---|---|"]
     for k in ("before", "after"):
         r = b[k]
@@ -202,8 +217,13 @@ def markdown(res) -> str:
                      f"{1e3 * r['wall_best_s']:.1f} / {1e3 * r['wall_median_s']:.1f} | "
                      f"{1e3 * r['cpu_best_s']:.1f} / {1e3 * r['cpu_median_s']:.1f} | {r['nodes_4wide']} | {r['leaves']} | "
                      f"{r['sah_cost']:.2f} |")
-    lines += ["", f"Same tree before and after: {'yes' if b['same_tree'] else 'no'}.", ""]
+    lines += ["", f"Same tree before and after: {'yes' if b['same_tree'] else 'no'}; after / before wall time "
+              f"(best): {b['after']['wall_best_s'] / b['before']['wall_best_s']:.2f}.", ""]
     return "\n".join(lines)
+
+
+PAGE = Page("accel", "Acceleration structures of the ray tracer", first_paragraph(__doc__),
+            "python bench/accel.py", markdown, smoke_note="32 x 24, one run, mesh and 200 spheres, 2 builds of 4,000 triangles")
 
 
 def main(argv=None) -> dict:
@@ -212,7 +232,10 @@ def main(argv=None) -> dict:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--before", default="7c5be9a")
     ap.add_argument("--spheres", default="1000,10000", help="sphere counts of the many-spheres scenes")
-    args = ap.parse_args(argv)
+    args = PAGE.parse(ap, argv)
+    builds, triangles = 15, 0
+    if args.smoke:
+        args.size, args.repeat, args.spheres, builds, triangles = "32x24", 1, "200", 2, 4000
     w, h = (int(x) for x in args.size.lower().split("x"))
     import workbench
     res = {"machine": f"{os.cpu_count()} CPUs (shared)", "load_average_start": os.getloadavg(), "size": f"{w}x{h}",
@@ -220,18 +243,16 @@ def main(argv=None) -> dict:
     t0 = time.perf_counter()
     for a in ACCELS:  # JIT or cache load of the kernels and the counting pass, outside the measurements
         workbench.render(many_scene(), "raycast", width=8, height=6, accel=a, traversal_stats=True)
-    res["scenes"] = {"mesh": structures(workbench.load_scene("mesh"), w, h, args.repeat),
-                     "many": structures(many_scene(), w, h, args.repeat)}
+    res["scenes"] = {"mesh": structures(workbench.load_scene("mesh"), w, h, args.repeat)}
+    if not args.smoke:  # (the smoke run: one triangle scene, one of analytic spheres)
+        res["scenes"]["many"] = structures(many_scene(), w, h, args.repeat)
     for n in (int(x) for x in args.spheres.split(",") if x):
         res["scenes"][f"spheres_{n}"] = structures(spheres_scene(n), w, h, args.repeat)
-    res["bvh_build"] = build_before_after(args.before)
+    res["bvh_build"] = build_before_after(args.before, builds, triangles, keep=args.smoke)
     res["load_average_end"] = os.getloadavg()
     res["bench_s"] = time.perf_counter() - t0
-    RESULTS.mkdir(parents=True, exist_ok=True)
-    (RESULTS / "accel.json").write_text(json.dumps(res, indent=2))
-    (RESULTS / "accel.md").write_text(markdown(res))
     print(markdown(res))
-    return res
+    return PAGE.write(args, res)
 
 
 if __name__ == "__main__":

@@ -7,6 +7,9 @@ values), and the per-channel differences to ours.  The light is also compared af
 by its luminance (its absolute level is a free choice in every renderer).
 
     .venv/bin/python bench/cornell_spectral.py [--references PATH]
+
+also writes ``docs/benchmarks/cornell_spectral.md``; ``--smoke`` is the same computation (it takes a
+second) written elsewhere.
 """
 from __future__ import annotations
 
@@ -19,6 +22,9 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "bench"))
+
+from _common import Page, first_paragraph, fmt, table  # noqa: E402
 
 from workbench.core import color, spectral  # noqa: E402
 
@@ -34,10 +40,36 @@ def describe(rgb) -> dict:
             "hue_deg": round(float(hsv[0]), 2), "saturation": round(float(hsv[1]), 4)}
 
 
-def main() -> int:
+def tables(res: dict) -> str:
+    cols = res["colours"]
+    names = ("white", "red", "green", "light")
+    rows = [[src] + [" ".join(fmt(v, 3) for v in c[k]["rgb"]) if k in c else "–" for k in names]
+            for src, c in cols.items()]
+    out = [f"Conversion: {res['conversion']['cmf']}; {res['conversion']['reflectance']}; "
+           f"{res['conversion']['light']}.  The anchors are the RGB values Tungsten and Mitsuba ship "
+           "(published tables, quoted, not run).", "",
+           "## Linear sRGB of each colour", "", table(["source", *names], rows),
+           "## Chromaticity (x, y) and luminance Y", "",
+           table(["source", *names], [[src] + [f"({c[k]['xy'][0]}, {c[k]['xy'][1]}) Y {fmt(c[k]['Y'])}"
+                                                if k in c else "–" for k in names] for src, c in cols.items()]),
+           "## Differences to the scene's values (spectral under the light): max |difference| per colour", "",
+           table(["source", "white", "red", "green", "light per unit Y (R, G, B)"],
+                 [[src] + [d[k]["max_abs"] for k in ("white", "red", "green")]
+                  + [" ".join(fmt(v) for v in d["light_per_unit_Y_minus_scene"])]
+                  for src, d in res["differences_to_scene_values"].items()]),
+           "## Findings", ""] + [f"* {f}" for f in res["findings"]]
+    return "\n".join(out) + "\n"
+
+
+PAGE = Page("cornell_spectral", "Cornell box colours: measured spectra against other renderers' RGB",
+            first_paragraph(__doc__), "python bench/cornell_spectral.py", tables,
+            smoke_note="the same computation (about a second)")
+
+
+def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--references", type=Path, default=DEFAULT_REFS)
-    args = ap.parse_args()
+    args = PAGE.parse(ap, argv)
     refs = {e["id"]: e for e in json.loads(args.references.read_text())}
     others = refs["CORNELL-rgb-variants"]["expected"]
 
@@ -104,11 +136,8 @@ def main() -> int:
         "differences_to_scene_values": diffs,
         "findings": findings,
     }
-    out = ROOT / "bench" / "results" / "cornell_spectral.json"
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(result, indent=2) + "\n")
     print(json.dumps(result, indent=2))
-    print(f"-> {out}")
+    PAGE.write(args, result)
     return 0
 
 

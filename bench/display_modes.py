@@ -3,24 +3,28 @@
 Each scene is rendered once (``--method``, default phong), then shown through each mode
 (workbench.core.display); the error against ``direct24`` is the workbench's usual metrics
 (RMSE and PSNR on linear values, FLIP).  Times are warm (one untimed run first, which also
-compiles the Floyd-Steinberg kernel).  Writes ``bench/results/display_modes.json``.
+compiles the Floyd-Steinberg kernel).  Writes ``bench/results/display_modes.json`` and
+``docs/benchmarks/display_modes.md``.
 
     .venv/bin/python bench/display_modes.py [--scenes whitted cornell] [--size 256x256]
+
+``--smoke``: ``whitted`` alone at 32 x 32, every mode.
 """
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "bench"))
 
 import workbench  # noqa: E402
 from workbench.compare.metrics import metrics  # noqa: E402
 from workbench.core.display import apply_display_mode  # noqa: E402
+from _common import Page, first_paragraph, table  # noqa: E402
 
 DITHER_SUFFIXES = ("", "-bayer", "-fs")
 MODES = (["direct24"] + [f"direct16-{b}{d}" for b in ("555", "565") for d in DITHER_SUFFIXES]
@@ -28,12 +32,29 @@ MODES = (["direct24"] + [f"direct16-{b}{d}" for b in ("555", "565") for d in DIT
             for d in DITHER_SUFFIXES])
 
 
-def main() -> int:
+def tables(res: dict) -> str:
+    w, h = res["size"]
+    out = [f"Each scene rendered once with `{res['method']}` at {w} x {h}, then shown through every mode; error "
+           "against the 24-bit image (`direct24`, the anchor: an error of 0).  Warm times.", ""]
+    for name, rows in res["scenes"].items():
+        out += [f"## {name}", "", table(["mode", "RMSE", "PSNR (dB)", "FLIP", "time (ms)"],
+                                        [[m, r["rmse"], r["psnr_db"], r["flip"], 1e3 * r["seconds"]]
+                                         for m, r in rows.items()])]
+    return "\n".join(out)
+
+
+PAGE = Page("display_modes", "Display modes: error and cost against the 24-bit image", first_paragraph(__doc__),
+            "python bench/display_modes.py", tables, smoke_note="whitted alone at 32 x 32")
+
+
+def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenes", nargs="+", default=["whitted", "cornell"])
     ap.add_argument("--method", default="phong")
     ap.add_argument("--size", default="256x256")
-    args = ap.parse_args()
+    args = PAGE.parse(ap, argv)
+    if args.smoke:
+        args.scenes, args.size = ["whitted"], "32x32"
     w, h = (int(v) for v in args.size.split("x"))
     out = {"method": args.method, "size": [w, h], "scenes": {}}
     for name in args.scenes:
@@ -52,10 +73,7 @@ def main() -> int:
             print(f"{name:8s} {mode:26s} RMSE {m['rmse']:.5f}  PSNR {m['psnr']:6.2f} dB  "
                   f"FLIP {m['flip']:.4f}  {dt * 1e3:7.1f} ms")
         out["scenes"][name] = rows
-    path = ROOT / "bench" / "results" / "display_modes.json"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(out, indent=2) + "\n")
-    print(f"-> {path}")
+    PAGE.write(args, out)
     return 0
 
 

@@ -18,9 +18,11 @@
    errors), so that the part of the error the noise cannot explain shows.
 
 The load average is recorded before and after (the machine is shared).  Writes
-``bench/results/kinds_exporters.json`` and prints it.  Run:
+``bench/results/kinds_exporters.json`` and ``docs/benchmarks/kinds_exporters.md`` and prints it.  Run:
 ``PYTHONPATH=. .venv/bin/python bench/kinds_exporters.py [--povray] [--mitsuba] [--size 320x240]``
-(both parts when neither is named).
+(both parts when neither is named).  Without POV-Ray or Mitsuba its part runs our side alone.
+``--smoke``: the ``kinds`` scene alone at 32 x 24 for POV-Ray; 16 x 12, 4 spp, one tessellation level
+(2) for Mitsuba.
 """
 from __future__ import annotations
 
@@ -37,9 +39,10 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))  # the comparison scenes are shared with the tests
-OUT = ROOT / "bench" / "results" / "kinds_exporters.json"
+sys.path.insert(0, str(ROOT / "bench"))
 
 import workbench  # noqa: E402
+from _common import Page, first_paragraph, fmt, ratio, skip_note, table  # noqa: E402
 from povray_kind_scenes import id_scene, kind_scenes, labels, object_ious  # noqa: E402
 from workbench.scene import model as m  # noqa: E402
 
@@ -58,10 +61,17 @@ def per_object_rmse(a: np.ndarray, b: np.ndarray, lab: np.ndarray, scene) -> dic
     return out
 
 
-def povray_part(w: int, h: int) -> dict:
+def povray_part(w: int, h: int, only=None, have_povray: bool = True) -> dict:
     res = {}
     for name, scene in kind_scenes().items():
+        if only is not None and name not in only:
+            continue
         l0 = load()
+        if not have_povray:  # our side alone
+            ours = workbench.render(scene, "raytrace", width=w, height=h, transmissive_shadows=True)
+            res[name] = dict(ours_trace_s=ours.timings["trace"], ours_trace_cpu_s=ours.timings.get("trace_cpu"),
+                             povray="skipped", load=[l0, load()])
+            continue
         pov = workbench.render(scene, "povray", width=w, height=h, threads=2)
         ours = workbench.render(scene, "raytrace", width=w, height=h, transmissive_shadows=True)
         a, b = pov.image.astype(np.float64), np.minimum(ours.image, 1.0).astype(np.float64)
@@ -97,7 +107,7 @@ def comparable(scene: m.Scene) -> m.Scene:
     return replace(scene, materials=mats, lights=tuple(lights), background=(0.0, 0.0, 0.0), ambient=(0.0, 0.0, 0.0))
 
 
-def mitsuba_part(w: int, h: int, spp: int, levels=(4, 16)) -> dict:
+def mitsuba_part(w: int, h: int, spp: int, levels=(4, 16), have_mitsuba: bool = True) -> dict:
     scene = comparable(workbench.load_scene("kinds"))
     lab = labels(workbench.render(id_scene(scene), "raycast", width=w, height=h).image)
     l0 = load()
@@ -107,6 +117,9 @@ def mitsuba_part(w: int, h: int, spp: int, levels=(4, 16)) -> dict:
            "pathtrace": dict(trace_s=pt.timings["trace"], trace_cpu_s=pt.timings.get("trace_cpu"),
                              left_out=pt.left_out, load=[l0, load()])}
     se_pt = np.asarray(pt.std_error, dtype=np.float64)
+    if not have_mitsuba:
+        res["mitsuba"] = skip_note("mitsuba")
+        return res
     for level in levels:
         l0 = load()
         mi = workbench.render(scene, "mitsuba", width=w, height=h, spp=spp, variant="scalar_rgb", tessellation=level)
@@ -126,28 +139,75 @@ def mitsuba_part(w: int, h: int, spp: int, levels=(4, 16)) -> dict:
     return res
 
 
-def main() -> dict:
-    ap = argparse.ArgumentParser()
+def tables(res: dict) -> str:
+    out = []
+    pv = res.get("povray")
+    if pv:
+        out += [f"## POV-Ray 3.7 (anchor) against the ray tracer, {pv['size']}, no antialiasing", "",
+                f"{pv['date']}, load {pv.get('load_start')} -> {pv.get('load_end')}.  Trace times: POV-Ray's own "
+                "\"Trace Time\", ours `timings[\"trace\"]`.", ""]
+        rows = []
+        for name, r in pv["scenes"].items():
+            if r.get("povray") == "skipped":
+                rows.append([name, "skipped", "–", "–", "–", "–", "–", r["ours_trace_s"], "–"])
+                continue
+            rows.append([name, r["rmse"], r["max_abs"], r["fraction_beyond_1em4"],
+                         min(r["iou_per_object"].values()) if r["iou_per_object"] else None,
+                         r["id_pixels_differing"], r["povray_trace_s"], r["ours_trace_s"],
+                         ratio(r["povray_trace_s"], r["ours_trace_s"])])
+        out.append(table(["scene", "RMSE", "max abs", "fraction > 1e-4", "min IoU per object", "ID pixels differing",
+                          "POV-Ray trace (s)", "ours trace (s)", "POV-Ray / ours"], rows))
+    mi = res.get("mitsuba")
+    if mi:
+        pt = mi["pathtrace"]
+        out += [f"## Mitsuba 3 (anchor, tessellated kinds) against the path tracer, {mi['size']}, {mi['spp']} spp", "",
+                f"{mi['date']}; scene: {mi['scene']}.  Path tracer: trace {fmt(pt['trace_s'])} s "
+                f"({fmt(pt.get('trace_cpu_s'))} CPU s).", ""]
+        if isinstance(mi.get("mitsuba"), str):
+            out.append(mi["mitsuba"] + ".\n")
+        rows = [[k.rsplit("_", 1)[1], r["triangles"], r["variant"], r["rmse"], r["noise_rms"], r["excess"],
+                 r["render_s"], r.get("render_cpu_s"), pt["trace_s"], ratio(r["render_s"], pt["trace_s"])]
+                for k, r in mi.items() if k.startswith("mitsuba_level_")]
+        if rows:
+            out.append(table(["tessellation level", "triangles", "variant", "RMSE", "noise RMS", "excess",
+                              "Mitsuba render (s)", "Mitsuba CPU (s)", "pathtrace trace (s)", "Mitsuba / ours"], rows))
+    return "\n".join(out)
+
+
+PAGE = Page("kinds_exporters", "The new object kinds through POV-Ray and Mitsuba 3", first_paragraph(__doc__),
+            "python bench/kinds_exporters.py", tables, anchors=("povray", "mitsuba"),
+            smoke_note="kinds at 32 x 24 (POV-Ray); 16 x 12, 4 spp, tessellation 2 (Mitsuba)")
+
+
+def main(argv=None) -> dict:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--povray", action="store_true")
     ap.add_argument("--mitsuba", action="store_true")
     ap.add_argument("--size", default="320x240")
     ap.add_argument("--mitsuba-size", default="160x120")
     ap.add_argument("--spp", type=int, default=256)
-    a = ap.parse_args()
+    a = PAGE.parse(ap, argv)
+    only, levels = None, (4, 16)
+    if a.smoke:
+        a.size, a.mitsuba_size, a.spp, only, levels = "32x24", "16x12", 4, ("kinds",), (2,)
     both = not (a.povray or a.mitsuba)
     w, h = (int(v) for v in a.size.split("x"))
-    res = json.loads(OUT.read_text()) if OUT.exists() else {}
+    out = a.out / "kinds_exporters.json"
+    res = json.loads(out.read_text()) if out.exists() and not both else {}
     res["machine"] = f"{os.cpu_count()} CPUs (shared)"
     t0 = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
     if a.povray or both:
-        res["povray"] = {"date": t0, "size": f"{w}x{h}", "load_start": load(), "scenes": povray_part(w, h),
-                         "load_end": load()}
+        have = PAGE.anchor(a, "povray") is not None
+        res["povray"] = {"date": t0, "size": f"{w}x{h}", "load_start": load(),
+                         "scenes": povray_part(w, h, only, have), "load_end": load()}
+        if not have:
+            res["povray"]["note"] = skip_note("povray")
     if a.mitsuba or both:
         mw, mh = (int(v) for v in a.mitsuba_size.split("x"))
-        res["mitsuba"] = {"date": t0, "load_start": load(), **mitsuba_part(mw, mh, a.spp), "load_end": load()}
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    OUT.write_text(json.dumps(res, indent=1))
-    return res
+        res["mitsuba"] = {"date": t0, "load_start": load(),
+                          **mitsuba_part(mw, mh, a.spp, levels, PAGE.anchor(a, "mitsuba") is not None),
+                          "load_end": load()}
+    return PAGE.write(a, res)
 
 
 if __name__ == "__main__":

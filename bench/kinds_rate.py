@@ -4,11 +4,13 @@ processes on the machine do not count), rays aimed at the object's
 bounds from a sphere around it (about half of them hit); and the raster path's cost: the
 tessellation's triangles and time at a few resolutions.
 
-Writes ``bench/results/kinds_rate.json`` and prints it.  Run:
+Writes ``bench/results/kinds_rate.json`` and ``docs/benchmarks/kinds_rate.md`` and prints it.  Run:
 ``NUMBA_CACHE_DIR=.numba_cache .venv/bin/python bench/kinds_rate.py [rays]`` (default 50000).
+``--smoke``: 500 rays per kind, tessellation at resolution 16 only.
 """
 from __future__ import annotations
 
+import argparse
 import datetime
 import json
 import math
@@ -20,13 +22,13 @@ from pathlib import Path
 
 import numba as nb
 import numpy as np
+from _common import Page, first_paragraph, table
 
 from workbench.scene.kinds import (blob, blob_kernels, isosurface, isosurface_kernels, lathe, lathe_kernels, prism,
                                    prism_kernels)
 from workbench.scene.kinds.expression import MAX_STACK
 
 ROOT = Path(__file__).resolve().parents[1]
-RESULTS = ROOT / "bench" / "results"
 NPAR = 20
 
 
@@ -86,7 +88,21 @@ def _tessellate(mod, obj, res):
     return mod.mesh(obj, res)
 
 
-def main(n_rays: int = 50_000) -> dict:
+def tables(res: dict) -> str:
+    rows = [[r["kind"], r["rays"], r["seconds"], r["mrays_per_s"], r["hit_fraction"],
+             "; ".join(f"{t['resolution']}: {t['triangles']} in {t['seconds']} s" for t in r["tessellation"])]
+            for r in res["results"]]
+    return (f"{res.get('threads', 1)} thread, CPU seconds.  No outside anchor: the raster path's tessellation of "
+            "the same object (triangles and time per resolution) stands beside the exact intersection.\n\n"
+            + table(["kind", "rays", "CPU (s)", "Mrays/s (first hits)", "hit fraction",
+                     "tessellation: resolution: triangles in seconds"], rows))
+
+
+PAGE = Page("kinds_rate", "Intersection rate per new object kind", first_paragraph(__doc__),
+            "python bench/kinds_rate.py", tables, smoke_note="500 rays, tessellation resolution 16 only")
+
+
+def main(n_rays: int = 50_000, resolutions=(16, 32, 64)) -> dict:
     rng = np.random.default_rng(1)
     rows = []
     for name, code, mod, obj in _objects():
@@ -104,7 +120,7 @@ def main(n_rays: int = 50_000) -> dict:
         _run(code, par, aux, O, D, t)
         dt = time.process_time() - t0
         tess = []
-        for res in (16, 32, 64):
+        for res in resolutions:
             t1 = time.process_time()
             _, _, F = _tessellate(mod, obj, res)
             tess.append(dict(resolution=res, triangles=int(len(F)), seconds=round(time.process_time() - t1, 4)))
@@ -115,10 +131,17 @@ def main(n_rays: int = 50_000) -> dict:
     out = dict(bench="kinds_rate", date=datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
                load_average=[round(x, 2) for x in os.getloadavg()], python=platform.python_version(),
                numba=nb.__version__, machine=platform.machine(), threads=1, results=rows)
-    RESULTS.mkdir(parents=True, exist_ok=True)
-    (RESULTS / "kinds_rate.json").write_text(json.dumps(out, indent=2) + "\n")
     return out
 
 
+def cli(argv=None) -> dict:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("rays", nargs="?", type=int, default=50_000, help="rays per kind")
+    args = PAGE.parse(ap, argv)
+    out = main(500, (16,)) if args.smoke else main(args.rays)
+    print(json.dumps(out, indent=2))
+    return PAGE.write(args, out)
+
+
 if __name__ == "__main__":
-    print(json.dumps(main(int(sys.argv[1]) if len(sys.argv) > 1 else 50_000), indent=2))
+    cli(sys.argv[1:])

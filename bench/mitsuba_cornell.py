@@ -12,7 +12,11 @@
   method against one shared high-spp Mitsuba reference (cached on disk).
 
 Usage: ``.venv/bin/python bench/mitsuba_cornell.py [--size 256] [--spp 64] [--repeat 2]
-[--with-pathtrace]`` writes ``bench/results/mitsuba_cornell.json`` and prints it.
+[--with-pathtrace]`` writes ``bench/results/mitsuba_cornell.json`` and
+``docs/benchmarks/mitsuba_cornell.md`` and prints it.  Without Mitsuba the Mitsuba rows are skipped
+(the path tracer's, with ``--with-pathtrace``, are still measured).  ``--smoke``: 16 x 16, 4 spp,
+one repeat, with the path tracer; the RMSE study (only with ``--rmse-study``) at 16 x 16 against a
+64-spp reference.
 """
 from __future__ import annotations
 
@@ -27,9 +31,10 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-OUT = ROOT / "bench" / "results" / "mitsuba_cornell.json"
+sys.path.insert(0, str(ROOT / "bench"))
 
 from workbench.compare.agreement import light_pixels  # noqa: E402  (re-exported for callers)
+from _common import Page, first_paragraph, fmt, ratio, skip_note, table  # noqa: E402
 
 
 def noise_image(result) -> np.ndarray | None:
@@ -51,12 +56,13 @@ def run_once(scene, method: str, size: int, spp: int, seed: int = 0) -> tuple[di
     from workbench.renderers.base import get_renderer
     opts = {"seed": seed} if "seed" in get_renderer(method).options else {}
     r = workbench.render(scene, method, width=size, height=size, spp=spp, **opts)
-    t_render = r.timings.get("render", r.timings["total"])
+    # the sampling phase: Mitsuba's mi.render calls, the path tracer's trace phase
+    t_render = r.timings.get("render", r.timings.get("trace", r.timings["total"]))
     entry = {"total_s": round(r.timings["total"], 3), "render_s": round(t_render, 3),
              "samples_per_second": round(spp * size * size / t_render),
              "timings": {k: round(v, 4) for k, v in r.timings.items()},
              "noise_rms": None if noise_image(r) is None else float(np.sqrt(np.mean(noise_image(r) ** 2)))}
-    cpu = r.stats.get("render_cpu_seconds")
+    cpu = r.stats.get("render_cpu_seconds") or r.timings.get("trace_cpu")
     if cpu:
         entry["samples_per_cpu_second"] = round(spp * size * size / cpu)
     for k in ("variant", "variant_reason", "mitsuba_version", "render_cpu_seconds", "child_peak_rss_bytes",
@@ -100,22 +106,27 @@ def validate_pathtrace(pt, mi, exclude: np.ndarray | None = None) -> dict:
     return out
 
 
-def pathtrace_vs_mitsuba(scene_name: str = "cornell", size: int = 256, spp: int = 64, repeat: int = 2) -> dict:
+def pathtrace_vs_mitsuba(scene_name: str = "cornell", size: int = 256, spp: int = 64, repeat: int = 2,
+                         have_mitsuba: bool = True) -> dict:
     """Both methods on the same scene, size and spp in the same run, alternating (best time of
-    ``repeat`` each), plus :func:`validate_pathtrace` on the last images."""
+    ``repeat`` each), plus :func:`validate_pathtrace` on the last images (the path tracer alone
+    when Mitsuba is absent)."""
     import workbench
     from workbench.renderers.base import available
     if "pathtrace" not in available():
         return {"status": "pathtrace method not registered in this tree"}
     scene = workbench.load_scene(scene_name)
-    runs = {"pathtrace": [], "mitsuba": []}
+    runs = {"pathtrace": [], "mitsuba": []} if have_mitsuba else {"pathtrace": []}
     last = {}
     workbench.render(scene, "pathtrace", width=16, height=16, spp=2)  # JIT compile, apart
     for _ in range(repeat):
-        for m in ("pathtrace", "mitsuba"):
+        for m in runs:
             e, last[m] = run_once(scene, m, size, spp)
             runs[m].append(e)
     best = {m: min(v, key=lambda e: e["render_s"]) for m, v in runs.items()}
+    if not have_mitsuba:
+        return {"scene": scene_name, "size": size, "spp": spp, "runs": runs, "best": best,
+                "mitsuba": skip_note("mitsuba")}
     return {"scene": scene_name, "size": size, "spp": spp, "runs": runs, "best": best,
             "samples_per_second_ratio_pathtrace_over_mitsuba":
                 best["pathtrace"]["samples_per_second"] / best["mitsuba"]["samples_per_second"],
@@ -150,7 +161,57 @@ def rmse_against_shared_reference(scene_name: str = "cornell", size: int = 128, 
     return out
 
 
-def main() -> None:
+def tables(res: dict) -> str:
+    out = [f"`cornell` at {res['size']} x {res['size']}, {res['spp']} spp; {res['image_definition']}.", ""]
+    mits = res["mitsuba"]
+    if isinstance(mits, str):
+        out.append(mits + ".\n")
+    else:
+        out += ["## Mitsuba 3 (the anchor) alone", "",
+                table(["run", "render (s)", "whole method (s)", "samples/s", "samples/CPU-s", "variant", "noise RMS"],
+                      [[i + 1, e["render_s"], e["total_s"], e["samples_per_second"], e.get("samples_per_cpu_second"),
+                        e.get("variant"), e.get("noise_rms")] for i, e in enumerate(mits)])]
+        v = res.get("mitsuba_best", {}).get("variant_reason")
+        if v:
+            out += [f"Variant: {v}", ""]
+    pv = res.get("pathtrace_vs_mitsuba")
+    if pv and "best" in pv:
+        b = pv["best"]
+        out += ["## Path tracer (ours) and Mitsuba 3 (anchor), same run, alternating", ""]
+        rows = [[m, e["render_s"], e["samples_per_second"], e.get("samples_per_cpu_second"), e.get("noise_rms")]
+                for m, e in b.items()]
+        out.append(table(["method (best run)", "sampling (s)", "samples/s", "samples/CPU-s", "noise RMS"], rows))
+        if "mitsuba" in b:
+            out += [f"Samples per second, pathtrace / Mitsuba: "
+                    f"{ratio(b['pathtrace']['samples_per_second'], b['mitsuba']['samples_per_second'])}; per CPU second: "
+                    f"{ratio(b['pathtrace'].get('samples_per_cpu_second'), b['mitsuba'].get('samples_per_cpu_second'))}.",
+                    ""]
+            for k in ("validation_all_pixels", "validation_off_light"):
+                val = pv.get(k, {})
+                out.append(f"* {k.replace('_', ' ')}: noise ratio {fmt(val.get('noise_ratio'))}, mean radiance ratio "
+                           f"{fmt(val.get('mean_ratio'))}, |z| > 3 fraction {fmt(val.get('frac_abs_z_gt_3'))}")
+            out.append("")
+        else:
+            out.append(pv.get("mitsuba", "") + "\n")
+    elif pv:
+        out.append(f"Path tracer comparison: {pv.get('status')}\n")
+    st = res.get("rmse_against_shared_reference")
+    if st and "skipped" in st:
+        out.append(f"Error against time: {st['skipped']}.\n")
+    elif st:
+        out += [f"## Error against time, shared Mitsuba reference ({st['reference']['spp']} spp, {st['size']} px)", ""]
+        rows = [[m, e["spp"], e["render_s"], e["rmse"]] for m, v in st["methods"].items() if isinstance(v, list)
+                for e in v]
+        out.append(table(["method", "spp", "render (s)", "RMSE"], rows))
+    return "\n".join(out)
+
+
+PAGE = Page("mitsuba_cornell", "Mitsuba 3 on the Cornell box", first_paragraph(__doc__),
+            "python bench/mitsuba_cornell.py --with-pathtrace", tables, anchors=("mitsuba",),
+            smoke_note="16 x 16, 4 spp, one repeat, with the path tracer")
+
+
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", type=int, default=256)
     ap.add_argument("--spp", type=int, default=64)
@@ -158,7 +219,10 @@ def main() -> None:
     ap.add_argument("--with-pathtrace", action="store_true")
     ap.add_argument("--rmse-study", action="store_true",
                     help="also error against time vs a shared 4096-spp Mitsuba reference at 128x128 (cached)")
-    a = ap.parse_args()
+    a = PAGE.parse(ap, argv)
+    if a.smoke:
+        a.size, a.spp, a.repeat, a.with_pathtrace = 16, 4, 1, True
+    have = PAGE.anchor(a, "mitsuba") is not None
     import workbench
     scene = workbench.load_scene("cornell")
     res = {"date": time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()),
@@ -166,19 +230,24 @@ def main() -> None:
            "scene": "cornell", "size": a.size, "spp": a.spp,
            "image_definition": "box-filtered pixel average, linear float32, not clipped",
            "mitsuba": []}
-    for i in range(a.repeat):
-        e, r = run_once(scene, "mitsuba", a.size, a.spp, seed=i)
-        res["mitsuba"].append(e)
-    res["mitsuba_best"] = min(res["mitsuba"], key=lambda e: e["render_s"])
-    res["mitsuba_mean_radiance"] = r.image.mean(axis=(0, 1)).tolist()
+    if have:
+        for i in range(a.repeat):
+            e, r = run_once(scene, "mitsuba", a.size, a.spp, seed=i)
+            res["mitsuba"].append(e)
+        res["mitsuba_best"] = min(res["mitsuba"], key=lambda e: e["render_s"])
+        res["mitsuba_mean_radiance"] = r.image.mean(axis=(0, 1)).tolist()
+    else:
+        res["mitsuba"] = skip_note("mitsuba")
     if a.with_pathtrace:
-        res["pathtrace_vs_mitsuba"] = pathtrace_vs_mitsuba("cornell", a.size, a.spp, a.repeat)
-    if a.rmse_study:
-        res["rmse_against_shared_reference"] = rmse_against_shared_reference()
+        res["pathtrace_vs_mitsuba"] = pathtrace_vs_mitsuba("cornell", a.size, a.spp, a.repeat, have)
+    if a.rmse_study and not have:
+        res["rmse_against_shared_reference"] = {"skipped": skip_note("mitsuba") + " (it makes the reference)"}
+    elif a.rmse_study:
+        res["rmse_against_shared_reference"] = (rmse_against_shared_reference(size=16, reference_spp=64, spps=(4, 16))
+                                                if a.smoke else rmse_against_shared_reference())
     res["load_average_1min_after"] = os.getloadavg()[0]
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    OUT.write_text(json.dumps(res, indent=1))
     print(json.dumps(res, indent=1))
+    PAGE.write(a, res)
 
 
 if __name__ == "__main__":

@@ -18,7 +18,8 @@ best of ``--repeat`` runs, so other work on the host inflates it least).
   BSDF and light sampling, MIS, Russian roulette: the shading arithmetic).
 
 Usage: ``PYTHONPATH=. .venv/bin/python bench/pathtrace_profile.py`` writes
-``bench/results/pathtrace_profile.json`` and prints it.
+``bench/results/pathtrace_profile.json`` and ``docs/benchmarks/pathtrace_profile.md`` and prints it.
+``--smoke``: 8 x 8 pixels, 1 spp, one repeat, 4,096 random-number paths.
 """
 from __future__ import annotations
 
@@ -35,7 +36,9 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-OUT = ROOT / "bench" / "results" / "pathtrace_profile.json"
+sys.path.insert(0, str(ROOT / "bench"))
+
+from _common import Page, first_paragraph, fmt, kv_table  # noqa: E402
 
 
 def best_cpu(f, *args, repeat: int):
@@ -48,19 +51,53 @@ def best_cpu(f, *args, repeat: int):
     return best, out
 
 
-def main() -> None:
+def tables(res: dict) -> str:
+    sm, ra, rg, sh = res["sample"], res["rays"], res["rng"], res["shares"]
+    return (f"`{res['scene']}`, {res['size']} x {res['size']} pixels, {res['spp']} spp, {res['threads']} thread, "
+            f"CPU time, best of the repeats; load {res.get('load_before')} -> {res.get('load_after')}.  No outside "
+            "anchor: the ray tracer's general `closest` (`cast_all`) is the baseline of the path tracer's `cast`.\n\n"
+            + kv_table([
+                ("CPU time per sample (ns)", sm["cpu_ns"]),
+                ("rays per sample: camera / extension / shadow",
+                 f"{fmt(sm['camera_rays'])} / {fmt(sm['extension_rays'])} / {fmt(sm['shadow_rays'])}"),
+                ("mean path length", sm["mean_path_length"]),
+                ("closest hit per ray (ns): cast / cast_all / ratio",
+                 f"{fmt(ra['cast_closest_hit_ns'])} / {fmt(ra['cast_all_closest_hit_ns'])} / "
+                 f"{ra['cast_all_closest_hit_ns'] / ra['cast_closest_hit_ns']:.2f}"),
+                ("any hit per ray (ns): cast / cast_all / ratio",
+                 f"{fmt(ra['cast_any_hit_ns'])} / {fmt(ra['cast_all_any_hit_ns'])} / "
+                 f"{ra['cast_all_any_hit_ns'] / ra['cast_any_hit_ns']:.2f}"),
+                ("one random number (ns) / a path's key (ns)", f"{fmt(rg['rand_ns'])} / {fmt(rg['path_key_ns'])}"),
+                ("accumulation per sample (ns)", res["accumulate_ns_per_sample"]),
+                ("Python per pass (ms, best / median)",
+                 f"{fmt(res['pass_overhead_ms'])} / {fmt(res.get('pass_overhead_ms_median'))}"),
+                ("share: intersection", sh["intersection"]), ("share: random numbers (at most)", sh["rng_at_most"]),
+                ("share: accumulation", sh["accumulate"]), ("share: shading and sampling", sh["shading_and_sampling"]),
+            ]))
+
+
+PAGE = Page("pathtrace_profile", "Where a path-traced sample's time goes", first_paragraph(__doc__),
+            "python bench/pathtrace_profile.py", tables, smoke_note="8 x 8, 1 spp, one repeat")
+
+
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", type=int, default=128)
     ap.add_argument("--spp", type=int, default=8)
     ap.add_argument("--repeat", type=int, default=7)
-    a = ap.parse_args()
+    a = PAGE.parse(ap, argv)
+    paths = 1 << 20
+    if a.smoke:
+        a.size, a.spp, a.repeat, paths = 8, 1, 1, 1 << 12
     nb.set_num_threads(1)
     import workbench
     from workbench.renderers.pathtrace import kernels as K
     from workbench.renderers.pathtrace.session import PathTraceSession
     from workbench.renderers.kernels.columns import PathOpt
     from workbench.renderers.kernels.flags import NO_REFCOUNT
-    from workbench.renderers.kernels.intersect import scratch, surface
+    # the module, not its functions: numba's cache key hashes a kernel's closure variables, and a
+    # dispatcher pickles differently in every process (the cache would never hit)
+    from workbench.renderers.kernels import intersect as KI
 
     @nb.njit(**NO_REFCOUNT)
     def record(geo, cam, em_tri, nsamp, scr, rows, O, D, TM, AH):
@@ -84,7 +121,7 @@ def main() -> None:
                     if k < 0:
                         break
                     px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
-                    surface(geo, k, f, tri, b1, b2, px, py, pz, 1e-12, h_ng, h_ns, h_uv, h_po, h_ev, 0)
+                    KI.surface(geo, k, f, tri, b1, b2, px, py, pz, 1e-12, h_ng, h_ns, h_uv, h_po, h_ev, 0, scr[0])
                     nx, ny, nz = h_ng[0, 0], h_ng[0, 1], h_ng[0, 2]
                     if nx * dx + ny * dy + nz * dz > 0.0:
                         nx, ny, nz = -nx, -ny, -nz
@@ -154,7 +191,7 @@ def main() -> None:
 
     @nb.njit
     def work_arrays():
-        return scratch(), K.hit_rows()
+        return KI.scratch(), K.hit_rows()
 
     scene = workbench.load_scene("cornell")
     out = {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "threads": 1, "scene": "cornell",
@@ -189,10 +226,10 @@ def main() -> None:
     out["rays"] = rays
 
     rng(4, 4)
-    tr, _ = best_cpu(rng, 1 << 20, 16, repeat=a.repeat)
-    t_key, _ = best_cpu(rng, 1 << 20, 0, repeat=a.repeat)
-    rand_ns = (tr - t_key) / (16 << 20) * 1e9
-    key_ns = t_key / (1 << 20) * 1e9
+    tr, _ = best_cpu(rng, paths, 16, repeat=a.repeat)
+    t_key, _ = best_cpu(rng, paths, 0, repeat=a.repeat)
+    rand_ns = (tr - t_key) / (16 * paths) * 1e9
+    key_ns = t_key / paths * 1e9
     # random numbers per sample: 2 (pixel) and, per surface hit, up to 8 (light choice and point,
     # roulette, lobe, direction): the kernel draws at most 8 per bounce
     bounces = ses.stats()["mean_path_length"]
@@ -224,9 +261,8 @@ def main() -> None:
     out["intersection_ns_per_sample"] = isect
     out["intersection_ns_per_sample_with_closest"] = isect_general
     out["load_after"] = round(os.getloadavg()[0], 2)
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    OUT.write_text(json.dumps(out, indent=1))
     print(json.dumps(out, indent=1))
+    PAGE.write(a, out)
 
 
 if __name__ == "__main__":

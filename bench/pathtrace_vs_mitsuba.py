@@ -22,7 +22,10 @@
   ``--target`` (RMS of the per-pixel standard error), timed (wall and CPU), load average.
 
 Usage: ``PYTHONPATH=. .venv/bin/python bench/pathtrace_vs_mitsuba.py [--repeat 2] [--quick]``
-writes ``bench/results/pathtrace_vs_mitsuba.json`` and prints it.
+writes ``bench/results/pathtrace_vs_mitsuba.json`` and ``docs/benchmarks/pathtrace_vs_mitsuba.md`` and
+prints it (``--quick``: small sizes, printed only unless ``--out`` is given).  Without Mitsuba its
+rows, the shared reference and the equal-RMSE part are skipped.  ``--smoke``: 16 x 16 at 4 spp, one
+repeat; equal RMSE at 8 x 8, 2 and 4 spp, one seed, against a 16-spp reference; a 0.2-noise reference.
 """
 from __future__ import annotations
 
@@ -37,8 +40,10 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-OUT = ROOT / "bench" / "results" / "pathtrace_vs_mitsuba.json"
+sys.path.insert(0, str(ROOT / "bench"))
 THREADS = 2
+
+from _common import Page, first_paragraph, fmt, ratio, skip_note, table  # noqa: E402
 #: What is compared: label -> (method, options).  ``pathtrace_rr5`` starts Russian roulette at
 #: the 5th bounce, as Mitsuba's path integrator does (the method's default is the 3rd).
 VARIANTS = {"pathtrace": ("pathtrace", {}), "mitsuba": ("mitsuba", {"variant": "scalar_rgb"}),
@@ -69,12 +74,16 @@ def render(scene, label: str, size: int, spp: int, seed: int):
                "load_before": l0, "load_after": load()}
 
 
-def throughput(scene, size: int, spp: int, repeat: int) -> dict:
+def throughput(scene, size: int, spp: int, repeat: int, have_mitsuba: bool = True) -> dict:
     runs = []
+    labels = [m for m in VARIANTS if have_mitsuba or m != "mitsuba"]
     for k in range(repeat):
-        for m in VARIANTS:
+        for m in labels:
             runs.append(render(scene, m, size, spp, seed=k)[1])
-    best = {m: max((e for e in runs if e["method"] == m), key=lambda e: e["samples_per_s"]) for m in VARIANTS}
+    best = {m: max((e for e in runs if e["method"] == m), key=lambda e: e["samples_per_s"]) for m in labels}
+    if not have_mitsuba:
+        return {"scene": scene.name, "size": size, "spp": spp, "threads": THREADS, "runs": runs, "best": best,
+                "mitsuba": skip_note("mitsuba")}
     return {"scene": scene.name, "size": size, "spp": spp, "threads": THREADS, "runs": runs, "best": best,
             "ratio_samples_per_s": best["pathtrace"]["samples_per_s"] / best["mitsuba"]["samples_per_s"],
             "ratio_samples_per_cpu_s": best["pathtrace"]["samples_per_cpu_s"] / best["mitsuba"]["samples_per_cpu_s"],
@@ -144,7 +153,49 @@ def reference(scene, size: int, target: float) -> dict:
             "mean_radiance": ses.image.mean(axis=(0, 1)).tolist()}
 
 
-def main() -> None:
+def tables(res: dict) -> str:
+    t, q, ref = res["throughput"], res.get("equal_rmse"), res["reference"]
+    b = t["best"]
+    m = b.get("mitsuba")
+    out = [f"{res['image_definition']}.", "",
+           f"## Throughput: `{t['scene']}` at {t['size']} x {t['size']}, {t['spp']} spp, {t['threads']} threads, "
+           "best of the alternating runs", "",
+           table(["method", "sampling wall (s)", "sampling CPU (s)", "samples/s", "samples/CPU-s",
+                  "samples/s over Mitsuba (anchor)", "samples/CPU-s over Mitsuba"],
+                 [[k, e["sample_wall_s"], e["sample_cpu_s"], e["samples_per_s"], e["samples_per_cpu_s"],
+                   ratio(e["samples_per_s"], m["samples_per_s"]) if m else "–",
+                   ratio(e["samples_per_cpu_s"], m["samples_per_cpu_s"]) if m else "–"] for k, e in b.items()])]
+    if "mitsuba" in t and isinstance(t["mitsuba"], str):
+        out.append(t["mitsuba"] + ".\n")
+    if q and "fit" in q:
+        r = q["reference"]
+        out += [f"## Time to equal error: {q['size']} x {q['size']}, seeds {q['seeds']}, against Mitsuba at "
+                f"{r['spp']} spp (noise {fmt(r['noise_rms'])})", "",
+                f"Target excess RMSE {fmt(q['target_excess_rmse'])} (pathtrace's at 64 spp).", "",
+                table(["method", "c", "c off the light", "CPU s per spp", "spp to target", "CPU s to target",
+                       "CPU time to equal RMSE over Mitsuba", "same, off the light"],
+                      [[k, f["c"], f["c_off_light"], f["cpu_s_per_spp"], f["spp_to_target"], f["cpu_s_to_target"],
+                        fmt(get_ratio(q, k, "cpu_time_to_equal_rmse_over_mitsuba")),
+                        fmt(get_ratio(q, k, "cpu_time_to_equal_rmse_off_light_over_mitsuba"))]
+                       for k, f in q["fit"].items()])]
+    elif q:
+        out.append(f"Equal-RMSE part: {q.get('skipped')}.\n")
+    out += [f"## Path tracer to noise {ref['target_noise_rms']} at {ref['size']} x {ref['size']}", "",
+            table(["spp", "noise reached", "wall (s)", "trace wall (s)", "trace CPU (s)"],
+                  [[ref["spp"], ref["reached_noise_rms"], ref["wall_s"], ref["trace_wall_s"], ref["trace_cpu_s"]]])]
+    return "\n".join(out)
+
+
+def get_ratio(q, method, key):
+    return q.get("ratios", {}).get(method, {}).get(key, 1.0 if method == "mitsuba" else None)
+
+
+PAGE = Page("pathtrace_vs_mitsuba", "The path tracer against Mitsuba 3 on the Cornell box", first_paragraph(__doc__),
+            "python bench/pathtrace_vs_mitsuba.py", tables, anchors=("mitsuba",),
+            smoke_note="16 x 16 at 4 spp; equal RMSE at 8 x 8 against a 16-spp reference")
+
+
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=2)
     ap.add_argument("--size", type=int, default=256)
@@ -153,9 +204,15 @@ def main() -> None:
     ap.add_argument("--ref-spp", type=int, default=4096)
     ap.add_argument("--target", type=float, default=0.01, help="noise level of the 256x256 pathtrace reference")
     ap.add_argument("--quick", action="store_true", help="small sizes (a smoke test)")
-    a = ap.parse_args()
+    out_given = "--out" in (sys.argv[1:] if argv is None else argv)
+    a = PAGE.parse(ap, argv)
+    spps, seeds = (16, 64, 256), (7, 8, 9)
     if a.quick:
         a.size, a.spp, a.rmse_size, a.ref_spp, a.repeat, a.target = 32, 8, 16, 256, 1, 0.05
+    if a.smoke:
+        a.size, a.spp, a.rmse_size, a.ref_spp, a.repeat, a.target = 16, 4, 8, 16, 1, 0.2
+        spps, seeds = (2, 4), (7,)
+    have = PAGE.anchor(a, "mitsuba") is not None
     import numba
 
     import workbench
@@ -165,14 +222,14 @@ def main() -> None:
     res = {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "machine": f"{os.cpu_count()} CPUs, shared",
            "image_definition": "box-filtered pixel average, linear RGB, not clipped (both methods)",
            "load_before": load()}
-    res["throughput"] = throughput(scene, a.size, a.spp, a.repeat)
-    res["equal_rmse"] = equal_rmse(scene, a.rmse_size, a.ref_spp)
+    res["throughput"] = throughput(scene, a.size, a.spp, a.repeat, have)
+    res["equal_rmse"] = (equal_rmse(scene, a.rmse_size, a.ref_spp, spps, seeds) if have else
+                         {"skipped": skip_note("mitsuba") + " (it makes the shared reference)"})
     res["reference"] = reference(scene, a.size, a.target)
     res["load_after"] = load()
-    if not a.quick:
-        OUT.parent.mkdir(parents=True, exist_ok=True)
-        OUT.write_text(json.dumps(res, indent=1))
     print(json.dumps(res, indent=1))
+    if not a.quick or out_given or a.smoke:
+        PAGE.write(a, res)
 
 
 if __name__ == "__main__":

@@ -32,8 +32,10 @@ empty numba cache directory (it
 compiles the kernels this scene needs: the fused kernel of :mod:`workbench.renderers.raytrace`).
 The load average is recorded before and after (the machine is shared).
 
-Writes ``bench/results/povray_whitted.json`` and prints it.  Run:
-``.venv/bin/python bench/povray_whitted.py``.
+Writes ``bench/results/povray_whitted.json`` and ``docs/benchmarks/povray_whitted.md`` and prints
+it.  Run: ``.venv/bin/python bench/povray_whitted.py``.  Without POV-Ray our side is measured alone
+(its columns skipped).  ``--smoke``: 64 x 48, one run each, no cold compile (minutes on an empty cache)
+and no warm-up command.
 """
 from __future__ import annotations
 
@@ -47,9 +49,9 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _common import Page, first_paragraph, fmt, ratio, skip_note, table
 
 ROOT = Path(__file__).resolve().parents[1]
-RESULTS = ROOT / "bench" / "results"
 W, H = 640, 480
 THRESHOLD = 1.0 / 255.0
 PY = sys.executable
@@ -78,13 +80,14 @@ def _povray_once(pov: Path, out: Path) -> dict:
                 mrays_per_cpu_s=(rays + shadow) / max(cpu, 1e-9) / 1e6)
 
 
-def alternate(pov_file: Path, scene_name: str, tmp: Path, warm_cache: str | None = None,
-              repeats: int = 7) -> tuple[dict, dict, dict | None]:
+def alternate(pov_file: Path | None, scene_name: str, tmp: Path, warm_cache: str | None = None,
+              repeats: int = 7) -> tuple[dict | None, dict, dict | None]:
     """POV-Ray and ours run alternately ``repeats`` times each: a POV-Ray command, our render
     in this process (warm JIT cache) and, with ``warm_cache``, our whole command.  The shared
     machine's speed drifts over minutes (other guests on the host): alternating exposes both
     programs to the same drift.  Returns POV-Ray's statistics of its best trace (its ``wall_s``
-    the best whole command), ours of our best trace, and our best whole command (or None)."""
+    the best whole command), ours of our best trace, and our best whole command (or None).
+    ``pov_file`` None: POV-Ray is absent, ours alone (its statistics None)."""
     import numba
 
     import workbench
@@ -93,11 +96,12 @@ def alternate(pov_file: Path, scene_name: str, tmp: Path, warm_cache: str | None
     workbench.render(scene, "raytrace", width=32, height=24)  # JIT (or cache load)
     povs, ours, cmds = [], [], []
     for i in range(repeats):
-        povs.append(_povray_once(pov_file, tmp / f"{scene_name}_pov.png"))
+        if pov_file is not None:
+            povs.append(_povray_once(pov_file, tmp / f"{scene_name}_pov.png"))
         ours.append(workbench.render(scene, "raytrace", width=W, height=H, threshold=THRESHOLD, max_depth=5))
         if warm_cache is not None:
             cmds.append(ours_command(scene_name, warm_cache, tmp / f"{scene_name}_{i}.png"))
-    pov = dict(min(povs, key=lambda d: d["trace_s"]), wall_s=min(d["wall_s"] for d in povs))
+    pov = dict(min(povs, key=lambda d: d["trace_s"]), wall_s=min(d["wall_s"] for d in povs)) if povs else None
     best = min(ours, key=lambda r: r.timings["trace"])
     st = best.stats
     mine = dict(trace_s=best.timings["trace"], trace_cpu_s=best.timings["trace_cpu"], total_s=best.timings["total"],
@@ -156,47 +160,104 @@ def povray_method(scene_name: str, repeats: int = 3) -> dict:
                                        mean_abs=float(d.mean()), max_abs=float(d.max())))
 
 
-def main() -> dict:
-    RESULTS.mkdir(parents=True, exist_ok=True)
+def tables(res: dict) -> str:
+    out = [f"{res['size']}, trace level {res['max_depth']}, threshold / adc_bailout {res['threshold_adc_bailout']:.5f}; "
+           f"{res['machine']}.  Rays counted: {res['ray_counting']}.", ""]
+    if res.get("povray_absent"):
+        out += [res["povray_absent"] + ".", ""]
+    for name in ("whitted", "mesh"):
+        r = res.get(name)
+        if not r:
+            continue
+        pov, ours = r.get("povray") or {}, r["ours_trace"]
+        warm = r.get("ours_command_warm") or {}
+        title = "Whitted scene" if name == "whitted" else f"mesh, {r.get('triangles')} triangles"
+        def row(label, key, theirs, mine, faster):
+            a, b = theirs.get(key), mine.get(key)
+            return [label, a, b, (ratio(a, b) if faster == "smaller" else ratio(b, a)) if faster else "–"]
+        rows = [row("trace (s)", "trace_s", pov, ours, "smaller"),
+                row("trace CPU (s)", "trace_cpu_s", pov, ours, "smaller"),
+                row("rays traced", "total_rays", pov, ours, None),
+                row("Mrays/s", "mrays_per_s", pov, ours, "larger"),
+                row("Mrays per CPU-s", "mrays_per_cpu_s", pov, ours, "larger"),
+                row("whole command, warm (s)", "wall_s", pov, warm, "smaller")]
+        out += [f"## {title}", "", table(["", "POV-Ray 3.7 (anchor)", "ours", "ours faster by (x)"], rows)]
+        cold = r.get("ours_command_cold")
+        extra = []
+        if cold:
+            extra.append(f"our command on an empty numba cache: {fmt(cold['wall_s'])} s (compile {fmt(cold['compile_s'])} s)")
+        pm = r.get("povray_method")
+        if pm:
+            iv = pm["image_vs_raytrace"]
+            extra.append(f"the `povray` method (export, process, read-back): {fmt(pm['total_s'])} s; its image against "
+                         f"the ray tracer's: {fmt(100 * iv['fraction_beyond_1em4'])} % of pixels beyond 1e-4, max "
+                         f"{fmt(iv['max_abs'])}")
+        if r.get("targets"):
+            extra.append("targets: " + ", ".join(f"{k}: {'met' if v else 'not met'}" for k, v in r["targets"].items()))
+        out += [f"* {e}" for e in extra] + [""]
+    return "\n".join(out)
+
+
+PAGE = Page("povray_whitted", "The ray tracer against POV-Ray 3.7", first_paragraph(__doc__),
+            "python bench/povray_whitted.py", tables, anchors=("povray",), variants=True,
+            smoke_note="64 x 48, one run each, no cold compile")
+
+
+def main(argv=None) -> dict:
+    global W, H
+    import argparse
+    args = PAGE.parse(argparse.ArgumentParser(description=__doc__.splitlines()[0]), argv)
+    repeats, method_repeats = 7, 3
+    if args.smoke:
+        W, H, repeats, method_repeats = 64, 48, 1, 1
+    have = PAGE.anchor(args, "povray") is not None
     res: dict = {"machine": f"{os.cpu_count()} CPUs (shared), both renderers on 2 threads",
                  "load_average_start": os.getloadavg(),
                  "size": f"{W}x{H}", "threshold_adc_bailout": THRESHOLD, "max_depth": 5,
                  "ray_counting": "every ray traced, by kind: POV-Ray's Rays (eye + reflected + refracted) "
                                  "+ Shadow Ray Tests; ours primary + shadow feelers + reflected + refracted"}
+    if not have:
+        res["povray_absent"] = skip_note("povray")
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         # --- Whitted
-        cold = ours_command("whitted", str(tmp / "cold_cache"), tmp / "cold.png")
-        warm_cache = str(ROOT / ".numba_cache")
-        ours_command("whitted", warm_cache, tmp / "w0.png")  # make sure the cache is warm
-        whitted_pov = tmp / "whitted.pov"
-        export_pov("whitted", whitted_pov)
-        pov, inproc, warm = alternate(whitted_pov, "whitted", tmp, warm_cache)
+        # (the smoke run skips the cold compile: minutes of kernel compiles on an empty cache)
+        cold = None if args.smoke else ours_command("whitted", str(tmp / "cold_cache"), tmp / "cold.png")
+        warm_cache = os.environ.get("NUMBA_CACHE_DIR") or str(ROOT / ".numba_cache")
+        if not args.smoke:
+            ours_command("whitted", warm_cache, tmp / "w0.png")  # make sure the cache is warm
+        whitted_pov = tmp / "whitted.pov" if have else None
+        if have:
+            export_pov("whitted", whitted_pov)
+        pov, inproc, warm = alternate(whitted_pov, "whitted", tmp, warm_cache, repeats)
         res["whitted"] = dict(
             povray=pov, ours_trace=inproc, ours_command_warm=warm, ours_command_cold=cold,
-            numba_cold_compile_s=cold["compile_s"],
-            rays_per_s_ratio=inproc["mrays_per_s"] / pov["mrays_per_s"],
-            rays_per_cpu_s_ratio=inproc["mrays_per_cpu_s"] / pov["mrays_per_cpu_s"],
-            trace_time_ratio=pov["trace_s"] / inproc["trace_s"],
-            command_ratio_pov_over_ours=pov["wall_s"] / warm["wall_s"],
-            povray_method=povray_method("whitted"),
-            targets={"rays_per_s_ratio >= 2": inproc["mrays_per_s"] / pov["mrays_per_s"] >= 2,
-                     "warm command no slower than POV-Ray": warm["wall_s"] <= pov["wall_s"]})
+            numba_cold_compile_s=cold["compile_s"] if cold else None)
+        if have:
+            res["whitted"].update(
+                rays_per_s_ratio=inproc["mrays_per_s"] / pov["mrays_per_s"],
+                rays_per_cpu_s_ratio=inproc["mrays_per_cpu_s"] / pov["mrays_per_cpu_s"],
+                trace_time_ratio=pov["trace_s"] / inproc["trace_s"],
+                command_ratio_pov_over_ours=pov["wall_s"] / warm["wall_s"],
+                povray_method=povray_method("whitted", method_repeats),
+                targets={"rays_per_s_ratio >= 2": inproc["mrays_per_s"] / pov["mrays_per_s"] >= 2,
+                         "warm command no slower than POV-Ray": warm["wall_s"] <= pov["wall_s"]})
         # --- mesh
-        mesh_pov = tmp / "mesh_blob.pov"
-        export_pov("mesh", mesh_pov)
-        povm, oursm, _ = alternate(mesh_pov, "mesh", tmp)
+        mesh_pov = tmp / "mesh_blob.pov" if have else None
+        if have:
+            export_pov("mesh", mesh_pov)
+        povm, oursm, _ = alternate(mesh_pov, "mesh", tmp, None, repeats)
         warm_m = ours_command("mesh", warm_cache, tmp / "m.png")
-        res["mesh"] = dict(
-            triangles=81920, povray=povm, ours_trace=oursm, ours_command_warm=warm_m,
-            rays_per_s_ratio=oursm["mrays_per_s"] / povm["mrays_per_s"],
-            rays_per_cpu_s_ratio=oursm["mrays_per_cpu_s"] / povm["mrays_per_cpu_s"],
-            trace_time_ratio=povm["trace_s"] / oursm["trace_s"],
-            targets={"rays_per_s_ratio >= 3": oursm["mrays_per_s"] / povm["mrays_per_s"] >= 3})
+        res["mesh"] = dict(triangles=81920, povray=povm, ours_trace=oursm, ours_command_warm=warm_m)
+        if have:
+            res["mesh"].update(
+                rays_per_s_ratio=oursm["mrays_per_s"] / povm["mrays_per_s"],
+                rays_per_cpu_s_ratio=oursm["mrays_per_cpu_s"] / povm["mrays_per_cpu_s"],
+                trace_time_ratio=povm["trace_s"] / oursm["trace_s"],
+                targets={"rays_per_s_ratio >= 3": oursm["mrays_per_s"] / povm["mrays_per_s"] >= 3})
     res["load_average_end"] = os.getloadavg()
-    (RESULTS / "povray_whitted.json").write_text(json.dumps(res, indent=2))
     print(json.dumps(res, indent=2))
-    return res
+    return PAGE.write(args, res)
 
 
 if __name__ == "__main__":

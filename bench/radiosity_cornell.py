@@ -24,7 +24,9 @@ dropped first): 18 MB holds all 2,120 rows of the Cornell box, 3,200 of the 10,3
 the big case.
 
 Usage: ``.venv/bin/python bench/radiosity_cornell.py [--quick]`` writes
-``bench/results/radiosity_cornell.json`` and prints it.
+``bench/results/radiosity_cornell.json`` and ``docs/benchmarks/radiosity_cornell.md`` and prints it.
+Without pyviewfactor the ``pvf`` part is skipped.  ``--smoke``: about 100 patches (200 for ``big``),
+16-pixel hemicubes, 20 pairs, a 2-second limit.
 """
 from __future__ import annotations
 
@@ -41,7 +43,9 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-OUT = ROOT / "bench" / "results" / "radiosity_cornell.json"
+sys.path.insert(0, str(ROOT / "bench"))
+
+from _common import Page, first_paragraph, fmt, kv_table, ratio, skip_note, table  # noqa: E402
 
 
 def peak_mb() -> float:
@@ -296,35 +300,96 @@ def part_big(count: int, res: int, limit: float) -> dict:
             "full_matrix_would_need_mb": len(p) ** 2 * 8 / 2 ** 20}
 
 
-def main():
+def tables(res: dict) -> str:
+    out = [f"{res.get('machine')}{'; quick sizes' if res.get('quick') else ''}.", ""]
+    f = res.get("full")
+    if f and "error" not in f:
+        out += [f"## full: {f['patches']} patches, hemicube {f['hemicube_resolution']} px ({f['gl_renderer']})", "",
+                kv_table([("form factors (s)", f["form_factor_seconds"]), ("direct LU solve (s)", f["direct_solve_seconds"]),
+                          (f"hemicube + direct (s; target {f['target_seconds']})", f["hemicube_plus_direct_seconds"]),
+                          ("peak RSS with the full matrix (MB)", f["peak_rss_mb_full_matrix"]),
+                          ("progressive on the stored matrix, to 1 % RMS (s)",
+                           f["progressive_on_stored_matrix"]["seconds_to_1pct_rms"])]),
+                "Matrix-free progressive refinement to within 1 % (area-weighted RMS) of the converged solution:", "",
+                table(["run", "rows from", "relax", "wall s to 1 %", "CPU s to 1 %", "shots", "rows computed",
+                       "target (s)"],
+                      [[k.replace("progressive_", ""), r["source"], r["relax"], r["seconds_to_1pct_rms"],
+                        r["cpu_seconds_to_1pct_rms"], r["shots_to_1pct_rms"], r["rows_computed"], r["target_seconds"]]
+                       for k, r in f.items() if k.startswith("progressive_") and isinstance(r, dict) and "source" in r])]
+    elif f:
+        out += ["## full: failed", "", "```", f["error"], "```", ""]
+    v = res.get("pvf")
+    if v and "skipped" in v:
+        out += ["## pvf", "", v["skipped"] + ".", ""]
+    elif v and "error" not in v:
+        hc, an = v["hemicube_vs_pyviewfactor"], v["analytic_vs_pyviewfactor"]
+        out += [f"## pvf: against pyviewfactor {v['pyviewfactor_version']} (the anchor), {v['pairs']} pairs of "
+                f"{v['room_patches']} room patches", "",
+                table(["", "pyviewfactor (anchor)", "hemicube (ours)", "analytic (ours)"],
+                      [["seconds per pair", v["pyviewfactor_seconds_per_pair"], v["hemicube_seconds_per_pair"],
+                        v["analytic_seconds_per_pair"]],
+                       ["pyviewfactor / ours, per pair", "1", ratio(v["pyviewfactor_seconds_per_pair"], v["hemicube_seconds_per_pair"]),
+                        ratio(v["pyviewfactor_seconds_per_pair"], v["analytic_seconds_per_pair"])],
+                       ["mean abs error vs pyviewfactor", 0.0, hc["mean_abs"], an["mean_abs"]],
+                       ["median rel. error (F > 1e-4)", 0.0, hc["median_rel_F>1e-4"], an["median_rel_F>1e-4"]],
+                       ["95th percentile rel. error", 0.0, hc["p95_rel_F>1e-4"], an["p95_rel_F>1e-4"]]]),
+                f"pyviewfactor for the full matrix would take about {fmt(v['pyviewfactor_seconds_full_matrix_estimate'])} s; "
+                f"the hemicube took {fmt(v['hemicube_seconds_full_matrix'])} s.", ""]
+    elif v:
+        out += ["## pvf: failed", "", "```", v["error"], "```", ""]
+    b = res.get("big")
+    if b and "error" not in b:
+        out += [f"## big: {b['patches']} patches, matrix-free progressive refinement", "",
+                kv_table([("shots", b["shots"]), ("seconds", b["seconds"]), ("converged to 1e-2", b["converged_to_tol_1e-2"]),
+                          ("peak RSS (MB)", b["peak_rss_mb"]), ("a full matrix would need (MB)", b["full_matrix_would_need_mb"])])]
+    elif b:
+        out += ["## big: failed", "", "```", b["error"], "```", ""]
+    return "\n".join(out)
+
+
+PAGE = Page("radiosity_cornell", "Radiosity on the Cornell box", first_paragraph(__doc__),
+            "python bench/radiosity_cornell.py", tables, anchors=("pyviewfactor",),
+            smoke_note="about 100 patches, 16-pixel hemicubes, 20 pairs")
+
+
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--part", choices=("full", "pvf", "big"))
-    ap.add_argument("--quick", action="store_true", help="small sizes (smoke test)")
+    ap.add_argument("--quick", action="store_true", help="small sizes")
     ap.add_argument("--parts", default="full,pvf,big",
                     help="comma-separated parts to run; others are kept from the last results file")
-    a = ap.parse_args()
+    a = PAGE.parse(ap, argv)
     q = a.quick
     if a.part:
-        fn = {"full": lambda: part_full(300 if q else 2000, 64 if q else 128),
-              "pvf": lambda: part_pvf(300 if q else 2000, 64 if q else 128, 200 if q else 2000),
-              "big": lambda: part_big(1000 if q else 10000, 64 if q else 128, 10.0 if q else 120.0)}[a.part]
+        size = ("smoke" if a.smoke else "quick" if q else "full")
+        fn = {"full": lambda: part_full(*{"smoke": (100, 16), "quick": (300, 64), "full": (2000, 128)}[size]),
+              "pvf": lambda: part_pvf(*{"smoke": (100, 16, 20), "quick": (300, 64, 200), "full": (2000, 128, 2000)}[size]),
+              "big": lambda: part_big(*{"smoke": (200, 16, 2.0), "quick": (1000, 64, 10.0),
+                                        "full": (10000, 128, 120.0)}[size])}[a.part]
         print(json.dumps(fn()))
         return
     parts = a.parts.split(",")
-    results = json.loads(OUT.read_text()) if OUT.exists() and len(parts) < 3 else {}
+    out = a.out / "radiosity_cornell.json"
+    results = json.loads(out.read_text()) if out.exists() and len(parts) < 3 else {}
+    results.pop("environment", None)
     results.update({"machine": f"{os.cpu_count()} CPUs (shared), llvmpipe", "quick": q})
     for part in parts:
         results[f"{part}_date"] = time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime())
         results[f"{part}_load_average_1min_before"] = os.getloadavg()[0]
-        cmd = [sys.executable, __file__, "--part", part] + (["--quick"] if q else [])
+        if part == "pvf" and PAGE.anchor(a, "pyviewfactor") is None:
+            results[part] = {"skipped": skip_note("pyviewfactor")}
+            continue
+        cmd = ([sys.executable, __file__, "--part", part, "--out", str(a.out)] + (["--quick"] if q else [])
+               + (["--smoke"] if a.smoke else []))
         r = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
         if r.returncode:
             results[part] = {"error": r.stderr[-2000:]}
         else:
             results[part] = json.loads(r.stdout.strip().splitlines()[-1])
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    OUT.write_text(json.dumps(results, indent=1))
     print(json.dumps(results, indent=1))
+    PAGE.write(a, results)
+    if any("error" in results[p] for p in parts):
+        sys.exit(f"radiosity_cornell: part(s) failed: {[p for p in parts if 'error' in results[p]]}")
 
 
 if __name__ == "__main__":

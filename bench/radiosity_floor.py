@@ -32,15 +32,15 @@ they overlap and partly cancel; the JSON also gives the root-sum-square for comp
   identical paths on this all-Lambertian scene give an identical image.
 
 Usage: ``.venv/bin/python bench/radiosity_floor.py [--size 128] [--spp 1024]`` writes
-``bench/results/radiosity_floor.json`` and ``bench/results/radiosity_floor.md`` (the README's
-table) and prints the table.  The two 1024-spp path-traced images take about 2 x 2.5 min on the
+``bench/results/radiosity_floor.json`` and ``docs/benchmarks/radiosity_floor.md`` (the README's
+table) and prints the table.  ``--smoke``: 16 x 16, 4 spp references, ``patch_size`` 0.2 alone, 16
+Malley rays per patch.  The two 1024-spp path-traced images take about 2 x 2.5 min on the
 busy 2-core host the first time, then come from the reference cache.
 """
 from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import os
 import sys
 import time
@@ -50,7 +50,10 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-OUT = ROOT / "bench" / "results" / "radiosity_floor.json"
+sys.path.insert(0, str(ROOT / "bench"))
+
+from _common import Page, first_paragraph  # noqa: E402
+
 MITSUBA_ISSUE = {0.2: 0.0455, 0.1: 0.0399, 0.05: 0.0361, 0.025: 0.0358}
 """Radiosity against Mitsuba 3 (scalar_rgb, 4096 spp, box filter, 128 x 128, clipped), issue 13."""
 BLOCKS = ("short_block", "tall_block")
@@ -134,7 +137,20 @@ def flat_display(patches, radiance, scene):
     return img
 
 
-def main() -> int:
+def tables(out: dict) -> str:
+    w, h = out["size"]
+    return (f"`{out['scene']}` at {w} x {h}, clipped to {out['clip']}; {out['note']}.  The anchor is the converged "
+            f"path tracer (`pathtrace`, {out['spp']} spp) of the same run, and Mitsuba 3 at 4096 spp as quoted "
+            "from issue 13 (not run here).\n\n" + table(out)
+            + ("\nSteps (s): " + ", ".join(f"{k} {v}" for k, v in out["steps_s"].items())
+               + f"; total {out.get('total_s')} s.\n" if out.get("steps_s") else ""))
+
+
+PAGE = Page("radiosity_floor", "Where radiosity's error floor on the Cornell box comes from", first_paragraph(__doc__),
+            "python bench/radiosity_floor.py", tables, smoke_note="16 x 16, 4 spp, patch_size 0.2 alone")
+
+
+def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", type=int, default=128)
     ap.add_argument("--spp", type=int, default=1024, help="samples per pixel of the path-traced references")
@@ -143,11 +159,13 @@ def main() -> int:
     ap.add_argument("--malley-max", type=int, default=1000, help="Malley form factors up to this many patches")
     ap.add_argument("--band", type=float, default=1.5, help="half-width in pixels of the contact/junction bands")
     ap.add_argument("--sizes", type=float, nargs="+", default=[0.2, 0.1, 0.05, 0.025])
-    args = ap.parse_args()
+    args = PAGE.parse(ap, argv)
+    if args.smoke:
+        args.size, args.spp, args.f_spp, args.rays, args.malley_max, args.sizes = 16, 4, 2, 16, 100, [0.2]
 
     import workbench
     from workbench.compare.reference_cache import cached_render
-    from workbench.renderers.base import _convert_options, get_renderer
+    from workbench.renderers.base import convert_options, get_renderer
     from workbench.renderers.radiosity.display import draw
     from workbench.renderers.radiosity.method import solve_scene
     from workbench.scene.model import AreaLight
@@ -213,7 +231,7 @@ def main() -> int:
         "rest": float(d2[rest].sum() / d2.sum())}
     out["b_pixel_filter"]["rmse_off_light_and_edges"] = float(np.sqrt(d2[rest].sum() / (3 * d2.size)))
 
-    opts = _convert_options(get_renderer("radiosity"), {})
+    opts = convert_options(get_renderer("radiosity"), {})
     rows = {}
     for ps in args.sizes:
         o = dict(opts, patch_size=ps)
@@ -255,13 +273,8 @@ def main() -> int:
     out["steps_s"] = steps
     out["total_s"] = round(time.perf_counter() - t_start, 1)
     out["load_after"] = os.getloadavg()
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    tmp = OUT.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(out, indent=2))
-    tmp.replace(OUT)
-    md = table(out)
-    OUT.with_suffix(".md").write_text(md)
-    print(md)
+    print(table(out))
+    PAGE.write(args, out)
     return 0
 
 

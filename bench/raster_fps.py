@@ -23,7 +23,9 @@ same scene and camera is measured beside ours, in a child process
 
     .venv/bin/python bench/raster_fps.py [--seconds 1.0] [--size 512] [--scenes a,b]
 
-Writes ``bench/results/raster_fps.json`` and prints it.
+Writes ``bench/results/raster_fps.json`` and ``docs/benchmarks/raster_fps.md`` and prints it.  Without
+pyrender its column is skipped.  ``--smoke``: ``whitted`` alone at 32 x 32, 0.05 s per rate, 2
+pyrender frames.
 """
 from __future__ import annotations
 
@@ -33,14 +35,12 @@ import os
 import platform
 import statistics
 import time
-from pathlib import Path
 
 import workbench
 from workbench.renderers import gl
 from workbench.renderers.raster import RasterSession
 from workbench.scene.library import bundled
-
-OUT = Path(__file__).resolve().parent / "results" / "raster_fps.json"
+from _common import Page, first_paragraph, ratio, skip_note, table
 
 
 def _rate(fn, seconds: float, batch: int = 5) -> dict:
@@ -62,7 +62,7 @@ def _rate(fn, seconds: float, batch: int = 5) -> dict:
             "fps_best": max(rates), "cpu_ms": 1e3 * (time.process_time() - c0) / n}
 
 
-def bench_scene(name: str, size: int, seconds: float) -> dict:
+def bench_scene(name: str, size: int, seconds: float, pyrender_frames: int = 10, have_pyrender: bool = True) -> dict:
     scene = workbench.load_scene(name)
     cam = scene.camera.with_resolution(size, size)
     row = {"scene": name, "methods": {}}
@@ -94,23 +94,50 @@ def bench_scene(name: str, size: int, seconds: float) -> dict:
         session.release()
         print(name, mode, row["methods"][mode], flush=True)
     try:
+        if not have_pyrender:
+            raise RuntimeError(skip_note("pyrender"))
         from workbench.renderers.reference import frame_time_in_child
-        row["pyrender"] = frame_time_in_child(name, size, size, frames=10)
+        row["pyrender"] = frame_time_in_child(name, size, size, frames=pyrender_frames)
     except Exception as e:  # reported, never fatal for the benchmark
         row["pyrender"] = {"error": str(e)}
     print(name, "pyrender", row["pyrender"], flush=True)
     return row
 
 
-def main():
+def tables(res: dict) -> str:
+    w, h = res["size"]
+    rows = []
+    for sc in res["scenes"]:
+        py = sc.get("pyrender", {})
+        py_ms = 1e3 * py["frame_seconds_median"] if py.get("frame_seconds_median") else None
+        for mode, m in sc["methods"].items():
+            rows.append([sc["scene"], mode, m["triangles"], m["fps"], m["fps_best"], m["cpu_ms_per_frame"],
+                         m["ms_with_readback"], py_ms if py_ms is not None else py.get("error", "–")[:60],
+                         ratio(py_ms, m["ms_with_readback"])])
+    return (f"{w} x {h}, {res['gl_renderer']}; load {res['load_average_1min']['before']} -> "
+            f"{res['load_average_1min']['after']}.  {res['note']}.\n\n"
+            + table(["scene", "method", "triangles", "fps", "fps (best batch)", "CPU ms/frame", "ms with read-back",
+                     "pyrender ms/frame (anchor, median)", "pyrender / ours (with read-back)"], rows))
+
+
+PAGE = Page("raster_fps", "Raster throughput: flat, Gouraud and Phong on llvmpipe", first_paragraph(__doc__),
+            "python bench/raster_fps.py", tables, anchors=("pyrender",),
+            smoke_note="whitted alone at 32 x 32, 0.05 s per rate")
+
+
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=1.0)
     ap.add_argument("--size", type=int, default=512)
     ap.add_argument("--scenes", default="")
-    args = ap.parse_args()
+    args = PAGE.parse(ap, argv)
+    frames = 10
+    if args.smoke:
+        args.seconds, args.size, args.scenes, frames = 0.05, 32, "whitted", 2
     names = args.scenes.split(",") if args.scenes else [p.stem for p in bundled()]
     load_before = os.getloadavg()
-    rows = [bench_scene(n, args.size, args.seconds) for n in names]
+    have = PAGE.anchor(args, "pyrender") is not None
+    rows = [bench_scene(n, args.size, args.seconds, frames, have) for n in names]
     result = {"benchmark": "raster_fps", "size": [args.size, args.size], "gl_renderer": gl.renderer_name(),
               "machine": platform.platform(), "cpu_count": os.cpu_count(),
               "load_average_1min": {"before": round(load_before[0], 2), "after": round(os.getloadavg()[0], 2)},
@@ -118,9 +145,8 @@ def main():
                       "fps = draw + finish (no read-back); pyrender's frame includes its read-back: "
                       "compare it with ms_with_readback",
               "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "scenes": rows}
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    OUT.write_text(json.dumps(result, indent=2))
     print(json.dumps(result, indent=2))
+    PAGE.write(args, result)
 
 
 if __name__ == "__main__":

@@ -17,19 +17,21 @@ needing none keep their frame rate.
 
     .venv/bin/python bench/raster_standins.py [--seconds 1.0] [--width 512] [--height 384]
 
-Writes ``bench/results/raster_standins.json`` and ``.md`` (and prints the table) and the figure
-``docs/images/whitted_standins.png`` (``--figure-only``: just the figure).
+Writes ``bench/results/raster_standins.json`` and ``docs/benchmarks/raster_standins.md`` (and prints
+the table) and the figure ``docs/images/whitted_standins.png`` (``--figure-only``: just the figure).
+``--smoke``: 32 x 24, 0.05 s per rate, the steps "none" and "all", one sweep of one value, two scenes
+for the "unneeded" part; the figure goes to the ``--out`` folder.
 """
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import platform
 import time
 from pathlib import Path
 
 import workbench
+from _common import Page, first_paragraph
 from raster_fps import _rate
 from workbench.compare.metrics import metrics
 from workbench.compare.reference import choose_reference
@@ -39,7 +41,6 @@ from workbench.renderers.raster import RasterSession
 from workbench.scene.features import scene_needs
 from workbench.scene.library import bundled
 
-OUT = Path(__file__).resolve().parent / "results" / "raster_standins"
 STEPS = [("none", "off"), ("envmap", "envmap"), ("+blend", "envmap,blend"), ("+shadows = all", "on"),
          ("blend alone", "blend"), ("shadows alone", "shadows")]
 SWEEPS = {"envmap_resolution": (16, 32, 64, 128, 256), "envmap_iterations": (0, 1, 2, 3, 5),
@@ -86,7 +87,7 @@ def measure(scene, mode: str, reference, width: int, height: int, seconds: float
 FIGURE = Path(__file__).resolve().parents[1] / "docs" / "images" / "whitted_standins.png"
 
 
-def figure(scene, reference, width: int, height: int) -> None:
+def figure(scene, reference, width: int, height: int, path: Path = FIGURE) -> None:
     """docs/images/whitted_standins.png: the Whitted reference, Phong with stand-ins off, with
     environment maps seen from the centre (``envmap_iterations=0``: parallax), with all stand-ins
     at their defaults, and the absolute error of the last (x4), each panel labelled with its RMSE."""
@@ -106,41 +107,46 @@ def figure(scene, reference, width: int, height: int) -> None:
         ImageDraw.Draw(im).text((6, 6), label, fill=(0, 0, 0))
         tiles.append(np.asarray(im))
     half = [np.asarray(Image.fromarray(x).resize((width // 2, height // 2))) for x in tiles]
-    FIGURE.parent.mkdir(parents=True, exist_ok=True)
+    path.parent.mkdir(parents=True, exist_ok=True)
     Image.fromarray(np.concatenate([np.concatenate(half[:3], 1), np.concatenate(half[3:] + [255 + 0 * half[0]], 1)],
-                                   0).astype(np.uint8)).save(FIGURE)
-    print("wrote", FIGURE)
+                                   0).astype(np.uint8)).save(path)
+    print("wrote", path)
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=1.0)
     ap.add_argument("--width", type=int, default=512)
     ap.add_argument("--height", type=int, default=384)
     ap.add_argument("--figure-only", action="store_true", help="only write docs/images/whitted_standins.png")
-    args = ap.parse_args()
+    args = PAGE.parse(ap, argv)
+    steps_, sweeps_, scenes, unneeded_size = STEPS, SWEEPS, bundled(), 512
+    if args.smoke:
+        args.width, args.height, args.seconds = 32, 24, 0.05
+        steps_ = [st for st in STEPS if st[0] in ("none", "+shadows = all")]
+        sweeps_, scenes, unneeded_size = {"envmap_resolution": SWEEPS["envmap_resolution"][:1]}, bundled()[:2], 32
     W, H, sec = args.width, args.height, args.seconds
     load_before = os.getloadavg()
     scene = workbench.load_scene("whitted")
     ref = choose_reference(scene, W, H)
-    figure(scene, ref.image, W, H)
+    figure(scene, ref.image, W, H, args.out / FIGURE.name if args.smoke else FIGURE)
     if args.figure_only:
         return
     steps = []
-    for label, standins in STEPS:
+    for label, standins in steps_:
         for mode in ("phong", "gouraud") if label in ("none", "+shadows = all") else ("phong",):
             steps.append({"step": label, **measure(scene, mode, ref.image, W, H, sec, standins=standins)})
     sweeps = {k: [measure(scene, "phong", ref.image, W, H, sec / 2, **{k: v}) for v in values]
-              for k, values in SWEEPS.items()}
+              for k, values in sweeps_.items()}
     unneeded = []
-    for path in bundled():
+    for path in scenes:
         s = workbench.load_scene(path.stem)
         p = sti.plan(scene_needs(s), sti.StandinOptions(), "phong", user_model=False, n_lights=len(s.point_lights()))
         row = {"scene": path.stem, "standins_built": sorted(p.covered)}
         if not p.any:
             for mode in ("phong", "gouraud"):
                 for standins in ("on", "off"):
-                    r = measure(s, mode, None, 512, 512, sec, standins=standins)
+                    r = measure(s, mode, None, unneeded_size, unneeded_size, sec, standins=standins)
                     row[f"{mode}_{standins}"] = {k: r[k] for k in ("fps", "fps_best", "cpu_ms_per_frame", "env_maps",
                                                                    "shadow_tiles")}
         unneeded.append(row)
@@ -154,16 +160,15 @@ def main():
                       "in setup_seconds); 2 shared cores: the load average lowers fps, cpu_ms_per_frame much less",
               "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
               "steps": steps, "sweeps": sweeps, "unneeded": unneeded}
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    OUT.with_suffix(".json").write_text(json.dumps(result, indent=2))
-    OUT.with_suffix(".md").write_text(markdown(result))
     print(markdown(result))
+    PAGE.write(args, result)
 
 
 def markdown(r: dict) -> str:
     """The result as Markdown tables."""
     W, H = r["size"]
-    out = [f"# Raster stand-ins on `whitted` at {W} x {H}", "",
+    out = [f"The anchor is the Whitted ray tracer's image (the reference, same run); the stand-ins' RMSE against "
+           f"it, step by step, at {W} x {H}.", "",
            f"Reference: {r['reference']['method']} {r['reference']['options']}; {r['gl_renderer']}; "
            f"load average {r['load_average_1min']['before']} -> {r['load_average_1min']['after']} on "
            f"{r['cpu_count']} cores; {r['date']}.", "",
@@ -187,6 +192,10 @@ def markdown(r: dict) -> str:
         fps = [f"{u[f'{m}_on']['fps']} / {u[f'{m}_off']['fps']}" if f"{m}_on" in u else "" for m in ("phong", "gouraud")]
         out.append(f"| {u['scene']} | {', '.join(u['standins_built']) or 'none'} | {fps[0]} | {fps[1]} |")
     return "\n".join(out) + "\n"
+
+
+PAGE = Page("raster_standins", "Raster stand-ins for global effects on `whitted`", first_paragraph(__doc__),
+            "python bench/raster_standins.py", markdown, smoke_note="32 x 24, 0.05 s per rate, steps none and all, one sweep of one value")
 
 
 if __name__ == "__main__":

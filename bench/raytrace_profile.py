@@ -13,19 +13,22 @@ the kernels.
 CPU seconds over wall seconds of a kernel is its thread utilisation (2.0 = both threads busy;
 on a shared machine other processes lower it).
 
-Writes ``bench/results/raytrace_profile.json`` and prints it.  Run:
-``.venv/bin/python bench/raytrace_profile.py``.
+Writes ``bench/results/raytrace_profile.json`` and ``docs/benchmarks/raytrace_profile.md`` and prints
+it.  Run: ``.venv/bin/python bench/raytrace_profile.py``.  ``--smoke``: 32 x 24, one render per case.
 """
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import time
 from pathlib import Path
 
+from _common import Page, first_paragraph, fmt, table
+
 ROOT = Path(__file__).resolve().parents[1]
-RESULTS = ROOT / "bench" / "results"
 W, H = 640, 480
+REPEATS = 3
 KERNELS = ("trace_batch", "shade_batch", "compact", "accumulate", "column_sums")
 
 
@@ -54,12 +57,13 @@ def _instrument(kernels, whitted, log):
     whitted._Tracer.trace = trace
 
 
-def fused(threads: int, repeats: int = 3) -> dict:
+def fused(threads: int, repeats: int | None = None) -> dict:
     """Best trace phase of the fused path."""
     import numba
 
     import workbench
     numba.set_num_threads(threads)
+    repeats = repeats or REPEATS
     scene = workbench.load_scene("whitted")
     r = min((workbench.render(scene, "raytrace", width=W, height=H, threshold=1.0 / 255.0, max_depth=5)
              for _ in range(repeats)), key=lambda r: r.timings["trace"])
@@ -67,11 +71,12 @@ def fused(threads: int, repeats: int = 3) -> dict:
                 total_rays=r.stats["total_rays"], mrays_per_s=r.stats["total_rays"] / r.timings["trace"] / 1e6)
 
 
-def profile(threads: int, repeats: int = 3) -> dict:
+def profile(threads: int, repeats: int | None = None) -> dict:
     import numba
 
     import workbench
     numba.set_num_threads(threads)
+    repeats = repeats or REPEATS
     scene = workbench.load_scene("whitted")
     best = None
     for _ in range(repeats):
@@ -98,7 +103,7 @@ def profile(threads: int, repeats: int = 3) -> dict:
                 per_generation=per_gen)
 
 
-def mesh_intersection(repeats: int = 3) -> dict:
+def mesh_intersection(repeats: int | None = None) -> dict:
     """The mesh scene on one thread: the trace phase of a render against the intersection
     queries of its rays alone, through :func:`intersect.closest` (analytic primitives, the
     mesh's box, the 4-wide BVH) and through the BVH alone (box test + :func:`walks.bvh_hit`):
@@ -115,6 +120,7 @@ def mesh_intersection(repeats: int = 3) -> dict:
     from workbench.renderers.raytrace.flatten import flatten
     from workbench.renderers.raytrace.whitted import _alloc, camera_rays, kernel_options
     numba.set_num_threads(1)
+    repeats = repeats or REPEATS
     scene = workbench.load_scene("mesh")
     r = min((workbench.render(scene, "raytrace", width=W, height=H, threshold=1.0 / 255.0, max_depth=5)
              for _ in range(repeats)), key=lambda r: r.timings["trace"])
@@ -133,7 +139,7 @@ def mesh_intersection(repeats: int = 3) -> dict:
     sets = dict(primary=(O, D, np.zeros(n), np.full(n, np.inf), False),
                 shadow=(fo[want], fd[want], ftmin[want], ftmax[want], True))
 
-    @numba.njit(**dict(NO_REFCOUNT, cache=False))  # as the kernels: no reference counting
+    @numba.njit(**NO_REFCOUNT)  # as the kernels: no reference counting (cached: a smoke run loads it)
     def queries(geo, O, D, tmin, tmax, shadow, bvh_only, extent, scr, rel_eps, zero):
         stack, st, sp_, sf, sn = scr
         node, child, leaf, first, tv4, bounds = (geo.bvh_node, geo.bvh_child, geo.bvh_leaf, geo.bvh_first,
@@ -174,10 +180,41 @@ def mesh_intersection(repeats: int = 3) -> dict:
 LOG: list = []
 
 
-def main() -> dict:
+def tables(res: dict) -> str:
+    fu, wf, me = res["fused"], res["wavefront"], res["mesh"]
+    out = [f"Whitted scene at {res['size']}, depth 5, threshold 1/255, warm; {res['machine']}; numba threading layer "
+           f"{res.get('numba_threading_layer')}.  No outside anchor (POV-Ray on the same scene: "
+           "[povray_whitted](povray_whitted.md)); the wavefront path is the baseline of the fused kernel.", "",
+           "## Fused kernel against the wavefront path", "",
+           table(["threads", "fused trace (s)", "fused Mrays/s", "wavefront trace (s)", "wavefront Mrays/s",
+                  "wavefront / fused", "wavefront glue share", "trace_batch utilisation"],
+                 [[f["threads"], f["trace_s"], f["mrays_per_s"], w["trace_s"], w["mrays_per_s"],
+                   f"{w['trace_s'] / f['trace_s']:.2f}", w["glue_share"], w["utilisation"].get("trace_batch")]
+                  for f, w in zip(fu, wf)]),
+           "## Wavefront kernels (wall s, CPU s)", "",
+           table(["threads"] + list(wf[0]["kernels"]),
+                 [[w["threads"]] + [f"{fmt(k['wall_s'])} / {fmt(k['cpu_s'])}" for k in w["kernels"].values()]
+                  for w in wf]),
+           f"## Mesh scene ({me['triangles']} triangles), one thread", "",
+           table(["rays", "count", "closest (s)", "BVH alone (s)"],
+                 [[k, me[f"{k}_rays"], me[f"{k}_closest_s"], me[f"{k}_bvh_s"]] for k in ("primary", "shadow")]),
+           f"Trace phase {fmt(me['trace_s'])} s; intersection share {fmt(me['intersection_share_of_trace'])}, BVH share "
+           f"{fmt(me['bvh_share_of_trace'])}.", ""]
+    return "\n".join(out)
+
+
+PAGE = Page("raytrace_profile", "Where the Whitted ray tracer spends its trace phase", first_paragraph(__doc__),
+            "python bench/raytrace_profile.py", tables, smoke_note="32 x 24, one render per case")
+
+
+def main(argv=None) -> dict:
+    global W, H, REPEATS
     import numba
 
     import workbench
+    args = PAGE.parse(argparse.ArgumentParser(description=__doc__.splitlines()[0]), argv)
+    if args.smoke:
+        W, H, REPEATS = 32, 24, 1
     from workbench.renderers.raytrace import kernels, whitted
     workbench.render(workbench.load_scene("whitted"), "raytrace", width=32, height=24)  # JIT / cache
     res = dict(machine=f"{os.cpu_count()} CPUs (shared); load average {os.getloadavg()[0]:.2f} at start",
@@ -188,10 +225,8 @@ def main() -> dict:
     workbench.render(workbench.load_scene("whitted"), "raytrace", width=32, height=24)
     _instrument(kernels, whitted, LOG)
     res["wavefront"] = [profile(t) for t in (1, 2)]
-    RESULTS.mkdir(parents=True, exist_ok=True)
-    (RESULTS / "raytrace_profile.json").write_text(json.dumps(res, indent=2))
     print(json.dumps(res, indent=2))
-    return res
+    return PAGE.write(args, res)
 
 
 if __name__ == "__main__":

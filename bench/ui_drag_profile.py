@@ -20,7 +20,9 @@ is the work of a frame); without it a stage's time is what it waits for.
 
 Usage: python bench/ui_drag_profile.py [--sync] [--step 0] [--display indexed16-kmeans-fs]
        [--seconds 6] [--window 1600x900] [--size 512] [--methods flat,gouraud,phong]
-Writes ``bench/results/ui_drag_profile[_sync][_MODE].json`` and prints a table.
+Writes ``bench/results/ui_drag_profile[_sync][_MODE].json`` and ``docs/benchmarks/ui_drag_profile.md``
+(every variant found beside the result) and prints a table.  Needs ``Xvfb``.  ``--smoke``: 0.5 s of
+counted frames, 64 px panels in an 800 x 500 window.
 """
 from __future__ import annotations
 
@@ -36,6 +38,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "bench"))
+from _common import Page, first_paragraph, fmt, table  # noqa: E402
 from ui_fps import free_display  # noqa: E402
 
 
@@ -80,7 +83,7 @@ def run(args) -> dict:
     from workbench.app.ui.state import new_state
 
     clock = StageClock(args.sync)
-    script = scripts.Fps(Path(args.out), seconds=args.seconds, display=args.display or None,
+    script = scripts.Fps(Path(args.script_out), seconds=args.seconds, display=args.display or None,
                          step=args.step)
     counted = {"n": 0}
 
@@ -131,7 +134,23 @@ def run(args) -> dict:
             "run_seconds": time.perf_counter() - t0, "run_cpu_seconds": time.process_time() - c0}
 
 
-def main() -> None:
+def tables(res: dict) -> str:
+    log = res["fps_script"]
+    st = res["stages_ms_per_frame"]
+    return (f"{res['frames']} frames counted, display `{res['display']}`, {'glFinish after every stage' if res['sync'] else 'no sync'}"
+            f"; {fmt(log.get('fps'))} fps, {fmt(log.get('cpu_ms_per_frame'))} CPU ms per frame; {res['gl_renderer']}; "
+            f"load {[round(x, 2) for x in res.get('load_average_1_5_15_before', [])]}.  No outside anchor: the stages' sum against the frame.\n\n"
+            + table(["stage", "wall ms / frame", "CPU ms / frame"],
+                    [[k, v["wall_ms"], v["cpu_ms"]] for k, v in st.items()]
+                    + [["**sum**", res["sum_wall_ms"], res["sum_cpu_ms"]]]))
+
+
+PAGE = Page("ui_drag_profile", "Where a frame of a camera drag goes (the UI window)", first_paragraph(__doc__),
+            "python bench/ui_drag_profile.py  (variants: --sync, --step 0, --display indexed16-kmeans-fs)", tables,
+            variants=True, smoke_note="0.5 s of frames, 64 px panels, 800 x 500 window")
+
+
+def main(argv=None) -> None:
     p = argparse.ArgumentParser()
     p.add_argument("--scene", default="whitted")
     p.add_argument("--methods", default="flat,gouraud,phong")
@@ -143,8 +162,11 @@ def main() -> None:
     p.add_argument("--step", type=float, default=0.002, help="radians of orbit per frame (0: "
                    "a static camera, the frame without panel draws)")
     p.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
-    p.add_argument("--out", default="", help=argparse.SUPPRESS)
-    a = p.parse_args()
+    p.add_argument("--script-out", default="", help=argparse.SUPPRESS)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    a = PAGE.parse(p, argv)
+    if a.smoke:
+        a.seconds, a.size, a.window = 0.5, 64, "800x500"
     if a.child:
         print(json.dumps(run(a)))
         return
@@ -158,8 +180,8 @@ def main() -> None:
             time.sleep(0.05)
         with tempfile.TemporaryDirectory() as out:
             load = os.getloadavg()
-            child = subprocess.run([sys.executable, __file__, "--child", "--out", out,
-                                    *sys.argv[1:]], cwd=ROOT, timeout=600,
+            child = subprocess.run([sys.executable, __file__, "--child", "--script-out", out,
+                                    *argv, "--out", str(a.out)], cwd=ROOT, timeout=600,
                                    env={**os.environ, "DISPLAY": f":{n}"}, capture_output=True,
                                    text=True)
             if child.returncode != 0:  # the window's own error, not the wrapper's traceback
@@ -172,7 +194,7 @@ def main() -> None:
     result = {"load_average_1_5_15_before": load, **json.loads(res.strip().splitlines()[-1])}
     name = ("ui_drag_profile" + ("_sync" if a.sync else "") + ("_static" if not a.step else "")
             + (f"_{a.display}" if a.display else ""))
-    (ROOT / "bench" / "results" / f"{name}.json").write_text(json.dumps(result, indent=1))
+    PAGE.write(a, result, stem=name)
     log = result["fps_script"]
     print(f"{result['frames']} frames, {log.get('fps', 0):.1f} fps, "
           f"{log.get('cpu_ms_per_frame', 0):.1f} CPU ms/frame, load {load[0]:.2f}")

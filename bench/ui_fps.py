@@ -52,6 +52,9 @@ control row, then holds the three 512 px panels side by side, so all three are o
 pixels on llvmpipe).
 
 Usage: python bench/ui_fps.py [--scene whitted] [--size 512] [--window 1600x900]
+writes ``bench/results/ui_fps.json`` and ``docs/benchmarks/ui_fps.md``.  Needs ``Xvfb``.  ``--smoke``:
+the cases ``drag_gl_only`` (its script counts frames for 10 s: it cannot be shorter without changing
+the package's script) and ``raytrace_without_window``, 64 px panels in an 800 x 500 window.
 """
 from __future__ import annotations
 
@@ -64,6 +67,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+from _common import Page, first_paragraph, fmt, table
 
 ROOT = Path(__file__).resolve().parents[1]
 SPP = 16
@@ -131,7 +136,40 @@ def soak(result: dict) -> dict:
     return result
 
 
-def main() -> None:
+def tables(res: dict) -> str:
+    cpu = f"{res.get('cpu_count')} CPUs, {res.get('processor') or res.get('machine')}"
+    rows = []
+    for name, c in res.items():
+        if not isinstance(c, dict) or "fps" not in c:
+            continue
+        rows.append([name, c.get("window"), c.get("panel_size"), ", ".join(c.get("methods", [])), c["fps"],
+                     c.get("cpu_ms_per_frame"), c.get("gui_ms_mean"), c.get("frames"), c.get("gl_panel_draws"),
+                     c.get("raytrace_seconds"), c.get("note", "")[:80]])
+    out = [f"{cpu}; Xvfb + llvmpipe.  No outside anchor: the plain-process ray trace "
+           "(`raytrace_without_window`) is the baseline of the window's background job.", "",
+           table(["case", "window", "panel px", "methods", "fps", "CPU ms/frame", "GUI ms (mean)", "frames",
+                  "GL panel draws", "ray trace with the window open (s)", "note"], rows)]
+    rw = res.get("raytrace_without_window")
+    if rw:
+        out.append(f"Ray trace without the window ({rw['size']} px, {rw['spp']} spp): {fmt(rw['seconds'])} s on "
+                   f"{rw.get('numba_threads')} numba threads.\n")
+    idle = res.get("idle")
+    if idle and "idle" in idle:
+        i = idle["idle"]
+        out.append(f"Idle: {fmt(i['fps'])} fps, {fmt(i['cpu_percent_of_a_core'])} % of a core over {fmt(i['seconds'])} s.\n")
+    for k in ("soak", "soak_10min"):
+        sk = res.get(k)
+        if sk and "rss_mb_round4_last" in sk:
+            out.append(f"{k}: {len(sk['rounds'])} rounds, RSS {fmt(sk['rss_mb_round4_last'][0])} MB at round 4 -> "
+                       f"{fmt(sk['rss_mb_round4_last'][1])} MB at the last; jobs kept at most {sk.get('jobs_kept_max')}.\n")
+    return "\n".join(out)
+
+
+PAGE = Page("ui_fps", "Frames per second of the UI window", first_paragraph(__doc__), "python bench/ui_fps.py",
+            tables, smoke_note="drag_gl_only (10 s of counting) and raytrace_without_window, 64 px panels")
+
+
+def main(argv=None) -> None:
     p = argparse.ArgumentParser()
     p.add_argument("--scene", default="whitted")
     p.add_argument("--size", type=int, default=512)
@@ -139,7 +177,9 @@ def main() -> None:
                    "issue's 1600x900)")
     p.add_argument("--cases", default="", help="comma-separated cases to run (default: all); "
                    "the results file keeps the others' entries")
-    a = p.parse_args()
+    a = PAGE.parse(p, argv)
+    if a.smoke:
+        a.size, a.window, a.cases = 64, "800x500", a.cases or "drag_gl_only,raytrace_without_window"
     cases = {"static_camera_raytrace_running": lambda: measure(a.scene, a.size, a.window, True, "fps_static"),
              "drag_with_raytrace_panel": lambda: measure(a.scene, a.size, a.window, True, "fps"),
              "drag_gl_only": lambda: measure(a.scene, a.size, a.window, False, "fps"),
@@ -155,16 +195,15 @@ def main() -> None:
     bad = [c for c in chosen if c not in cases]
     if bad:
         p.error(f"unknown cases {bad}; known: {', '.join(cases)}")
-    out = ROOT / "bench" / "results" / "ui_fps.json"
+    out = a.out / "ui_fps.json"
     res = json.loads(out.read_text()) if a.cases and out.exists() else {}
+    res.pop("environment", None)
     for c in chosen:
         res[c] = cases[c]()
     res.update({"cpu_count": os.cpu_count(), "machine": platform.machine(),
                 "processor": platform.processor() or platform.uname().processor})
-    tmp = out.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(res, indent=1))
-    tmp.replace(out)
     print(json.dumps(res, indent=1))
+    PAGE.write(a, res)
 
 
 if __name__ == "__main__":

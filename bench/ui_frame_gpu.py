@@ -17,21 +17,20 @@ process CPU time (every thread: llvmpipe's rasteriser threads included):
 * ``encodes`` and ``window_encodes``: the three sRGB encodings alone, into textures or into the
   window.
 
-Usage: python bench/ui_frame_gpu.py [--frames 40]  ->  bench/results/ui_frame_gpu.json
+Usage: python bench/ui_frame_gpu.py [--frames 40]  ->  bench/results/ui_frame_gpu.json and
+docs/benchmarks/ui_frame_gpu.md.  ``--smoke``: 2 counted frames.
 """
 from __future__ import annotations
 
 import argparse
 import ctypes
-import json
 import os
 import time
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
+from _common import Page, first_paragraph, ratio, table
 
-ROOT = Path(__file__).resolve().parents[1]
 WINDOW = (1600, 900)
 PANEL = (512, 384)
 RECTS = [(10 + k * 520, 400, 508, 381) for k in range(3)] + [(10, 10, 340, 255)]
@@ -49,7 +48,22 @@ class WindowStandIn:
         return getattr(self._ctx, name)
 
 
-def main() -> None:
+def tables(res: dict) -> str:
+    ms = res["ms_per_frame"]
+    base = ms.get("encode_blit", {}).get("wall_ms")
+    return (f"{res['frames']} frames after 2 warm-up frames; window {res['window'][0]} x {res['window'][1]}, panels "
+            f"{res['panel'][0]} x {res['panel'][1]}; {res['gl_renderer']}; load {[round(x, 2) for x in res.get('load_average_1_5_15_before', [])]} "
+            f"-> {[round(x, 2) for x in res.get('load_average_after', [])]}.  No outside anchor: `encode_blit` (the sequence `window_passes` "
+            "replaced) is the baseline.\n\n"
+            + table(["sequence", "wall ms / frame", "CPU ms / frame", "wall: encode_blit / this"],
+                    [[k, v["wall_ms"], v["cpu_ms"], ratio(base, v["wall_ms"])] for k, v in ms.items()]))
+
+
+PAGE = Page("ui_frame_gpu", "The GPU side of one camera-drag frame", first_paragraph(__doc__),
+            "python bench/ui_frame_gpu.py", tables, smoke_note="2 counted frames")
+
+
+def main(argv=None) -> None:
     import workbench
     from workbench.app.ui import camera as cam
     from workbench.app.ui.frames import SCALE_FLOOR, DisplayPasses
@@ -57,7 +71,9 @@ def main() -> None:
     from workbench.renderers.base import get_renderer
     p = argparse.ArgumentParser()
     p.add_argument("--frames", type=int, default=40)
-    a = p.parse_args()
+    a = PAGE.parse(p, argv)
+    if a.smoke:
+        a.frames = 2
     ctx = gl.context()
     win = WindowStandIn(ctx)
     screen, passes = win.screen, DisplayPasses(win)
@@ -151,7 +167,7 @@ def main() -> None:
     res = {"frames": a.frames, "window": WINDOW, "panel": PANEL, "gl_renderer": gl.renderer_name(ctx),
            "load_average_1_5_15_before": load, "load_average_after": os.getloadavg(),
            "ms_per_frame": ms}
-    (ROOT / "bench" / "results" / "ui_frame_gpu.json").write_text(json.dumps(res, indent=1))
+    PAGE.write(a, res)
     for k, v in ms.items():
         print(f"{k:<16} wall {v['wall_ms']:6.2f} ms  CPU {v['cpu_ms']:6.2f} ms")
     print("load", [round(x, 2) for x in load], "->", [round(x, 2) for x in res["load_average_after"]])

@@ -6,26 +6,28 @@ flat, Gouraud and Phong panels of ``whitted`` at 512 x 384 drawn as the window d
 (the default) and off.  Wall and CPU milliseconds per frame (the mean over the frames; the
 machine is shared: the load average is recorded).
 
-    .venv/bin/python bench/ui_standins.py   ->  bench/results/ui_standins.{json,md}
+    .venv/bin/python bench/ui_standins.py   ->  bench/results/ui_standins.json, docs/benchmarks/ui_standins.md
+
+``--smoke``: 64 x 48 panels, 2 frames per case.
 """
 from __future__ import annotations
 
-import json
+import argparse
 import os
 import time
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 
 import workbench
+from _common import Page, first_paragraph, ratio, table
 from workbench.app.ui import camera as cam
 from workbench.renderers import gl
 from workbench.renderers.base import get_renderer
 
-OUT = Path(__file__).resolve().parent / "results"
 METHODS = ("flat", "gouraud", "phong")
 FRAMES = 30
+SIZE = (512, 384)
 
 
 def _frame(ctx, sessions, camera) -> None:
@@ -50,9 +52,9 @@ def _timed(ctx, sessions, cameras, before=None) -> dict:
 def run(standins: str) -> dict:
     ctx = gl.context()
     scene = workbench.load_scene("whitted")
-    camera = scene.camera.with_resolution(512, 384)
+    camera = scene.camera.with_resolution(*SIZE)
     scene = scene.with_camera(camera)
-    sessions = {m: get_renderer(m).session(scene, 512, 384, ctx=ctx, **({"standins": standins}
+    sessions = {m: get_renderer(m).session(scene, *SIZE, ctx=ctx, **({"standins": standins}
                                                                        if m != "flat" else {}))
                 for m in METHODS}
     _frame(ctx, sessions, camera)  # first frame: llvmpipe's code generation
@@ -82,22 +84,35 @@ def run(standins: str) -> dict:
     return out
 
 
-def main() -> None:
-    results = {"benchmark": "ui_standins", "scene": "whitted", "size": [512, 384], "methods": list(METHODS),
+def tables(results: dict) -> str:
+    runs = results["runs"]
+    off = runs.get("off", {})
+    rows = [[s] + [f"{r[k]['wall_ms']:.1f} ({r[k]['cpu_ms']:.1f})" for k in ("drag", "light_colour", "light_move")]
+            + [ratio(r["light_move"]["cpu_ms"], off.get("light_move", {}).get("cpu_ms"))] for s, r in runs.items()]
+    w, h = results["size"]
+    return (f"{' + '.join(results['methods'])} panels, {results['scene']} {w} x {h}, {results['frames']} frames each; "
+            f"load {results['load_before']:.1f} -> {results['load_after']:.1f}; {results['gl_renderer']}.  "
+            "No outside anchor: stand-ins off is the baseline.\n\n"
+            + table(["stand-ins", "drag ms (CPU)", "light colour ms (CPU)", "light move ms (CPU)",
+                     "light move CPU: this / off"], rows)
+            + f"\nMaps drawn by the drag (stand-ins on): {runs.get('on', {}).get('maps_drawn_by_drag')}.\n")
+
+
+PAGE = Page("ui_standins", "What the stand-ins cost the window's GL panels", first_paragraph(__doc__),
+            "python bench/ui_standins.py", tables, smoke_note="64 x 48 panels, 2 frames per case")
+
+
+def main(argv=None) -> None:
+    global FRAMES, SIZE
+    args = PAGE.parse(argparse.ArgumentParser(description=__doc__.splitlines()[0]), argv)
+    if args.smoke:
+        FRAMES, SIZE = 2, (64, 48)
+    results = {"benchmark": "ui_standins", "scene": "whitted", "size": list(SIZE), "methods": list(METHODS),
                "frames": FRAMES, "load_before": os.getloadavg()[0],
                "gl_renderer": gl.renderer_name(gl.context()),
                "runs": {s: run(s) for s in ("on", "off")}, "load_after": os.getloadavg()[0]}
-    OUT.mkdir(exist_ok=True)
-    (OUT / "ui_standins.json").write_text(json.dumps(results, indent=1))
-    rows = ["| stand-ins | drag ms (CPU) | light colour ms (CPU) | light move ms (CPU) |", "|---|---|---|---|"]
-    for s, r in results["runs"].items():
-        rows.append(f"| {s} | " + " | ".join(f"{r[k]['wall_ms']:.1f} ({r[k]['cpu_ms']:.1f})"
-                                           for k in ("drag", "light_colour", "light_move")) + " |")
-    note = (f"\nflat + gouraud + phong panels, whitted 512x384, {FRAMES} frames each, "
-            f"load {results['load_before']:.1f} -> {results['load_after']:.1f}, {results['gl_renderer']}; "
-            f"maps drawn by the drag: {results['runs']['on']['maps_drawn_by_drag']}\n")
-    (OUT / "ui_standins.md").write_text("\n".join(rows) + "\n" + note)
-    print("\n".join(rows) + note)
+    print(tables(results))
+    PAGE.write(args, results)
 
 
 if __name__ == "__main__":

@@ -12,7 +12,8 @@ phases (vertices, scan, shade) apart.
 
     .venv/bin/python bench/zbuffer.py [--size 320x240] [--scenes whitted,quadrics,mesh,csg]
 
-Writes ``bench/results/zbuffer.json`` and prints it.
+Writes ``bench/results/zbuffer.json`` and ``docs/benchmarks/zbuffer.md`` and prints it.  ``--smoke``:
+``whitted`` alone at 32 x 24.
 """
 from __future__ import annotations
 
@@ -21,15 +22,14 @@ import json
 import os
 import platform
 import time
-from pathlib import Path
 
 import numpy as np
 
 import workbench
+from _common import Page, first_paragraph, ratio, table
 from workbench.renderers.base import get_renderer
 from workbench.renderers.zbuffer import near_clipped_mask
 
-OUT = Path(__file__).resolve().parent / "results" / "zbuffer.json"
 DIFFERS = 1e-2
 
 
@@ -40,11 +40,26 @@ def _timed(scene, method, w, h, **opts):
     return r, time.perf_counter() - t0
 
 
-def main() -> None:
+def tables(res: dict) -> str:
+    rows = [[r["scene"], r["mode"], r["triangles"], r["differing"], r["near_clipped"], r["other"], r["gl_nonfinite"],
+             r["zbuffer_seconds"], r["gl_seconds"], ratio(r["zbuffer_seconds"], r["gl_seconds"])] for r in res["rows"]]
+    return (f"{res['size']}; a pixel differs when a channel differs by more than {DIFFERS} (linear).  The anchor is "
+            "the GL method of the same mode (`interpolation=screen`, `standins=off`) on llvmpipe, same run.\n\n"
+            + table(["scene", "mode", "triangles", "differing px", "near-clipped", "other", "GL non-finite",
+                     "zbuffer (s)", "GL (s)", "zbuffer / GL"], rows))
+
+
+PAGE = Page("zbuffer", "The CPU Z-buffer against its GL twin", first_paragraph(__doc__), "python bench/zbuffer.py",
+            tables, smoke_note="whitted alone at 32 x 24")
+
+
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="320x240")
     ap.add_argument("--scenes", default="whitted,quadrics,mesh,csg")
-    a = ap.parse_args()
+    a = PAGE.parse(ap, argv)
+    if a.smoke:
+        a.size, a.scenes = "32x24", "whitted"
     w, h = (int(x) for x in a.size.split("x"))
     rows = []
     for name in a.scenes.split(","):
@@ -67,9 +82,7 @@ def main() -> None:
             print(json.dumps(rows[-1]))
     out = {"size": a.size, "machine": platform.processor() or platform.machine(),
            "load_average": os.getloadavg(), "rows": rows}
-    OUT.parent.mkdir(exist_ok=True)
-    OUT.write_text(json.dumps(out, indent=1))
-    print(f"wrote {OUT}")
+    PAGE.write(a, out)
 
 
 if __name__ == "__main__":
