@@ -31,6 +31,9 @@ NEEDS_XVFB = {"ui_fps", "ui_drag_profile"}
 SLOW: dict[str, str] = {
     "wheel_install": "builds and installs the wheel (pip), then starts the installed commands: ~30 s",
     "ui_fps": "the window's fps script counts frames for 10 s, fixed in the package (app/ui/scripts.py)",
+    "accel": "compiles a past revision's BVH builder beside today's: about 15 min on an empty numba cache",
+    "kinds_exporters": "every kind through the POV-Ray and Mitsuba exporters: about 8 min on an empty cache",
+    "raytrace_profile": "compiles its own profiling kernels for every kind: about 7 min on an empty cache",
 }
 """Smoke runs too long for the default test run (``-m slow`` runs them), and why."""
 WATCHED = (ROOT / "bench" / "results", ROOT / "docs")
