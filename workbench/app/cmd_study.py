@@ -74,6 +74,10 @@ def add_parser(sub):
                         "that has it), e.g. standins=off")
     p.add_argument("--jobs", type=int, default=1,
                    help="worker processes for the error evaluation, run after all timing (default 1)")
+    p.add_argument("--cluster", metavar="ADDRESS",
+                   help="run the points and the error evaluation on the workers of a Dask scheduler, e.g. "
+                        "tcp://HOST:8786 (needs workbench[cluster] here and the same workbench version on "
+                        "every worker; not with --jobs above 1; times are the workers'; docs/guide/cluster.md)")
     p.set_defaults(run=run)
 
 
@@ -81,12 +85,11 @@ def run(args) -> int:
     import sys
     from pathlib import Path
 
+    from ..compare.executors import check_options
     from ..compare.study import study
-    from ..core.errors import WorkbenchError
     from ..core.output_paths import check_output_dir
     from ..scene.io import load_scene
-    if args.jobs < 1:
-        raise WorkbenchError(f"--jobs must be >= 1, got {args.jobs}")
+    check_options(args.jobs, args.cluster)
     check_output_dir(args.out, "--out")
     scene = load_scene(args.scene)
     from ..renderers.base import check_methods, default_methods
@@ -94,7 +97,8 @@ def run(args) -> int:
     check_methods(methods)
     res = study(scene, args.out, methods=args.methods, size=args.size, quick=args.quick, repeat=args.repeat,
                 reference=args.reference, sweeps=sweeps_of(args.sweep, methods), jobs=args.jobs, progress=sys.stderr.isatty(),
-                command=" ".join(["workbench"] + sys.argv[1:]), fixed=fixed_options(args.set, methods))
+                command=" ".join(["workbench"] + sys.argv[1:]), fixed=fixed_options(args.set, methods),
+                cluster=args.cluster)
     ref = res["reference"]
     print(f"{scene.name} {res['size'][0]}x{res['size'][1]}: reference {ref['method']} {ref['options']}")
     for p in res["points"]:

@@ -565,17 +565,33 @@ def select(cat: Catalogue, only: str | None) -> list[dict]:
     return chosen
 
 
+def _case_job(cat: Catalogue, job: tuple[dict, str]) -> Row:
+    case, method = job
+    return run_case(cat, case, method)
+
+
 def stress(out_dir: str | Path, only: str | None = None, catalogue: str | Path = CATALOGUE,
-           progress: bool = False, command: str = "") -> dict:
+           progress: bool = False, command: str = "", jobs: int = 1, cluster: str | None = None) -> dict:
     """Run the catalogue (or the cases matching ``only``) and write ``stress.csv``,
-    ``stress.json``, ``stress.md`` and ``stress.html`` into ``out_dir``."""
+    ``stress.json``, ``stress.md`` and ``stress.html`` into ``out_dir``.
+
+    The (case, method) rows run in this process (``jobs = 1``), in ``jobs`` local worker
+    processes, or on the workers of the Dask scheduler at ``cluster`` (``tcp://HOST:8786``;
+    needs ``workbench[cluster]``; a case's scene files must be readable there at the same
+    path): :mod:`.executors`.  The rows come in the catalogue's order whichever ran them; their
+    ``time_s`` is measured where they ran."""
     cat = Catalogue(catalogue)
     cases = select(cat, only)
-    jobs = [(c, m) for c in cases for m in cat.methods(c)]
+    grid = [(c, m) for c in cases for m in cat.methods(c)]
     from tqdm import tqdm
-    rows = [run_case(cat, c, m) for c, m in tqdm(jobs, desc="stress", unit="case", disable=not progress, leave=False)]
+    from .executors import open_executor
+    with open_executor(jobs, cluster) as ex:
+        with tqdm(total=len(grid), desc="stress", unit="case", disable=not progress, leave=False) as bar:
+            rows = ex.map(_case_job, grid, shared=cat, done=lambda _: bar.update())
+        executor = ex.describe()
     result = {"kind": "stress", "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
               "command": command, "catalogue": str(cat.path), "registered_methods": available(),
+              "executor": executor,
               "cases": [{"id": c["id"], "title": c["title"], "kind": c["kind"], "check": c["check"],
                          "methods": cat.methods(c)} for c in cases],
               "rows": [asdict(r) for r in rows], "summary": summary(rows), "machine": machine_info()}

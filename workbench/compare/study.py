@@ -12,6 +12,12 @@ this one process, nothing else of the study running meanwhile.  Only the error e
 (FLIP dominates it) runs in parallel worker processes, after the last timed render, when
 ``jobs > 1``.  Machine load at the start is recorded with the results.
 
+On a Dask cluster (``cluster="tcp://HOST:8786"``, :mod:`.executors`) the points run on the
+cluster's workers instead, each point's renders on one worker (the worker is named in the
+point's ``worker``), and so does the error evaluation; the references are rendered here.  The
+rows are the same as a local run's, in the same order (the grid's, not the order the points
+finished); only the times (and the Pareto flags that follow from them) are the workers'.
+
 Outputs in ``out_dir``: ``study.csv``, ``study.json``, ``study.png`` (log-log error against
 warm run time per method, RMSE and FLIP panels, the Pareto front over all methods marked),
 ``study.html``.
@@ -21,7 +27,6 @@ from __future__ import annotations
 import csv
 import datetime as _dt
 import io
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +34,7 @@ import numpy as np
 from ..core.errors import WorkbenchError
 from ..renderers.base import check_methods, convert_options, default_methods, get_renderer
 from ..scene.model import Scene
+from .executors import Executor, open_executor
 from .html import esc, img_tag, page, table
 from .metrics import metrics
 from .outputs import dumps, jsonable, machine_info, staged
@@ -68,26 +74,54 @@ def pareto(times: list[float], errors: list[float]) -> list[bool]:
     return out
 
 
-def _metrics_job(args):
-    image, ref = args
-    return metrics(image, ref)
+def _metrics_job(reference, image):
+    return metrics(image, reference)
 
 
-def evaluate(images: list[np.ndarray], reference: np.ndarray, jobs: int) -> list[dict]:
-    """Metrics of every image against the reference, in ``jobs`` worker processes if > 1."""
-    if jobs <= 1 or len(images) < 2:
-        return [metrics(im, reference) for im in images]
-    import multiprocessing
-    # "spawn": fresh workers, not forks of a process holding GL contexts and numba threads
-    with ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("spawn")) as pool:
-        return list(pool.map(_metrics_job, [(im, reference) for im in images]))
+def _metrics_pair(_, pair):
+    image, reference = pair
+    return metrics(image, reference)
+
+
+def evaluate(images: list[np.ndarray], reference: np.ndarray, jobs: int = 1,
+             executor: Executor | None = None) -> list[dict]:
+    """Metrics of every image against the reference: on ``executor``'s workers when given,
+    else in ``jobs`` local worker processes if > 1 (spawned: fresh processes, not forks of one
+    holding GL contexts and numba threads)."""
+    if executor is None:
+        with open_executor(jobs) as ex:
+            return ex.map(_metrics_job, list(images), shared=reference)
+    return executor.map(_metrics_job, list(images), shared=reference)
+
+
+def _timed_point(shared, item) -> dict:
+    """One point of the grid: ``shared = (scene, width, height, repeat)``, ``item = (method,
+    knob, value, options)``; what the study keeps of its :func:`timed_run`, image included."""
+    scene, w, h, repeat = shared
+    method, _, _, options = item
+    run = timed_run(scene, method, w, h, repeat=repeat, options=options)
+    out = {"method": method, "status": run.status, "reason": run.reason}
+    if run.status == "ok":
+        out.update(time_s=run.time, warm_s=run.warm, cold_s=run.cold, compile_s=run.compile,
+                   nonfinite_pixels=run.result.stats.get("nonfinite_pixels", 0),
+                   features_used=run.result.features_used, left_out=run.result.left_out, image=run.image)
+    return out
+
+
+def _skip_inapplicable(item, earlier: list[dict]) -> dict | None:
+    """A method found not to apply at one setting is not run at the next: the scene, not the
+    setting, makes it inapplicable (the first point's reason stands for the rest)."""
+    for r in earlier:
+        if r["method"] == item[0] and r["status"] == "not_applicable":
+            return {"method": item[0], "status": "not_applicable", "reason": r["reason"]}
+    return None
 
 
 def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
           size: tuple[int, int] | None = None, quick: bool = False, repeat: int | None = None,
           reference: str | None = None, reference_image: tuple[np.ndarray, str] | None = None,
           sweeps: dict[str, tuple[str, list]] | None = None, jobs: int = 1, progress: bool = True,
-          command: str = "", fixed: dict[str, dict] | None = None) -> dict:
+          command: str = "", fixed: dict[str, dict] | None = None, cluster: str | None = None) -> dict:
     """Sweep each method's knob, time it and measure its error; write the study files.
 
     Parameters
@@ -103,6 +137,9 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
     sweeps : ``{method: (option, values)}`` to sweep another option than the method's knob
         (e.g. radiosity's ``hemicube_resolution``), values cheapest first.
     jobs : worker processes for the error evaluation (after all timing is done).
+    cluster : address of a Dask scheduler (``tcp://HOST:8786``): the points and the error
+        evaluation run on its workers (:mod:`.executors`; needs ``workbench[cluster]``);
+        ``jobs`` must then be 1.
     fixed : ``{method: {option: value}}`` held at every point of that method's sweep (e.g.
         ``standins=off`` for Gouraud and Phong; the matched reference follows them).
     """
@@ -141,7 +178,13 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
         w, h = size if size else ((160, max(1, round(160 / scene.camera.aspect))) if quick
                                   else (scene.camera.width, scene.camera.height))
     load = machine_info()
+    with open_executor(jobs, cluster) as ex:  # a bad --cluster fails here, before any render
+        return _study(scene, out_dir, names, w, h, quick, repeat, reference, reference_image, sweeps,
+                      jobs, progress, command, fixed, load, ex)
 
+
+def _study(scene, out_dir, names, w, h, quick, repeat, reference, reference_image, sweeps, jobs, progress,
+           command, fixed, load, ex: Executor) -> dict:
     plan = []
     for m in names:
         try:
@@ -155,25 +198,24 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
     from tqdm import tqdm
     bar = tqdm(total=len(plan) * (repeat + 1), desc=f"study {scene.name}", unit="render",
                disable=not progress, leave=False)
-    skip: dict[str, str] = {}
-    for m, knob, value, why in plan:
+    todo = [(m, knob, value, {**fixed.get(m, {}), knob: value}) for m, knob, value, why in plan if not why]
+    bar.update((len(plan) - len(todo)) * (repeat + 1))
+    runs = iter(ex.map_timed(_timed_point, todo, shared=(scene, w, h, repeat), skip=_skip_inapplicable,
+                             done=lambda _: bar.update(repeat + 1)))
+    where = iter(ex.last_where or [None] * len(todo))
+    for m, knob, value, why in plan:  # the grid's order, whichever order the points finished in
         p = {"method": m, "knob": knob, "value": value, "status": "failed" if why else "ok", "reason": why,
              "options": dict(fixed.get(m, {}))}
-        if why or m in skip:
-            p.update(status=p["status"] if why else "not_applicable", reason=why or skip[m])
-            bar.update(repeat + 1)
+        if why:
             points.append(p)
             continue
-        run = timed_run(scene, m, w, h, repeat=repeat, options={**fixed.get(m, {}), knob: value})
-        bar.update(repeat + 1)
-        p.update(status=run.status, reason=run.reason)
-        if run.status == "not_applicable":
-            skip[m] = run.reason  # the scene, not the setting, makes it inapplicable
-        if run.status == "ok":
-            p.update(time_s=run.time, warm_s=run.warm, cold_s=run.cold, compile_s=run.compile,
-                     nonfinite_pixels=run.result.stats.get("nonfinite_pixels", 0),
-                     features_used=run.result.features_used, left_out=run.result.left_out)
-            images.append((len(points), run.image))
+        run, worker = next(runs), next(where)
+        p.update(status=run["status"], reason=run["reason"])
+        if run["status"] == "ok":
+            p.update({k: v for k, v in run.items() if k not in ("method", "status", "reason", "image")})
+            if worker is not None:
+                p["worker"] = worker
+            images.append((len(points), run["image"]))
         points.append(p)
     bar.close()
     ok = [p for p in points if p["status"] == "ok"]
@@ -192,9 +234,9 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
         ref_info = refs.full.describe()
     for p in ok:
         p["is_reference"] = p["method"] == ref_info["method"] and {p["knob"]: p["value"]} == ref_info["options"]
-    for (i, _), mt in zip(images, evaluate([im for _, im in images], ref_img, jobs)):
+    for (i, _), mt in zip(images, evaluate([im for _, im in images], ref_img, executor=ex)):
         points[i].update(mt)
-    matched = _matched_errors(refs, points, images, jobs) if refs is not None else {}
+    matched = _matched_errors(refs, points, images, ex) if refs is not None else {}
     front = [p for p in ok if not p["is_reference"]]
     for key in ("rmse", "flip"):
         for p in ok:
@@ -207,11 +249,12 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
     result = {
         "kind": "study", "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "command": command, "quick": quick, "repeat": repeat, "size": [w, h], "jobs": jobs,
+        "executor": ex.describe(),
         "scene": {"name": scene.name, "source": scene.source, "needs": sorted(scene_needs(scene))},
         "reference": ref_info, "matched_references": matched,
         "timing_protocol": "per point: 1 cold call (compile reported apart) + `repeat` warm calls, all "
-                           "sequential in one process; time_s = median of warm wall times; error "
-                           f"evaluation afterwards ({'in %d worker processes' % jobs if jobs > 1 else 'in-process'})",
+                           f"{ex.where_timed()}; time_s = median of warm wall times; error "
+                           f"evaluation afterwards ({ex.where_untimed()})",
         "points": points, "machine": load,
         "notes": [SAMPLING_NOTE, ERROR_SPLIT_NOTE],
     }
@@ -230,7 +273,7 @@ ERROR_SPLIT_NOTE = ("Two errors per point: against the full reference (total err
                     "the method leaves out. Dashed lines in the plot are the matched errors.")
 
 
-def _matched_errors(refs: References, points: list[dict], images: list, jobs: int) -> dict:
+def _matched_errors(refs: References, points: list[dict], images: list, ex: Executor) -> dict:
     """Each rendered point's error against its method's matched reference (``rmse_matched``,
     ``flip_matched``, ``matched_reference``); returns the matched references' descriptions."""
     out, todo = {}, []
@@ -244,7 +287,7 @@ def _matched_errors(refs: References, points: list[dict], images: list, jobs: in
         out.setdefault(label, ref.describe())
         p["matched_reference"] = label
         todo.append((i, im, ref.image))
-    for (i, _, _), mt in zip(todo, [evaluate([im], r, 1)[0] for _, im, r in todo]):
+    for (i, _, _), mt in zip(todo, ex.map(_metrics_pair, [(im, r) for _, im, r in todo])):
         points[i].update(rmse_matched=mt["rmse"], flip_matched=mt["flip"], psnr_matched=mt["psnr"])
     return out
 
