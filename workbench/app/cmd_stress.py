@@ -8,7 +8,8 @@ def add_parser(sub):
     p.add_argument("--only", metavar="PATTERN", help="case ids matching this (substring or shell pattern)")
     p.add_argument("--catalogue", help="catalogue file (default: stress/cases.toml of the repository)")
     p.add_argument("--jobs", type=int, default=1,
-                   help="worker processes for the cases (default 1: in this process, one after the other)")
+                   help="worker processes for the cases (default 1: in this process, one after the other; "
+                        "with more, the rows' times share the cores)")
     p.add_argument("--cluster", metavar="ADDRESS",
                    help="run the cases on the workers of a Dask scheduler, e.g. tcp://HOST:8786 (needs "
                         "workbench[cluster] here and the same workbench version on every worker; not with "
