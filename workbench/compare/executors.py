@@ -82,12 +82,8 @@ def identity() -> dict:
         numba_version = numba.__version__
     except ImportError:
         numba_version = "none"
-    try:
-        from importlib.metadata import version
-        wb_version = version("workbench")
-    except Exception:  # noqa: BLE001 -- a checkout on PYTHONPATH has no metadata
-        wb_version = "unknown"
-    return {"code": code_identity(), "workbench": wb_version, "python": platform.python_version(),
+    from .. import __version__
+    return {"code": code_identity(), "workbench": __version__, "python": platform.python_version(),
             "numpy": numpy.__version__, "numba": numba_version, "host": socket.gethostname()}
 
 
