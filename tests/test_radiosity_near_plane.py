@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import find
+from hypothesis import find, settings
 
 import generators as g
 import workbench
@@ -35,7 +35,28 @@ def test_a_surface_nearer_than_its_patch_corners_is_drawn(kind, gl_ctx):
     which the patches are cut from, not the exact surface the camera could be inside of), with patches half the
     scene's diagonal: the radiosity image shows the emitter wherever the Phong raster sees it
     (up to 3 % of the pixels: the two tessellations' silhouettes)."""
-    obj = find(g.shapes(kind), lambda _: True)
+    obj = find(g.shapes(kind), lambda _: True, settings=SIMPLEST)
+    _check_near_plane(obj)
+
+
+SIMPLEST = settings(database=None, derandomize=True)
+"""``find``'s simplest example, the same on every machine: with hypothesis's example database
+(``.hypothesis/`` in the working folder, filled by other tests' ``find``) it may replay another."""
+
+LATHE_DEFECT = {"type": "lathe", "points": [[0.0, 1.0], [0.0, -0.8], [0.6, -0.7], [0.3, -0.2], [0.8, 0.4],
+                                            [0.4, 0.8], [0.0, 0.6], [0.0, -1.0]], "spline": "cubic"}
+"""A lathe the example database once replayed here: seen from 0.01 in front, its radiosity image
+is black on 89 of the 432 pixels the Phong raster sees (known defect, not yet understood)."""
+
+
+@pytest.mark.gl
+@pytest.mark.xfail(strict=True, reason="known defect: radiosity loses 89 of 432 pixels of this lathe "
+                                       "seen from 0.01 (found 2026-12-04, not yet fixed)")
+def test_the_lathe_the_database_replayed(gl_ctx):
+    _check_near_plane(LATHE_DEFECT)
+
+
+def _check_near_plane(obj: dict):
     far = np.array([0.3, 0.4, 5.0])
     r = workbench.render(_scene(obj, far, (0.0, 0.0, 0.0)), "phong", width=25, height=19)
     t = float(r.depth[9, 12])
@@ -47,4 +68,4 @@ def test_a_surface_nearer_than_its_patch_corners_is_drawn(kind, gl_ctx):
     rad = workbench.render(near, "radiosity", width=24, height=18, patch_size=0.5).image
     assert seen.sum() > 100
     lost = (seen & (rad.max(-1) <= 0.0)).sum()
-    assert lost <= 0.03 * seen.sum(), (kind, int(lost), int(seen.sum()))
+    assert lost <= 0.03 * seen.sum(), (obj["type"], int(lost), int(seen.sum()))
