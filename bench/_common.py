@@ -63,16 +63,6 @@ def first_paragraph(doc: str) -> str:
     return " ".join(doc.strip().split("\n\n")[0].split())
 
 
-def cpu_model() -> str:
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or platform.machine() or "unknown"
-
-
 def _version(dist: str) -> str | None:
     try:
         return importlib.metadata.version(dist)
@@ -136,6 +126,7 @@ def now_utc() -> str:
 
 def environment(anchors=()) -> dict:
     """The facts needed to read a run's numbers: machine, versions, outside anchors, date, load."""
+    from workbench.compare.outputs import cpu_model
     return {"date": now_utc(), "cpu_model": cpu_model(), "cores": os.cpu_count(),
             "platform": platform.platform(), "python": platform.python_version(),
             "numpy": _version("numpy"), "numba": _version("numba"), "git_commit": git_commit(),

@@ -28,6 +28,20 @@ def reference_cache(tmp_path_factory):
         os.environ["WORKBENCH_REFERENCE_CACHE"] = old
 
 
+@pytest.fixture(scope="session")
+def built_wheel(tmp_path_factory):
+    """(output of ``pip wheel``, path of the wheel): built once per run (``wheel_build``)."""
+    from wheel_build import build_wheel
+    return build_wheel(tmp_path_factory.mktemp("wheel_build"))
+
+
+@pytest.fixture(scope="session")
+def installed_wheel(built_wheel, tmp_path_factory):
+    """(site folder, environment, working folder) of the wheel installed (``wheel_build``)."""
+    from wheel_build import install_wheel
+    return install_wheel(built_wheel[1], tmp_path_factory.mktemp("wheel_site"))
+
+
 @pytest.fixture
 def gl_ctx():
     """The thread's moderngl context; asserts the GL error flag is clear before and after."""

@@ -2,17 +2,14 @@
 inside the package, and it renders from a folder outside the checkout, through ``python -m
 workbench``, the ``workbench`` script and the Python API.
 
-The wheel is built from a copy of the project's files (so nothing is written into the checkout),
-installed with ``pip install --no-deps --target SITE``, and run with this interpreter (for the
+The wheel is the one ``tests/wheel_build.py`` builds (from a copy of the project's files) and
+installs with ``pip install --no-deps --target SITE`` once per run; it is run with this interpreter (for the
 dependencies) and ``PYTHONPATH=SITE`` from a temporary working folder; every run checks that
 ``workbench`` was imported from SITE, not from the checkout.
 """
 from __future__ import annotations
 
-import importlib.util
 import json
-import os
-import shutil
 import subprocess
 import sys
 import time
@@ -23,47 +20,13 @@ import pytest
 
 import workbench
 
-ROOT = Path(__file__).resolve().parents[1]
-PROJECT_FILES = ("pyproject.toml", "setup.py", "README.md", "workbench", "shaders", "scenes", "stress", "examples")
 W, H = 64, 48
 
 
-def _can_build_offline() -> bool:
-    """This interpreter builds wheels itself (setuptools with ``bdist_wheel``): no isolated
-    build environment (and no index) needed."""
-    import setuptools
-    major, minor = (int(x) for x in setuptools.__version__.split(".")[:2])
-    return importlib.util.find_spec("wheel") is not None or (major, minor) >= (70, 1)
-
-
 @pytest.fixture(scope="module")
-def wheel_site(tmp_path_factory):
-    """(site dir, environment, working folder) of a freshly built and installed wheel."""
-    tmp = tmp_path_factory.mktemp("wheel")
-    src = tmp / "src"
-    src.mkdir()
-    for name in PROJECT_FILES:
-        p = ROOT / name
-        if p.is_dir():
-            shutil.copytree(p, src / name, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
-        else:
-            shutil.copy2(p, src / name)
-    dist = tmp / "dist"
-    cmd = [sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", str(dist), str(src)]
-    if _can_build_offline():
-        cmd.insert(4, "--no-build-isolation")
-    out = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
-    assert out.returncode == 0, out.stderr[-3000:]
-    (whl,) = dist.glob("workbench-*.whl")
-    site = tmp / "site"
-    out = subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "--quiet", "--target",
-                          str(site), str(whl)], capture_output=True, text=True, timeout=600)
-    assert out.returncode == 0, out.stderr[-3000:]
-    work = tmp / "work"  # the working folder of every run: outside the checkout
-    work.mkdir()
-    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
-    env.update(PYTHONPATH=str(site), NUMBA_CACHE_DIR=str(tmp / "numba_cache"))
-    return site, env, work
+def wheel_site(installed_wheel):
+    """(site dir, environment, working folder) of the built and installed wheel (``wheel_build``)."""
+    return installed_wheel
 
 
 def _run(args, env, cwd, timeout=600):

@@ -68,7 +68,7 @@ def machine_info(gl_renderer: str | None = None) -> dict:
     """Facts needed to read the timings: CPU, cores, OS, Python and key library versions."""
     import numpy
     info = {"platform": platform.platform(), "machine": platform.machine(),
-            "processor": platform.processor() or _cpu_model(), "cpu_count": os.cpu_count(),
+            "processor": platform.processor() or cpu_model(), "cpu_count": os.cpu_count(),
             "python": platform.python_version(), "numpy": numpy.__version__}
     try:
         info["load_average_1min"] = os.getloadavg()[0]
@@ -78,7 +78,8 @@ def machine_info(gl_renderer: str | None = None) -> dict:
     return info
 
 
-def _cpu_model() -> str:
+def cpu_model() -> str:
+    """The CPU's model name from ``/proc/cpuinfo``, ``"unknown"`` where there is none."""
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
             if line.startswith("model name"):
