@@ -341,7 +341,7 @@ class Page:
         lines = [f"# {self.title}", "", self.what, "",
                  f"Full run: `{self.command}` (writes `bench/results/{self.name}.json` and this page); "
                  f"`--smoke` runs the same code at tiny sizes in seconds and writes elsewhere "
-                 f"(`tests/test_bench_smoke.py`); `python bench/{self.name}.py --from-json` renders this page "
+                 f"(`tests/project/test_bench_smoke.py`); `python bench/{self.name}.py --from-json` renders this page "
                  f"again from the stored JSON.", ""]
         by = _git_stored(path) if stored else None
         if stored:

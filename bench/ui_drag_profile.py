@@ -79,11 +79,13 @@ class StageClock:
 def run(args) -> dict:
     from imgui_bundle import immapp
 
-    from workbench.app.ui import frames, main, plot, scripts
+    from workbench.app.ui import frames, main, plot
+    from workbench.app.ui.session_file import load_session
     from workbench.app.ui.state import new_state
 
     clock = StageClock(args.sync)
-    script = scripts.Fps(Path(args.script_out), seconds=args.seconds, display=args.display or None,
+    fps = load_session(f"{ROOT / 'tests' / 'app' / 'ui' / 'sessions.py'}:Fps")
+    script = fps(Path(args.script_out), seconds=args.seconds, display=args.display or None,
                          step=args.step)
     counted = {"n": 0}
 

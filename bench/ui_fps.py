@@ -1,8 +1,9 @@
 """Frames per second of the UI with three GL panels (flat, Gouraud, Phong) at 512 x 512 on a
 bundled scene while a ray trace runs in the background, under Xvfb (llvmpipe).
 
-Each case runs ``workbench ui --script fps|fps_static`` (the console script) in a
-subprocess on a fresh Xvfb display (``scripts.Fps`` counts frames for 10 s after 10 warm-up
+Each case runs ``workbench ui --script tests/app/ui/sessions.py:Fps`` (or another session of that
+file; the console script) in a
+subprocess on a fresh Xvfb display (``sessions.Fps`` counts frames for 10 s after 10 warm-up
 frames) and the results go to ``bench/results/ui_fps.json``:
 
 * ``static_camera_raytrace_running`` (the issue's case): nothing moves while a 16 spp ray trace
@@ -19,21 +20,21 @@ frames) and the results go to ``bench/results/ui_fps.json``:
 * ``raytrace_without_window``: the same 512 x 512, 16 spp ray trace rendered by the library in
   a plain process (numba's default threads), for the completion-time comparison;
 * ``material_drag``: the camera rests while the chosen material's ``kd`` slider moves every
-  frame (``scripts.SliderFps``; three GL panels), ``slider_drag``: the same with light 0's
+  frame (``sessions.SliderFps``; three GL panels), ``slider_drag``: the same with light 0's
   position slider moving every frame too; ``programs_compiled`` counts the GL programs the
   panels' sessions compiled during the count.
 
 * ``idle``: the three GL panels and the ray-trace panel, untouched: once nothing is in progress
   (the ray trace, the error plot's reference and evaluations), the frames drawn and the process
-  CPU time (every thread) over 10 s (``scripts.Idle``; hello_imgui idles at ``main.IDLE_FPS``),
+  CPU time (every thread) over 10 s (``sessions.Idle``; hello_imgui idles at ``main.IDLE_FPS``),
   then a knob change from the script whose job must still deliver its image;
 * ``soak``: 24 rounds of a scene switch (whitted, csg, cornell, quadrics), a method toggle, knob
-  changes and a short camera drag, each round waiting for the jobs (``scripts.Soak``, 256 px
+  changes and a short camera drag, each round waiting for the jobs (``sessions.Soak``, 256 px
   panels): the process RSS, the jobs kept and the GL objects alive after each round;
   ``soak_10min``: the same rounds for 10 minutes (``rss_growth_mb_round4_to_last``: from round 4,
   every scene seen once, to the last);
 * ``drag_indexed``: the ``drag_gl_only`` drag with every GL panel shown through
-  ``indexed16-kmeans-fs`` (``scripts.Fps`` with ``display``: during the drag the panels map to
+  ``indexed16-kmeans-fs`` (``sessions.Fps`` with ``display``: during the drag the panels map to
   the CLUT of their last exact image on the GPU, the exact mode is computed once the camera
   rests, ``ui/display_modes.py``);
 * ``drag_gl_bare``: the ``drag_gl_only`` drag with the panels' stand-ins off (``standins =
@@ -54,7 +55,7 @@ pixels on llvmpipe).
 Usage: python bench/ui_fps.py [--scene whitted] [--size 512] [--window 1600x900]
 writes ``bench/results/ui_fps.json`` and ``docs/benchmarks/ui_fps.md``.  Needs ``Xvfb``.  ``--smoke``:
 the cases ``drag_gl_only`` (its script counts frames for 10 s: it cannot be shorter without changing
-the package's script) and ``raytrace_without_window``, 64 px panels in an 800 x 500 window.
+its session) and ``raytrace_without_window``, 64 px panels in an 800 x 500 window.
 """
 from __future__ import annotations
 
@@ -71,6 +72,8 @@ from pathlib import Path
 from _common import Page, first_paragraph, fmt, table
 
 ROOT = Path(__file__).resolve().parents[1]
+SESSIONS = ROOT / "tests" / "app" / "ui" / "sessions.py"
+"""The project's scripted sessions of the window (``workbench ui --script FILE.py:NAME``)."""
 SPP = 16
 """Samples per pixel of the background ray trace (the ``fps_static`` script sets it)."""
 
@@ -97,7 +100,7 @@ def measure(scene: str, size: int, window: str, cpu: bool, script: str) -> dict:
             load = os.getloadavg()
             subprocess.run([str(Path(sys.executable).with_name("workbench")), "ui", scene, "--methods",
                             methods, "--size", str(size), "--window", window,
-                            "--script", script, "--out", out],
+                            "--script", f"{SESSIONS}:{script}", "--out", out],
                            cwd=ROOT, env={**os.environ, "DISPLAY": f":{n}"}, check=True,
                            timeout=900)
             summary = json.loads(Path(out, "summary.json").read_text())
@@ -181,15 +184,15 @@ def main(argv=None) -> None:
     if a.smoke:
         a.size, a.window, a.cases = 64, "800x500", a.cases or "drag_gl_only,raytrace_without_window"
     cases = {"static_camera_raytrace_running": lambda: measure(a.scene, a.size, a.window, True, "fps_static"),
-             "drag_with_raytrace_panel": lambda: measure(a.scene, a.size, a.window, True, "fps"),
-             "drag_gl_only": lambda: measure(a.scene, a.size, a.window, False, "fps"),
+             "drag_with_raytrace_panel": lambda: measure(a.scene, a.size, a.window, True, "Fps"),
+             "drag_gl_only": lambda: measure(a.scene, a.size, a.window, False, "Fps"),
              "drag_indexed": lambda: measure(a.scene, a.size, a.window, False, "fps_indexed"),
              "drag_gl_bare": lambda: measure(a.scene, a.size, a.window, False, "fps_bare"),
              "material_drag": lambda: measure(a.scene, a.size, a.window, False, "fps_material_drag"),
              "slider_drag": lambda: measure(a.scene, a.size, a.window, False, "fps_slider_drag"),
              "raytrace_without_window": lambda: raytrace_without_window(a.scene, a.size),
-             "idle": lambda: measure(a.scene, a.size, a.window, True, "idle"),
-             "soak": lambda: soak(measure(a.scene, 256, a.window, True, "soak")),
+             "idle": lambda: measure(a.scene, a.size, a.window, True, "Idle"),
+             "soak": lambda: soak(measure(a.scene, 256, a.window, True, "Soak")),
              "soak_10min": lambda: soak(measure(a.scene, 256, a.window, True, "soak_10min"))}
     chosen = [c for c in a.cases.split(",") if c] or list(cases)
     bad = [c for c in chosen if c not in cases]

@@ -11,8 +11,8 @@ generators make (an inside camera is put at an object's ``translate``), with a s
 ``r`` (1 at scale 1).
 
 Cases left out: glass touching the floor (objects float above it; every kind resting on a
-floor at scales 1e-6, 1 and 1e6 is tests/test_raytrace_scale_floor.py); isosurface fields are polynomials and square roots of sums of
-squares (a field with NaN values or a jump is refused at load, tests/test_kind_expression_checks.py).
+floor at scales 1e-6, 1 and 1e6 is tests/renderers/raytrace/test_raytrace_scale_floor.py); isosurface fields are polynomials and square roots of sums of
+squares (a field with NaN values or a jump is refused at load, tests/scene/kinds/test_kind_expression_checks.py).
 """
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """Scenes that put each new object kind (blob, isosurface, lathe, prism) in front of POV-Ray
 and the ray tracer at the same camera, and the per-object masks compared (test and bench
-helper: ``tests/test_povray_kinds.py``, ``bench/povray_kinds.py``).
+helper: ``tests/renderers/test_povray_kinds.py``, ``bench/povray_kinds.py``).
 
 Masks: an "ID" copy of a scene gives every top-level object (with all its CSG operands) a
 material of its own that only reflects the ambient light (``ka = 1``, ``kd = ks = kr = kt =

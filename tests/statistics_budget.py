@@ -4,11 +4,11 @@ A test that compares noisy estimates registers here the probability ``alpha`` th
 although the two estimates agree in expectation (over the random seeds; with fixed seeds a
 given build passes or fails every time, and :func:`band` turns ``alpha`` into the acceptance
 band its checks use).  By Bonferroni, the probability that any registered test fails falsely is
-at most the sum of the registered ``alpha``, which ``tests/test_statistics_budget.py`` keeps at
+at most the sum of the registered ``alpha``, which ``tests/project/test_statistics_budget.py`` keeps at
 or below :data:`SUITE_BUDGET` (slow tests included: they run on some machine too).
 
 Each comparison is also a function of its seed (:data:`SEEDED`), so that
-``tests/test_statistics_seeds.py`` (slow) can rerun it with 20 seeds and count its failures.
+``tests/project/test_statistics_seeds.py`` (slow) can rerun it with 20 seeds and count its failures.
 """
 from __future__ import annotations
 
@@ -42,7 +42,7 @@ ALPHA = {
     "test_pathtrace_modes::radiosity_cornell (slow)": 2e-6,
     # test_mitsuba_method.py: the mean of Mitsuba's cornell against radiosity's
     "test_mitsuba_method::cornell_mean": 2e-6,
-    # tests/test_statistics_seeds.py: two or more failures of one comparison over 20 seeds
+    # tests/project/test_statistics_seeds.py: two or more failures of one comparison over 20 seeds
     # (binomial: at most C(20, 2) alpha^2 per comparison, summed over the comparisons)
     "test_statistics_seeds::twenty_seeds (slow)": 1e-7,
 }

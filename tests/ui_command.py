@@ -9,6 +9,15 @@ WORKBENCH = str(Path(sys.executable).with_name("workbench"))
 """The console script installed with the package."""
 
 
+SESSIONS = Path(__file__).resolve().parent / "app" / "ui" / "sessions.py"
+"""The project's scripted sessions of the window (``--script FILE.py:NAME``)."""
+
+
+def script_of(name: str, file: str = "sessions.py") -> str:
+    """``--script``'s value for the session ``name`` of ``file`` (beside :data:`SESSIONS`)."""
+    return f"{SESSIONS.with_name(file)}:{name}"
+
+
 def ui_command(*args: str) -> list[str]:
     """``workbench ui ARGS...`` as a subprocess argument list."""
     return [WORKBENCH, "ui", *args]

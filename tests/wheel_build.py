@@ -1,4 +1,4 @@
-"""The wheel the packaging tests share (``tests/test_wheel.py``, ``tests/test_packaging.py``):
+"""The wheel the packaging tests share (``tests/project/test_wheel.py``, ``tests/project/test_packaging.py``):
 built once per test run from a copy of the project's files (a build writes ``build/`` and
 ``*.egg-info`` beside its sources; the checkout stays clean), the way a user builds it (``pip
 wheel``; in an isolated build environment unless this interpreter can build wheels itself), then

@@ -1,9 +1,9 @@
 """``workbench ui [SCENE]``: the interactive comparison window (imgui-bundle, GLFW).
 
-The one way to start the window: users, tests and benchmarks all run this command.  ``--script``
-drives the window from a named scripted session (:mod:`.ui.scripts`: the tests' and benchmarks'
-drivers) and ``--out`` receives its outputs: each recorded panel image, ``summary.json`` and
-``ui.png`` (the last frame).
+The one way to start the window: users, tests and benchmarks all run this command.  ``--script
+FILE.py:NAME`` drives the window from a scripted session written in Python
+(:mod:`.ui.session_file`; the project's own are in ``tests/app/ui/sessions.py``) and ``--out``
+receives its outputs: what the session records, ``summary.json`` and ``ui.png`` (the last frame).
 """
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ PANEL_SIZE_RANGE = (8, 4096)
 
 def add_parser(sub) -> None:
     # (the help names ui.state's FIRST_VIEW, EMITTER_VIEW and MAX_PANELS without importing the
-    # window's modules for every command; tests/test_ui_command.py checks that they agree)
+    # window's modules for every command; tests/app/ui/test_ui_command.py checks that they agree)
     p = sub.add_parser("ui", help="interactive side-by-side comparison window",
                        description="Open a window comparing the methods live on one camera: "
                                    "mouse orbit (left drag), pan (right drag), zoom (wheel).")
@@ -36,9 +36,10 @@ def add_parser(sub) -> None:
                    help="window size in pixels (default %dx%d)" % WINDOW_SIZE)
     p.add_argument("--frames", type=int, default=None, metavar="N",
                    help="close the window after N frames")
-    p.add_argument("--script", default=None, metavar="NAME",
-                   help="drive the window with a scripted session (for tests and benchmarks: "
-                        "check, features, fps, ...; see workbench/app/ui/scripts.py)")
+    p.add_argument("--script", default=None, metavar="FILE.py:NAME",
+                   help="drive the window with a scripted session: NAME(out) in the Python file "
+                        "FILE.py makes a callable the window calls once per frame with its state "
+                        "(the project's tests and benchmarks keep theirs in tests/app/ui/sessions.py)")
     p.add_argument("--out", type=Path, default=None, metavar="DIR",
                    help="write the last frame (ui.png), summary.json and the script's outputs here")
     p.set_defaults(run=run)
@@ -51,10 +52,9 @@ def run(args) -> int:
         raise WorkbenchError(f"--size must be in [{lo}, {hi}] pixels, got {args.size}")
     if args.frames is not None and args.frames < 1:
         raise WorkbenchError(f"--frames must be at least 1, got {args.frames}")
-    from .ui.scripts import SCRIPTS
-    if args.script is not None and args.script not in SCRIPTS:
-        raise WorkbenchError(f"--script {args.script!r}: unknown script, expected one of "
-                             f"{', '.join(sorted(SCRIPTS))}")
+    if args.script is not None:
+        from .ui.session_file import load_session
+        make_session = load_session(args.script)
     out = args.out if args.out is not None or args.script is None else Path("out/ui")
     if out is not None:
         from ..core.output_paths import check_output_dir
@@ -70,7 +70,7 @@ def run(args) -> int:
     from .ui.state import new_state
     from .ui.main import run
     state = new_state(args.scene, args.methods or None, args.size)
-    script = SCRIPTS[args.script](out) if args.script is not None else None
+    script = make_session(out) if args.script is not None else None
     code = run(state, frames=args.frames, script=script, window=args.window, out=out)
     if code and threading.active_count() > 1:
         # a signal closed the window while a CPU job was still inside a numba compile (which

@@ -23,7 +23,7 @@ Step 5 runs once per pixel after the scan, on the attributes the winning polygon
 the same image as shading each fragment when it passes the test, for opaque surfaces.
 
 Differences from the GL images drawn with ``interpolation=screen`` (measured by
-``tests/test_zbuffer.py`` and ``bench/zbuffer.py``: at most 0.01 % of the pixels): pixels
+``tests/renderers/raster/test_zbuffer.py`` and ``bench/zbuffer.py``: at most 0.01 % of the pixels): pixels
 whose centre lies on or within float32 rounding of an edge (GL's rasterisation rules and
 coverage), depth ties between surfaces that meet or coincide (float32 z and the driver's
 fixed-point conversion against float64 here), texture pattern boundaries (float32).

@@ -12,7 +12,7 @@ Into one folder (written whole or not at all: a temporary sibling renamed at the
   overrides, the panels skipped and why (a panel whose method does not apply to the scene, or
   whose render failed, has no image to write), and ``replay``: one ``workbench render``
   command per panel that renders ``scene.toml`` with the panel's options and display mode into
-  the same PNG and NPY (``tests/test_ui_export.py`` runs them).
+  the same PNG and NPY (``tests/app/ui/test_ui_export.py`` runs them).
 """
 from __future__ import annotations
 

@@ -4,7 +4,7 @@ name, a colour map, then the pixels in the image's byte order).
 
 Unlike ``hello_imgui.final_app_window_screenshot`` (the GL back buffer read by the process
 itself) this is the picture a user has on screen, taken from outside the process; the UI tests
-check it (tests/test_ui_screens.py) and the README's screenshot is one.
+check it (tests/app/ui/test_ui_screens.py) and the README's screenshot is one.
 """
 from __future__ import annotations
 

@@ -1,0 +1,61 @@
+"""Numba's cache folder is keyed by the code (``workbench.core.jit_cache``): an edit of a
+kernel module that another module's cached kernels inline must not load their stale machine
+code (numba itself checks only each function's own file)."""
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+from workbench.core import jit_cache
+
+ROOT = Path(__file__).resolve().parents[2]
+_PRINT = "import workbench, numba.core.config as c; print(c.CACHE_DIR)"
+
+
+def _cache_dir(pkg_parent: Path, base: Path) -> Path:
+    env = {**os.environ, "PYTHONPATH": str(pkg_parent), "NUMBA_CACHE_DIR": str(base)}
+    out = subprocess.run([sys.executable, "-c", _PRINT], env=env, cwd=pkg_parent, capture_output=True,
+                         text=True, timeout=120, check=True)
+    return Path(out.stdout.strip())
+
+
+def test_an_edited_kind_kernel_gets_a_cache_folder_of_its_own(tmp_path):
+    src = tmp_path / "src"
+    shutil.copytree(ROOT / "workbench", src / "workbench", ignore=shutil.ignore_patterns("__pycache__"))
+    base = tmp_path / "numba"
+    before = _cache_dir(src, base)
+    assert before.parent == base and before.is_dir()
+    assert _cache_dir(src, base) == before                      # same code: the warm cache
+    kernel = src / "workbench" / "scene" / "kinds" / "lathe_kernels.py"
+    kernel.write_text(kernel.read_text() + "\n# edited\n")
+    after = _cache_dir(src, base)
+    assert after.parent == base and after != before             # numba alone would reuse `before`
+    assert before.is_dir()                                      # the older version's cache is kept
+
+
+def test_a_child_process_keeps_the_keyed_folder_and_old_ones_are_pruned(tmp_path):
+    given = os.environ["NUMBA_CACHE_DIR"]
+    try:
+        _check_pruning(tmp_path)
+    finally:  # this process's numba must keep compiling into the run's warm cache
+        os.environ["NUMBA_CACHE_DIR"] = given
+        import numba.core.config
+        numba.core.config.reload_config()
+
+
+def _check_pruning(tmp_path):
+    fp = jit_cache.code_fingerprint()[:jit_cache.DIGITS]
+    old = [tmp_path / f"{i:016x}" for i in range(jit_cache.KEEP + 2)]
+    for i, p in enumerate(old):
+        p.mkdir()
+        os.utime(p, (1000.0 + i, 1000.0 + i))
+    (tmp_path / "notes").mkdir()                                # not a fingerprint: left alone
+    os.environ["NUMBA_CACHE_DIR"] = str(tmp_path)
+    current = jit_cache.use_code_keyed_cache()
+    assert current == tmp_path / fp and os.environ["NUMBA_CACHE_DIR"] == str(current)
+    assert jit_cache.use_code_keyed_cache() == current          # a child: no nesting
+    kept = sorted(p.name for p in tmp_path.iterdir())
+    assert kept == sorted([fp, "notes"] + [p.name for p in old[-jit_cache.KEEP:]])

@@ -1,0 +1,85 @@
+"""Kernels compiled only for the kinds a scene holds (the kernel layer: ``renderers/kernels``).
+
+The geometry record's kind marker names the scene's features; a kernel compiled for a marker
+without a kind never compiles that kind's kernels.  Checked in a new process (numba's
+dispatchers start empty there): a closest-hit search compiled for the spheres of the Whitted
+scene leaves the blob, isosurface, lathe and prism kernels and the CSG walk uncompiled, and the
+same search for a marker naming the blob compiles the blob's kernel and no other."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import workbench
+from workbench.renderers.kernels.layout import FEATURES, kinds_marker, marker_features
+from workbench.renderers.raytrace.flatten import flatten
+
+ROOT = Path(__file__).resolve().parents[3]
+EXTENDED = ("blob", "isosurface", "lathe", "prism", "csg")
+
+PROBE = r'''
+import json, sys
+import numba as nb
+import numpy as np
+import workbench
+from workbench.renderers.kernels.layout import kinds_marker
+from workbench.renderers.kernels import intersect as k
+from workbench.renderers.raytrace.flatten import flatten
+from workbench.scene.kinds import blob_kernels, isosurface_kernels, lathe_kernels, prism_kernels
+
+@nb.njit(error_model="numpy")  # IEEE divisions, as the kernels it inlines
+def first_hit(geo, scr):
+    stack, st, sp_, sf, sn = scr
+    return k.row_hit(geo, 0, 0.0, 0.0, 10.0, 0.0, 0.0, -1.0, 1.0, 0.0, np.inf, 1e-12, 1e-9, stack, st, sp_,
+                     sf, sn)
+
+geo = flatten(workbench.load_scene("whitted")).kernel_args()
+if sys.argv[1] == "blob":
+    geo = geo._replace(kinds=kinds_marker(["blob", "prim_tree"]))
+first_hit(geo, k.scratch())
+print(json.dumps({name: len(f.signatures) for name, f in [
+    ("blob", blob_kernels.blob_first), ("isosurface", isosurface_kernels.iso_first),
+    ("lathe", lathe_kernels.lathe_first), ("prism", prism_kernels.prism_first), ("csg", k.csg_hit)]}))
+'''
+
+
+def _compiled(marker: str) -> dict:
+    out = subprocess.run([sys.executable, "-c", PROBE, marker], capture_output=True, text=True, cwd=ROOT,
+                         timeout=600)
+    assert out.returncode == 0, out.stderr[-2000:]
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def test_a_scene_of_spheres_compiles_no_kind_kernel():
+    assert _compiled("scene") == {name: 0 for name in EXTENDED}
+
+
+def test_a_marker_naming_the_blob_compiles_the_blob_alone():
+    assert _compiled("blob") == {name: int(name == "blob") for name in EXTENDED}
+
+
+def test_features_of_the_bundled_scenes():
+    """The marker names the extended group iff the scene has one of its kinds, the triangles
+    iff it has triangles; every scene's marker is one of four."""
+    markers = set()
+    for path in sorted((ROOT / "scenes").glob("*.toml")):
+        scene = workbench.load_scene(str(path))
+        sd = flatten(scene)
+        names = marker_features(sd.kernel_args().kinds)
+        kinds = {o.kind for o in scene.objects}
+        extended = bool(kinds & {"blob", "isosurface", "lathe", "prism", "csg"})
+        assert all(n in names for n in EXTENDED) == extended, (path.stem, names)
+        assert ("triangles" in names) == (len(sd.tri_v) > 0), (path.stem, names)
+        markers.add(names)
+    assert len(markers) <= 4
+
+
+def test_unknown_feature_is_refused():
+    try:
+        kinds_marker(["torus"])
+    except ValueError as e:
+        assert "torus" in str(e) and all(f in str(e) for f in FEATURES)
+    else:
+        raise AssertionError("kinds_marker accepted an unknown feature")
