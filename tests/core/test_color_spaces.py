@@ -24,7 +24,7 @@ def _hue_dist(a, b):
 
 @pytest.mark.parametrize("fwd, inv", [(C.rgb_to_xyz, C.xyz_to_rgb), (C.rgb_to_cmy, C.cmy_to_rgb),
                                       (C.rgb_to_cmyk, C.cmyk_to_rgb), (C.rgb_to_hsv, C.hsv_to_rgb),
-                                      (C.rgb_to_hsl, C.hsl_to_rgb)])
+                                      (C.rgb_to_hsl, C.hsl_to_rgb), (C.rgb_to_hsi, C.hsi_to_rgb)])
 def test_round_trips_in_gamut(fwd, inv):
     x = np.concatenate([IN_GAMUT, EDGES[:12]]).reshape(-1, 2, 3)   # image-like leading shape
     np.testing.assert_allclose(inv(fwd(x)), x, atol=1e-6)
@@ -65,6 +65,8 @@ def test_edge_case_conventions():
     np.testing.assert_array_equal(C.rgb_to_hsv(black), [0, 0, 0])
     np.testing.assert_array_equal(C.rgb_to_hsl(white), [0, 0, 1])
     np.testing.assert_array_equal(C.rgb_to_hsv(grey), [0, 0, 0.3])   # undefined hue -> 0
+    np.testing.assert_array_equal(C.rgb_to_hsi(black), [0, 0, 0])
+    np.testing.assert_allclose(C.rgb_to_hsi(grey), [0, 0, 0.3], atol=1e-15)
     np.testing.assert_array_equal(C.rgb_to_cmyk(black), [0, 0, 0, 1])
     np.testing.assert_array_equal(C.rgb_to_cmyk(white), [0, 0, 0, 0])
     np.testing.assert_allclose(C.rgb_to_xyz(white), [0.9505, 1.0, 1.089], atol=1e-12)

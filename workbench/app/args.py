@@ -39,13 +39,25 @@ def at_least_one(text: str) -> int:
     return n
 
 
+def finite(text: str) -> float:
+    """A number that must be finite (argparse's ``float`` takes ``nan`` and ``inf``)."""
+    try:
+        x = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if x != x or x in (float("inf"), float("-inf")):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+    return x
+
+
 def value_after_option(argv: list[str]) -> list[str]:
     """``["--size", "-5x5"]`` -> ``["--size=-5x5"]``: a value that starts with a minus and a
     digit is the option's value (argparse takes it for an option and says "expected one
-    argument"), so that the converter can say what is wrong with it."""
+    argument"), so that the converter can say what is wrong with it.  After ``--`` (the end of
+    the options) it stays a positional argument."""
     out: list[str] = []
     for tok in argv:
-        if out and out[-1].startswith("--") and "=" not in out[-1] and len(tok) > 1 \
+        if out and out[-1].startswith("--") and out[-1] != "--" and "=" not in out[-1] and len(tok) > 1 \
                 and tok[0] == "-" and (tok[1].isdigit() or tok[1] == "."):
             out[-1] = f"{out[-1]}={tok}"
         else:

@@ -5,10 +5,18 @@
 * ``workbench colour display IMAGE_OR_SCENE --mode indexed16-kmeans-fs -o out.png``: an image
   file (PNG/JPEG, sRGB; or .npy, linear) or a scene rendered with ``--method``, shown through a
   display mode; prints the mode's error against the 24-bit image.
+* ``workbench colour convert 0.6 0.2 0.4 --from rgb --to hsi``: one colour from one space to
+  another (rgb, xyz, cmy, cmyk, hsv, hsl, hsi), or to all of them; a colour outside the RGB
+  cube is reported, its values shown unclipped.
 """
 from __future__ import annotations
 
+from .args import finite
+
 _IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".npy")
+_SPACE_NAMES = "rgb | xyz | cmy | cmyk | hsv | hsl | hsi"
+"""The names of ``workbench.core.color.SPACES`` for the help (written out: the parser does not
+import numpy)."""
 
 
 def add_parser(sub):
@@ -32,6 +40,16 @@ def add_parser(sub):
     d.add_argument("--method", "-m", default="phong", help="method rendering a scene (default phong)")
     d.add_argument("-o", "--output", required=True, help="output PNG")
     d.set_defaults(run=run_display)
+
+    c = csub.add_parser("convert", help="one colour from one space to another (RGB, XYZ, CMY(K), HSV, HSL, HSI)")
+    c.add_argument("components", nargs="+", type=finite, metavar="X",
+                   help="the colour's components in the --from space (4 for cmyk; hues in degrees; "
+                        "put -- before them when one is written like -1e-3)")
+    c.add_argument("--from", dest="source", default="rgb", metavar="SPACE",
+                   help=f"space of the components: {_SPACE_NAMES} (default rgb)")
+    c.add_argument("--to", dest="target", default="all", metavar="SPACE",
+                   help=f"space to convert to: {_SPACE_NAMES}, or all (default all)")
+    c.set_defaults(run=run_convert)
 
 
 def _png_output(path: str) -> None:
@@ -118,4 +136,43 @@ def run_display(args) -> int:
     m = metrics(shown, ref)
     print(f"{what}: {image.shape[1]}x{image.shape[0]} shown as {mode} -> {args.output}")
     print(f"  error against direct24: RMSE {m['rmse']:.5f}, PSNR {m['psnr']:.2f} dB, FLIP {m['flip']:.4f}")
+    return 0
+
+
+def _number(x: float) -> str:
+    """``x`` to 6 decimals, trailing zeros dropped (``330``, ``0.5``, ``0.333333``; no ``-0``)."""
+    text = f"{x:.6f}".rstrip("0").rstrip(".")
+    return "0" if text == "-0" else text
+
+
+def _colour_line(name: str, values) -> str:
+    """``hsi   H 330 deg  S 0.5  I 0.4``: a space's name and labelled components."""
+    from ..core.color import space_labels
+    parts = [f"{label} {_number(v)}{' deg' if label == 'H' else ''}"
+             for label, v in zip(space_labels(name), values)]
+    return f"{name:<5} " + "  ".join(parts)
+
+
+def run_convert(args) -> int:
+    import numpy as np
+
+    from ..core.color import SPACES, convert, space_labels
+    from ..core.errors import WorkbenchError
+    from ..core.tol import tol
+    for option, name in (("--from", args.source), ("--to", args.target)):
+        if name not in SPACES and (option, name) != ("--to", "all"):
+            raise WorkbenchError(f"colour convert: {option} {name!r} is not a colour space: "
+                                 f"expected {_SPACE_NAMES}{' or all' if option == '--to' else ''}")
+    targets = list(SPACES) if args.target == "all" else [args.target]
+    n = len(space_labels(args.source))
+    if len(args.components) != n:
+        raise WorkbenchError(f"colour convert: --from {args.source} takes {n} components "
+                             f"({' '.join(space_labels(args.source))}), got {len(args.components)}")
+    rgb = convert(np.array(args.components), args.source, "rgb")
+    for name in targets:
+        print(_colour_line(name, convert(rgb, "rgb", name)))
+    if np.any((rgb < -tol.zero) | (rgb > 1.0 + tol.zero)):
+        print(f"note: RGB ({', '.join(_number(v) for v in rgb)}) is outside the RGB cube [0, 1]: "
+              f"values shown unclipped (clipped to the cube: "
+              f"{', '.join(_number(v) for v in np.clip(rgb, 0.0, 1.0))})")
     return 0

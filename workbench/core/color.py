@@ -25,19 +25,35 @@ HSV, HSL
     coordinates of whatever RGB triple they are given*: conventionally that is the encoded
     (display) RGB, so :mod:`workbench.core.harmony` converts HSV to encoded sRGB and then
     decodes it to linear.  The CMY family likewise applies to the RGB values it is given.
+HSI
+    Gonzalez & Woods, *Digital Image Processing*, section 6.2.3 (the course's "Teinte,
+    Saturation, Luminance (HSI)"): intensity ``I = (R + G + B) / 3``, saturation
+    ``S = 1 - 3 min(R, G, B) / (R + G + B)``, hue the angle around the grey axis from the red
+    axis (arccos formula).  Hue in degrees in [0, 360) like HSV and HSL, S and I in [0, 1]
+    for colours inside the RGB cube.  Unlike the hexcone hue of HSV/HSL, the HSI hue is the
+    true angle, so the two hues agree only at multiples of 60 degrees.  The arccos is
+    ill-conditioned near 0 and 180 degrees (G close to B): there the hue keeps about
+    sqrt(eps) ~ 1.5e-8 rad, and RGB -> HSI -> RGB returns within 1e-7 instead of 1e-14.
 
-Edge cases (tested against colour-science)
-------------------------------------------
-* Black (0, 0, 0): HSV (0, 0, 0), HSL (0, 0, 0), CMY (1, 1, 1), CMYK (0, 0, 0, 1).
-* White (1, 1, 1): HSV (0, 0, 1), HSL (0, 0, 1), CMYK (0, 0, 0, 0).
+Edge cases (tested against colour-science; HSI, which it lacks, against hand-worked values)
+---------------------------------------------------------------------------------------------
+* Black (0, 0, 0): HSV (0, 0, 0), HSL (0, 0, 0), HSI (0, 0, 0), CMY (1, 1, 1), CMYK (0, 0, 0, 1).
+* White (1, 1, 1): HSV (0, 0, 1), HSL (0, 0, 1), HSI (0, 0, 1), CMYK (0, 0, 0, 0).
 * Greys (R = G = B): the hue is undefined; it is set to 0 and the saturation to 0.
 * Out of gamut (a component < 0 or > 1, e.g. from ``xyz_to_rgb`` of a spectral colour):
   no clipping.  The hue is still the angle of the triple around the grey axis; HSV
   saturation = (max - min) / max may exceed 1 or be negative (max < 0); HSL saturation =
   (max - min) / (1 - |2L - 1|) likewise.  Where that denominator is 0 the saturation is set
   to 0 (and the conversion back loses the chroma): HSV with max = 0 and min < 0, HSL with
-  L = 0 or 1 but max != min.  CMYK caps K at 1, so an RGB triple with every component < 0
-  becomes black.  Everywhere else the conversions invert exactly.
+  L = 0 or 1 but max != min.  HSI saturation = 1 - min / I likewise leaves [0, 1] (negative
+  when min < 0 < I) and is set to 0 where I = 0 but max != min.  CMYK caps K at 1, so an RGB
+  triple with every component < 0 becomes black.  Everywhere else the conversions invert
+  exactly.
+* The other way, a triple that looks valid (H in [0, 360), S and V/L/I in [0, 1]) is inside
+  the RGB cube for HSV and HSL, but not always for HSI: at a given hue and saturation the
+  cube's surface is reached below I = 1 (for a primary at S = 1, at I = 1/3), so e.g. HSI
+  (0, 1, 0.5) gives RGB (1.5, 0, 0).  It is returned unclipped, like every out-of-gamut colour
+  here; ``workbench colour convert`` reports it.
 """
 from __future__ import annotations
 
@@ -189,3 +205,80 @@ def hsl_to_rgb(hsl) -> np.ndarray:
     k = (n + h[..., None] / 30.0) % 12.0
     w = np.clip(np.minimum(k - 3.0, 9.0 - k), -1.0, 1.0)
     return lum[..., None] - a[..., None] * w
+
+
+def _hsi_hue(rgb: np.ndarray) -> np.ndarray:
+    """HSI hue in degrees [0, 360) of ``(..., 3)`` RGB (Gonzalez & Woods, section 6.2.3).
+
+    ``theta = arccos( [(R - G) + (R - B)] / 2 / sqrt((R - G)^2 + (R - B)(G - B)) )``,
+    ``H = theta`` if ``B <= G`` else ``360 - theta``; 0 where the square root (a multiple of the
+    distance to the grey axis) is 0 (greys).  The arccos argument is clipped to [-1, 1] against
+    rounding.
+    """
+    r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
+    den = np.sqrt(np.maximum((r - g) ** 2 + (r - b) * (g - b), 0.0))
+    theta = np.degrees(np.arccos(np.clip(_safe_div(0.5 * ((r - g) + (r - b)), den), -1.0, 1.0)))
+    h = np.where(den > tol.zero, np.where(b > g, 360.0 - theta, theta), 0.0)
+    return np.where(h >= 360.0, 0.0, h)       # 360 - theta with theta rounded to 0
+
+
+def rgb_to_hsi(rgb) -> np.ndarray:
+    """RGB ``(..., 3)`` -> HSI ``(..., 3)`` (Gonzalez & Woods, section 6.2.3).
+
+    ``H`` from :func:`_hsi_hue` in degrees, ``S = 1 - 3 min(R, G, B) / (R + G + B)``,
+    ``I = (R + G + B) / 3``.  Greys have H = 0 and S = 0; black is (0, 0, 0).  S is computed
+    as ``(I - min) / I`` and set to 0 where ``|I| <= tol.zero`` (see the module's edge cases).
+    """
+    rgb = _as3(rgb)
+    i = rgb.mean(axis=-1)
+    return np.stack([_hsi_hue(rgb), _safe_div(i - rgb.min(axis=-1), i), i], axis=-1)
+
+
+def hsi_to_rgb(hsi) -> np.ndarray:
+    """HSI ``(..., 3)`` -> RGB ``(..., 3)`` by the three 120-degree sectors (Gonzalez & Woods,
+    section 6.2.3).  Hue taken modulo 360, then ``h = H - 120 k`` in sector ``k = 0, 1, 2``:
+
+    * the sector's smallest channel (B, R, G for k = 0, 1, 2): ``I (1 - S)``;
+    * its leading channel (R, G, B): ``I [1 + S cos h / cos(60 - h)]``;
+    * the third (G, B, R): ``3 I`` minus the other two.
+
+    No clipping: a triple outside the RGB cube (possible for H, S, I each in range, e.g.
+    (0, 1, 0.5) -> (1.5, 0, 0)) is returned as computed.
+    """
+    hsi = _as3(hsi)
+    hue, s, i = hsi[..., 0] % 360.0, hsi[..., 1], hsi[..., 2]
+    k = np.minimum(hue // 120.0, 2.0)      # hue % 360 can round to 360.0
+    h = np.radians(hue - 120.0 * k)
+    low = i * (1.0 - s)
+    lead = i * (1.0 + s * np.cos(h) / np.cos(np.pi / 3.0 - h))
+    by_role = np.stack([lead, 3.0 * i - (lead + low), low], axis=-1)   # (leading, third, smallest)
+    role = (np.arange(3) - k[..., None].astype(np.intp)) % 3          # channel c has role (c - k) mod 3
+    return np.take_along_axis(by_role, role, axis=-1)
+
+
+#: The colour spaces offered by name (``workbench colour convert``): name -> (component labels,
+#: RGB -> space, space -> RGB).  Hues (H) are in degrees.
+SPACES = {
+    "rgb": (("R", "G", "B"), _as3, _as3),
+    "xyz": (("X", "Y", "Z"), rgb_to_xyz, xyz_to_rgb),
+    "cmy": (("C", "M", "Y"), rgb_to_cmy, cmy_to_rgb),
+    "cmyk": (("C", "M", "Y", "K"), rgb_to_cmyk, cmyk_to_rgb),
+    "hsv": (("H", "S", "V"), rgb_to_hsv, hsv_to_rgb),
+    "hsl": (("H", "S", "L"), rgb_to_hsl, hsl_to_rgb),
+    "hsi": (("H", "S", "I"), rgb_to_hsi, hsi_to_rgb),
+}
+
+
+def space_labels(name: str) -> tuple[str, ...]:
+    """The component labels of the colour space ``name`` (a key of :data:`SPACES`)."""
+    if name not in SPACES:
+        raise WorkbenchError(f"unknown colour space {name!r}: expected one of {', '.join(SPACES)}")
+    return SPACES[name][0]
+
+
+def convert(values, source: str, target: str) -> np.ndarray:
+    """Colours ``(..., n)`` in space ``source`` -> space ``target`` (names of :data:`SPACES`),
+    through RGB; unclipped, like every conversion here."""
+    for name in (source, target):
+        space_labels(name)                 # an unknown name is refused before any work
+    return SPACES[target][1](SPACES[source][2](values))
