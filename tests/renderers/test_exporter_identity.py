@@ -1,9 +1,7 @@
 """The exporters' output for bundled scenes is pinned: the POV-Ray SDL text and the Mitsuba
-scene dictionary that the exporters wrote before they asked each object kind's module
-(``povray``, ``mitsuba``; issue 14) are kept in ``tests/golden/exporters`` (written by
-main at 7c5be9a with :func:`mitsuba_record`), and the exporters must still write them
-exactly.  Regenerate only for an intended change of the mapping:
-``python -c "import tests.test_exporter_identity as t; t.write_golden()"``.
+scene dictionary (recorded by :func:`mitsuba_record`) are kept in ``tests/golden/exporters``,
+and the exporters must still write them exactly.  Regenerate only for an intended change of the
+mapping: ``cd tests/renderers && python -c "import test_exporter_identity as t; t.write_golden()"``.
 
 Text and structure must be the same; numbers agree to :data:`REL_TOL` relative (or
 :data:`ABS_TOL` absolute, for values that are rounding noise around zero): the exported

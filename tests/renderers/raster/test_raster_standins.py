@@ -1,10 +1,9 @@
 """The raster family's stand-ins for global effects (workbench/renderers/raster_standins.py):
 environment maps reflect what the ray tracer reflects, shadow maps darken what its shadow
-feelers darken, blending tints by the material's colour, ``standins="off"`` is the old image,
-and the error against the Whitted reference drops with each stand-in."""
+feelers darken, blending tints by the material's colour, and the error against the Whitted reference drops with
+each stand-in (``standins="off"``, the bare local model, is pinned by test_raster_golden)."""
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,7 +16,6 @@ from workbench.scene.tessellate import DEFAULT_LEVEL
 from workbench.renderers import raster_standins as sti
 from workbench.scene.io import scene_from_dict
 
-OLD = Path(__file__).resolve().parents[2] / "golden" / "raster" / "standins_off_f2e4b0a.npz"
 
 
 def _mirror_scene(**mirror):
@@ -125,22 +123,6 @@ def test_shadow_maps_darken_the_pixels_the_ray_tracer_shadows(gl_ctx, method):
     # a bias of zero: the floor shadows itself (acne) where it is lit
     acne = workbench.render(scene, method, standins="shadows", shadow_bias=0.0).image
     assert ((off - acne).max(-1) > 0.02)[judged & ~truth].mean() > 0.05
-
-
-def test_standins_off_is_the_old_image():
-    """``standins="off"`` renders what main f2e4b0a rendered before the stand-ins existed: bit
-    for bit on the GL renderer that made the file (float32 images of whitted and cornell at
-    64 x 48), within 2/255 on another one (llvmpipe output varies across Mesa versions)."""
-    from workbench.renderers import gl
-    old = np.load(OLD)
-    same_gl = str(old["gl_renderer"]) == gl.renderer_name()
-    for key in [k for k in old.files if k != "gl_renderer"]:
-        scene_name, method = key.rsplit("_", 1)
-        img = workbench.render(workbench.load_scene(scene_name), method, width=64, height=48, standins="off").image
-        if same_gl:
-            assert np.array_equal(img, old[key]), key
-        else:
-            assert np.abs(img - old[key]).max() <= 2 / 255, key
 
 
 def test_rmse_against_the_whitted_reference_drops_with_each_standin(gl_ctx):
