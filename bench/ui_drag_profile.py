@@ -79,7 +79,7 @@ class StageClock:
 def run(args) -> dict:
     from imgui_bundle import immapp
 
-    from workbench.app.ui import frames, main, plot, scripts
+    from workbench.app.ui import main, panel_refresh, plot, scripts
     from workbench.app.ui.state import new_state
 
     clock = StageClock(args.sync)
@@ -93,7 +93,7 @@ def run(args) -> dict:
         counted["n"] += clock.counting
 
     counting_script.keeps_awake = True
-    frames.update_images = clock.wrap(frames.update_images, "update_images")
+    panel_refresh.update_images = clock.wrap(panel_refresh.update_images, "update_images")
     plot.track = clock.wrap(plot.track, "track")
     real_run = immapp.run
 
