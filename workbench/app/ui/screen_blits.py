@@ -2,10 +2,10 @@
 
 The display passes (:mod:`.display_passes`) draw into the window's framebuffer under imgui's
 drawing (:class:`ScreenBlits`), not drawn by imgui as quads: straight from the linear image
-while it changes, from an RGBA8 display texture made once when it stays.  During a drag the
-window's sRGB framebuffer encodes a direct24 panel (``GL_FRAMEBUFFER_SRGB``,
-ARB_framebuffer_sRGB), within one level of IEC 61966-2-1 as
-:func:`workbench.core.imageio.to_srgb8` computes it.
+while it changes, from an RGBA8 display texture made once when it stays.  During a drag a
+direct24 panel is sRGB-encoded by the window's framebuffer where it is sRGB-capable
+(``GL_FRAMEBUFFER_SRGB``, ARB_framebuffer_sRGB), within one level of the IEC 61966-2-1
+numbers of :func:`workbench.core.imageio.to_srgb8`.
 """
 from __future__ import annotations
 
