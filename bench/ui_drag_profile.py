@@ -79,7 +79,7 @@ class StageClock:
 def run(args) -> dict:
     from imgui_bundle import immapp
 
-    from workbench.app.ui import frames, main, plot
+    from workbench.app.ui import main, panel_refresh, plot
     from workbench.app.ui.session_file import load_session
     from workbench.app.ui.state import new_state
 
@@ -95,7 +95,7 @@ def run(args) -> dict:
         counted["n"] += clock.counting
 
     counting_script.keeps_awake = True
-    frames.update_images = clock.wrap(frames.update_images, "update_images")
+    panel_refresh.update_images = clock.wrap(panel_refresh.update_images, "update_images")
     plot.track = clock.wrap(plot.track, "track")
     real_run = immapp.run
 

@@ -7,9 +7,9 @@ the run weighs on each alike) and timed from the first call to ``glFinish``, wal
 process CPU time (every thread: llvmpipe's rasteriser threads included):
 
 * ``draws``: the three panels' draws alone (no wait between them);
-* ``window_passes``: what a drag frame does now (``ui/frames.py``): the window cleared, the
-  draws, the difference pass and its statistics reduced on the GPU, then each panel
-  sRGB-encoded and the difference colour-mapped straight into the window;
+* ``window_passes``: what a drag frame does now (``ui/panel_refresh.py``,
+  ``ui/panel_show.py``): the window cleared, the draws, the difference pass and its statistics
+  reduced on the GPU, then each panel sRGB-encoded and the difference colour-mapped straight into the window;
 * ``encode_blit``: the sequence it replaced: ``glFinish`` after each draw, each panel
   encoded into an RGBA8 display texture, the difference map read back for its maximum and
   mean and colour-mapped into a texture, then the four textures copied into the window by
@@ -38,7 +38,7 @@ RECTS = [(10 + k * 520, 400, 508, 381) for k in range(3)] + [(10, 10, 340, 255)]
 
 
 class WindowStandIn:
-    """The context seen by :class:`~workbench.app.ui.frames.DisplayPasses` with ``screen``, a
+    """The context seen by :class:`~workbench.app.ui.display_passes.DisplayPasses` with ``screen``, a
     1600 x 900 framebuffer, as the window's."""
 
     def __init__(self, ctx):
@@ -66,7 +66,7 @@ PAGE = Page("ui_frame_gpu", "The GPU side of one camera-drag frame", first_parag
 def main(argv=None) -> None:
     import workbench
     from workbench.app.ui import camera as cam
-    from workbench.app.ui.frames import SCALE_FLOOR, DisplayPasses
+    from workbench.app.ui.display_passes import SCALE_FLOOR, DisplayPasses
     from workbench.renderers import gl
     from workbench.renderers.base import get_renderer
     p = argparse.ArgumentParser()

@@ -13,7 +13,7 @@ import numpy as np
 
 from workbench.app.ui import camera as cam
 from workbench.app.ui.export import export
-from workbench.app.ui.frames import shown_texture
+from workbench.app.ui.panel_show import shown_texture
 from workbench.app.ui.inspect import select_ray_tree
 from workbench.app.ui.layout import window_report
 from workbench.app.ui.panels import status_text
@@ -458,7 +458,7 @@ class Screens:
 
     def __call__(self, state: AppState) -> None:
         from workbench.app.ui import screenshot
-        from workbench.app.ui.frames import in_progress
+        from workbench.app.ui.panel_refresh import in_progress
         from workbench.app.ui.glfw_title import window_title
         busy = in_progress(state) and time.perf_counter() - self.t0 < CPU_WAIT_SECONDS
         if state.frame < 2 or busy:
@@ -535,7 +535,7 @@ class SliderFrames:
     change the chosen material's ``kd`` and light 0's position (:func:`slider_step`, edit k =
     the frame number) and the next frame records the images drawn with them (``edit{k}_M.npy``)
     with the programs compiled and the draws so far; then the values rest until the panels
-    have compiled them back in (``frames.LIVE_REST_SECONDS``), the images are recorded again
+    have compiled them back in (``panel_refresh.LIVE_REST_SECONDS``), the images are recorded again
     (``settled_M.npy``) and the script quits."""
 
     def __init__(self, out: Path):
@@ -666,7 +666,7 @@ def rss_bytes() -> int:
 
 
 class Idle:
-    """Nothing touched: once nothing is in progress (:func:`.frames.in_progress`: jobs, the
+    """Nothing touched: once nothing is in progress (:func:`workbench.app.ui.panel_refresh.in_progress`: jobs, the
     error plot's reference and evaluations) and ``settle`` seconds have passed (longer than
     hello_imgui's time active after the last event), count the frames drawn and the
     process CPU time over ``seconds``; then change the ray tracer's knob from the script (no
@@ -681,7 +681,7 @@ class Idle:
         self.t0, self.step = None, 0
 
     def __call__(self, state: AppState) -> None:
-        from workbench.app.ui.frames import in_progress
+        from workbench.app.ui.panel_refresh import in_progress
         now = time.perf_counter()
         if self.step == 0 and in_progress(state) and now - self.t_begin < CPU_WAIT_SECONDS:
             self.t_start = now

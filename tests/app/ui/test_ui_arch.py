@@ -76,7 +76,8 @@ def test_a_method_registered_at_test_time_appears_in_the_window(dummy_methods, w
     """Registered in the test, not in the UI: listed in the Methods window, accepted as a
     panel, rendered as its kind says (a GL panel drawn in the window's context, a CPU panel
     by a background job), and a point of the error plot once final."""
-    from workbench.app.ui.frames import release_gl, update_images
+    from workbench.app.ui.panel_gpu import release_gl
+    from workbench.app.ui.panel_refresh import update_images
     from workbench.app.ui.plot import _final_image
     from workbench.app.ui.state import choosable_methods, method_kind, new_state
     assert {"dummy_cpu", "dummy_gl"} <= set(choosable_methods())

@@ -115,7 +115,8 @@ def test_difference_statistics_reduced_on_the_gpu_are_the_map_s(window_ctx):
     reduction, not from a read-back of the map: the same maximum, and the sum up to float32
     rounding (at most one rounding per term added: |error| <= n eps sum); the map itself is
     read whole or one value at a time (the probe) only when asked."""
-    from workbench.app.ui.frames import DisplayPasses, read_value, read_values
+    from workbench.app.ui.display_passes import DisplayPasses
+    from workbench.app.ui.panel_gpu import read_value, read_values
     bound = window_ctx.fbo  # the passes end on the stand-in screen, which the fixture releases
     passes = DisplayPasses(window_ctx)
     rng = np.random.default_rng(3)

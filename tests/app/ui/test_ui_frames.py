@@ -1,8 +1,8 @@
-"""GL panels kept on the GPU (``workbench.app.ui.frames``): under Xvfb the ``gpu_panels`` script
-(a subprocess, as in test_ui.py) checks that a frame with nothing changed draws no GL panel and
-reads no pixels back, that a camera change redraws each GL panel once, and that what imgui
-shows (the RGBA8 display texture) is the CLI's image of the same camera within one 8-bit
-level; closing leaves no thread.  The lazy image store is tested on its own."""
+"""GL panels kept on the GPU (``workbench.app.ui.panel_refresh``, ``panel_gpu``,
+``panel_show``): under Xvfb the ``gpu_panels`` script (a subprocess, as in test_ui.py) checks
+that a frame with nothing changed draws no GL panel and reads no pixels back, that a camera
+change redraws each GL panel once, and that what imgui shows (the RGBA8 display texture) is
+the CLI's image of the same camera within one 8-bit level; closing leaves no thread.  The lazy image store is tested on its own."""
 from __future__ import annotations
 
 import json

@@ -12,7 +12,8 @@ import pytest
 
 import workbench
 from workbench.app.ui.file_browser import add_model, listing
-from workbench.app.ui.frames import release_gl, update_images
+from workbench.app.ui.panel_gpu import release_gl
+from workbench.app.ui.panel_refresh import update_images
 from workbench.app.ui.state import new_state, short_name
 from workbench.renderers import raster
 

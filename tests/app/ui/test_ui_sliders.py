@@ -1,4 +1,4 @@
-"""Material and light sliders on the GL panels (``workbench.app.ui.frames`` with
+"""Material and light sliders on the GL panels (``workbench.app.ui.panel_refresh`` with
 ``RasterSession.update``): under Xvfb the ``slider_frames`` script (a subprocess, as in
 test_ui.py) changes a material's kd and light 0's position every frame for six frames.  Each
 frame must show the new values (the panel image changes, and the last one is the CLI image of

@@ -13,7 +13,8 @@ import pytest
 
 import workbench
 from workbench.app.ui import camera as cam
-from workbench.app.ui.frames import release_gl, update_images
+from workbench.app.ui.panel_gpu import release_gl
+from workbench.app.ui.panel_refresh import update_images
 from workbench.app.ui.state import new_state, set_light_value, set_material_value, set_option
 from workbench.compare.metrics import metrics
 from workbench.renderers.base import get_renderer

@@ -72,7 +72,7 @@ def test_the_linear_pass_into_an_srgb_framebuffer_shows_the_srgb_levels(gl_ctx):
     within one of ``to_srgb8``'s (the rasteriser's encoding rounds some ties the other way),
     row 0 of a framebuffer image on top."""
     from workbench.app.ui import window_quad
-    from workbench.app.ui.frames import GL_FRAMEBUFFER_SRGB
+    from workbench.app.ui.screen_blits import GL_FRAMEBUFFER_SRGB
     from workbench.core.imageio import to_srgb8
     from workbench.renderers import gl
     ctx = gl_ctx

@@ -1,6 +1,6 @@
 """The panels' linear images, read back from the GPU only when someone looks at the pixels.
 
-A raster panel lives on the GPU (see :mod:`.frames`): after each draw its entry here is made
+A raster panel lives on the GPU (see :mod:`.panel_refresh` and :mod:`.panel_gpu`): after each draw its entry here is made
 *pending*, a function that reads the float framebuffer back.  The first access (pixel probe,
 difference view, export, a test script) calls it once and keeps the array until the panel is
 drawn again, so a frame in which nothing asks for pixels reads nothing back.  The pixel probe

@@ -24,7 +24,7 @@ from .state import AppState
 IDLE_FPS = 2.0
 """Frames per second while nothing changes and no input comes (hello_imgui's idling: it sleeps
 between frames; an input event, :func:`hello_imgui.request_refresh` from a background job that
-delivers, or :func:`.frames.in_progress` wakes it at once)."""
+delivers, or :func:`.panel_refresh.in_progress` wakes it at once)."""
 
 
 def frame_rest(last: float | None, now: float, cap: float, job_running: bool) -> float:
@@ -149,13 +149,15 @@ def write_outputs(state: AppState, script, out: Path, seconds: float, shown: lis
 
 def _loop(state: AppState, max_frames: int | None, script, window: tuple[int, int]) -> list:
     """hello_imgui's runner with the workbench's callbacks; returns when the window closes,
-    with the images' rectangles of the last frame (:attr:`.frames.ScreenBlits.last`)."""
+    with the images' rectangles of the last frame (:attr:`.screen_blits.ScreenBlits.last`)."""
     import moderngl
     from imgui_bundle import hello_imgui, immapp
 
     from ...renderers import gl
     from . import window_style
-    from .frames import draw_shown_images, in_progress, release_gl, update_images
+    from .panel_gpu import release_gl
+    from .panel_refresh import in_progress, update_images
+    from .panel_show import draw_shown_images
     from .layout import docking_params
     from .panels import status_bar
     from .plot import track

@@ -5,12 +5,13 @@ import numpy as np
 from imgui_bundle import imgui
 
 from . import camera as cam
-from .frames import (SCALE_FLOOR, difference_on_gpu, image_stats, show_difference, show_panel,
-                     stale, upload, upload_linear)
 from .colours import colour_scale, hot_table
+from .display_passes import SCALE_FLOOR
 from .export import export
 from .gl_sessions import KNOB_VALUES, STANDIN_CHOICES, draws_standins
 from .inspect import pixel_under_mouse, probe_tooltip, select_ray_tree
+from .panel_gpu import stale, upload, upload_linear
+from .panel_show import difference_on_gpu, image_stats, show_difference, show_panel
 from .patch_view import select_patch
 from .placement import PANEL_GAP, PANEL_LINES, focus, panel_grid
 from .state import (DISPLAY_MODES, HARMONIES, MATERIAL_FIELDS, AppState, choosable_methods,

@@ -166,7 +166,7 @@ def patch_view(state: AppState) -> None:
     """The picked patch: item buffer (unfolded hemicube) and form-factor row."""
     from imgui_bundle import imgui
 
-    from .frames import stale, upload
+    from .panel_gpu import stale, upload
     pick = state.patch_pick
     if pick is None:
         imgui.text_disabled("Ctrl+click a surface in the radiosity panel")

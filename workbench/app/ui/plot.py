@@ -68,7 +68,7 @@ def _final_image(state: AppState, method: str) -> tuple[np.ndarray, float] | Non
 def _reference(state: AppState, plot: ErrorPlot) -> np.ndarray | None:
     """The reference image of the current key once rendered (requests it meanwhile)."""
     from ...compare.reference import candidates, finest_options
-    from .frames import tiled
+    from .panel_refresh import tiled
     from .jobs import JobBoard
     if plot.ref_image is not None:
         return plot.ref_image
@@ -175,7 +175,7 @@ def _matched(state: AppState, plot: ErrorPlot, method: str):
     plot.matched.pop(method, None)
     plot.matched_options[method] = held
     from ...compare.reference import finest_options, matched_spec
-    from .frames import tiled
+    from .panel_refresh import tiled
     from .jobs import JobBoard
     spec = matched_spec(method, state.scene, options)
     if spec is None:

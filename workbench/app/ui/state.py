@@ -126,7 +126,7 @@ class AppState:
     pixels along the longer side, the scene camera's aspect); ``view`` (zoom, centre u, centre v)
     the linked 2D zoom of every image panel.  ``images`` holds each panel's last
     linear (H, W, 3) float32 image (raster ones read back from the GPU on first access),
-    ``timings`` its last render time in seconds.  ``gpu`` is :class:`.frames.PanelGPU` (raster
+    ``timings`` its last render time in seconds.  ``gpu`` is :class:`.panel_gpu.PanelGPU` (raster
     sessions, the sRGB display pass), made in the window's GL context.
     """
 

@@ -1,0 +1,212 @@
+"""Each panel's picture redrawn only when what it shows changes (:func:`update_images`, once
+per frame before the widgets).
+
+* GL methods (``ui_kind`` ``"gl"``: flat, Gouraud, Phong, a user's shading model) draw through a cached
+  :class:`~workbench.renderers.raster.RasterSession` (one per scene, method and options,
+  built by :func:`.gl_sessions.build_session`; replaced sessions are released) into the
+  session's float framebuffer, in the window's own moderngl context, and only when the
+  panel's inputs change: the scene version (materials, lights), the panel's options
+  (tessellation, stand-ins) and the shared camera (which carries the panel size).  A frame
+  in which nothing changed draws nothing.  A material or light slider keeps
+  the session (``RasterSession.update``): the edited values are drawn by live programs that
+  read them from uniforms (compiled once, no geometry upload), and once the values have
+  rested for :data:`LIVE_REST_SECONDS` they are compiled back in (``settle``: the literal
+  programs, the fast static variant), one program per frame.
+* During a drag (a panel drawn in consecutive frames) the frame does not wait for the GPU
+  after a panel's draw (no ``glFinish``): it is timed once the camera rests, by one more draw
+  of the same image (:func:`timed_draw`).  llvmpipe itself still waits where a pass reads a
+  panel whose draw is not done.
+* CPU and progressive methods are requested from the :class:`~.jobs.JobBoard`; their image is
+  taken when the job reports new tiles (``Job.version``), drawn over the panel's previous
+  image until done (:func:`over_stale`).
+* :func:`in_progress` tells the loop whether something on screen changes by itself.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from .panel_gpu import PanelGPU, RasterPanel, gpu, read_pixel, stale, take_gpu_stats
+from .state import AppState, method_kind
+
+LIVE_REST_SECONDS = 0.5
+"""How long edited material or light values must stay unchanged before a GL panel compiles
+them back into its programs (until then it draws them from uniforms)."""
+
+
+def tiled(method: str) -> bool:
+    """The method accepts ``on_tile`` (it reports partial images band by band)."""
+    from ...renderers.base import get_renderer
+    return "on_tile" in get_renderer(method).options
+
+
+def refresh_raster(state: AppState, method: str) -> bool:
+    """Redraw ``method``'s panel if its inputs changed; returns whether it drew."""
+    from ...core.errors import WorkbenchError
+    from ...renderers.raster import RasterSession
+    from .gl_sessions import build_session, session_status
+    g = gpu(state)
+    key = (state.scene_version, tuple(sorted(state.options[method].items())))
+    panel = g.raster.get(method)
+    if (panel is not None and panel.session_key != key and panel.session_key[1] == key[1]
+            and panel.session.update(state.scene)):
+        # only material or light values changed: same session, live programs
+        panel.session_key, panel.drawn, panel.edited = key, None, time.perf_counter()
+    elif panel is None or panel.session_key != key:
+        if state.panel_errors.get(method, (None,))[0] == key:
+            return False  # did not build for these inputs: its message stays shown
+        if panel is not None:
+            g.compiled += panel.session.programs.compiles
+            panel.session.release()
+            del g.raster[method]
+            g.linear.pop(method, None)
+        try:
+            session = build_session(state, method)
+        except WorkbenchError as e:  # over the memory limit, a model that does not compile: one line
+            state.panel_errors[method] = (key, str(e))
+            state.status[method] = str(e)
+            if method in state.images:  # del, not pop: a pending read of a released session
+                del state.images[method]
+            state.ctx.screen.use()
+            return False
+        state.panel_errors.pop(method, None)
+        panel = g.raster[method] = RasterPanel(session, key)
+        state.status[method] = session_status(panel.session)
+    if (panel.session.live and time.perf_counter() - panel.edited > LIVE_REST_SECONDS
+            and g.settle_frame != state.frame):
+        # the values rested: compiled back in (the static variant), one program per frame
+        # over all panels (each costs llvmpipe ~0.1 s, most of it at its first draw)
+        g.settle_frame = state.frame
+        panel.session.settle(budget=1)
+        panel.drawn = None
+    cam = state.camera
+    if panel.drawn == cam and method in state.images:
+        if not panel.timed:  # the drag has ended: time a draw of the image shown
+            timed_draw(state, panel, method)
+            panel.draws += 1
+        return False
+    fbo = panel.session.framebuffer(cam.width, cam.height)
+    if panel.drawn_frame == state.frame - 1:
+        # drawn last frame too (a drag): no wait for the draw to end, so that llvmpipe's
+        # threads rasterise it while this thread goes on with the frame; it is timed once
+        # the camera rests
+        panel.session.draw_to(fbo, cam, *shared_near_far(g, panel.session, cam))
+        state.ctx.screen.use()  # back to the window's framebuffer for imgui
+        panel.timed = False
+    else:
+        timed_draw(state, panel, method, fbo)
+    state.images.set_pending(method, lambda: RasterSession.read_image(fbo),
+                             pixel=lambda i, j, shape: read_pixel(fbo, i, j, shape),
+                             shape=(cam.height, cam.width))
+    g.linear[method] = (fbo.color_attachments[0], True, state.images.version(method))
+    panel.drawn, panel.draws, panel.drawn_frame = cam, panel.draws + 1, state.frame
+    return True
+
+
+def timed_draw(state: AppState, panel: RasterPanel, method: str, fbo=None) -> None:
+    """Draw ``panel`` at ``state.camera`` into ``fbo`` (by default its framebuffer of the
+    camera's size, redrawing the image it holds: the same image) and wait for the draw to end:
+    ``state.timings[method]`` is the draw's time, not just its submission."""
+    cam = state.camera
+    if fbo is None:
+        fbo = panel.session.framebuffer(cam.width, cam.height)
+    t0 = time.perf_counter()
+    panel.session.draw_to(fbo, cam, *shared_near_far(gpu(state), panel.session, cam))
+    state.ctx.finish()
+    state.ctx.screen.use()  # back to the window's framebuffer for imgui
+    state.timings[method] = time.perf_counter() - t0
+    panel.timed = True
+
+
+def shared_near_far(g: PanelGPU, session, cam) -> tuple[float, float]:
+    """The automatic clip planes of ``session`` for ``cam``, computed once per camera for
+    sessions with the same parts' boxes (the GL panels of one scene and tessellation share
+    them: 3-10 ms of Python each on a loaded machine, every frame of a drag)."""
+    key = session.part_boxes.tobytes()
+    if g.near_far.get("camera") != cam:
+        g.near_far = {"camera": cam}
+    if key not in g.near_far:
+        g.near_far[key] = session.near_far(cam)
+    return g.near_far[key]
+
+
+def refresh_cpu(state: AppState, method: str) -> None:
+    """Ask for ``method``'s background job; take its image when it has new tiles."""
+    job = state.jobs.request(state.scene, state.camera, method, state.options[method],
+                             tiled=tiled(method))
+    if job.cancelled.is_set():
+        state.status[method] = "restarting (stale image)"
+    elif job.error:
+        state.status[method] = job.error
+    elif job.done:
+        state.timings[method] = job.seconds
+        state.status[method] = (f"done: {job.spp} spp, noise {job.noise:.3g}"
+                                if job.progressive and job.noise is not None else "done")
+    elif job.progressive:
+        from ...renderers.base import get_renderer
+        target = state.options[method][get_renderer(method).knob.name]
+        state.status[method] = (f"refining: {job.spp}/{target} spp" +
+                                ("" if job.noise is None else f", noise {job.noise:.3g}"))
+    else:
+        state.status[method] = (f"rendering: {job.rows_done}/{state.camera.height} rows"
+                                if tiled(method) else "rendering...")
+    shape = (state.camera.height, state.camera.width, 3)
+    if stale(state, f"{method} job", (id(job), job.version, shape)) or method not in state.images:
+        image = job.snapshot()
+        # the previous job's image is kept while its successor waits, unless it has another
+        # size (a scene switch changed the panels' aspect): then black until the new one comes
+        state.images[method] = (over_stale(state, method, job, image)
+                                if image.shape == shape else np.zeros(shape, np.float32))
+
+
+def over_stale(state: AppState, method: str, job, image: np.ndarray) -> np.ndarray:
+    """What a CPU panel shows of ``job``'s ``image`` (H, W, 3): the image once done; before,
+    its rendered bands (rows ``0 .. job.rows_done``; a progressive job's image once it has a
+    sample) over the panel's previous image (its *backdrop*, taken when the job first shows),
+    so a restarted render never blanks the panel (it used to show black until its bands came)."""
+    g = gpu(state)
+    held = g.backdrops.get(method)
+    if held is None or held[0] != id(job):
+        prev = state.images[method] if method in state.images else None
+        held = g.backdrops[method] = (id(job), prev)
+    back = held[1]
+    if job.done or back is None or back.shape != image.shape:
+        return image
+    if job.progressive:
+        return image if job.spp > 0 else back
+    out = back.copy()
+    out[:job.rows_done] = image[:job.rows_done]
+    return out
+
+
+def update_images(state: AppState) -> None:
+    """Bring every selected panel up to date (called once per frame, before the widgets)."""
+    from .pyrender_proc import refresh_pyrender
+    if state.gpu is not None:
+        take_gpu_stats(state, "difference")
+    state.jobs.keep_only(state.methods)
+    if state.gpu is not None:  # a removed panel's approximation keeps nothing awake
+        state.gpu.modes.approximate &= set(state.methods)
+    for m in state.methods:
+        kind = method_kind(state, m)
+        if kind == "gl":
+            refresh_raster(state, m)
+        elif kind == "child":
+            refresh_pyrender(state)
+        else:
+            refresh_cpu(state, m)
+
+
+def in_progress(state: AppState) -> bool:
+    """Something on screen changes by itself this frame: a background job or the pyrender child
+    is working, the error plot waits for its reference or evaluations, or a GL panel has edited
+    values still to compile back in.  The loop then runs at full rate (capped while a job runs,
+    :func:`.main.frame_rest`); otherwise it idles."""
+    proc = state.pyrender
+    g = state.gpu
+    return (state.jobs.busy() or (proc is not None and proc.busy) or state.errors.busy(state.frame)
+            or (g is not None and (any(p.session.live or not p.timed for p in g.raster.values())
+                                   or g.modes.busy()
+                                   or any(g.stats.get(k, (None,))[0] != v[0]
+                                          for k, v in g.gpu_stats.items()))))
