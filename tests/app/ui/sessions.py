@@ -14,7 +14,7 @@ import numpy as np
 from workbench.app.ui import camera as cam
 from workbench.app.ui.export import export
 from workbench.app.ui.panel_show import shown_texture
-from workbench.app.ui.inspect import select_ray_tree
+from workbench.app.ui.inspect import select_ray_tree, shown_field
 from workbench.app.ui.layout import window_report
 from workbench.app.ui.panels import status_text
 from workbench.app.ui.state import AppState, method_kind, set_display, set_material_value, set_option, shown_image
@@ -81,7 +81,10 @@ class Check:
                 tree = select_ray_tree(state, i, j)["tree"]
                 self.log["ray_tree"] = {"pixel": [i, j], "color": tree["color"],
                                         "depth": tree.get("depth"),
-                                        "n_children": len(tree.get("children", []))}
+                                        "n_children": len(tree.get("children", [])),
+                                        "object_shown": shown_field(tree, "object"),
+                                        "object_name": state.scene.objects[tree["object"]].name
+                                        if tree["object"] is not None else None}
             state.quit = True
 
 

@@ -106,6 +106,8 @@ def test_ray_tree_of_a_pixel_matches_the_raytrace_panel(session):
     i, j = rt["pixel"]
     assert np.allclose(rt["color"], _img(out, "final", "raytrace")[i, j], atol=2e-3)
     assert rt["n_children"] >= 1
+    # the inspector names the hit object as the scene does (or by kind), then its index
+    assert rt["object_shown"].startswith(rt["object_name"] or "sphere ") and "(#" in rt["object_shown"], rt
 
 
 def test_export_writes_panels_and_settings(session):

@@ -193,6 +193,8 @@ def test_ray_tree_of_a_glass_pixel():
     i, j = 19, 19  # on the glass sphere
     tree = workbench.raytrace.ray_tree(sc, i, j, max_depth=2)
     assert tree["object"] == 2
+    glass = sc.objects[2]
+    assert tree["object_name"] == (glass.name or "sphere 2") and tree["material"] == glass.material
     kinds = [c["kind"] for c in tree["children"]]
     assert kinds == ["reflection", "refraction"]
     assert len(tree["shadow_feelers"]) >= 1

@@ -47,11 +47,21 @@ def select_ray_tree(state: AppState, i: int, j: int) -> dict:
     return state.ray_tree
 
 
+def shown_field(node: dict, key: str):
+    """What the inspector shows for ``node[key]``: the hit object as its scene name (or kind
+    and index) followed by its index, ``"glass (#2)"``; any other field as it is."""
+    v = node[key]
+    if key == "object" and v is not None and "object_name" in node:
+        return f"{node['object_name']} (#{v})"
+    return v
+
+
 def _show_node(label: str, node) -> None:
     if isinstance(node, dict):
         if imgui.tree_node(f"{label}##{id(node)}"):
-            for k, v in node.items():
-                _show_node(str(k), v)
+            for k in node:
+                if k != "object_name":
+                    _show_node(str(k), shown_field(node, k))
             imgui.tree_pop()
     elif isinstance(node, list) and node and isinstance(node[0], (dict, list)):
         if imgui.tree_node(f"{label} [{len(node)}]##{id(node)}"):

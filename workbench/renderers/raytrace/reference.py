@@ -215,7 +215,9 @@ def raytrace(ctx: Context, O, D, recurs=0, weight=np.ones(3), media=(), tmin=0.0
     if hit is None:
         node.update(object=None, stop="left the scene")
         return background(ctx, D)
-    node.update(t=float(hit.t), object=hit.item.index)
+    obj = hit.item.obj
+    node.update(t=float(hit.t), object=hit.item.index,
+                object_name=obj.name or f"{obj.kind} {hit.item.index}", material=obj.material)
     att = np.ones(3)
     if media:
         att = np.exp(-np.asarray(media[-1].absorption) * hit.t)
@@ -346,7 +348,8 @@ def ray_tree(scene: m.Scene, i: int, j: int, **options) -> dict:
     """The ray tree of pixel (row ``i``, column ``j``) at the camera's resolution.
 
     Returns a nested dict: ``origin``, ``direction``, ``depth``, ``weight`` (accumulated RGB),
-    ``t``, ``object`` (scene index or None), ``shadow_feelers`` (light index and visibility),
+    ``t``, ``object`` (scene index or None), ``object_name`` (its ``name`` in the scene file, else
+    its kind and index, e.g. ``"sphere 2"``), ``material`` (its material's name), ``shadow_feelers`` (light index and visibility),
     ``children`` (each ``kind`` reflection / refraction, its ``coefficient`` and either a
     ``ray`` node or a ``stop`` reason: max depth / threshold), ``stop`` (why this ray did not
     continue: left the scene, no reflection or transmission), ``total_internal_reflection``,
