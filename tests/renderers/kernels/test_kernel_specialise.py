@@ -4,13 +4,16 @@ The geometry record's kind marker names the scene's features; a kernel compiled 
 without a kind never compiles that kind's kernels.  Checked in a new process (numba's
 dispatchers start empty there): a closest-hit search compiled for the spheres of the Whitted
 scene leaves the blob, isosurface, lathe and prism kernels and the CSG walk uncompiled, and the
-same search for a marker naming the blob compiles the blob's kernel and no other."""
+same search for a marker naming the blob compiles the blob's kernel and no other, and compiles
+it as a function of its own, not marked for inlining (``kernels/flags.py``)."""
 from __future__ import annotations
 
 import json
 import subprocess
 import sys
 from pathlib import Path
+
+import pytest
 
 import workbench
 from workbench.renderers.kernels.layout import FEATURES, kinds_marker, marker_features
@@ -39,9 +42,12 @@ geo = flatten(workbench.load_scene("whitted")).kernel_args()
 if sys.argv[1] == "blob":
     geo = geo._replace(kinds=kinds_marker(["blob", "prim_tree"]))
 first_hit(geo, k.scratch())
-print(json.dumps({name: len(f.signatures) for name, f in [
+compiled = {name: len(f.signatures) for name, f in [
     ("blob", blob_kernels.blob_first), ("isosurface", isosurface_kernels.iso_first),
-    ("lathe", lathe_kernels.lathe_first), ("prism", prism_kernels.prism_first), ("csg", k.csg_hit)]}))
+    ("lathe", lathe_kernels.lathe_first), ("prism", prism_kernels.prism_first), ("csg", k.csg_hit)]}
+apart = [blob_kernels.blob_first, blob_kernels.blob_crossings]
+inlined = sorted(f.py_func.__name__ for f in apart for cres in f.overloads.values() if cres.fndesc.inline)
+print(json.dumps({"compiled": compiled, "inlined": inlined}))
 '''
 
 
@@ -53,11 +59,24 @@ def _compiled(marker: str) -> dict:
 
 
 def test_a_scene_of_spheres_compiles_no_kind_kernel():
-    assert _compiled("scene") == {name: 0 for name in EXTENDED}
+    assert _compiled("scene")["compiled"] == {name: 0 for name in EXTENDED}
 
 
-def test_a_marker_naming_the_blob_compiles_the_blob_alone():
-    assert _compiled("blob") == {name: int(name == "blob") for name in EXTENDED}
+@pytest.fixture(scope="module")
+def blob_probe() -> dict:
+    return _compiled("blob")
+
+
+def test_a_marker_naming_the_blob_compiles_the_blob_alone(blob_probe):
+    assert blob_probe["compiled"] == {name: int(name == "blob") for name in EXTENDED}
+
+
+def test_kernels_under_an_inlined_helper_stay_functions_of_their_own(blob_probe):
+    """``row_hit`` and ``prim_hit`` are inlined helpers (``flags.INLINE``); the kind gate they call
+    and the blob's kernels below it are compiled when they are typed, and numba gives a callee
+    that does not set ``forceinline`` its caller's: unless the gate sets it to ``False``
+    (``flags.GATE``), they would be inlined into every caller."""
+    assert blob_probe["inlined"] == []
 
 
 def test_features_of_the_bundled_scenes():

@@ -14,7 +14,7 @@ from numba.extending import overload
 from ...scene.kinds import CSGNODE
 from ...scene.kinds.csg import CSG_DEPTH
 from ...scene.kinds.expression import MAX_STACK
-from .flags import GATE, INLINE, NO_REFCOUNT
+from .flags import GATE, INLINE
 from .shapes import CSG_EVENTS, _normalize, _to_object, csg_hit, object_normal, prim_hit
 from .specialise import has
 from .walks import BVH_STACK, _bounds_hit, bvh_hit, node_ray, open_node
@@ -48,7 +48,7 @@ PRIM_STACK_BASE = max(BVH_STACK, MAX_STACK)
 which runs inside that traversal."""
 
 
-@nb.njit(**NO_REFCOUNT)
+@nb.njit(**INLINE)
 def prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only, any_hit, zero, eps,
                   stack, st, sp_, sf, sn):
     """Closest hit through the analytic primitives' 4-wide tree (:class:`.accel.PrimTree`;
@@ -91,7 +91,7 @@ def prim_tree_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, s
     raise TypeError("prim_tree_gate is callable from numba-compiled code only")
 
 
-@overload(prim_tree_gate, jit_options=GATE)
+@overload(prim_tree_gate, jit_options=INLINE)
 def _prim_tree_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only, any_hit, zero, eps,
                     stack, st, sp_, sf, sn):
     on = has(geo.types[-1], "prim_tree")  # geo.kinds' type
@@ -110,7 +110,7 @@ def triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     raise TypeError("triangles_gate is callable from numba-compiled code only")
 
 
-@overload(triangles_gate, jit_options=GATE)
+@overload(triangles_gate, jit_options=INLINE)
 def _triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     on = has(geo.types[-1], "triangles")
 

@@ -32,7 +32,7 @@ def _to_object(xf, k, ox, oy, oz, dx, dy, dz):
             xf[k, 8] * dx + xf[k, 9] * dy + xf[k, 10] * dz)
 
 
-@nb.njit(**NO_REFCOUNT)
+@nb.njit(**INLINE)
 def solve_quadratic(A, B, C, zero):
     """Real roots of ``A t^2 + B t + C`` sorted (DESIGN errata 7: ``q = -(B + sign(B) sqrt(disc))/2``,
     roots ``q/A`` and ``C/q``); a negligible ``A`` (:func:`linear`) gives the linear root ``-C/B``.
@@ -159,7 +159,7 @@ def _in_bounds(par, k, x, y, z, slack):
             and par[k, 12] - slack <= z <= par[k, 15] + slack)
 
 
-@nb.njit(**NO_REFCOUNT)
+@nb.njit(**INLINE)
 def _polygon_hit(k, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax):
     """Planar convex polygon ``k``: plane hit inside every edge.  Not inlined (a rarely used
     path: one compiled copy instead of one per call site of :func:`closest`)."""
@@ -183,7 +183,7 @@ def _polygon_hit(k, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax):
     return t, 0
 
 
-@nb.njit(**NO_REFCOUNT)
+@nb.njit(**INLINE)
 def _quadric_hit(k, par, ox, oy, oz, dx, dy, dz, tmin, tmax, zero):
     """General quadric ``k`` cut to its bounds: first root in ``(tmin, tmax)`` inside them.
     Not inlined (see :func:`_polygon_hit`)."""

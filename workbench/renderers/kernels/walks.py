@@ -7,7 +7,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from .flags import INLINE, NO_REFCOUNT
+from .flags import INLINE
 from .layout import MAX_DEPTH
 
 BVH_STACK = 3 * MAX_DEPTH + 4
@@ -188,7 +188,7 @@ def _slp_vectorized(dispatcher):
 
 
 @_slp_vectorized
-@nb.njit(**NO_REFCOUNT)
+@nb.njit(**INLINE)
 def bvh_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
     """Closest (or any) triangle hit through the 4-wide BVH: :func:`bvh_walk` without counting.
     Returns ``(t, tri, b1, b2)``."""
