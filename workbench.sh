@@ -26,9 +26,15 @@ fi
 stamp=.venv/.installed-$(sha1sum pyproject.toml | cut -c1-12)
 if [ ! -f "$stamp" ]; then
   echo "== installing Python packages into .venv (first run takes a few minutes)"
-  # (pip's notes about this machine's unused local index folders are filtered out)
+  # (filtered out: pip's notes about this machine's unused local index folders, and setuptools'
+  # "Editable installation" notice, which it prints for any editable install whose data folders
+  # are mapped into the package, as shaders/ scenes/ stress/ examples/ are, to warn of a folder
+  # named like the package in the working directory: here that folder is the package itself)
   { .venv/bin/python -m pip install -q --upgrade pip &&
-    .venv/bin/python -m pip install -q -e '.[test,bench,reference]'; } 2>&1 | { grep -v -e 'is ignored: it is neither' || true; }
+    .venv/bin/python -m pip install -q -e '.[test,bench,reference]'; } 2>&1 | {
+    grep -v -e 'is ignored: it is neither' -e 'BuildBackendWarning: Editable installation' \
+            -e '^ *!! *$' -e '^ *[*]\{20,\} *$' -e 'Please be careful with folders in your working' \
+            -e 'name as your package as they may take precedence' -e 'with strategy, WheelFile' -e '^ *$' || true; }
   rm -f .venv/.installed-*; touch "$stamp"
 fi
 export NUMBA_CACHE_DIR="$PWD/.numba_cache"
