@@ -215,9 +215,10 @@ def raytrace(ctx: Context, O, D, recurs=0, weight=np.ones(3), media=(), tmin=0.0
     if hit is None:
         node.update(object=None, stop="left the scene")
         return background(ctx, D)
-    obj = hit.item.obj
-    node.update(t=float(hit.t), object=hit.item.index,
-                object_name=obj.name or f"{obj.kind} {hit.item.index}", material=obj.material)
+    node.update(t=float(hit.t), object=hit.item.index)
+    if tree is not None:  # names for the ray tree only, not on every ray of an image
+        obj = hit.item.obj
+        node.update(object_name=obj.name or f"{obj.kind} {hit.item.index}", material=obj.material)
     att = np.ones(3)
     if media:
         att = np.exp(-np.asarray(media[-1].absorption) * hit.t)
