@@ -41,13 +41,13 @@ def _run(code, par, aux, O, D, t_out):
     for i in range(O.shape[0]):
         ox, oy, oz, dx, dy, dz = O[i, 0], O[i, 1], O[i, 2], D[i, 0], D[i, 1], D[i, 2]
         if code == 0:
-            t, _ = blob_kernels.blob_first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
+            t, _ = blob_kernels.first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
         elif code == 1:
-            t, _ = isosurface_kernels.iso_first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
+            t, _ = isosurface_kernels.first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
         elif code == 2:
-            t, _ = lathe_kernels.lathe_first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
+            t, _ = lathe_kernels.first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
         else:
-            t, _ = prism_kernels.prism_first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
+            t, _ = prism_kernels.first(par, 0, aux, ox, oy, oz, dx, dy, dz, 0.0, np.inf, out_t, out_f, stack)
         t_out[i] = t
 
 

@@ -346,7 +346,8 @@ def export_scene(scene: m.Scene, folder: str, tessellation: int, spp: int = 16,
             left.append(f"{F.OPACITY}: object {obj.name or obj.kind!r} cut out (constant opacity "
                         f"{mat.opacity.value} < {OPACITY_CUT})")
             continue
-        if kind_of(obj).mitsuba(obj, sw) is None:
+        write = getattr(kind_of(obj), "mitsuba", None)  # optional for a plugin kind
+        if write is None or write(obj, sw) is None:
             left.append(f"{obj.kind}: object kind not exported to Mitsuba 3")
     # lights
     black = {"type": "diffuse", "reflectance": rgb((0.0, 0.0, 0.0))}

@@ -227,7 +227,8 @@ class Writer:
         """The object's SDL, written by its kind's ``povray(o, w, in_csg)`` (shape in object
         space, texture, ``matrix``); a kind that cannot express the object returns None and
         it is left out (noted)."""
-        sdl = kind_of(o).povray(o, self, in_csg)
+        write = getattr(kind_of(o), "povray", None)  # optional for a plugin kind
+        sdl = None if write is None else write(o, self, in_csg)
         if sdl is None:
             self.leave(f"{o.kind}: object kind not exported to POV-Ray")
             return ""

@@ -60,6 +60,7 @@ import numpy as np
 from ..core.errors import WorkbenchError
 from ..scene import features as ft
 from ..scene.model import AREA_LIGHT_PREFIX, AreaLight, Camera, Environment, Material, Scene
+from ..scene.kinds import KINDS
 from ..scene.parts import Part
 from ..scene.prepared import prepare
 from ..scene.tessellate import (DEFAULT_LEVEL, MAX_LEVEL, NORMAL_RULES, area_light_parts, tessellate_scene,
@@ -76,8 +77,6 @@ from . import raster_standins as sti
 DEPTH_CHOICES = (16, 24, 32)
 #: Varying interpolation: GL's perspective-correct one, or the course's screen-space scanline.
 INTERPOLATIONS = ("perspective", "screen")
-#: Object kinds tessellated as closed, outward-wound surfaces.
-CLOSED_KINDS = ("sphere", "box", "csg", "blob", "isosurface", "prism")
 #: Texture units of the image samplers.
 UNITS = {"u_tex_image": 0, "u_bump_image": 1, "u_op_image": 2, "u_env_image": 3, "u_env_cube": 4,
          "u_shadow_atlas": 5, "u_env_depth": 6}
@@ -89,6 +88,13 @@ NOT_RASTER = {
     ft.REFRACTION: "refraction needs ray tracing (transmissive surfaces drawn with their local model)",
     ft.ABSORPTION: "absorption needs ray tracing",
 }
+
+
+def _closed(kind: str) -> bool:
+    """Whether a part of this kind is a closed, outward-wound surface (the kind's
+    ``CLOSED_TESSELLATION``; False for parts that are no object kind, e.g. an area light's)."""
+    k = KINDS.get(kind)
+    return k is not None and k.CLOSED_TESSELLATION
 
 
 def _set(prog, name: str, value) -> None:
@@ -874,7 +880,7 @@ class RasterSession:
             for d in blended:
                 # closed solids seen from outside their box: only their front faces (the back
                 # ones would blend in twice); from inside, the inner (back) faces are the surface
-                if d.part.kind in CLOSED_KINDS and _beyond_near(camera, [_box_corners(d.part.positions)], near)[0]:
+                if _closed(d.part.kind) and _beyond_near(camera, [_box_corners(d.part.positions)], near)[0]:
                     ctx.enable(moderngl.CULL_FACE)
                 if d.tint is not None:
                     # stand-in transparency: behind *= kt C, then + the surface's own light

@@ -43,9 +43,9 @@ if sys.argv[1] == "blob":
     geo = geo._replace(kinds=kinds_marker(["blob", "prim_tree"]))
 first_hit(geo, k.scratch())
 compiled = {name: len(f.signatures) for name, f in [
-    ("blob", blob_kernels.blob_first), ("isosurface", isosurface_kernels.iso_first),
-    ("lathe", lathe_kernels.lathe_first), ("prism", prism_kernels.prism_first), ("csg", k.csg_hit)]}
-apart = [blob_kernels.blob_first, blob_kernels.blob_crossings]
+    ("blob", blob_kernels.first), ("isosurface", isosurface_kernels.first),
+    ("lathe", lathe_kernels.first), ("prism", prism_kernels.first), ("csg", k.csg_hit)]}
+apart = [blob_kernels.first, blob_kernels.blob_crossings]
 inlined = sorted(f.py_func.__name__ for f in apart for cres in f.overloads.values() if cres.fndesc.inline)
 print(json.dumps({"compiled": compiled, "inlined": inlined}))
 '''

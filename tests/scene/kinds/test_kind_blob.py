@@ -50,7 +50,7 @@ def test_one_component_is_a_sphere(s, T):
         P = O + t * D
         assert np.allclose(n, (P - c) / R, rtol=0, atol=REL)
         head, aux = B.params(b, 0)
-        nn = np.array(BK.blob_normal(table(head), 0, aux, 0, *P, scratch()[2]))
+        nn = np.array(BK.normal(table(head), 0, aux, 0, *P, scratch()[2]))
         assert np.allclose(nn / np.linalg.norm(nn), n, rtol=0, atol=1e-12)
 
 
@@ -80,7 +80,7 @@ def test_numba_twin_agrees_and_crossings_alternate():
         assert len(got) == len(ref)
         assert np.allclose(got, [t for t, _ in ref], rtol=1e-12, atol=1e-12)
         assert_alternates(ref, lambda t: bool(B.inside(TWO, O + t * D)))
-        assert all(BK.blob_inside(par, 0, aux, *(O + t * D), scratch()[2]) == B.inside(TWO, O + t * D)
+        assert all(BK.inside(par, 0, aux, *(O + t * D), scratch()[2]) == B.inside(TWO, O + t * D)
                    for t in rng.uniform(-5, 5, 4))
         hit += bool(ref)
         for t, _ in ref:      # the field is the threshold on the surface

@@ -95,7 +95,7 @@ def test_sphere_hits_and_normals():
         t, n = I.intersect(s, O, D)
         assert np.allclose(n, O + t * D, rtol=0, atol=REL)
         head, aux = I.params(s, 0)
-        nn = np.array(IK.iso_normal(table(head), 0, aux, 0, *(O + t * D), np.zeros((MAX_STACK, 4))))
+        nn = np.array(IK.normal(table(head), 0, aux, 0, *(O + t * D), np.zeros((MAX_STACK, 4))))
         assert np.allclose(nn / np.linalg.norm(nn), n, rtol=0, atol=1e-12)
 
 
@@ -202,4 +202,4 @@ def test_no_gradient_gives_a_zero_normal_not_nan():
     s = _iso("sqrt(x^2 + y^2 + z^2)", 1.0, 1.0, (-2,) * 3, (2,) * 3)
     assert I.normal(s, 0, np.zeros(3)).tolist() == [0.0, 0.0, 0.0]
     head, aux = I.params(s, 0)
-    assert IK.iso_normal(table(head), 0, aux, 0, 0.0, 0.0, 0.0, np.zeros((MAX_STACK, 4))) == (0.0, 0.0, 0.0)
+    assert IK.normal(table(head), 0, aux, 0, 0.0, 0.0, 0.0, np.zeros((MAX_STACK, 4))) == (0.0, 0.0, 0.0)

@@ -24,8 +24,8 @@ def _lathe(points):
 def _first(la, O, D, tmin=0.0, tmax=np.inf):
     head, aux = L.params(la, 0)
     par = table(head)
-    t, f = LK.lathe_first(par, 0, aux, *map(float, O), *map(float, D), tmin, tmax, *scratch())
-    n = LK.lathe_normal(par, 0, aux, f, *(O + t * D), scratch()[2]) if t < np.inf else None
+    t, f = LK.first(par, 0, aux, *map(float, O), *map(float, D), tmin, tmax, *scratch())
+    n = LK.normal(par, 0, aux, f, *(O + t * D), scratch()[2]) if t < np.inf else None
     return t, f, n
 
 
@@ -77,13 +77,13 @@ def test_closed_cup_is_a_solid():
         O = rng.normal(size=3) * 3
         D = rng.normal(size=3) * 0.5 + [0, 1, 0] - O
         ref = L.crossings(la, O, D)
-        n = LK.lathe_events(par, 0, aux, *O, *D, ot, of, 32, scratch()[2])
+        n = LK.events(par, 0, aux, *O, *D, ot, of, 32, scratch()[2])
         assert np.allclose(ot[:n], [t for t, _ in ref], rtol=1e-13, atol=0) and of[:n].tolist() == [f for _, f in ref]
         assert_alternates(ref, lambda t: bool(L.inside(la, O + t * D)))
         for t, f in ref[::2]:       # entering: the outward normal faces the ray
             assert L.normal(la, f, O + t * D) @ D < 0
         p = rng.normal(size=3)
-        assert LK.lathe_inside(par, 0, aux, *p, scratch()[2]) == L.inside(la, p)
+        assert LK.inside(par, 0, aux, *p, scratch()[2]) == L.inside(la, p)
         hits += bool(ref)
     assert hits > 200
 

@@ -32,8 +32,8 @@ def _lathe(points, spline):
 def _first(la, O, D):
     head, aux = L.params(la, 0)
     par = table(head)
-    t, f = LK.lathe_first(par, 0, aux, *map(float, O), *map(float, D), 0.0, np.inf, *scratch())
-    n = np.array(LK.lathe_normal(par, 0, aux, f, *(O + t * D), scratch()[2])) if t < np.inf else None
+    t, f = LK.first(par, 0, aux, *map(float, O), *map(float, D), 0.0, np.inf, *scratch())
+    n = np.array(LK.normal(par, 0, aux, f, *(O + t * D), scratch()[2])) if t < np.inf else None
     return t, n
 
 
@@ -129,17 +129,17 @@ def test_numba_twin_and_solid(points, spline):
         if i % 10 == 0:
             D[1] = 0.0 if i % 20 == 0 else 1e-6 * D[0]     # horizontal and nearly horizontal
         ref = L.crossings(la, O, D)
-        n = LK.lathe_events(par, 0, aux, *O, *D, ot, of, 64, scratch()[2])
+        n = LK.events(par, 0, aux, *O, *D, ot, of, 64, scratch()[2])
         assert np.allclose(ot[:n], [t for t, _ in ref], rtol=1e-12, atol=0) and of[:n].tolist() == [f for _, f in ref]
         assert_alternates(ref, lambda t: bool(L.inside(la, O + t * D)))
         for t, f in ref:
             nr = L.normal(la, f, O + t * D)
-            nn = LK.lathe_normal(par, 0, aux, f, *(O + t * D), scratch()[2])
+            nn = LK.normal(par, 0, aux, f, *(O + t * D), scratch()[2])
             assert np.allclose(nn, nr, atol=1e-9)
         for t, f in ref[::2]:       # entering: the outward normal faces the ray
             assert L.normal(la, f, O + t * D) @ D < 0
         p = rng.normal(size=3)
-        assert LK.lathe_inside(par, 0, aux, *p, scratch()[2]) == L.inside(la, p)
+        assert LK.inside(par, 0, aux, *p, scratch()[2]) == L.inside(la, p)
         hits += bool(ref)
     assert hits > 60
 

@@ -53,13 +53,13 @@ def test_square_is_a_box(clockwise):
         D = rng.uniform(lo, hi) - O + rng.normal(size=3)
         want_t, want_n = _slab(lo, hi, O, D)
         t, n = R.intersect(p, O, D)
-        nt, nf = RK.prism_first(par, 0, aux, *O, *D, 0.0, np.inf, *scratch())
+        nt, nf = RK.first(par, 0, aux, *O, *D, 0.0, np.inf, *scratch())
         if want_t == np.inf:
             assert t == np.inf and nt == np.inf
             continue
         hit += 1
         assert t == pytest.approx(want_t, rel=REL) and nt == pytest.approx(want_t, rel=REL)
-        assert np.allclose(n, want_n, atol=1e-15) and np.allclose(RK.prism_normal(par, 0, aux, nf, *(O + nt * D), scratch()[2]), want_n, atol=1e-15)
+        assert np.allclose(n, want_n, atol=1e-15) and np.allclose(RK.normal(par, 0, aux, nf, *(O + nt * D), scratch()[2]), want_n, atol=1e-15)
     assert hit > 150
 
 
@@ -73,13 +73,13 @@ def test_concave_star_is_a_solid():
         O = rng.normal(size=3) * 2
         D = rng.normal(size=3) * 0.5 - O
         ref = R.crossings(p, O, D)
-        n = RK.prism_events(par, 0, aux, *O, *D, ot, of, 32, scratch()[2])
+        n = RK.events(par, 0, aux, *O, *D, ot, of, 32, scratch()[2])
         assert np.allclose(ot[:n], [t for t, _ in ref], rtol=1e-13, atol=0) and of[:n].tolist() == [f for _, f in ref]
         assert_alternates(ref, lambda t: bool(R.inside(p, O + t * D)))
         for t, f in ref[::2]:
             assert R.normal(p, f) @ D < 0
         q = rng.normal(size=3) * 0.7
-        assert RK.prism_inside(par, 0, aux, *q, scratch()[2]) == R.inside(p, q)
+        assert RK.inside(par, 0, aux, *q, scratch()[2]) == R.inside(p, q)
 
 
 def test_ray_through_a_vertex_enters_once():
@@ -98,7 +98,7 @@ def test_scale_invariance():
         got = [t for t, _ in R.crossings(p, k * O, D)]
         assert np.allclose(np.array(got) / k, base, rtol=REL, atol=0)
         head, aux = R.params(p, 0)
-        assert RK.prism_first(table(head), 0, aux, *(k * O), *D, 0.0, np.inf, *scratch())[0] / k == pytest.approx(base[0], rel=REL)
+        assert RK.first(table(head), 0, aux, *(k * O), *D, 0.0, np.inf, *scratch())[0] / k == pytest.approx(base[0], rel=REL)
 
 
 def test_tessellation_is_closed_with_the_right_volume():

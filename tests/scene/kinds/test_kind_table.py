@@ -30,13 +30,13 @@ def _first(ptype, par, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, stack):
     for k in range(ptype.shape[0]):
         kind = ptype[k]
         if kind == blob.PTYPE:
-            t, f = blob_kernels.blob_first(par, k, aux, ox, oy, oz, dx, dy, dz, 0.0, best, out_t, out_f, stack)
+            t, f = blob_kernels.first(par, k, aux, ox, oy, oz, dx, dy, dz, 0.0, best, out_t, out_f, stack)
         elif kind == isosurface.PTYPE:
-            t, f = isosurface_kernels.iso_first(par, k, aux, ox, oy, oz, dx, dy, dz, 0.0, best, out_t, out_f, stack)
+            t, f = isosurface_kernels.first(par, k, aux, ox, oy, oz, dx, dy, dz, 0.0, best, out_t, out_f, stack)
         elif kind == lathe.PTYPE:
-            t, f = lathe_kernels.lathe_first(par, k, aux, ox + 3.0, oy, oz, dx, dy, dz, 0.0, best, out_t, out_f, stack)
+            t, f = lathe_kernels.first(par, k, aux, ox + 3.0, oy, oz, dx, dy, dz, 0.0, best, out_t, out_f, stack)
         else:
-            t, f = prism_kernels.prism_first(par, k, aux, ox, oy, oz, dx, dy, dz, 0.0, best, out_t, out_f, stack)
+            t, f = prism_kernels.first(par, k, aux, ox, oy, oz, dx, dy, dz, 0.0, best, out_t, out_f, stack)
         if t < best:
             best, bk, bf = t, k, f
     return best, bk, bf
@@ -80,7 +80,7 @@ def test_nearest_hit_over_a_mixed_table():
 def test_events_of_each_row_match_the_readable_crossings():
     ptype, par, aux = _table()
     rng = np.random.default_rng(10)
-    events = [blob_kernels.blob_events, isosurface_kernels.iso_events, lathe_kernels.lathe_events, prism_kernels.prism_events]
+    events = [blob_kernels.events, isosurface_kernels.events, lathe_kernels.events, prism_kernels.events]
     mods = [blob, isosurface, lathe, prism]
     for k, obj in enumerate(OBJECTS):
         for _ in range(20):

@@ -9,13 +9,14 @@ import pytest
 
 from workbench.scene import features, model as m
 from workbench.scene.io import SceneError, scene_from_dict
-from workbench.scene.kinds import KINDS, crossings, kind_of
+from workbench.scene.kinds import KERNEL_FUNCTIONS, KERNEL_PTYPES_FROM, KINDS, crossings, kernel_module, kind_of
 
 LEAF = ("parse", "bound_points", "tessellate", "patch_surfaces", "flatten", "inside", "povray", "mitsuba")
 SOLID = ("solid_mesh", "analytic_normals")
 COMPOSITE = ("parse", "children", "tessellate", "patch_surfaces", "flatten", "crossings",
              "containing", "world_bounds", "povray", "mitsuba")
-CONSTANTS = ("TYPE", "MODEL", "FEATURE", "PTYPE", "SOLID", "CONVEX", "COMPOSITE", "KEYS", "REQUIRED")
+CONSTANTS = ("TYPE", "MODEL", "FEATURE", "PTYPE", "SOLID", "CONVEX", "COMPOSITE", "CLOSED_TESSELLATION",
+             "KERNELS", "KEYS", "REQUIRED")
 
 
 @pytest.mark.parametrize("name", sorted(KINDS))
@@ -38,6 +39,15 @@ def test_ptypes_are_unique_and_match_the_kernels():
     assert (shapes.SPHERE, shapes.RECT, shapes.BOX, shapes.POLYGON, shapes.QUADRIC,
             intersect.CSGNODE) == tuple(KINDS[n].PTYPE for n in ("sphere", "plane", "box", "polygon",
                                                                  "quadric", "csg"))
+
+
+@pytest.mark.parametrize("name", sorted(KINDS))
+def test_a_kind_has_a_kernel_module_exactly_when_the_kernels_do_not_know_it(name):
+    k = KINDS[name]
+    assert (k.KERNELS is not None) == (k.PTYPE >= KERNEL_PTYPES_FROM)
+    module = kernel_module(k)
+    if module is not None:
+        assert all(callable(getattr(module, f, None)) for f in KERNEL_FUNCTIONS)
 
 
 def _scene(objects):

@@ -9,9 +9,14 @@ compiled for it, is specialised to that set (:mod:`.specialise`).
 """
 from __future__ import annotations
 
+import hashlib
+import inspect
+from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
+
+from ...scene.kinds import PACKAGE_KINDS, kernel_kinds, kernel_module
 
 MAX_DEPTH = 60
 """Deepest binary level of a BVH build (``raytrace.bvh``): a node there is a leaf whatever its
@@ -20,37 +25,55 @@ It bounds the traversal stacks: radiosity's visibility test keeps one pending ch
 level, the 4-wide walks at most three per level (``walks.BVH_STACK``), so neither ever drops
 a node."""
 
-FEATURES = ("blob", "isosurface", "lathe", "prism", "csg", "triangles", "prim_tree")
-"""What a kernel compiles only when the scene has it: the kinds with kernels of their own
-(``workbench.scene.kinds.*_kernels``), CSG programs, the triangles' BVH walk and the analytic
-primitives' tree walk."""
+GROUPS = ("csg", "triangles", "prim_tree")
+"""What a kernel compiles only when the scene has it, besides the kinds with kernel modules of
+their own: CSG programs, the triangles' BVH walk and the analytic primitives' tree walk."""
 
 
-def kinds_marker(features) -> np.ndarray:
+def marker_name(kind) -> str:
+    """A kind's field in the kind marker: its ``TYPE`` for the package's kinds; a plugin's
+    ``TYPE`` and a digest of its two modules' sources, so that a kernel compiled, and cached,
+    for an older version of a plugin is never reused (the package's own kernel sources key the
+    whole cache folder, :mod:`workbench.core.jit_cache`)."""
+    if kind.TYPE in PACKAGE_KINDS:
+        return kind.TYPE
+    h = hashlib.sha256()
+    for module in (kind, kernel_module(kind)):
+        h.update(Path(inspect.getfile(module)).read_bytes())
+    return f"{kind.TYPE}_{h.hexdigest()[:12]}"
+
+
+def features() -> tuple[str, ...]:
+    """Every name a kind marker may hold, in marker order: the kinds with kernel modules of
+    their own (:func:`marker_name`, registry order), then :data:`GROUPS`."""
+    return tuple(marker_name(k) for k in kernel_kinds()) + GROUPS
+
+
+def kinds_marker(present) -> np.ndarray:
     """An empty array whose structured dtype has one field per feature present (field order
-    fixed by :data:`FEATURES`; a field ``base`` always, so that the dtype is never empty).
+    that of :func:`features`; a field ``base`` always, so that the dtype is never empty).
 
     Parameters
     ----------
-    features : iterable of names from :data:`FEATURES`.
+    present : iterable of names from :func:`features`.
 
     Returns
     -------
     (0,) structured array; its numba type names the features, nothing else.
     """
-    wanted = set(features)
-    unknown = wanted - set(FEATURES)
+    wanted, known = set(present), features()
+    unknown = wanted - set(known)
     if unknown:
-        raise ValueError(f"unknown kernel features {sorted(unknown)}; known: {', '.join(FEATURES)}")
-    names = ["base"] + [f for f in FEATURES if f in wanted]
+        raise ValueError(f"unknown kernel features {sorted(unknown)}; known: {', '.join(known)}")
+    names = ["base"] + [f for f in known if f in wanted]
     return np.zeros(0, dtype=np.dtype([(n, np.uint8) for n in names]))
 
 
 def marker_features(kinds) -> tuple[str, ...]:
-    """The features a marker (:func:`kinds_marker`, or its numba type) names."""
+    """The features a marker (:func:`kinds_marker`, or its numba type) names, in its order."""
     dtype = kinds.dtype
     fields = dtype.fields if isinstance(dtype.fields, dict) else dict(dtype.fields)
-    return tuple(f for f in FEATURES if f in fields)
+    return tuple(f for f in fields if f != "base")
 
 
 class Geometry(NamedTuple):

@@ -11,13 +11,11 @@ import numba as nb
 import numpy as np
 
 from ...core.tol import tol
-from ...scene.kinds import BOX, POLYGON, QUADRIC, RECT, SPHERE
-from ...scene.kinds import blob, isosurface, lathe, prism
+from ...scene.kinds import BOX, KERNEL_PTYPES_FROM, POLYGON, QUADRIC, RECT, SPHERE
 from ...scene.kinds.csg import CSG_DIFFERENCE, CSG_INTERSECTION, CSG_UNION
 from .flags import INLINE, NO_REFCOUNT
 from .specialise import exotic_events, exotic_first, exotic_normal
 
-BLOB, ISOSURFACE, LATHE, PRISM = blob.PTYPE, isosurface.PTYPE, lathe.PTYPE, prism.PTYPE
 CSG_EVENTS = 32
 """Events (entries and exits) a CSG operand's interval list holds."""
 TOL_CUT = tol.cut
@@ -206,7 +204,7 @@ def prim_hit(kinds, k, ptype, par, poly_v, aux, ox, oy, oz, dx, dy, dz, ux, uy, 
              zero, out_t, out_f, stack):
     """Closest hit ``tmin < t < tmax`` of analytic primitive ``k`` (object-space ray with
     direction ``d``; spheres use its unit direction ``u`` and ``inv_s = 1 / |d|``).  The
-    kinds with variable-length data (blob, isosurface, lathe, prism: :mod:`workbench.scene.kinds`)
+    kinds with kernel modules of their own (``KERNELS``: :mod:`workbench.scene.kinds`)
     read it from ``aux`` and use the scratch ``out_t``, ``out_f``, ``stack``.
     Returns ``(t, face)``, ``t = inf`` on a miss."""
     kind = ptype[k]
@@ -242,7 +240,7 @@ def prim_hit(kinds, k, ptype, par, poly_v, aux, ox, oy, oz, dx, dy, dz, ux, uy, 
         return _polygon_hit(k, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax)
     if kind == QUADRIC:
         return _quadric_hit(k, par, ox, oy, oz, dx, dy, dz, tmin, tmax, zero)
-    # blob, isosurface, lathe, prism: compiled only for a scene that has them
+    # the kinds with kernel modules of their own: compiled only for a scene that has them
     return exotic_first(kinds, kind, par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack)
 
 
@@ -402,7 +400,7 @@ def csg_hit(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy,
 def object_normal(kinds, k, face, ptype, par, aux, x, y, z, stack):
     """Outward normal (unnormalised) of primitive ``k`` at object-space point, by face."""
     kind = ptype[k]
-    if kind == BLOB or kind == ISOSURFACE or kind == LATHE or kind == PRISM:
+    if kind >= KERNEL_PTYPES_FROM:
         return exotic_normal(kinds, kind, par, k, aux, face, x, y, z, stack)
     if face >= 1 and (kind == BOX or kind == QUADRIC):
         a = (face - 1) // 2

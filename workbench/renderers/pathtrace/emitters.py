@@ -96,9 +96,11 @@ def _prim_triangles(sd: SceneData, k: int):
         return np.stack(out)
     return None
 
-KIND_NAMES = {k.PTYPE: k.TYPE for k in KINDS.values()}
-"""ptype -> the kind's name in scene files (every registered kind: an emissive blob, lathe,
-prism or isosurface named a ptype past a hand-written list of six and raised IndexError)."""
+def kind_name(ptype: int) -> str:
+    """The scene-file name of the kind of a ``ptype`` (every registered kind, plugins included:
+    an emissive blob, lathe, prism or isosurface named a ptype past a hand-written list of six
+    and raised IndexError)."""
+    return next((k.TYPE for k in KINDS.values() if k.PTYPE == ptype), "primitive")
 
 
 def build_emitters(sd: SceneData) -> Emitters:
@@ -114,7 +116,7 @@ def build_emitters(sd: SceneData) -> Emitters:
         t = _prim_triangles(sd, k)
         if t is None:
             unsampled.append(f"primitive {k} (object {sd.obj[k]}): an emissive "
-                             f"{KIND_NAMES.get(int(sd.ptype[k]), 'primitive')} "
+                             f"{kind_name(int(sd.ptype[k]))} "
                              "is found by BSDF sampling only (no next-event estimation)")
             continue
         tris.append(t)

@@ -13,7 +13,7 @@ import numpy as np
 
 from ...core.errors import NotApplicable, WorkbenchError
 from ...scene import features as ft
-from ...scene.kinds import containing, kind_of
+from ...scene.kinds import KINDS, containing, kind_of
 from ...scene.model import Scene
 from ...scene.prepared import prepare
 from ..base import Knob, Option, RenderResult
@@ -22,8 +22,9 @@ from .formfactors import FormFactors, compute
 from .patches import PatchSet, patches_from_scene
 
 #: features radiosity builds, and why it leaves out each of the others
-HANDLED = {ft.EMITTERS, ft.AREA_LIGHTS, ft.POLYGONS, ft.PLANES, ft.BOXES, ft.MESHES, ft.SPHERES,
-           ft.QUADRICS, ft.CSG, ft.TRANSFORMS, ft.SHADOWS, ft.BLOBS, ft.ISOSURFACES, ft.LATHES, ft.PRISMS}
+#: (and every object kind's feature: a kind is cut into patches, from its tessellation if it
+#: has no ``patch_surfaces``; :func:`handled`)
+HANDLED = {ft.EMITTERS, ft.AREA_LIGHTS, ft.TRANSFORMS, ft.SHADOWS}
 REASONS = {
     ft.POINT_LIGHTS: "radiosity only knows emitting surfaces (area lights, emissive materials)",
     ft.DIRECTIONAL_LIGHTS: "radiosity only knows emitting surfaces (area lights, emissive materials)",
@@ -38,6 +39,11 @@ REASONS = {
     ft.OPACITY: "patches are opaque",
     ft.ENVIRONMENT: "radiosity has no environment light",
 }
+
+
+def handled() -> set[str]:
+    """:data:`HANDLED` and the features of every registered object kind."""
+    return HANDLED | {k.FEATURE for k in KINDS.values()}
 
 
 def common_options() -> dict[str, Option]:
@@ -201,7 +207,7 @@ def solve_scene(scene: Scene, opts: dict, method: str) -> Solution:
     timings["patches"] = time.perf_counter() - t0
     needs = ft.scene_needs(scene)
     left_out = left_out + [f"{f}: {REASONS.get(f, 'not used by radiosity')}"
-                           for f in sorted(needs - HANDLED)]
+                           for f in sorted(needs - handled())]
     if len(patches) == 0 or not (patches.emission > 0).any():
         raise NotApplicable(f"{method}: the scene has no emitters (no area light and no emissive "
                             "material): radiosity has nothing to distribute")
@@ -234,7 +240,7 @@ def solve_scene(scene: Scene, opts: dict, method: str) -> Solution:
     stats.update({"iterations": res.iterations, "converged": res.converged,
                   "solver_message": res.message, "error_bound": res.error_bound,
                   "residual_history": [float(x) for x in res.residuals[-50:]]})
-    used = sorted((needs & HANDLED) | {ft.EMITTERS})
+    used = sorted((needs & handled()) | {ft.EMITTERS})
     return Solution(patches, np.asarray(res.display), stats, timings, left_out, used)
 
 

@@ -254,8 +254,9 @@ def _surfaces(scene: m.Scene, h: float) -> tuple[list, list[str]]:
         name = obj.name or f"{obj.kind}_{i}"
         mat = scene.material_of(obj)
         emis = np.asarray(mat.emission, dtype=np.float64)
-        surfaces = kind_of(obj).patch_surfaces(obj, obj.world_from_object, h)
-        if surfaces is None:  # curved: one patch per triangle of its tessellation
+        cut = getattr(kind_of(obj), "patch_surfaces", None)  # optional for a plugin kind
+        surfaces = None if cut is None else cut(obj, obj.world_from_object, h)
+        if surfaces is None:  # curved (or a plugin kind): one patch per triangle of its tessellation
             try:
                 parts = _curved(obj, h)
             except WorkbenchError as e:

@@ -32,12 +32,11 @@ import numpy as np
 from ...core.tol import tol
 from ...core.transform import transform_normals
 from ...scene import model as m
-from ...scene.kinds import kind_of
-from ...scene.kinds import blob, isosurface, lathe, prism
+from ...scene.kinds import PACKAGE_KINDS, kernel_kinds, kind_of
 from ...scene.kinds.csg import CSGNODE
 from ...scene.prepared import PreparedScene, prepare
 from ..kernels.columns import LIGHT_COLS, Light, Mat, pack
-from ..kernels.layout import Geometry, kinds_marker
+from ..kernels.layout import Geometry, kinds_marker, marker_name
 
 if TYPE_CHECKING:
     from .accel import PrimTree
@@ -51,11 +50,6 @@ SHADOW_CROSSINGS = 32
 """Surfaces a shadow feeler goes on through (transmissive with ``transmissive_shadows``, cut out
 or partly opaque by an opacity map) before it stops with the visibility gathered so far."""
 NPAR = 20
-_KERNEL_KINDS = (("blob", blob.PTYPE), ("isosurface", isosurface.PTYPE), ("lathe", lathe.PTYPE),
-                 ("prism", prism.PTYPE))
-"""The kinds with kernels of their own, by feature name (:data:`..kernels.layout.FEATURES`)."""
-EXTENDED_PTYPES = frozenset([code for _, code in _KERNEL_KINDS] + [CSGNODE])
-"""Rows that make a scene compile the extended kinds' kernels (:meth:`SceneData.features`)."""
 _IDENTITY_ROWS = np.eye(4)[:3].reshape(-1)
 
 
@@ -97,15 +91,19 @@ class SceneData:
     program, lathe profiles, prism polygons), flat float64; each row holds its offset."""
 
     def features(self) -> tuple[str, ...]:
-        """What the kernels compile for this scene (:data:`..kernels.layout.FEATURES`), in
-        two groups, so that all scenes together need at most four compiled variants of each
-        kernel: the extended kinds (blob, isosurface, lathe, prism, CSG: all five if the scene
-        has any of them among its rows, CSG leaves included) and the triangles' tree (if the
-        scene has triangles).  The analytic primitives' tree walk is always compiled."""
+        """What the kernels compile for this scene (:func:`..kernels.layout.features`), in
+        groups, so that all scenes of the package's kinds together need at most four compiled
+        variants of each kernel: the extended kinds (the package's kinds with kernel modules of
+        their own, and CSG: all of them if the scene has any among its rows, CSG leaves
+        included), each plugin kind the scene has (:func:`workbench.scene.kinds.register`),
+        and the triangles' tree (if the scene has triangles).  The analytic primitives' tree
+        walk is always compiled."""
         present = {int(p) for p in np.unique(self.ptype)}
+        package = [k for k in kernel_kinds() if k.TYPE in PACKAGE_KINDS]
         out = []
-        if present & EXTENDED_PTYPES:
-            out += [name for name, _ in _KERNEL_KINDS] + ["csg"]
+        if present & ({k.PTYPE for k in package} | {CSGNODE}):
+            out += [k.TYPE for k in package] + ["csg"]
+        out += [marker_name(k) for k in kernel_kinds() if k.TYPE not in PACKAGE_KINDS and k.PTYPE in present]
         if len(self.tri_v):
             out.append("triangles")
         return tuple(out) + ("prim_tree",)

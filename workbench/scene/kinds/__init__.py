@@ -1,11 +1,17 @@
 """Object kinds as plugins (pbrt-v4's ``Shape::Create``, Mitsuba 3's plugins): one module per
 kind of ``[[objects]]`` table, and :data:`KINDS`, the registry by scene-file ``type`` name.
 
-Adding a kind = one new module here + one line in :data:`KINDS` (+ its case in the kernels'
-dispatch over ``ptype``: :mod:`workbench.renderers.kernels.specialise` for a kind with kernels
-of its own, compiled only for scenes that have it, and the feature name that marks it,
-:data:`workbench.renderers.kernels.layout.FEATURES`).  Renderers ask the
-registry (:func:`kind_of`) instead of testing classes.  Kind modules are in the scene layer:
+A kind is two files and one registry line: its scene module (this page's contract below) and,
+for a kind the kernels do not know, its kernel module (``KERNELS``: ``first``, ``events``,
+``normal``), plus its entry in :data:`KINDS`, or :func:`register` for a kind defined outside
+the package (a plugin; ``tests/scene/kinds/toy_disk.py`` is one).  Everything else reads the
+registry: the scene reader, the needs manifest (``FEATURE``), the ray tracer's table
+(``flatten``) and the kernels' dispatch (:mod:`workbench.renderers.kernels.specialise`, which
+compiles a kind's kernels only for a scene that has it), the raster (``tessellate``,
+``CLOSED_TESSELLATION``), radiosity (``patch_surfaces``, else the tessellation), the path
+tracer's emitters and the exporters (``povray``, ``mitsuba``: a kind without them is left out
+with the reason, never an error).  Renderers ask the registry (:func:`kind_of`) instead of
+testing classes.  Kind modules are in the scene layer:
 they import ``workbench.core``, the scene's :mod:`..model`, :mod:`..readers`, :mod:`..parts`,
 other kind modules, numpy and numba, never ``workbench.renderers`` nor this registry (a
 composite kind is handed the dispatch, see below).
@@ -24,6 +30,13 @@ Constants
                 lathe: solid when its profile is closed) also has ``solid(obj) -> bool``
                 (:func:`.csg.is_solid` asks it).
 ``CONVEX``      True when it cannot shadow itself (one such object alone needs no shadow rays).
+``CLOSED_TESSELLATION``  True when its triangles (``tessellate``) are a closed, outward-wound
+                surface (the raster then culls back faces of its blended objects seen from
+                outside).
+``KERNELS``     kinds the kernels do not know (``PTYPE >= KERNEL_PTYPES_FROM``): the dotted
+                name of its kernel module, which defines the numba functions ``first``,
+                ``events``, ``normal`` (and ``inside``) with the signatures of
+                :mod:`.crossing_events`.
 ``COMPOSITE``   True only for kinds made of other objects (CSG), see below.
 ``KEYS``, ``REQUIRED``  the keys of its table beside the common ones (``type``, ``material``,
                 ``transform``, ``name``, ``tessellation``), and which of them are required.
@@ -86,6 +99,7 @@ the writer's ``w.shape`` (the exporters' dispatch, handed over in ``w``).
 """
 from __future__ import annotations
 
+import importlib
 from types import MappingProxyType, ModuleType
 
 import numpy as np
@@ -94,9 +108,72 @@ from ...core.errors import WorkbenchError
 from .. import model as m
 from . import blob, box, csg, isosurface, lathe, mesh, plane, polygon, prism, quadric, sphere
 
-KINDS = MappingProxyType({k.TYPE: k for k in (sphere, plane, box, quadric, polygon, mesh, csg,
-                                              blob, isosurface, lathe, prism)})
-"""The registry: scene-file ``type`` name -> kind module."""
+_REGISTRY = {k.TYPE: k for k in (sphere, plane, box, quadric, polygon, mesh, csg, blob, isosurface, lathe, prism)}
+KINDS = MappingProxyType(_REGISTRY)
+"""The registry: scene-file ``type`` name -> kind module (the package's, then those added by
+:func:`register`)."""
+PACKAGE_KINDS = frozenset(_REGISTRY)
+"""The package's own kinds (the others are plugins)."""
+KERNEL_PTYPES_FROM = 7
+"""``ptype`` of the first kind with a kernel module of its own (``KERNELS``); the kinds below it
+(sphere, rectangle, box, polygon, quadric, CSG, mesh) are intersected by
+:mod:`workbench.renderers.kernels.shapes` itself."""
+CONTRACT = ("TYPE", "MODEL", "FEATURE", "PTYPE", "SOLID", "CONVEX", "COMPOSITE", "CLOSED_TESSELLATION",
+            "KEYS", "REQUIRED", "KERNELS", "parse", "bound_points", "tessellate", "flatten", "hits",
+            "normal", "inside")
+"""What a plugin kind's scene module defines (the module docstring says what each is)."""
+KERNEL_FUNCTIONS = ("first", "events", "normal")
+"""What its kernel module defines (numba functions, signatures of :mod:`.crossing_events`)."""
+
+
+def register(kind: ModuleType) -> ModuleType:
+    """Add a kind defined outside the package (a plugin) to :data:`KINDS`; returns it.
+
+    Raises WorkbenchError naming what is wrong: a name of :data:`CONTRACT` missing, a ``TYPE``,
+    ``FEATURE`` or ``PTYPE`` already taken, a ``PTYPE`` below :data:`KERNEL_PTYPES_FROM`, a
+    composite kind, or a kernel module that cannot be imported or lacks a name of
+    :data:`KERNEL_FUNCTIONS`.  Registering the same module again does nothing."""
+    where = f"kind module {getattr(kind, '__name__', kind)!r}"
+    missing = [n for n in CONTRACT if not hasattr(kind, n)]
+    if missing:
+        raise WorkbenchError(f"{where}: missing {', '.join(missing)} (see workbench.scene.kinds)")
+    if _REGISTRY.get(kind.TYPE) is kind:
+        return kind
+    if not isinstance(kind.PTYPE, int) or not KERNEL_PTYPES_FROM <= kind.PTYPE < 2 ** 31:
+        raise WorkbenchError(f"{where}: PTYPE must be an int >= {KERNEL_PTYPES_FROM}, got {kind.PTYPE!r}")
+    for other in _REGISTRY.values():
+        for attr in ("TYPE", "FEATURE", "PTYPE"):
+            if getattr(other, attr) == getattr(kind, attr):
+                raise WorkbenchError(f"{where}: {attr} {getattr(kind, attr)!r} is taken by kind {other.TYPE!r}")
+    if getattr(kind.MODEL, "kind", None) != kind.TYPE:
+        raise WorkbenchError(f"{where}: its MODEL's kind is {getattr(kind.MODEL, 'kind', None)!r}, not its TYPE {kind.TYPE!r}")
+    if kind.COMPOSITE:
+        raise WorkbenchError(f"{where}: composite kinds (made of other objects) cannot be plugins")
+    if not isinstance(kind.KERNELS, str):
+        raise WorkbenchError(f"{where}: KERNELS must be the dotted name of its kernel module, got {kind.KERNELS!r}")
+    module = kernel_module(kind)
+    lacking = [n for n in KERNEL_FUNCTIONS if not callable(getattr(module, n, None))]
+    if lacking:
+        raise WorkbenchError(f"{where}: its kernel module {kind.KERNELS!r} lacks {', '.join(lacking)}")
+    _REGISTRY[kind.TYPE] = kind
+    return kind
+
+
+def kernel_module(kind: ModuleType) -> ModuleType | None:
+    """The kernel module of a kind with one (``KERNELS``), None for the kinds the kernels know.
+    Raises WorkbenchError when it cannot be imported."""
+    name = getattr(kind, "KERNELS", None)
+    if name is None:
+        return None
+    try:
+        return importlib.import_module(name)
+    except ImportError as e:
+        raise WorkbenchError(f"kind {kind.TYPE!r}: cannot import its kernel module {name!r} ({e})") from None
+
+
+def kernel_kinds() -> tuple[ModuleType, ...]:
+    """The registered kinds with kernel modules of their own, in registry order."""
+    return tuple(k for k in _REGISTRY.values() if getattr(k, "KERNELS", None) is not None)
 
 SPHERE, RECT, BOX, POLYGON = sphere.PTYPE, plane.PTYPE, box.PTYPE, polygon.PTYPE
 QUADRIC, CSGNODE, MESH = quadric.PTYPE, csg.PTYPE, mesh.PTYPE

@@ -44,6 +44,8 @@ PTYPE = 7
 """Its ``ptype`` in the ray tracer's primitive table."""
 SOLID = True
 CONVEX = False
+CLOSED_TESSELLATION = True
+KERNELS = "workbench.scene.kinds.blob_kernels"
 COMPOSITE = False
 KEYS = frozenset({"threshold", "components"})
 REQUIRED = KEYS

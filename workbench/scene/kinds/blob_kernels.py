@@ -194,7 +194,7 @@ def blob_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out, cap):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def blob_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
+def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
     """Nearest hit ``tmin < t < tmax``: ``(t, 0)``, ``(inf, 0)`` on a miss."""
     if blob_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, 1) == 1:
         return out_t[0], 0
@@ -202,7 +202,7 @@ def blob_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, st
 
 
 @nb.njit(cache=True, error_model="numpy")
-def blob_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
+def events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
     """Interval list along the whole line (entering / leaving alternate); returns the count."""
     m = blob_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, -np.inf, np.inf, out_t, cap)
     for i in range(m):
@@ -211,7 +211,7 @@ def blob_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def blob_normal(par, k, aux, face, x, y, z, stack):
+def normal(par, k, aux, face, x, y, z, stack):
     """Outward normal -grad F at the object-space point (not normalised)."""
     off, n = int(par[k, 0]), int(par[k, 1])
     nx, ny, nz = 0.0, 0.0, 0.0
@@ -229,7 +229,7 @@ def blob_normal(par, k, aux, face, x, y, z, stack):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def blob_inside(par, k, aux, x, y, z, stack):
+def inside(par, k, aux, x, y, z, stack):
     """F(x, y, z) > T."""
     off, n = int(par[k, 0]), int(par[k, 1])
     F = 0.0

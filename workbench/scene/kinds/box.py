@@ -14,6 +14,8 @@ PTYPE = BOX = 2
 SOLID = True
 COMPOSITE = False
 CONVEX = True
+CLOSED_TESSELLATION = True
+KERNELS = None
 KEYS = frozenset({"min", "max"})
 REQUIRED = frozenset({"min", "max"})
 

@@ -7,15 +7,16 @@ entering and leaving that CSG needs.  Testing the point midway between consecuti
 crossings (and far before the first and after the last: outside, the solids are bounded)
 decides each one instead.
 
-Kernel entry points of the new kinds (blob, isosurface, lathe, prism) share one signature per
-role, so that the ray tracer's dispatch over ``ptype`` is one line per kind:
+A kind's kernel module (its ``KERNELS``: blob, isosurface, lathe, prism, any plugin) defines
+one function per role, by these names and signatures, so that the kernels' dispatch over
+``ptype`` (:mod:`workbench.renderers.kernels.specialise`) is generated from the registry:
 
-* ``<kind>_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack)
+* ``first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack)
   -> (t, face)``: nearest hit in ``(tmin, tmax)``, ``(inf, 0)`` on a miss;
-* ``<kind>_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack) -> count``:
+* ``events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack) -> count``:
   the interval list along the whole line (a CSG leaf);
-* ``<kind>_normal(par, k, aux, face, x, y, z, stack) -> (nx, ny, nz)``: outward, object space;
-* ``<kind>_inside(par, k, aux, x, y, z, stack) -> bool``.
+* ``normal(par, k, aux, face, x, y, z, stack) -> (nx, ny, nz)``: outward, object space;
+* ``inside(par, k, aux, x, y, z, stack) -> bool``.
 
 ``par`` is the (P, NPAR) parameter table and ``k`` the kind's row, ``aux`` the flat float64
 array of variable-length data (each row holds its offset and count); ``out_t`` (float64),

@@ -39,6 +39,8 @@ PTYPE = CSGNODE = 5
 SOLID = True
 COMPOSITE = True
 CONVEX = False
+CLOSED_TESSELLATION = True
+KERNELS = None
 KEYS = frozenset({"op", "left", "right"})
 REQUIRED = frozenset({"op", "left", "right"})
 CSG_UNION, CSG_INTERSECTION, CSG_DIFFERENCE = -1, -2, -3

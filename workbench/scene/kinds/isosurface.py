@@ -38,6 +38,8 @@ PTYPE = 8
 """Its ``ptype`` in the ray tracer's primitive table."""
 SOLID = True
 CONVEX = False
+CLOSED_TESSELLATION = True
+KERNELS = "workbench.scene.kinds.isosurface_kernels"
 COMPOSITE = False
 KEYS = frozenset({"function", "threshold", "max_gradient", "bounds"})
 REQUIRED = frozenset({"function", "max_gradient", "bounds"})

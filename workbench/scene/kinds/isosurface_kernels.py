@@ -99,7 +99,7 @@ def iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f,
 
 
 @nb.njit(cache=True, error_model="numpy")
-def iso_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
+def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
     """Nearest hit ``tmin < t < tmax``: ``(t, face)``, ``(inf, 0)`` on a miss."""
     if iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, 1, stack) == 1:
         return out_t[0], out_f[0]
@@ -107,13 +107,13 @@ def iso_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, sta
 
 
 @nb.njit(cache=True, error_model="numpy")
-def iso_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
+def events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
     """Interval list along the whole line (entering / leaving alternate); returns the count."""
     return iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, -np.inf, np.inf, out_t, out_f, cap, stack)
 
 
 @nb.njit(cache=True, error_model="numpy")
-def iso_normal(par, k, aux, face, x, y, z, stack):
+def normal(par, k, aux, face, x, y, z, stack):
     """Outward normal at the object-space point (not normalised); ``stack``: (depth, 4)
     scratch of the gradient evaluator."""
     if face >= 1:
@@ -127,7 +127,7 @@ def iso_normal(par, k, aux, face, x, y, z, stack):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def iso_inside(par, k, aux, x, y, z, stack):
+def inside(par, k, aux, x, y, z, stack):
     """f(x, y, z) < threshold inside the bounds."""
     if not (par[k, 4] <= x <= par[k, 7] and par[k, 5] <= y <= par[k, 8] and par[k, 6] <= z <= par[k, 9]):
         return False

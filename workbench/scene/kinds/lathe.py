@@ -49,6 +49,8 @@ PTYPE = 9
 SOLID = True
 """When its profile is closed (:func:`solid`); an open lathe is a sheet."""
 CONVEX = False
+CLOSED_TESSELLATION = False
+KERNELS = "workbench.scene.kinds.lathe_kernels"
 COMPOSITE = False
 KEYS = frozenset({"points", "spline"})
 REQUIRED = frozenset({"points"})

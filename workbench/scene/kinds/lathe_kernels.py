@@ -69,7 +69,7 @@ def _segment_roots(aux, j, ox, oy, oz, dx, dy, dz, zero):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def lathe_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
+def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
     """Nearest hit ``tmin < t < tmax``: ``(t, segment)``, ``(inf, 0)`` on a miss."""
     if par[k, 4] != 0.0:
         return _spline_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, stack)
@@ -87,7 +87,7 @@ def lathe_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, s
 
 
 @nb.njit(cache=True, error_model="numpy")
-def lathe_inside(par, k, aux, x, y, z, stack):
+def inside(par, k, aux, x, y, z, stack):
     """Even-odd test of ``(rho, y)`` against the closed profile."""
     if par[k, 2] == 0.0:
         return False
@@ -106,7 +106,7 @@ def lathe_inside(par, k, aux, x, y, z, stack):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def lathe_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
+def events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
     """Interval list of a closed lathe along the whole line (entering / leaving alternate),
     written to ``out_t``, ``out_f`` (segment); returns the count (hits past ``cap`` are
     dropped: a line meets at most two per segment)."""
@@ -129,7 +129,7 @@ def lathe_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
         if nxt == t:
             continue
         tm = 0.5 * (t + nxt)
-        after = nxt < np.inf and lathe_inside(par, k, aux, ox + tm * dx, oy + tm * dy, oz + tm * dz, stack)
+        after = nxt < np.inf and inside(par, k, aux, ox + tm * dx, oy + tm * dy, oz + tm * dz, stack)
         if after != status:
             out_t[w], out_f[w] = t, out_f[i]
             w += 1
@@ -138,7 +138,7 @@ def lathe_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def lathe_normal(par, k, aux, face, x, y, z, stack):
+def normal(par, k, aux, face, x, y, z, stack):
     """Normal of segment ``face`` at the object-space point (unit)."""
     if par[k, 4] != 0.0:
         return _spline_normal(par, k, aux, face, x, y, z, stack)

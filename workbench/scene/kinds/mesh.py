@@ -18,6 +18,8 @@ PTYPE = MESH = 6
 SOLID = True
 COMPOSITE = False
 CONVEX = False
+CLOSED_TESSELLATION = False
+KERNELS = None
 KEYS = frozenset({"path", "generate", "vertices", "faces", "crease_angle"})
 REQUIRED = frozenset()
 

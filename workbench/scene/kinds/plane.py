@@ -15,6 +15,8 @@ PTYPE = RECT = 1
 SOLID = False
 COMPOSITE = False
 CONVEX = True
+CLOSED_TESSELLATION = False
+KERNELS = None
 KEYS = frozenset({"point", "normal", "size", "u_axis"})
 REQUIRED = frozenset({"normal", "size"})
 

@@ -18,6 +18,8 @@ PTYPE = POLYGON = 3
 SOLID = False
 COMPOSITE = False
 CONVEX = True
+CLOSED_TESSELLATION = False
+KERNELS = None
 KEYS = frozenset({"vertices"})
 REQUIRED = frozenset({"vertices"})
 

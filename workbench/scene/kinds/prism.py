@@ -34,6 +34,8 @@ PTYPE = 10
 """Its ``ptype`` in the ray tracer's primitive table."""
 SOLID = True
 CONVEX = False
+CLOSED_TESSELLATION = True
+KERNELS = "workbench.scene.kinds.prism_kernels"
 COMPOSITE = False
 KEYS = frozenset({"polygon", "heights"})
 REQUIRED = KEYS

@@ -24,7 +24,7 @@ def _in_polygon_nb(aux, off, n, x, z):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def prism_inside(par, k, aux, x, y, z, stack):
+def inside(par, k, aux, x, y, z, stack):
     return par[k, 2] < y < par[k, 3] and _in_polygon_nb(aux, int(par[k, 0]), int(par[k, 1]), x, z)
 
 
@@ -65,7 +65,7 @@ def prism_hits(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, tmin, tma
 
 
 @nb.njit(cache=True, error_model="numpy")
-def prism_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
+def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
     """Nearest hit ``tmin < t < tmax``: ``(t, face)``, ``(inf, 0)`` on a miss."""
     off, n, y0, y1 = int(par[k, 0]), int(par[k, 1]), par[k, 2], par[k, 3]
     best, bf = tmax, -1
@@ -84,7 +84,7 @@ def prism_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, s
 
 
 @nb.njit(cache=True, error_model="numpy")
-def prism_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
+def events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
     """Interval list along the whole line (entering / leaving alternate); returns the count."""
     m = prism_hits(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, -np.inf, np.inf)
     sort_hits(out_t, out_f, m)
@@ -95,7 +95,7 @@ def prism_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
         if nxt == t:
             continue
         tm = 0.5 * (t + nxt)
-        after = nxt < np.inf and prism_inside(par, k, aux, ox + tm * dx, oy + tm * dy, oz + tm * dz, stack)
+        after = nxt < np.inf and inside(par, k, aux, ox + tm * dx, oy + tm * dy, oz + tm * dz, stack)
         if after != status:
             out_t[w], out_f[w] = t, out_f[i]
             w += 1
@@ -104,7 +104,7 @@ def prism_events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def prism_normal(par, k, aux, face, x, y, z, stack):
+def normal(par, k, aux, face, x, y, z, stack):
     """Unit outward normal of ``face``."""
     if face < 2:
         return 0.0, (1.0 if face == 1 else -1.0), 0.0

@@ -25,6 +25,8 @@ PTYPE = QUADRIC = 4
 SOLID = True
 COMPOSITE = False
 CONVEX = False
+CLOSED_TESSELLATION = False
+KERNELS = None
 KEYS = frozenset({"Q", "shape", "radii", "bounds"})
 REQUIRED = frozenset()
 SHAPES = ("ellipsoid", "cylinder", "cone", "hyperboloid", "hyperboloid2", "paraboloid")

@@ -14,6 +14,8 @@ PTYPE = SPHERE = 0
 SOLID = True
 COMPOSITE = False
 CONVEX = True
+CLOSED_TESSELLATION = True
+KERNELS = None
 KEYS = frozenset({"center", "radius"})
 REQUIRED = frozenset({"radius"})
 
