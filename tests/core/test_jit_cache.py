@@ -36,6 +36,26 @@ def test_an_edited_kind_kernel_gets_a_cache_folder_of_its_own(tmp_path):
     assert before.is_dir()                                      # the older version's cache is kept
 
 
+def test_an_edit_outside_the_kernel_sources_keeps_the_warm_cache(tmp_path):
+    src = tmp_path / "src"
+    shutil.copytree(ROOT / "workbench", src / "workbench", ignore=shutil.ignore_patterns("__pycache__"))
+    base = tmp_path / "numba"
+    before = _cache_dir(src, base)
+    raster = src / "workbench" / "renderers" / "raster.py"    # GLSL raster: no numba kernel reads it
+    raster.write_text(raster.read_text() + "\n# edited\n")
+    assert _cache_dir(src, base) == before
+    constants = src / "workbench" / "core" / "tol.py"          # read by the kernels as constants
+    constants.write_text(constants.read_text() + "\n# edited\n")
+    assert _cache_dir(src, base) != before
+
+
+def test_the_kernel_sources_are_the_numba_modules_and_what_they_import():
+    names = {str(p.relative_to(ROOT / "workbench")) for p in jit_cache.kernel_sources()}
+    assert {"renderers/raytrace/kernels.py", "renderers/kernels/intersect.py", "scene/kinds/lathe_kernels.py",
+            "scene/kinds/lathe.py", "core/tol.py", "renderers/kernels/specialise.py"} <= names
+    assert not names & {"renderers/raster.py", "app/cli.py", "compare/report.py"}
+
+
 def test_a_child_process_keeps_the_keyed_folder_and_old_ones_are_pruned(tmp_path):
     given = os.environ["NUMBA_CACHE_DIR"]
     try:
@@ -47,7 +67,7 @@ def test_a_child_process_keeps_the_keyed_folder_and_old_ones_are_pruned(tmp_path
 
 
 def _check_pruning(tmp_path):
-    fp = jit_cache.code_fingerprint()[:jit_cache.DIGITS]
+    fp = jit_cache.kernel_fingerprint()[:jit_cache.DIGITS]
     old = [tmp_path / f"{i:016x}" for i in range(jit_cache.KEEP + 2)]
     for i, p in enumerate(old):
         p.mkdir()

@@ -6,14 +6,17 @@ not detected).  The ray tracer's dispatch compiles every kind's kernels into its
 functions, so after an edit of, say, ``scene/kinds/lathe_kernels.py`` (a ``git checkout``, a
 merge) the unchanged ``renderers/raytrace/kernels.py`` would load its stale machine code and
 draw the old shape.  :func:`use_code_keyed_cache` points ``NUMBA_CACHE_DIR`` at
-``BASE/<code fingerprint>``, so any change to the layers a kernel may import (core, scene,
-renderers) compiles afresh; the few most recently used older folders are kept, the rest
-removed.
+``BASE/<kernel fingerprint>``: a digest of the kernel sources (:func:`kernel_sources`: every
+module that imports numba, and every workbench module those import, whose constants the
+kernels compile in), so an edit of any of them compiles afresh while an edit elsewhere (the
+window, the reports, a renderer's Python side) keeps the warm cache; the few most recently
+used older folders are kept, the rest removed.
 """
 from __future__ import annotations
 
 import hashlib
 import os
+import re
 import shutil
 import sys
 from pathlib import Path
@@ -27,13 +30,71 @@ DIGITS = 16
 
 
 def code_fingerprint() -> str:
-    """SHA-256 (hex) over the workbench's core, scene and renderer sources, sorted by path."""
+    """SHA-256 (hex) over the workbench's core, scene and renderer sources, sorted by path (what
+    a rendered image may depend on: the reference cache's key)."""
     root = Path(__file__).resolve().parents[1]
+    return _digest(root, [p for pkg in CODE_PACKAGES for p in (root / pkg).rglob("*.py")])
+
+
+_IMPORT = re.compile(rb"^[ \t]*(?:from[ \t]+(\.*)([\w.]*)[ \t]+import[ \t]+(\([^)]*\)|[^\n]*)|import[ \t]+([\w., \t]+))",
+                     re.M)
+"""An import statement: ``from <dots><module> import <names>`` or ``import <modules>``."""
+_NUMBA = re.compile(rb"^[ \t]*(?:import|from)[ \t]+numba\b", re.M)
+
+
+def _imports(path: Path, text: bytes, root: Path) -> set[Path]:
+    """The workbench modules a module's source ``text`` imports (``workbench.*`` and relative
+    imports, at any depth of the file), as source paths that exist."""
+    here = path.relative_to(root.parent).parts[:-1]     # the module's package, as a path
+    found = set()
+    for dots, module, names, plain in _IMPORT.findall(text):
+        if plain:
+            targets = [n.strip().split(b" ")[0].decode().split(".") for n in plain.split(b",")]
+        else:
+            base = list(here[:len(here) - len(dots) + 1]) if dots else []
+            mod = base + (module.decode().split(".") if module else [])
+            words = names.strip(b"()").replace(b"\n", b" ").split(b",")
+            targets = [mod] + [mod + [w.split()[0].decode()] for w in words if w.split()]
+        for parts in targets:
+            if not parts or parts[0] != root.name:
+                continue
+            target = root.parent.joinpath(*parts)
+            for candidate in (target.with_suffix(".py"), target / "__init__.py"):
+                if candidate.is_file():
+                    found.add(candidate)
+    return found
+
+
+def kernel_sources() -> list[Path]:
+    """The modules numba kernels are compiled from: every module of the layers kernels live in
+    (:data:`CODE_PACKAGES`) that imports numba, and, transitively, every workbench module
+    those import (their constants are compiled in), sorted."""
+    root = Path(__file__).resolve().parents[1]
+    text = {p: p.read_bytes() for pkg in CODE_PACKAGES for p in (root / pkg).rglob("*.py")}
+    todo = [p for p, t in text.items() if _NUMBA.search(t)]
+    seen: set[Path] = set()
+    while todo:
+        p = todo.pop()
+        if p in seen:
+            continue
+        seen.add(p)
+        if p not in text:
+            text[p] = p.read_bytes()
+        todo.extend(_imports(p, text[p], root) - seen)
+    return sorted(seen)
+
+
+def kernel_fingerprint() -> str:
+    """SHA-256 (hex) over :func:`kernel_sources`: the numba cache folder's key."""
+    root = Path(__file__).resolve().parents[1]
+    return _digest(root, kernel_sources())
+
+
+def _digest(root: Path, paths) -> str:
     h = hashlib.sha256()
-    for pkg in CODE_PACKAGES:
-        for p in sorted((root / pkg).rglob("*.py")):
-            h.update(str(p.relative_to(root)).encode())
-            h.update(p.read_bytes())
+    for p in sorted(paths):
+        h.update(str(p.relative_to(root)).encode())
+        h.update(p.read_bytes())
     return h.hexdigest()
 
 
@@ -57,10 +118,11 @@ def _prune(base: Path, current: Path) -> None:
 
 
 def use_code_keyed_cache() -> Path:
-    """Set ``NUMBA_CACHE_DIR`` to ``BASE/<fingerprint>`` (``BASE``: the variable's value, or
-    :func:`default_base`) and return it; a value that already ends in this fingerprint (a
-    child process) is kept.  Numba imported before this call re-reads its configuration."""
-    fp = code_fingerprint()[:DIGITS]
+    """Set ``NUMBA_CACHE_DIR`` to ``BASE/<fingerprint>`` (:func:`kernel_fingerprint`; ``BASE``:
+    the variable's value, or :func:`default_base`) and return it; a value that already ends in
+    this fingerprint (a child process) is kept.  Numba imported before this call re-reads its
+    configuration."""
+    fp = kernel_fingerprint()[:DIGITS]
     given = os.environ.get("NUMBA_CACHE_DIR")
     if given and Path(given).name == fp:
         return Path(given)
