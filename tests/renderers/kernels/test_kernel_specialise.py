@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 
 import workbench
-from workbench.renderers.kernels.layout import FEATURES, kinds_marker, marker_features
+from workbench.renderers.kernels.layout import features, kinds_marker, marker_features
 from workbench.renderers.raytrace.flatten import flatten
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -99,6 +99,6 @@ def test_unknown_feature_is_refused():
     try:
         kinds_marker(["torus"])
     except ValueError as e:
-        assert "torus" in str(e) and all(f in str(e) for f in FEATURES)
+        assert "torus" in str(e) and all(f in str(e) for f in features())
     else:
         raise AssertionError("kinds_marker accepted an unknown feature")
