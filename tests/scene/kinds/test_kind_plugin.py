@@ -106,6 +106,8 @@ def test_every_method_draws_the_plugin_kind(renders):
 def _broken(**changes) -> types.ModuleType:
     mod = types.ModuleType("broken_kind")
     mod.__dict__.update({k: v for k, v in vars(toy_disk).items() if not k.startswith("__")})
+    if "TYPE" in changes:  # its model names the new type, unless the case says otherwise
+        mod.MODEL = type("Model", (toy_disk.Disk,), {"kind": changes["TYPE"]})
     for k, v in changes.items():
         if v is None:
             del mod.__dict__[k]
@@ -118,6 +120,7 @@ def _broken(**changes) -> types.ModuleType:
     (dict(hits=None), "missing hits"),
     (dict(PTYPE=KINDS["blob"].PTYPE, TYPE="disk2", FEATURE="disks2"), "PTYPE 7 is taken by kind 'blob'"),
     (dict(TYPE="sphere"), "TYPE 'sphere' is taken"),
+    (dict(TYPE="disk6", FEATURE="disks6", PTYPE=43, MODEL=toy_disk.Disk), "its MODEL's kind is 'disk', not its TYPE 'disk6'"),
     (dict(PTYPE=3, TYPE="disk3", FEATURE="disks3"), "PTYPE must be an int >= 7"),
     (dict(KERNELS="no_such_module_here", TYPE="disk4", FEATURE="disks4", PTYPE=41), "cannot import its kernel module"),
     (dict(KERNELS="toy_disk", TYPE="disk5", FEATURE="disks5", PTYPE=42), "lacks first, events"),
