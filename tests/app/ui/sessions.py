@@ -447,6 +447,26 @@ class ExportCheck:
             state.quit = True
 
 
+class ExportRefining:
+    """Export (into ``out/export``) in the first frame whose path-traced panel shows a running
+    image of at least two passes, short of its target; log the panel's progress as taken
+    (``state.progress``) and the status line, and quit (at most :data:`CPU_WAIT_SECONDS`)."""
+
+    def __init__(self, out: Path):
+        self.out, self.log, self.t0 = out, {}, time.perf_counter()
+
+    def __call__(self, state: AppState) -> None:
+        held = state.progress.get("pathtrace", {})
+        if held.get("state") == "refining" and held["passes"] >= 2:
+            self.log["exported"] = [p.name for p in export(state, self.out / "export")]
+            self.log["progress"] = dict(held)
+            self.log["status"] = state.status["export"]
+            state.quit = True
+        elif time.perf_counter() - self.t0 > CPU_WAIT_SECONDS:
+            self.log["progress"] = dict(held)
+            state.quit = True
+
+
 class Screens:
     """What a user sees of the default view: once nothing is in progress (the jobs, the error
     plot's reference and points; at most :data:`CPU_WAIT_SECONDS`) and a few frames later,

@@ -152,12 +152,47 @@ def refresh_cpu(state: AppState, method: str) -> None:
         state.status[method] = (f"rendering: {job.rows_done}/{state.camera.height} rows"
                                 if tiled(method) else "rendering...")
     shape = (state.camera.height, state.camera.width, 3)
-    if stale(state, f"{method} job", (id(job), job.version, shape)) or method not in state.images:
-        image = job.snapshot()
+    key = (id(job), job.version, shape, job.cancelled.is_set())
+    if stale(state, f"{method} job", key) or method not in state.images:
+        image, held = job.snapshot()
         # the previous job's image is kept while its successor waits, unless it has another
         # size (a scene switch changed the panels' aspect): then black until the new one comes
-        state.images[method] = (over_stale(state, method, job, image)
-                                if image.shape == shape else np.zeros(shape, np.float32))
+        if image.shape == shape:
+            state.images[method] = over_stale(state, method, job, image)
+            state.progress[method] = shown_progress(state, method, job, held)
+        else:
+            state.images[method] = np.zeros(shape, np.float32)
+            state.progress[method] = {"state": "waiting"}
+
+
+def shown_progress(state: AppState, method: str, job, held: dict) -> dict:
+    """What ``method``'s panel shows of ``job`` (``held``: :meth:`.jobs.Job.snapshot`'s
+    account of the image taken), as the export records it (issue #29, item 5: an export
+    recorded the target spp of a panel still refining).
+
+    ``state``: ``"done"`` (the finished render of the current request), ``"refining"`` (a
+    progressive job's running image), ``"rendering"`` (``rows_done`` of ``rows`` rendered, over
+    the previous image), ``"stale"`` (the previous request's image: a restart is pending, or
+    nothing of the new render has come yet).  A progressive job's also ``spp`` (samples per
+    pixel in the image), ``target_spp`` (its knob), ``passes``, ``noise`` (RMS standard error of
+    the pixel means, None before two samples) and ``converged`` (it reached its target)."""
+    from ...renderers.base import get_renderer
+    rows = state.camera.height
+    if job.cancelled.is_set():
+        out = {"state": "stale"}
+    elif held["done"]:
+        out = {"state": "done"}
+    elif job.progressive:
+        out = {"state": "refining" if held["spp"] > 0 else "stale"}
+    elif held["rows_done"] > 0:
+        out = {"state": "rendering", "rows_done": held["rows_done"], "rows": rows}
+    else:
+        out = {"state": "stale"}
+    if job.progressive and out["state"] != "stale":
+        target = int(state.options[method][get_renderer(method).knob.name])
+        out.update(spp=held["spp"], target_spp=target, passes=held["passes"],
+                   noise=held["noise"], converged=held["done"] and held["spp"] >= target)
+    return out
 
 
 def over_stale(state: AppState, method: str, job, image: np.ndarray) -> np.ndarray:

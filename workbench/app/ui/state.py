@@ -173,6 +173,10 @@ class AppState:
     """method -> (what its GL session was to be built from, one-line message) of a GL panel
     whose session could not be built (a user's model that does not compile): the message is
     shown, and the build is not tried again until what it is built from changes."""
+    progress: dict[str, dict] = field(default_factory=dict)
+    """method -> what a CPU or progressive panel's image is (done, refining at how many spp,
+    rendering how many rows, stale): :func:`.panel_refresh.shown_progress`; the export records
+    it."""
     kinds: dict[str, str] = field(default_factory=dict)
     """method -> its renderer's ``ui_kind`` (:func:`method_kind`)."""
     cut: set = field(default_factory=set)
