@@ -467,6 +467,50 @@ class ExportRefining:
             state.quit = True
 
 
+class DiffPause:
+    """The difference view during a drag (``phong`` against ``raytrace``): once the ray trace
+    is done, save the map (``before_difference.npy``) and the status; orbit the camera for
+    ``frames`` frames, logging from the second (the status is the previous frame's gui's) the
+    difference's status line and whether its map is still the one before; then rest until the ray trace at the final camera is done and the
+    view is live again, saving both panels and the map (``after_*.npy``)."""
+
+    def __init__(self, out: Path, frames: int = 4):
+        self.out, self.frames, self.log = out, frames, {"drag": []}
+        self.step, self.k, self.t0, self.done_frames = 0, 0, time.perf_counter(), 0
+
+    def _save(self, state: AppState, phase: str) -> None:
+        for m in ("phong", "raytrace", "difference"):
+            np.save(self.out / f"{phase}_{m}.npy", np.asarray(state.images[m], np.float32))
+
+    def __call__(self, state: AppState) -> None:
+        timeout = time.perf_counter() - self.t0 > CPU_WAIT_SECONDS
+        job = state.jobs.current.get("raytrace")
+        done = job is not None and job.image is not None and job.key[1] == state.camera
+        self.done_frames = self.done_frames + 1 if done else 0
+        # the map of the finished ray trace: drawn in a frame after the one it came in
+        if self.step == 0 and state.frame >= 3 and (self.done_frames >= 3 or timeout):
+            self.log["before_status"] = state.status.get("difference")
+            self._save(state, "before")
+            self.before = np.array(state.images["difference"])
+            self.step = 1
+        elif self.step == 1:
+            if self.k >= 2:  # the status of the gui of the frame before (drawn after the script)
+                self.log["drag"].append({"status": state.status.get("difference"),
+                                         "kept": bool(np.array_equal(state.images["difference"],
+                                                                     self.before))})
+            if self.k < self.frames:
+                state.camera = cam.orbit(state.camera, 0.08, 0.0)
+                self.k += 1
+            else:
+                self.step, self.t0 = 2, time.perf_counter()
+        elif self.step == 2 and ((done and "difference" not in state.status) or timeout):
+            self.step = 3  # one more frame: the map of this frame's images
+        elif self.step == 3:
+            self.log["after_status"] = state.status.get("difference")
+            self._save(state, "after")
+            state.quit = True
+
+
 class Screens:
     """What a user sees of the default view: once nothing is in progress (the jobs, the error
     plot's reference and points; at most :data:`CPU_WAIT_SECONDS`) and a few frames later,

@@ -30,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .panel_refresh import mismatch
 from .state import AppState, method_kind, shown_image
 
 
@@ -190,7 +191,8 @@ def settings(state: AppState, folder: Path, skipped: dict[str, str], records: di
             "material_overrides": state.overrides,
             "light_overrides": {str(k): v for k, v in state.light_overrides.items()},
             "difference": {"a": state.diff_pair[0], "b": state.diff_pair[1],
-                           "kind": state.diff_kind},
+                           "kind": state.diff_kind,
+                           "paused": mismatch(state, *state.diff_pair)},
             "skipped": skipped,
             "replay": [replay_command(state, m, folder, options[m]) for m in shown]}
 

@@ -75,6 +75,7 @@ class Job:
         # in its key (every material or light edit builds a new Scene)
         self.scene = scene
         self.key = job_key(scene, camera, method, options)
+        self.camera = camera
         self.partial = np.zeros((camera.height, camera.width, 3), np.float32)
         self.image = None
         self.seconds = None

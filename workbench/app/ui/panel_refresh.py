@@ -96,6 +96,7 @@ def refresh_raster(state: AppState, method: str) -> bool:
         panel.timed = False
     else:
         timed_draw(state, panel, method, fbo)
+    state.image_requests[method] = (cam, state.scene)
     state.images.set_pending(method, lambda: RasterSession.read_image(fbo),
                              pixel=lambda i, j, shape: read_pixel(fbo, i, j, shape),
                              shape=(cam.height, cam.width))
@@ -160,9 +161,31 @@ def refresh_cpu(state: AppState, method: str) -> None:
         if image.shape == shape:
             state.images[method] = over_stale(state, method, job, image)
             state.progress[method] = shown_progress(state, method, job, held)
+            if state.progress[method]["state"] in ("done", "refining") or method not in state.image_requests:
+                state.image_requests[method] = (job.camera, job.scene)
+            # else: the previous image (or its rows not yet rendered again) still shows
         else:
             state.images[method] = np.zeros(shape, np.float32)
             state.progress[method] = {"state": "waiting"}
+            state.image_requests.pop(method, None)
+
+
+def mismatch(state: AppState, a: str, b: str) -> str:
+    """Why panels ``a`` and ``b`` do not show the same camera and scene (empty when they do):
+    during a drag a GL panel follows the camera while a ray-traced one keeps its previous image
+    until its new render is done (issue #29, item 7: the difference view compared them
+    unflagged)."""
+    ra, rb = state.image_requests.get(a), state.image_requests.get(b)
+    if ra is None or rb is None:
+        return f"waiting for {a if ra is None else b}"
+    def same(r, q) -> bool:  # scenes by identity: every edit makes a new one
+        return r[0] == q[0] and r[1] is q[1]
+
+    if same(ra, rb):
+        return ""
+    what = "camera" if ra[0] != rb[0] else "scene edit"
+    behind = [m for m in (a, b) if state.progress.get(m, {}).get("state") in ("stale", "rendering")]
+    return f"{a} and {b} show different {what}s" + (f" ({behind[0]} re-renders)" if len(behind) == 1 else "")
 
 
 def shown_progress(state: AppState, method: str, job, held: dict) -> dict:

@@ -10,7 +10,8 @@ from .display_passes import SCALE_FLOOR
 from .export import export
 from .gl_sessions import KNOB_VALUES, STANDIN_CHOICES, draws_standins
 from .inspect import pixel_under_mouse, probe_tooltip, select_ray_tree
-from .panel_gpu import stale, upload, upload_linear
+from .panel_gpu import gpu, stale, upload, upload_linear
+from .panel_refresh import mismatch
 from .panel_show import difference_on_gpu, image_stats, show_difference, show_panel
 from .patch_view import select_patch
 from .placement import PANEL_GAP, PANEL_LINES, focus, panel_grid
@@ -261,7 +262,10 @@ def image_panels(state: AppState) -> None:
 
 
 def difference_panel(state: AppState) -> None:
-    """Error map between two chosen methods with its colour scale."""
+    """Error map between two chosen methods with its colour scale.  While the two images are
+    not of the same camera and scene (:func:`.panel_refresh.mismatch`: a drag moves a GL panel
+    while a ray-traced one re-renders) the view pauses on the last map of two matching images
+    and says so (``state.status["difference"]``; issue #29, item 7)."""
     from ...compare.metrics import error_map
     imgui.separator_text("difference")
     ms = state.methods
@@ -290,9 +294,21 @@ def difference_panel(state: AppState) -> None:
     if not all(state.images.has_shape(m, shape) for m in (a, b)):
         imgui.text_disabled("waiting for both images at the panels' size")
         return  # one is still the previous scene's (another size): nothing to compare yet
+    why = mismatch(state, a, b)
+    if why:  # a drag: the map of two images from one camera (the last) stays, flagged
+        state.status["difference"] = (f"paused: {why}; the map shown is the last one of two "
+                                      "images of the same camera and scene")
+        imgui.push_text_wrap_pos(0.0)
+        imgui.text_colored(imgui.ImVec4(1.0, 0.6, 0.3, 1.0), state.status["difference"])
+        imgui.pop_text_wrap_pos()
+        last = gpu(state).shown.get("difference")
+        if last is None or last[:3] != (a, b, state.diff_kind) or "difference" not in state.images:
+            return
+    else:
+        state.status.pop("difference", None)
     # recomputed only when either image or the kind changed (a static frame reads no pixels)
     key = (a, b, state.diff_kind, state.images.version(a), state.images.version(b))
-    if stale(state, "difference", key) or "difference" not in state.images:
+    if not why and (stale(state, "difference", key) or "difference" not in state.images):
         if not (state.diff_kind == "abs" and difference_on_gpu(state, a, b, hot_table())):
             # FLIP (or images of different sizes: error_map says so)
             err = error_map(state.images[a], state.images[b], state.diff_kind)

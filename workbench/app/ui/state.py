@@ -177,6 +177,10 @@ class AppState:
     """method -> what a CPU or progressive panel's image is (done, refining at how many spp,
     rendering how many rows, stale): :func:`.panel_refresh.shown_progress`; the export records
     it."""
+    image_requests: dict[str, tuple] = field(default_factory=dict)
+    """method -> (camera, scene) its panel's image was made for (a GL panel's last draw, a CPU
+    job's request, or the previous one while a restart is pending); the difference view
+    pauses while its two differ (:func:`.panel_refresh.mismatch`)."""
     kinds: dict[str, str] = field(default_factory=dict)
     """method -> its renderer's ``ui_kind`` (:func:`method_kind`)."""
     cut: set = field(default_factory=set)
