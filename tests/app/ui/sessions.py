@@ -6,6 +6,7 @@ the mouse and sliders call, and records images into ``out``.  The ``Controls`` s
 ``session_controls.py`` beside this file."""
 from __future__ import annotations
 
+import ctypes
 import time
 from pathlib import Path
 
@@ -509,6 +510,71 @@ class DiffPause:
             self.log["after_status"] = state.status.get("difference")
             self._save(state, "after")
             state.quit = True
+
+
+def move_pointer(x: float, y: float) -> None:
+    """Move the X pointer to (``x``, ``y``) pixels of the window, as a mouse does: through its
+    own X connection (a warp by GLFW's ``glfwSetCursorPos`` is not reported to the window)."""
+    from workbench.app.ui.glfw_title import glfw_library
+    glfw = glfw_library()
+    glfw.glfwGetWindowPos.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.c_int)]
+    wx, wy = ctypes.c_int(), ctypes.c_int()
+    glfw.glfwGetWindowPos(glfw.glfwGetCurrentContext(), ctypes.byref(wx), ctypes.byref(wy))
+    x11 = ctypes.CDLL("libX11.so.6")
+    x11.XOpenDisplay.restype = ctypes.c_void_p
+    x11.XOpenDisplay.argtypes = [ctypes.c_char_p]
+    x11.XDefaultRootWindow.restype = ctypes.c_ulong
+    x11.XDefaultRootWindow.argtypes = [ctypes.c_void_p]
+    x11.XWarpPointer.argtypes = [ctypes.c_void_p, ctypes.c_ulong, ctypes.c_ulong, ctypes.c_int,
+                                 ctypes.c_int, ctypes.c_uint, ctypes.c_uint, ctypes.c_int, ctypes.c_int]
+    x11.XCloseDisplay.argtypes = [ctypes.c_void_p]
+    dpy = x11.XOpenDisplay(None)
+    x11.XWarpPointer(dpy, 0, x11.XDefaultRootWindow(dpy), 0, 0, 0, 0,
+                     int(round(wx.value + x)), int(round(wy.value + y)))
+    x11.XCloseDisplay(dpy)  # flushes the request
+
+
+class PlotHover:
+    """The error plot with ``raytrace`` at its finest knob (the reference's own setting: error
+    0, below any log axis): once the plot has every panel's point and every matched one (at
+    most :data:`CPU_WAIT_SECONDS`), the pointer is moved (through X, as a mouse would) onto the
+    ray tracer's point, drawn at the axis floor (again whenever the plot's layout moves it), and
+    the plot's tooltip, axes and points are logged; quits once the tooltip came (or 40 frames
+    later)."""
+
+    def __init__(self, out: Path):
+        self.out, self.log, self.t0, self.moved, self.target = out, {}, time.perf_counter(), None, None
+
+    def _point_pixel(self, plot) -> tuple[float, float]:
+        (pt,) = plot.points["raytrace"].values()
+        x0, y0, w, h = plot.axes["rect"]
+        (xl, xh), (yl, yh) = plot.axes["x"]["limits"], plot.axes["y"]["limits"]
+        fx = np.log(pt["seconds"] * 1e3 / xl) / np.log(xh / xl)
+        fy = np.log(max(pt[plot.metric], yl * 1.5) / yl) / np.log(yh / yl)  # the floor: 1.5 up
+        return x0 + fx * w, y0 + (1 - fy) * h
+
+    def __call__(self, state: AppState) -> None:
+        from workbench.renderers.base import get_renderer
+        plot = state.errors
+        if state.frame == 2:
+            set_option(state, "raytrace", "max_depth", get_renderer("raytrace").knob.values[-1])
+            return
+        have = (all(plot.points.get(m) for m in state.methods) and plot.axes
+                and not (plot.pending or plot.matched_pending or plot.matched_message))
+        if self.moved is None and not (have or time.perf_counter() - self.t0 > CPU_WAIT_SECONDS):
+            return
+        if plot.hover or (self.moved is not None and state.frame > self.moved + 40):
+            self.log.update(hover=plot.hover, axes=plot.axes, cut=sorted(state.cut),
+                            points={m: [[p["seconds"], p["rmse"]] for p in plot.points[m].values()]
+                                    for m in state.methods})
+            state.quit = True
+            return
+        target = self._point_pixel(plot)
+        if self.target is None or np.hypot(*np.subtract(target, self.target)) > 1.0:
+            move_pointer(*target)
+            self.target = target
+        if self.moved is None:
+            self.moved = state.frame
 
 
 class Screens:

@@ -87,6 +87,11 @@ class ErrorPlot:
     matched_boards: dict = field(default_factory=dict)
     matched_message: str = ""
     metric: str = "rmse"
+    hover: str = ""
+    """The tooltip of the point under the mouse in the last frame (empty: none)."""
+    axes: dict = field(default_factory=dict)
+    """The last frame's plot: ``{"rect": [x, y, w, h] pixels of the plot area, "x"|"y":
+    {"limits": [lo, hi], "ticks": [[value, label, pixel along the axis, label's size]]}}``."""
     shown: int = -2
     gave_up: bool = False
     board: object = None
