@@ -577,6 +577,26 @@ class PlotHover:
             self.moved = state.frame
 
 
+class Resize:
+    """Log the window's size at frame 1, resize it at frame 2 to ``size`` (GLFW, as a user's
+    drag of its corner), log it again at frame 6 and quit."""
+
+    def __init__(self, out: Path, size: tuple[int, int] = (900, 560)):
+        self.out, self.size, self.log = out, size, {}
+
+    def __call__(self, state: AppState) -> None:
+        from workbench.app.ui.glfw_title import glfw_library, window_size
+        if state.frame == 1:
+            self.log["opened"] = list(window_size())
+        elif state.frame == 2:
+            glfw = glfw_library()
+            glfw.glfwSetWindowSize.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_int]
+            glfw.glfwSetWindowSize(glfw.glfwGetCurrentContext(), *self.size)
+        elif state.frame == 6:
+            self.log["resized"] = list(window_size())
+            state.quit = True
+
+
 class Screens:
     """What a user sees of the default view: once nothing is in progress (the jobs, the error
     plot's reference and points; at most :data:`CPU_WAIT_SECONDS`) and a few frames later,

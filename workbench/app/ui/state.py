@@ -190,6 +190,8 @@ class AppState:
     """method -> its renderer's ``ui_kind`` (:func:`method_kind`)."""
     cut: set = field(default_factory=set)
     """Widgets that ran past their window's right edge in the last frame (``panels.check_fits``)."""
+    window_size: tuple[int, int] = (0, 0)
+    """The window's size when it closed (GLFW), kept for the next run (:mod:`.window_size`)."""
     quit: bool = False
     """Close the window at the end of this frame (scripts; SIGTERM and SIGINT)."""
     quit_signal: int = 0
