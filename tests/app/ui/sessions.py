@@ -188,7 +188,8 @@ class Features:
 class Layout:
     """Frames 4 to 8 drawn with every widget in place (the docked windows have their sizes from
     frame 2 on; the script sees the previous frame's widgets): logs
-    the widgets that ran past their window's edge (``state.cut``), the window report and the
+    the widgets that ran past their window's edge (``state.cut``), the section titles wrapped
+    (``state.wrapped``, frame 8's), the window report and the
     panels' blit rectangles, then quits."""
 
     def __init__(self, out: Path):
@@ -197,6 +198,7 @@ class Layout:
     def __call__(self, state: AppState) -> None:
         if 4 <= state.frame <= 8:
             self.log["cut"] = sorted(set(self.log["cut"]) | state.cut)
+            self.log["wrapped"] = sorted(state.wrapped)
         if state.frame == 8:
             self.log["windows"] = window_report()
             self.log["blits"] = [[m, list(r)] for m, r in state.gpu.blits.last]

@@ -14,6 +14,7 @@ from .panel_gpu import gpu, stale, upload, upload_linear
 from .panel_refresh import mismatch
 from .panel_show import difference_on_gpu, image_stats, show_difference, show_panel
 from .patch_view import select_patch
+from .section import section
 from .placement import PANEL_GAP, PANEL_LINES, focus, panel_grid
 from .state import (DISPLAY_MODES, HARMONIES, MATERIAL_FIELDS, AppState, choosable_methods,
                     set_display, set_material_value, set_option, set_scene, short_name,
@@ -109,7 +110,7 @@ def method_list(state: AppState) -> None:
 def parameters(state: AppState) -> None:
     """Sliders: the chosen material's coefficients and each selected method's quality knob."""
     from ...renderers.base import get_renderer
-    imgui.separator_text("material")
+    section(state, "material")
     names = list(state.scene.materials)
     imgui.push_item_width(-label_room("material", *MATERIAL_FIELDS))  # labels fit beside
     changed, idx = imgui.combo("material", names.index(state.material), names)
@@ -124,13 +125,15 @@ def parameters(state: AppState) -> None:
         if changed:
             set_material_value(state, state.material, f, v)
     imgui.pop_item_width()
-    imgui.separator_text("quality")
+    section(state, "quality")
     for m in state.methods:
         knob = get_renderer(m).knob
         values = list(knob.values)
         cur = state.options[m][knob.name]
         idx = values.index(cur) if cur in values else 0
-        imgui.text(f"{m}: {knob.name}")  # its own line: a label beside the slider was cut
+        imgui.push_text_wrap_pos(0.0)  # its own line(s): a label beside the slider was cut
+        imgui.text(f"{short_name(m)}: {knob.name}")
+        imgui.pop_text_wrap_pos()
         imgui.set_next_item_width(-1)
         changed, idx = imgui.slider_int(f"##knob {m}", idx, 0, len(values) - 1,
                                         format=str(values[idx]))
@@ -267,7 +270,7 @@ def difference_panel(state: AppState) -> None:
     while a ray-traced one re-renders) the view pauses on the last map of two matching images
     and says so (``state.status["difference"]``; issue #29, item 7)."""
     from ...compare.metrics import error_map
-    imgui.separator_text("difference")
+    section(state, "difference")
     ms = state.methods
     a, b = (x if x in ms else ms[0] for x in state.diff_pair)
     kinds = ["abs", "flip"]
@@ -338,7 +341,7 @@ def difference_panel(state: AppState) -> None:
 def colour_wheel(state: AppState) -> None:
     """The chromatic circle with the course's harmonies for a chosen base hue (HSV)."""
     from ...core.harmony import wheel_image
-    imgui.separator_text("colour wheel")
+    section(state, "colour wheel")
     hue, kind = state.wheel
     _, hue = imgui.slider_float("base hue", hue, 0.0, 360.0)
     _, k = imgui.combo("harmony", HARMONIES.index(kind), list(HARMONIES))

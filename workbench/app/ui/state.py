@@ -192,6 +192,9 @@ class AppState:
     """Widgets that ran past their window's right edge in the last frame (``panels.check_fits``)."""
     window_size: tuple[int, int] = (0, 0)
     """The window's size when it closed (GLFW), kept for the next run (:mod:`.window_size`)."""
+    wrapped: set = field(default_factory=set)
+    """Section titles too long for their window in the last frame, wrapped instead of cut
+    (:func:`.section.section`)."""
     quit: bool = False
     """Close the window at the end of this frame (scripts; SIGTERM and SIGINT)."""
     quit_signal: int = 0
