@@ -27,10 +27,20 @@ ZOOM_STEP = 0.9
 MATERIAL_RANGES = {"ka": (0.0, 1.0), "kd": (0.0, 1.0), "ks": (0.0, 1.0),
                    "shininess": (1.0, 500.0), "kr": (0.0, 1.0), "kt": (0.0, 1.0),
                    "ior": (1.0, 2.5)}
+def right_edge() -> float:
+    """The right edge of the current window's content (screen pixels): less its padding and,
+    when shown, its vertical scrollbar (which covers what lies under it: at 1024x600 the Scene
+    window's "reset zoom" ran under it unnoticed)."""
+    from imgui_bundle.imgui import internal
+    scrollbar = internal.get_current_window().scrollbar_sizes.x
+    return (imgui.get_window_pos().x + imgui.get_window_width()
+            - imgui.get_style().window_padding.x - scrollbar)
+
+
 def check_fits(state: AppState, name: str) -> None:
     """Note in ``state.cut`` whether the last item (its frame and label) ends past the right
-    edge of its window's content: nothing should (scripts and tests read it)."""
-    right = imgui.get_window_pos().x + imgui.get_window_width() - imgui.get_style().window_padding.x
+    edge of its window's content (:func:`right_edge`): nothing should (scripts and tests read it)."""
+    right = right_edge()
     if imgui.get_item_rect_max().x > right + 1.0:
         state.cut.add(name)
     else:
@@ -41,8 +51,7 @@ def same_line_if_fits(width: float) -> None:
     """Continue the line if an item ``width`` pixels wide still fits in the window, else
     start a new line (buttons that wrap instead of running past the edge)."""
     spacing = imgui.get_style().item_spacing.x
-    right = imgui.get_window_pos().x + imgui.get_window_width() - imgui.get_style().window_padding.x
-    if imgui.get_item_rect_max().x + spacing + width <= right:
+    if imgui.get_item_rect_max().x + spacing + width <= right_edge():
         imgui.same_line()
 
 
