@@ -88,7 +88,6 @@ def add_model(state: AppState, path: Path) -> bool:
 
 def file_browser(state: AppState) -> None:
     """The scene file browser (:func:`browse`), under its title."""
-    from imgui_bundle import imgui
     section(state, "scene file")
     browse(state.browser, "open", lambda path: open_scene(state, path))
 

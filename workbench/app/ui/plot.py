@@ -285,7 +285,7 @@ def _point(image: np.ndarray, reference: np.ndarray, seconds: float, label: str)
 def error_plot(state: AppState) -> None:
     """Log-log plot: one line per method through its knob settings, run time on x (a dashed
     one of the same colour: its error against its matched reference)."""
-    from imgui_bundle import imgui, implot
+    from imgui_bundle import imgui
     plot = state.errors
     plot.shown = state.frame
     imgui.set_next_item_width(100)
