@@ -28,6 +28,27 @@ def reference_cache(tmp_path_factory):
         os.environ["WORKBENCH_REFERENCE_CACHE"] = old
 
 
+@pytest.fixture(scope="session", autouse=True)
+def config_dir(tmp_path_factory):
+    """The window's remembered size (``workbench.app.ui.window_size``) kept in a folder of the
+    run, not in ~/.config; removed after each test (:func:`fresh_window_size`), so a window
+    closed at one size does not open the next test's at it."""
+    folder = tmp_path_factory.mktemp("config")
+    old = os.environ.get("WORKBENCH_CONFIG_DIR")
+    os.environ["WORKBENCH_CONFIG_DIR"] = str(folder)
+    yield folder
+    if old is None:
+        os.environ.pop("WORKBENCH_CONFIG_DIR", None)
+    else:
+        os.environ["WORKBENCH_CONFIG_DIR"] = old
+
+
+@pytest.fixture(autouse=True)
+def fresh_window_size(config_dir):
+    yield
+    (config_dir / "window.json").unlink(missing_ok=True)
+
+
 @pytest.fixture(scope="session")
 def built_wheel(tmp_path_factory):
     """(output of ``pip wheel``, path of the wheel): built once per run (``wheel_build``)."""

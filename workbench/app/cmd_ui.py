@@ -32,8 +32,9 @@ def add_parser(sub) -> None:
     p.add_argument("--size", type=int, default=256,
                    help="panel resolution: pixels along the longer side, the other side keeps the "
                         "scene camera's aspect (default %%(default)s; %d to %d)" % PANEL_SIZE_RANGE)
-    p.add_argument("--window", type=size, default=WINDOW_SIZE, metavar="WxH",
-                   help="window size in pixels (default %dx%d)" % WINDOW_SIZE)
+    p.add_argument("--window", type=size, default=None, metavar="WxH",
+                   help="window size in pixels, at least 320x240 (default: the size the window "
+                        "had when last closed, else %dx%d)" % WINDOW_SIZE)
     p.add_argument("--frames", type=int, default=None, metavar="N",
                    help="close the window after N frames")
     p.add_argument("--script", default=None, metavar="FILE.py:NAME",
@@ -52,6 +53,11 @@ def run(args) -> int:
         raise WorkbenchError(f"--size must be in [{lo}, {hi}] pixels, got {args.size}")
     if args.frames is not None and args.frames < 1:
         raise WorkbenchError(f"--frames must be at least 1, got {args.frames}")
+    from .ui.window_size import MIN_SIZE, remembered
+    window = args.window
+    if window is not None and not (window[0] >= MIN_SIZE[0] and window[1] >= MIN_SIZE[1]):
+        raise WorkbenchError(f"--window must be at least {MIN_SIZE[0]}x{MIN_SIZE[1]} pixels, "
+                             f"got {window[0]}x{window[1]}")
     if args.script is not None:
         from .ui.session_file import load_session
         make_session = load_session(args.script)
@@ -67,11 +73,15 @@ def run(args) -> int:
             out.mkdir(parents=True, exist_ok=True)
         except OSError as e:
             raise WorkbenchError(f"--out {out}: cannot create the folder ({e.strerror})") from None
+    if window is None:  # the size the window had when last closed (ui.window_size)
+        window, note = remembered()
+        if note:
+            print(note, file=sys.stderr)
     from .ui.state import new_state
     from .ui.main import run
     state = new_state(args.scene, args.methods or None, args.size)
     script = make_session(out) if args.script is not None else None
-    code = run(state, frames=args.frames, script=script, window=args.window, out=out)
+    code = run(state, frames=args.frames, script=script, window=window or WINDOW_SIZE, out=out)
     if code and threading.active_count() > 1:
         # a signal closed the window while a CPU job was still inside a numba compile (which
         # cannot be interrupted): its children are gone, so end without waiting for it

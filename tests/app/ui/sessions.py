@@ -6,6 +6,7 @@ the mouse and sliders call, and records images into ``out``.  The ``Controls`` s
 ``session_controls.py`` beside this file."""
 from __future__ import annotations
 
+import ctypes
 import time
 from pathlib import Path
 
@@ -187,7 +188,8 @@ class Features:
 class Layout:
     """Frames 4 to 8 drawn with every widget in place (the docked windows have their sizes from
     frame 2 on; the script sees the previous frame's widgets): logs
-    the widgets that ran past their window's edge (``state.cut``), the window report and the
+    the widgets that ran past their window's edge (``state.cut``), the section titles wrapped
+    (``state.wrapped``, frame 8's), the window report and the
     panels' blit rectangles, then quits."""
 
     def __init__(self, out: Path):
@@ -196,6 +198,7 @@ class Layout:
     def __call__(self, state: AppState) -> None:
         if 4 <= state.frame <= 8:
             self.log["cut"] = sorted(set(self.log["cut"]) | state.cut)
+            self.log["wrapped"] = sorted(state.wrapped)
         if state.frame == 8:
             self.log["windows"] = window_report()
             self.log["blits"] = [[m, list(r)] for m, r in state.gpu.blits.last]
@@ -444,6 +447,155 @@ class ExportCheck:
                                   or time.perf_counter() - self.t0 > CPU_WAIT_SECONDS):
             self.log["exported"] = [p.name for p in export(state, self.out / "export")]
             self.log["status"] = state.status["export"]
+            state.quit = True
+
+
+class ExportRefining:
+    """Export (into ``out/export``) in the first frame whose path-traced panel shows a running
+    image of at least two passes, short of its target; log the panel's progress as taken
+    (``state.progress``) and the status line, and quit (at most :data:`CPU_WAIT_SECONDS`)."""
+
+    def __init__(self, out: Path):
+        self.out, self.log, self.t0 = out, {}, time.perf_counter()
+
+    def __call__(self, state: AppState) -> None:
+        held = state.progress.get("pathtrace", {})
+        if held.get("state") == "refining" and held["passes"] >= 2:
+            self.log["exported"] = [p.name for p in export(state, self.out / "export")]
+            self.log["progress"] = dict(held)
+            self.log["status"] = state.status["export"]
+            state.quit = True
+        elif time.perf_counter() - self.t0 > CPU_WAIT_SECONDS:
+            self.log["progress"] = dict(held)
+            state.quit = True
+
+
+class DiffPause:
+    """The difference view during a drag (``phong`` against ``raytrace``): once the ray trace
+    is done, save the map (``before_difference.npy``) and the status; orbit the camera for
+    ``frames`` frames, logging from the second (the status is the previous frame's gui's) the
+    difference's status line and whether its map is still the one before; then rest until the ray trace at the final camera is done and the
+    view is live again, saving both panels and the map (``after_*.npy``)."""
+
+    def __init__(self, out: Path, frames: int = 4):
+        self.out, self.frames, self.log = out, frames, {"drag": []}
+        self.step, self.k, self.t0, self.done_frames = 0, 0, time.perf_counter(), 0
+
+    def _save(self, state: AppState, phase: str) -> None:
+        for m in ("phong", "raytrace", "difference"):
+            np.save(self.out / f"{phase}_{m}.npy", np.asarray(state.images[m], np.float32))
+
+    def __call__(self, state: AppState) -> None:
+        timeout = time.perf_counter() - self.t0 > CPU_WAIT_SECONDS
+        job = state.jobs.current.get("raytrace")
+        done = job is not None and job.image is not None and job.key[1] == state.camera
+        self.done_frames = self.done_frames + 1 if done else 0
+        # the map of the finished ray trace: drawn in a frame after the one it came in
+        if self.step == 0 and state.frame >= 3 and (self.done_frames >= 3 or timeout):
+            self.log["before_status"] = state.status.get("difference")
+            self._save(state, "before")
+            self.before = np.array(state.images["difference"])
+            self.step = 1
+        elif self.step == 1:
+            if self.k >= 2:  # the status of the gui of the frame before (drawn after the script)
+                self.log["drag"].append({"status": state.status.get("difference"),
+                                         "kept": bool(np.array_equal(state.images["difference"],
+                                                                     self.before))})
+            if self.k < self.frames:
+                state.camera = cam.orbit(state.camera, 0.08, 0.0)
+                self.k += 1
+            else:
+                self.step, self.t0 = 2, time.perf_counter()
+        elif self.step == 2 and ((done and "difference" not in state.status) or timeout):
+            self.step = 3  # one more frame: the map of this frame's images
+        elif self.step == 3:
+            self.log["after_status"] = state.status.get("difference")
+            self._save(state, "after")
+            state.quit = True
+
+
+def move_pointer(x: float, y: float) -> None:
+    """Move the X pointer to (``x``, ``y``) pixels of the window, as a mouse does: through its
+    own X connection (a warp by GLFW's ``glfwSetCursorPos`` is not reported to the window)."""
+    from workbench.app.ui.glfw_title import glfw_library
+    glfw = glfw_library()
+    glfw.glfwGetWindowPos.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.c_int)]
+    wx, wy = ctypes.c_int(), ctypes.c_int()
+    glfw.glfwGetWindowPos(glfw.glfwGetCurrentContext(), ctypes.byref(wx), ctypes.byref(wy))
+    x11 = ctypes.CDLL("libX11.so.6")
+    x11.XOpenDisplay.restype = ctypes.c_void_p
+    x11.XOpenDisplay.argtypes = [ctypes.c_char_p]
+    x11.XDefaultRootWindow.restype = ctypes.c_ulong
+    x11.XDefaultRootWindow.argtypes = [ctypes.c_void_p]
+    x11.XWarpPointer.argtypes = [ctypes.c_void_p, ctypes.c_ulong, ctypes.c_ulong, ctypes.c_int,
+                                 ctypes.c_int, ctypes.c_uint, ctypes.c_uint, ctypes.c_int, ctypes.c_int]
+    x11.XCloseDisplay.argtypes = [ctypes.c_void_p]
+    dpy = x11.XOpenDisplay(None)
+    x11.XWarpPointer(dpy, 0, x11.XDefaultRootWindow(dpy), 0, 0, 0, 0,
+                     int(round(wx.value + x)), int(round(wy.value + y)))
+    x11.XCloseDisplay(dpy)  # flushes the request
+
+
+class PlotHover:
+    """The error plot with ``raytrace`` at its finest knob (the reference's own setting: error
+    0, below any log axis): once the plot has every panel's point and every matched one (at
+    most :data:`CPU_WAIT_SECONDS`), the pointer is moved (through X, as a mouse would) onto the
+    ray tracer's point, drawn at the axis floor (again whenever the plot's layout moves it), and
+    the plot's tooltip, axes and points are logged; quits once the tooltip came (or 40 frames
+    later)."""
+
+    def __init__(self, out: Path):
+        self.out, self.log, self.t0, self.moved, self.target = out, {}, time.perf_counter(), None, None
+
+    def _point_pixel(self, plot) -> tuple[float, float]:
+        (pt,) = plot.points["raytrace"].values()
+        x0, y0, w, h = plot.axes["rect"]
+        (xl, xh), (yl, yh) = plot.axes["x"]["limits"], plot.axes["y"]["limits"]
+        fx = np.log(pt["seconds"] * 1e3 / xl) / np.log(xh / xl)
+        fy = np.log(max(pt[plot.metric], yl * 1.5) / yl) / np.log(yh / yl)  # the floor: 1.5 up
+        return x0 + fx * w, y0 + (1 - fy) * h
+
+    def __call__(self, state: AppState) -> None:
+        from workbench.renderers.base import get_renderer
+        plot = state.errors
+        if state.frame == 2:
+            set_option(state, "raytrace", "max_depth", get_renderer("raytrace").knob.values[-1])
+            return
+        have = (all(plot.points.get(m) for m in state.methods) and plot.axes
+                and not (plot.pending or plot.matched_pending or plot.matched_message))
+        if self.moved is None and not (have or time.perf_counter() - self.t0 > CPU_WAIT_SECONDS):
+            return
+        if plot.hover or (self.moved is not None and state.frame > self.moved + 40):
+            self.log.update(hover=plot.hover, axes=plot.axes, cut=sorted(state.cut),
+                            points={m: [[p["seconds"], p["rmse"]] for p in plot.points[m].values()]
+                                    for m in state.methods})
+            state.quit = True
+            return
+        target = self._point_pixel(plot)
+        if self.target is None or np.hypot(*np.subtract(target, self.target)) > 1.0:
+            move_pointer(*target)
+            self.target = target
+        if self.moved is None:
+            self.moved = state.frame
+
+
+class Resize:
+    """Log the window's size at frame 1, resize it at frame 2 to ``size`` (GLFW, as a user's
+    drag of its corner), log it again at frame 6 and quit."""
+
+    def __init__(self, out: Path, size: tuple[int, int] = (900, 560)):
+        self.out, self.size, self.log = out, size, {}
+
+    def __call__(self, state: AppState) -> None:
+        from workbench.app.ui.glfw_title import glfw_library, window_size
+        if state.frame == 1:
+            self.log["opened"] = list(window_size())
+        elif state.frame == 2:
+            glfw = glfw_library()
+            glfw.glfwSetWindowSize.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_int]
+            glfw.glfwSetWindowSize(glfw.glfwGetCurrentContext(), *self.size)
+        elif state.frame == 6:
+            self.log["resized"] = list(window_size())
             state.quit = True
 
 

@@ -114,3 +114,30 @@ def test_drag_with_an_indexed_mode_and_a_ray_traced_panel(xvfb, tmp_path):
     assert log["raytrace_black_rows"] == 0
     for m in ("flat", "phong"):  # at rest, exactly the CLI's mode
         assert np.array_equal(np.load(tmp_path / f"shown_{m}.npy"), np.load(tmp_path / f"cli_{m}.npy"))
+
+
+@pytest.mark.gl
+def test_the_difference_pauses_and_says_so_while_the_cameras_differ(xvfb, tmp_path):
+    """Issue #29, item 7: during a drag the Phong panel follows the camera while the ray
+    tracer's keeps its previous image; the difference view then keeps the map of the last
+    camera both had (not one of a moving raster against a still ray trace) and says so; once
+    the ray trace at the new camera is done it is live again: the map of the two panels."""
+    from workbench.compare.metrics import error_map
+    out = tmp_path / "ui"
+    p = subprocess.run([*ui_command(), "whitted", "--methods", "phong,raytrace", "--size", "64",
+                        "--script", script_of("DiffPause"), "--out", str(out)],
+                       cwd=ROOT, env={**os.environ, "DISPLAY": xvfb}, capture_output=True,
+                       text=True, timeout=400)
+    assert p.returncode == 0, p.stderr[-2000:]
+    log = json.loads((out / "summary.json").read_text())["script"]
+    assert log["before_status"] is None and log["after_status"] is None
+    assert len(log["drag"]) == 3
+    for frame in log["drag"]:
+        assert frame["kept"], frame  # the map of before the drag, not recomputed
+        assert frame["status"].startswith("paused: phong and raytrace show different cameras "
+                                          "(raytrace re-renders)"), frame
+    for phase in ("before", "after"):
+        ph, rt, diff = (np.load(out / f"{phase}_{m}.npy") for m in ("phong", "raytrace", "difference"))
+        assert np.abs(diff - error_map(ph, rt, "abs")).max() <= 1e-6, phase
+    # the drag moved the camera: the maps before and after are of different images
+    assert np.abs(np.load(out / "before_phong.npy") - np.load(out / "after_phong.npy")).max() > 0.05

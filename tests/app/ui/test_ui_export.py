@@ -90,3 +90,42 @@ def test_export_replayed_through_the_cli_gives_the_same_images(exported, tmp_pat
         a = np.asarray(Image.open(folder / f"{m}.png")).astype(int)
         b = np.asarray(Image.open(tmp_path / f"{m}.png")).astype(int)
         assert (np.abs(a - b).max(-1) > 0).mean() <= 0.01, m
+
+
+@pytest.mark.gl
+def test_an_export_while_the_path_tracer_refines_records_what_it_had(xvfb, tmp_path):
+    """Issue #29, item 5: a path-traced panel exported while it refines records the spp and
+    passes its image has (not the knob's target, 256) and that it had not converged; its
+    replay renders that many spp, which gives the exported image (the sampler is seeded by
+    the sample's index, so passes of another size give the same sums)."""
+    from workbench.app.ui.jobs import PASS_SAMPLES
+    out = tmp_path / "ui"
+    p = subprocess.run([*ui_command(), "cornell", "--methods", "phong,pathtrace", "--size", "96",
+                        "--script", script_of("ExportRefining"), "--out", str(out)],
+                       cwd=ROOT, env={**os.environ, "DISPLAY": xvfb}, capture_output=True,
+                       text=True, timeout=400)
+    assert p.returncode == 0, p.stderr[-2000:]
+    log = json.loads((out / "summary.json").read_text())["script"]
+    assert "exported" in log, log  # the panel was seen refining
+    folder = (out / "export").resolve()
+    settings = json.loads((folder / "settings.json").read_text())
+    rec = settings["panels"]["pathtrace"]
+    w, h = settings["camera"]["width"], settings["camera"]["height"]
+    per_pass = max(1, PASS_SAMPLES // (w * h))
+    assert rec["state"] == "refining" and rec["converged"] is False and rec["target_spp"] == 256
+    assert rec["passes"] >= 2 and rec["spp"] == rec["passes"] * per_pass < 256
+    assert rec["noise"] > 0 and rec == log["progress"]
+    assert settings["panels"]["phong"] == {"state": "done"}
+    assert settings["options"]["pathtrace"]["spp"] == rec["spp"]
+    cmd = next(c for c in settings["replay"] if c[4] == "pathtrace")
+    assert f"spp={rec['spp']}" in cmd and "spp=256" not in cmd
+    assert f"pathtrace at {rec['spp']}/256 spp (not converged)" in log["status"]
+    args = cmd[2:]
+    args[args.index("-o") + 1] = str(tmp_path / "pt.png")
+    args[args.index("--npy") + 1] = str(tmp_path / "pt.npy")
+    r = subprocess.run([str(Path(ui_command()[0])), "render", *args], cwd=tmp_path,
+                       capture_output=True, text=True, timeout=400)
+    assert r.returncode == 0, r.stderr[-2000:]
+    ui, cli = np.load(folder / "pathtrace.npy"), np.load(tmp_path / "pt.npy")
+    assert np.isfinite(ui).all() and ui.shape == cli.shape == (h, w, 3)
+    assert np.abs(ui - cli).max() <= 1e-5

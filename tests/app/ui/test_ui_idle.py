@@ -71,6 +71,9 @@ def test_nothing_is_cut_off_and_panels_fit(xvfb, tmp_path, window):
     assert p.returncode == 0, p.stderr[-2000:]
     log = json.loads((tmp_path / "summary.json").read_text())["script"]
     assert log["cut"] == []
+    # issue #29, item 6: a section title too long for its window is wrapped, not ended by
+    # "..." (the Methods window's "your shading model (GLSL)", at both sizes)
+    assert "your shading model (GLSL)" in log["wrapped"]
     w, h = (int(x) for x in window.split("x"))
     panels = {m: r for m, r in log["blits"] if m != "difference"}
     assert len(panels) >= 3  # the first view of an emitter scene

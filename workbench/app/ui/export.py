@@ -10,9 +10,13 @@ Into one folder (written whole or not at all: a temporary sibling renamed at the
   written in and the camera as moved (its resolution the panels'), file paths made absolute;
 * ``settings.json``: scene, camera, methods with their options and display modes, the
   overrides, the panels skipped and why (a panel whose method does not apply to the scene, or
-  whose render failed, has no image to write), and ``replay``: one ``workbench render``
-  command per panel that renders ``scene.toml`` with the panel's options and display mode into
-  the same PNG and NPY (``tests/app/ui/test_ui_export.py`` runs them).
+  whose render failed, has no image to write), ``panels``: the state each exported image was
+  in (:func:`panel_record`: done, or a path tracer still refining at how many spp and passes of
+  its target, whether it converged; a ray trace with how many rows rendered; a stale image),
+  and ``replay``: one ``workbench render`` command per panel that renders ``scene.toml`` with
+  the panel's options and display mode into the same PNG and NPY (``tests/app/ui/test_ui_export.py``
+  runs them).  A refining panel's options and replay carry the spp its image has, not its
+  target (issue #29, item 5: such an export recorded spp=256).
 """
 from __future__ import annotations
 
@@ -26,7 +30,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .state import AppState, shown_image
+from .panel_refresh import mismatch
+from .state import AppState, method_kind, shown_image
 
 
 def toml_value(v) -> str:
@@ -125,30 +130,71 @@ def skipped_panels(state: AppState) -> dict[str, str]:
     return out
 
 
-def replay_command(state: AppState, method: str, folder: Path) -> list[str]:
-    """The ``workbench render`` command that renders ``method``'s panel from ``scene.toml``."""
+def panel_record(state: AppState, method: str) -> dict:
+    """The state ``method``'s exported image was in: ``{"state": "done"}`` for a GL panel (drawn
+    in the frame) and a child's image of the current request; a CPU or progressive panel's
+    :func:`.panel_refresh.shown_progress` (``refining`` with ``spp``, ``target_spp``,
+    ``passes``, ``noise``, ``converged``; ``rendering`` with ``rows_done``; ``stale``); a
+    child's image of an earlier request ``stale``."""
+    kind = method_kind(state, method)
+    if kind in ("cpu", "progressive"):
+        return dict(state.progress.get(method, {"state": "stale"}))
+    if kind == "child":
+        proc = state.pyrender
+        current = (state.scene_version, state.camera, tuple(sorted(state.options[method].items())))
+        return {"state": "done" if proc is not None and proc.image_key == current else "stale"}
+    return {"state": "done"}
+
+
+def shown_options(state: AppState, method: str, record: dict) -> dict:
+    """The panel's options as its image has them: a refining panel's ``spp`` is the spp done
+    (its target is ``record["target_spp"]``)."""
+    from ...renderers.base import get_renderer
+    opts = dict(state.options.get(method, {}))
+    if "spp" in record and not record.get("converged"):
+        opts[get_renderer(method).knob.name] = record["spp"]
+    return opts
+
+
+def progress_note(method: str, record: dict) -> str:
+    """One phrase on a panel exported before its render was done (empty when done)."""
+    if record["state"] == "refining":
+        return f"{method} at {record['spp']}/{record['target_spp']} spp (not converged)"
+    if record["state"] == "rendering":
+        return f"{method} partial ({record['rows_done']}/{record['rows']} rows)"
+    if record["state"] != "done":
+        return f"{method} {record['state']} (an earlier request's image)"
+    return ""
+
+
+def replay_command(state: AppState, method: str, folder: Path, options: dict) -> list[str]:
+    """The ``workbench render`` command that renders ``method``'s panel from ``scene.toml``
+    with ``options`` (:func:`shown_options`)."""
     cmd = ["workbench", "render", str(folder / "scene.toml"), "--method", method,
            "--size", f"{state.camera.width}x{state.camera.height}"]
-    for k, v in state.options.get(method, {}).items():
+    for k, v in options.items():
         cmd += ["--set", f"{k}={v}"]
     cmd += ["--display", state.display.get(method, "direct24"),
             "-o", str(folder / f"{method}.png"), "--npy", str(folder / f"{method}.npy")]
     return cmd
 
 
-def settings(state: AppState, folder: Path, skipped: dict[str, str]) -> dict:
-    """The export's ``settings.json``."""
+def settings(state: AppState, folder: Path, skipped: dict[str, str], records: dict) -> dict:
+    """The export's ``settings.json`` (``records``: :func:`panel_record` of each panel
+    exported)."""
     shown = [m for m in state.methods if m not in skipped]
+    options = {m: shown_options(state, m, records.get(m, {})) for m in state.methods}
     return {"scene": str(state.scene_path), "scene_file": str(folder / "scene.toml"),
             "camera": asdict(state.camera), "methods": list(state.methods),
-            "options": {m: state.options[m] for m in state.methods},
+            "options": options, "panels": records,
             "display": {m: state.display.get(m, "direct24") for m in state.methods},
             "material_overrides": state.overrides,
             "light_overrides": {str(k): v for k, v in state.light_overrides.items()},
             "difference": {"a": state.diff_pair[0], "b": state.diff_pair[1],
-                           "kind": state.diff_kind},
+                           "kind": state.diff_kind,
+                           "paused": mismatch(state, *state.diff_pair)},
             "skipped": skipped,
-            "replay": [replay_command(state, m, folder) for m in shown]}
+            "replay": [replay_command(state, m, folder, options[m]) for m in shown]}
 
 
 def export(state: AppState, folder: Path) -> list[Path]:
@@ -162,6 +208,7 @@ def export(state: AppState, folder: Path) -> list[Path]:
     shutil.rmtree(tmp, ignore_errors=True)
     tmp.mkdir(parents=True)
     skipped = skipped_panels(state)
+    records = {m: panel_record(state, m) for m in state.methods if m not in skipped}
     names = []
     for m in state.methods:
         if m in skipped:
@@ -175,12 +222,15 @@ def export(state: AppState, folder: Path) -> list[Path]:
         np.save(tmp / "difference.npy", np.asarray(err, np.float32))
         names += ["difference.png", "difference.npy"]
     (tmp / "scene.toml").write_text(toml_text(scene_document(state)), encoding="utf-8")
-    (tmp / "settings.json").write_text(json.dumps(settings(state, folder, skipped), indent=1,
-                                                  default=str))
+    (tmp / "settings.json").write_text(json.dumps(settings(state, folder, skipped, records),
+                                                  indent=1, default=str))
     names += ["scene.toml", "settings.json"]
     if folder.exists():
         shutil.rmtree(folder)
     os.replace(tmp, folder)
     note = "" if not skipped else "; skipped: " + "; ".join(f"{m} ({why})" for m, why in skipped.items())
+    unfinished = [x for x in (progress_note(m, r) for m, r in records.items()) if x]
+    if unfinished:
+        note += "; as shown: " + "; ".join(unfinished)
     state.status["export"] = f"saved {len(names)} files to {folder}{note}"
     return [folder / n for n in names]

@@ -14,6 +14,7 @@ import time
 from pathlib import Path
 
 from ...core.errors import WorkbenchError
+from .section import section
 from .state import AppState, Browser, add_shading_model, set_scene
 
 RELIST_SECONDS = 1.0
@@ -87,8 +88,7 @@ def add_model(state: AppState, path: Path) -> bool:
 
 def file_browser(state: AppState) -> None:
     """The scene file browser (:func:`browse`), under its title."""
-    from imgui_bundle import imgui
-    imgui.separator_text("scene file")
+    section(state, "scene file")
     browse(state.browser, "open", lambda path: open_scene(state, path))
 
 
@@ -96,7 +96,7 @@ def shading_picker(state: AppState) -> None:
     """The picker of users' shading models: a ``*.glsl`` file becomes a method panel
     (``glsl:FILE``); under it, the one-line compile error of each added model that failed."""
     from imgui_bundle import imgui
-    imgui.separator_text("your shading model (GLSL)")
+    section(state, "your shading model (GLSL)")
     browse(state.shading_browser, "add", lambda path: add_model(state, path))
     imgui.push_text_wrap_pos(0.0)
     for m in state.user_methods:

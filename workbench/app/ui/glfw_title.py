@@ -24,6 +24,17 @@ def shown_title() -> str:
     return (glfw.glfwGetWindowTitle(glfw.glfwGetCurrentContext()) or b"").decode()
 
 
+def window_size() -> tuple[int, int]:
+    """The window's size now (GLFW's, screen coordinates: pixels on X11)."""
+    import ctypes
+    glfw = glfw_library()
+    glfw.glfwGetWindowSize.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_int),
+                                       ctypes.POINTER(ctypes.c_int)]
+    w, h = ctypes.c_int(), ctypes.c_int()
+    glfw.glfwGetWindowSize(glfw.glfwGetCurrentContext(), ctypes.byref(w), ctypes.byref(h))
+    return w.value, h.value
+
+
 def window_title(state) -> str:
     """The window's title: the scene shown (``state`` an :class:`~.state.AppState`)."""
     return f"workbench ui: {state.scene_path.stem}"

@@ -7,6 +7,7 @@ from dataclasses import replace
 import numpy as np
 from imgui_bundle import imgui
 
+from .section import section
 from .state import AppState
 
 
@@ -78,7 +79,7 @@ def _show_node(label: str, node) -> None:
 
 def ray_tree_view(state: AppState) -> None:
     """The selected pixel's ray tree as nested tree nodes (Ctrl+click in the raytrace panel)."""
-    imgui.separator_text("ray tree (Ctrl+click the raytrace panel)")
+    section(state, "ray tree (Ctrl+click the raytrace panel)")
     if state.ray_tree is not None:
         i, j = state.ray_tree["pixel"]
         imgui.set_next_item_open(True, imgui.Cond_.once)

@@ -67,6 +67,7 @@ class Job:
     version : number of changes of ``partial``/``image``/``error`` so far.
     spp, noise : a progressive job's samples per pixel so far and its noise (RMS standard
     error of the pixel means; None before two samples).
+    passes : a progressive job's passes done so far.
     """
 
     def __init__(self, scene, camera, method: str, options: dict, tiled: bool, notify=None):
@@ -74,6 +75,7 @@ class Job:
         # in its key (every material or light edit builds a new Scene)
         self.scene = scene
         self.key = job_key(scene, camera, method, options)
+        self.camera = camera
         self.partial = np.zeros((camera.height, camera.width, 3), np.float32)
         self.image = None
         self.seconds = None
@@ -84,7 +86,7 @@ class Job:
         # add_samples(n), image, samples and noise_rmse): the panel shows the running image, its
         # samples per pixel and noise, and the job ends at the method's spp option
         self.progressive = get_renderer(method).ui_kind == "progressive"
-        self.spp, self.noise = 0, None
+        self.spp, self.noise, self.passes = 0, None, 0
         self.cancelled = threading.Event()
         self.lock = threading.Lock()
         self.notify = notify
@@ -156,14 +158,21 @@ class Job:
             noise = session.noise_rmse
             with self.lock:
                 self.partial, self.spp, self.noise = image, session.samples, noise
+                self.passes += 1
                 self.version += 1
             self._notify()
         return session.image
 
-    def snapshot(self) -> np.ndarray:
-        """The finished image, else a copy of the partial one."""
+    def snapshot(self) -> tuple[np.ndarray, dict]:
+        """The finished image, else a copy of the partial one, with what it holds, read in the
+        same lock as the image (the thread goes on meanwhile): ``done``, ``rows_done`` and a
+        progressive job's ``spp``, ``passes`` and ``noise``."""
         with self.lock:
-            return self.image if self.image is not None else self.partial.copy()
+            image = self.image if self.image is not None else self.partial.copy()
+            held = {"done": self.image is not None, "rows_done": self.rows_done}
+            if self.progressive:
+                held.update(spp=self.spp, passes=self.passes, noise=self.noise)
+            return image, held
 
     @property
     def done(self) -> bool:

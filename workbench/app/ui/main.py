@@ -12,6 +12,7 @@ import json
 import multiprocessing
 import os
 import signal
+import sys
 import threading
 import time
 from contextlib import contextmanager
@@ -140,6 +141,7 @@ def write_outputs(state: AppState, script, out: Path, seconds: float, shown: lis
                "gl_renderer": state.gl_renderer, "methods": state.methods,
                "scene": state.scene_path.stem,
                "panel_size": [state.camera.width, state.camera.height],
+               "window": list(state.window_size),
                "timings": state.timings, "shown": [[m, list(r)] for m, r in shown],
                "threads": [t.name for t in threading.enumerate()],
                "child_processes": [c.name for c in multiprocessing.active_children()],
@@ -197,6 +199,12 @@ def _loop(state: AppState, max_frames: int | None, script, window: tuple[int, in
             hello_imgui.get_runner_params().app_shall_exit = True
 
     def before_exit():
+        from .glfw_title import window_size
+        from .window_size import remember
+        state.window_size = window_size()
+        note = remember(state.window_size)  # the next run opens at this size
+        if note:
+            print(note, file=sys.stderr)
         if state.gpu is not None:
             shown.extend(state.gpu.blits.last)
         stop_background(state)

@@ -96,6 +96,7 @@ def refresh_raster(state: AppState, method: str) -> bool:
         panel.timed = False
     else:
         timed_draw(state, panel, method, fbo)
+    state.image_requests[method] = (cam, state.scene)
     state.images.set_pending(method, lambda: RasterSession.read_image(fbo),
                              pixel=lambda i, j, shape: read_pixel(fbo, i, j, shape),
                              shape=(cam.height, cam.width))
@@ -152,12 +153,69 @@ def refresh_cpu(state: AppState, method: str) -> None:
         state.status[method] = (f"rendering: {job.rows_done}/{state.camera.height} rows"
                                 if tiled(method) else "rendering...")
     shape = (state.camera.height, state.camera.width, 3)
-    if stale(state, f"{method} job", (id(job), job.version, shape)) or method not in state.images:
-        image = job.snapshot()
+    key = (id(job), job.version, shape, job.cancelled.is_set())
+    if stale(state, f"{method} job", key) or method not in state.images:
+        image, held = job.snapshot()
         # the previous job's image is kept while its successor waits, unless it has another
         # size (a scene switch changed the panels' aspect): then black until the new one comes
-        state.images[method] = (over_stale(state, method, job, image)
-                                if image.shape == shape else np.zeros(shape, np.float32))
+        if image.shape == shape:
+            state.images[method] = over_stale(state, method, job, image)
+            state.progress[method] = shown_progress(state, method, job, held)
+            if state.progress[method]["state"] in ("done", "refining") or method not in state.image_requests:
+                state.image_requests[method] = (job.camera, job.scene)
+            # else: the previous image (or its rows not yet rendered again) still shows
+        else:
+            state.images[method] = np.zeros(shape, np.float32)
+            state.progress[method] = {"state": "waiting"}
+            state.image_requests.pop(method, None)
+
+
+def mismatch(state: AppState, a: str, b: str) -> str:
+    """Why panels ``a`` and ``b`` do not show the same camera and scene (empty when they do):
+    during a drag a GL panel follows the camera while a ray-traced one keeps its previous image
+    until its new render is done (issue #29, item 7: the difference view compared them
+    unflagged)."""
+    ra, rb = state.image_requests.get(a), state.image_requests.get(b)
+    if ra is None or rb is None:
+        return f"waiting for {a if ra is None else b}"
+    def same(r, q) -> bool:  # scenes by identity: every edit makes a new one
+        return r[0] == q[0] and r[1] is q[1]
+
+    if same(ra, rb):
+        return ""
+    what = "camera" if ra[0] != rb[0] else "scene edit"
+    behind = [m for m in (a, b) if state.progress.get(m, {}).get("state") in ("stale", "rendering")]
+    return f"{a} and {b} show different {what}s" + (f" ({behind[0]} re-renders)" if len(behind) == 1 else "")
+
+
+def shown_progress(state: AppState, method: str, job, held: dict) -> dict:
+    """What ``method``'s panel shows of ``job`` (``held``: :meth:`.jobs.Job.snapshot`'s
+    account of the image taken), as the export records it (issue #29, item 5: an export
+    recorded the target spp of a panel still refining).
+
+    ``state``: ``"done"`` (the finished render of the current request), ``"refining"`` (a
+    progressive job's running image), ``"rendering"`` (``rows_done`` of ``rows`` rendered, over
+    the previous image), ``"stale"`` (the previous request's image: a restart is pending, or
+    nothing of the new render has come yet).  A progressive job's also ``spp`` (samples per
+    pixel in the image), ``target_spp`` (its knob), ``passes``, ``noise`` (RMS standard error of
+    the pixel means, None before two samples) and ``converged`` (it reached its target)."""
+    from ...renderers.base import get_renderer
+    rows = state.camera.height
+    if job.cancelled.is_set():
+        out = {"state": "stale"}
+    elif held["done"]:
+        out = {"state": "done"}
+    elif job.progressive:
+        out = {"state": "refining" if held["spp"] > 0 else "stale"}
+    elif held["rows_done"] > 0:
+        out = {"state": "rendering", "rows_done": held["rows_done"], "rows": rows}
+    else:
+        out = {"state": "stale"}
+    if job.progressive and out["state"] != "stale":
+        target = int(state.options[method][get_renderer(method).knob.name])
+        out.update(spp=held["spp"], target_spp=target, passes=held["passes"],
+                   noise=held["noise"], converged=held["done"] and held["spp"] >= target)
+    return out
 
 
 def over_stale(state: AppState, method: str, job, image: np.ndarray) -> np.ndarray:

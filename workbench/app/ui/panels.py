@@ -10,9 +10,11 @@ from .display_passes import SCALE_FLOOR
 from .export import export
 from .gl_sessions import KNOB_VALUES, STANDIN_CHOICES, draws_standins
 from .inspect import pixel_under_mouse, probe_tooltip, select_ray_tree
-from .panel_gpu import stale, upload, upload_linear
+from .panel_gpu import gpu, stale, upload, upload_linear
+from .panel_refresh import mismatch
 from .panel_show import difference_on_gpu, image_stats, show_difference, show_panel
 from .patch_view import select_patch
+from .section import section
 from .placement import PANEL_GAP, PANEL_LINES, focus, panel_grid
 from .state import (DISPLAY_MODES, HARMONIES, MATERIAL_FIELDS, AppState, choosable_methods,
                     set_display, set_material_value, set_option, set_scene, short_name,
@@ -25,10 +27,20 @@ ZOOM_STEP = 0.9
 MATERIAL_RANGES = {"ka": (0.0, 1.0), "kd": (0.0, 1.0), "ks": (0.0, 1.0),
                    "shininess": (1.0, 500.0), "kr": (0.0, 1.0), "kt": (0.0, 1.0),
                    "ior": (1.0, 2.5)}
+def right_edge() -> float:
+    """The right edge of the current window's content (screen pixels): less its padding and,
+    when shown, its vertical scrollbar (which covers what lies under it: at 1024x600 the Scene
+    window's "reset zoom" ran under it unnoticed)."""
+    from imgui_bundle.imgui import internal
+    scrollbar = internal.get_current_window().scrollbar_sizes.x
+    return (imgui.get_window_pos().x + imgui.get_window_width()
+            - imgui.get_style().window_padding.x - scrollbar)
+
+
 def check_fits(state: AppState, name: str) -> None:
     """Note in ``state.cut`` whether the last item (its frame and label) ends past the right
-    edge of its window's content: nothing should (scripts and tests read it)."""
-    right = imgui.get_window_pos().x + imgui.get_window_width() - imgui.get_style().window_padding.x
+    edge of its window's content (:func:`right_edge`): nothing should (scripts and tests read it)."""
+    right = right_edge()
     if imgui.get_item_rect_max().x > right + 1.0:
         state.cut.add(name)
     else:
@@ -39,8 +51,7 @@ def same_line_if_fits(width: float) -> None:
     """Continue the line if an item ``width`` pixels wide still fits in the window, else
     start a new line (buttons that wrap instead of running past the edge)."""
     spacing = imgui.get_style().item_spacing.x
-    right = imgui.get_window_pos().x + imgui.get_window_width() - imgui.get_style().window_padding.x
-    if imgui.get_item_rect_max().x + spacing + width <= right:
+    if imgui.get_item_rect_max().x + spacing + width <= right_edge():
         imgui.same_line()
 
 
@@ -108,7 +119,7 @@ def method_list(state: AppState) -> None:
 def parameters(state: AppState) -> None:
     """Sliders: the chosen material's coefficients and each selected method's quality knob."""
     from ...renderers.base import get_renderer
-    imgui.separator_text("material")
+    section(state, "material")
     names = list(state.scene.materials)
     imgui.push_item_width(-label_room("material", *MATERIAL_FIELDS))  # labels fit beside
     changed, idx = imgui.combo("material", names.index(state.material), names)
@@ -123,13 +134,15 @@ def parameters(state: AppState) -> None:
         if changed:
             set_material_value(state, state.material, f, v)
     imgui.pop_item_width()
-    imgui.separator_text("quality")
+    section(state, "quality")
     for m in state.methods:
         knob = get_renderer(m).knob
         values = list(knob.values)
         cur = state.options[m][knob.name]
         idx = values.index(cur) if cur in values else 0
-        imgui.text(f"{m}: {knob.name}")  # its own line: a label beside the slider was cut
+        imgui.push_text_wrap_pos(0.0)  # its own line(s): a label beside the slider was cut
+        imgui.text(f"{short_name(m)}: {knob.name}")
+        imgui.pop_text_wrap_pos()
         imgui.set_next_item_width(-1)
         changed, idx = imgui.slider_int(f"##knob {m}", idx, 0, len(values) - 1,
                                         format=str(values[idx]))
@@ -261,9 +274,12 @@ def image_panels(state: AppState) -> None:
 
 
 def difference_panel(state: AppState) -> None:
-    """Error map between two chosen methods with its colour scale."""
+    """Error map between two chosen methods with its colour scale.  While the two images are
+    not of the same camera and scene (:func:`.panel_refresh.mismatch`: a drag moves a GL panel
+    while a ray-traced one re-renders) the view pauses on the last map of two matching images
+    and says so (``state.status["difference"]``; issue #29, item 7)."""
     from ...compare.metrics import error_map
-    imgui.separator_text("difference")
+    section(state, "difference")
     ms = state.methods
     a, b = (x if x in ms else ms[0] for x in state.diff_pair)
     kinds = ["abs", "flip"]
@@ -290,9 +306,21 @@ def difference_panel(state: AppState) -> None:
     if not all(state.images.has_shape(m, shape) for m in (a, b)):
         imgui.text_disabled("waiting for both images at the panels' size")
         return  # one is still the previous scene's (another size): nothing to compare yet
+    why = mismatch(state, a, b)
+    if why:  # a drag: the map of two images from one camera (the last) stays, flagged
+        state.status["difference"] = (f"paused: {why}; the map shown is the last one of two "
+                                      "images of the same camera and scene")
+        imgui.push_text_wrap_pos(0.0)
+        imgui.text_colored(imgui.ImVec4(1.0, 0.6, 0.3, 1.0), state.status["difference"])
+        imgui.pop_text_wrap_pos()
+        last = gpu(state).shown.get("difference")
+        if last is None or last[:3] != (a, b, state.diff_kind) or "difference" not in state.images:
+            return
+    else:
+        state.status.pop("difference", None)
     # recomputed only when either image or the kind changed (a static frame reads no pixels)
     key = (a, b, state.diff_kind, state.images.version(a), state.images.version(b))
-    if stale(state, "difference", key) or "difference" not in state.images:
+    if not why and (stale(state, "difference", key) or "difference" not in state.images):
         if not (state.diff_kind == "abs" and difference_on_gpu(state, a, b, hot_table())):
             # FLIP (or images of different sizes: error_map says so)
             err = error_map(state.images[a], state.images[b], state.diff_kind)
@@ -322,7 +350,7 @@ def difference_panel(state: AppState) -> None:
 def colour_wheel(state: AppState) -> None:
     """The chromatic circle with the course's harmonies for a chosen base hue (HSV)."""
     from ...core.harmony import wheel_image
-    imgui.separator_text("colour wheel")
+    section(state, "colour wheel")
     hue, kind = state.wheel
     _, hue = imgui.slider_float("base hue", hue, 0.0, 360.0)
     _, k = imgui.combo("harmony", HARMONIES.index(kind), list(HARMONIES))

@@ -36,9 +36,6 @@ from .state import AppState, ErrorPlot, choosable_methods, method_kind, short_na
 SETTLE_SECONDS = 0.3
 """The camera and scene must stay unchanged this long before the reference render starts."""
 METRICS = ("rmse", "flip")
-FLOOR = 1e-6
-"""Errors are drawn at least this large on the log axis (the reference itself has error 0)."""
-MARGIN = 1.5
 CLEAR_FILLS = ("frame_bg", "plot_bg", "legend_bg")
 """implot colours drawn fully transparent (imgui skips such fills): the plot shows the window
 background instead of painting its frame, plot area and legend, which on llvmpipe cost
@@ -122,17 +119,18 @@ MATCHED_SUFFIX = " vs matched"
 
 
 def plotted_lines(plot: ErrorPlot, methods, metric: str) -> dict:
-    """{label: (run times in ms, errors)} of the methods on screen (a removed panel's line
-    leaves the legend), each sorted by run time, errors at least :data:`FLOOR`: the method's
-    total errors under its name, its errors against its matched reference (where evaluated)
-    under ``name + MATCHED_SUFFIX``, right after it."""
+    """{label: (run times in ms, errors, the points)} of the methods on screen (a removed
+    panel's line leaves the legend), each sorted by run time: the method's total errors under
+    its name, its errors against its matched reference (where evaluated) under
+    ``name + MATCHED_SUFFIX``, right after it.  Errors as evaluated (0 for the reference
+    itself): the axis floor is the view's (:func:`.plot_axes.error_limits`)."""
     lines = {}
     for m in methods:
         for label, points in ((m, plot.points), (m + MATCHED_SUFFIX, plot.matched_points)):
             rows = sorted(points.get(m, {}).values(), key=lambda p: p["seconds"])
             if rows:
                 lines[label] = (np.array([p["seconds"] * 1e3 for p in rows]),
-                                np.maximum(np.array([p[metric] for p in rows]), FLOOR))
+                                np.array([p[metric] for p in rows], float), rows)
     return lines
 
 
@@ -284,20 +282,10 @@ def _point(image: np.ndarray, reference: np.ndarray, seconds: float, label: str)
     return {**_evaluate(image, reference), "seconds": float(seconds), "label": label}
 
 
-def log_limits(values: np.ndarray) -> tuple[float, float]:
-    """Axis range of positive ``values`` on a log axis: a factor :data:`MARGIN` beyond them,
-    and at least one decade (so that the axis has a labelled tick)."""
-    lo, hi = float(values.min()) / MARGIN, float(values.max()) * MARGIN
-    if hi < 10.0 * lo:
-        mid = np.sqrt(lo * hi)
-        lo, hi = mid / np.sqrt(10.0), mid * np.sqrt(10.0)
-    return lo, hi
-
-
 def error_plot(state: AppState) -> None:
     """Log-log plot: one line per method through its knob settings, run time on x (a dashed
     one of the same colour: its error against its matched reference)."""
-    from imgui_bundle import imgui, implot
+    from imgui_bundle import imgui
     plot = state.errors
     plot.shown = state.frame
     imgui.set_next_item_width(100)
@@ -316,29 +304,93 @@ def error_plot(state: AppState) -> None:
         imgui.text_disabled(f"no matched reference: {', '.join(map(short_name, none))} (total error only)")
     imgui.pop_text_wrap_pos()
     lines = plotted_lines(plot, state.methods, plot.metric)
+    draw_plot(plot, lines)
+
+
+def draw_plot(plot: ErrorPlot, lines: dict) -> None:
+    """The implot plot of ``lines`` (:func:`plotted_lines`): log-log, the ticks labelled as
+    densely as their labels leave room for at the plot's size (:func:`.plot_axes.log_ticks`:
+    run times as ``ms`` / ``s``), the error axis at most :data:`~.plot_axes.ERROR_DECADES`
+    decades deep with points below its floor drawn at the floor as grey down-triangles (legend:
+    "below the axis floor"), and the point under the mouse described in a tooltip
+    (:func:`.plot_axes.hover_text`: method, run time, errors, settings), also kept in
+    ``plot.hover`` with the axes in ``plot.axes`` (scripts read them)."""
+    from imgui_bundle import imgui, implot
+    from .plot_axes import (error_label, error_limits, hover_text, log_limits, log_ticks,
+                            nearest_point, time_label)
     for name in CLEAR_FILLS:
         implot.push_style_color(getattr(implot.Col_, name), imgui.ImVec4(0.0, 0.0, 0.0, 0.0))
+    avail = imgui.get_content_region_avail()
+    if lines:
+        xs, ys = (np.concatenate([v[k] for v in lines.values()]) for k in (0, 1))
+        xlim, (floor, *ylim) = log_limits(xs), error_limits(ys)
+    else:  # 1 ms to 1 s
+        xlim, (floor, *ylim) = (1.0, 1e3), error_limits(np.zeros(0))
+    # the legend: outside on the right where the plot keeps most of the width, else under the
+    # plot (in a row if its entries fit, else a column): at 1024x600 the plot's tab is ~250 px
+    # wide and a legend beside it left the plot 14 px
+    entries = [short_name(k.removesuffix(MATCHED_SUFFIX)) + k[len(k.removesuffix(MATCHED_SUFFIX)):]
+               for k in lines] + ["below the axis floor"]
+    widths = [imgui.calc_text_size(e).x + 30.0 for e in entries]
+    text_h = imgui.get_text_line_height()
+    row_h = imgui.get_text_line_height_with_spacing()
+    if avail.x - max(widths) >= 2 * max(widths, default=0.0) + 150.0:
+        where, flags, room_x, room_y = implot.Location_.east, implot.LegendFlags_.outside, max(widths), 0.0
+    elif sum(widths) <= avail.x - 20.0:
+        where, flags = implot.Location_.south, implot.LegendFlags_.outside | implot.LegendFlags_.horizontal
+        room_x, room_y = 0.0, row_h + 10.0
+    else:
+        where, flags, room_x, room_y = implot.Location_.south, implot.LegendFlags_.outside, 0.0, len(entries) * row_h + 10.0
+    # the plot area's length along each axis, estimated before the plot exists (its ticks
+    # are set up first), conservatively: the legend's room and the axes' labels taken off
+    x_ticks = log_ticks(*xlim, max(40.0, avail.x - room_x - 5 * text_h),
+                        lambda t: imgui.calc_text_size(t).x, time_label)
+    y_ticks = log_ticks(*ylim, max(20.0, avail.y - room_y - 3 * text_h), lambda t: text_h, error_label)
+    plot.hover = ""
     if implot.begin_plot("##error against run time", imgui.ImVec2(-1, -1)):
-        implot.setup_axes("run time (ms)", plot.metric)
-        implot.setup_legend(implot.Location_.north_east, implot.LegendFlags_.outside)
+        implot.setup_axes("run time", plot.metric)
+        implot.setup_legend(where, flags)
         implot.setup_axis_scale(implot.ImAxis_.x1, implot.Scale_.log10)
         implot.setup_axis_scale(implot.ImAxis_.y1, implot.Scale_.log10)
-        if lines:
-            xs, ys = (np.concatenate([v[k] for v in lines.values()]) for k in (0, 1))
-            implot.setup_axes_limits(*log_limits(xs), *log_limits(ys), implot.Cond_.always)
-        else:  # 1 ms to 1 s, errors 1e-3 to 1
-            implot.setup_axes_limits(1.0, 1e3, 1e-3, 1.0, implot.Cond_.always)
-        colours = {}
-        for label, (xs, ys) in lines.items():
+        implot.setup_axes_limits(*xlim, *ylim, implot.Cond_.always)
+        implot.setup_axis_ticks(implot.ImAxis_.x1, *x_ticks, False)
+        implot.setup_axis_ticks(implot.ImAxis_.y1, *y_ticks, False)
+        colours, shown_points = {}, []
+        for label, (xs, ys, rows) in lines.items():
             m = label.removesuffix(MATCHED_SUFFIX)
             colour = colours.setdefault(m, implot.get_colormap_color(len(colours)))
             marker = getattr(implot.Marker_, marker_of(m))
             shown = short_name(m) + label[len(m):]  # a user's model by its file's name
+            drawn = np.maximum(ys, floor)
             if label == m:
-                implot.plot_line(shown, xs, ys, implot.Spec(line_color=colour, marker=marker, marker_size=5))
+                implot.plot_line(shown, xs, drawn, implot.Spec(line_color=colour, marker=marker, marker_size=5))
             else:  # dashes of the same colour, smaller markers (one legend entry: same label)
-                implot.plot_line(shown, *dashed(xs, ys), implot.Spec(line_color=colour))
-                implot.plot_scatter(shown, xs, ys, implot.Spec(line_color=colour, marker=marker,
-                                                               marker_size=3))
+                implot.plot_line(shown, *dashed(xs, drawn), implot.Spec(line_color=colour))
+                implot.plot_scatter(shown, xs, drawn, implot.Spec(line_color=colour, marker=marker,
+                                                                  marker_size=3))
+            shown_points += [(shown, label != m, x, y, row) for x, y, row in zip(xs, drawn, rows)]
+        below = [(x, y) for _, _, x, y, row in shown_points if row[plot.metric] < floor]
+        if below:
+            bx, by = (np.array(v, float) for v in zip(*below))
+            grey = imgui.ImVec4(0.7, 0.7, 0.7, 1.0)
+            implot.plot_scatter("below the axis floor", bx, by, implot.Spec(
+                line_color=grey, marker_line_color=grey, marker_fill_color=grey,
+                marker=implot.Marker_.down, marker_size=8))
+        pos, size = implot.get_plot_pos(), implot.get_plot_size()
+        plot.axes = {"rect": [pos.x, pos.y, size.x, size.y],
+                     "x": {"limits": list(xlim), "ticks": [
+                         [v, t, implot.plot_to_pixels(v, ylim[0]).x, imgui.calc_text_size(t).x]
+                         for v, t in zip(*x_ticks)]},
+                     "y": {"limits": list(ylim), "ticks": [
+                         [v, t, implot.plot_to_pixels(xlim[0], v).y, text_h] for v, t in zip(*y_ticks)]}}
+        if implot.is_plot_hovered() and shown_points:
+            mouse = imgui.get_mouse_pos()
+            pixels = np.array([[p.x, p.y] for p in (implot.plot_to_pixels(x, y)
+                                                      for _, _, x, y, _ in shown_points)])
+            k = nearest_point(pixels, (mouse.x, mouse.y))
+            if k is not None:
+                name, matched, _, _, row = shown_points[k]
+                plot.hover = hover_text(name, row, plot.metric, matched, floor)
+                imgui.set_tooltip(plot.hover)
         implot.end_plot()
     implot.pop_style_color(len(CLEAR_FILLS))

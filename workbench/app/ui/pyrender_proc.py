@@ -132,6 +132,9 @@ def refresh_pyrender(state) -> None:
                  state.scene, state.camera, opts)
     if proc.poll():
         state.images[METHOD] = proc.image
+        version, camera = proc.image_key[:2]  # the scene of another version: never the current
+        state.image_requests[METHOD] = (camera, state.scene if version == state.scene_version
+                                        else version)
         state.timings[METHOD] = proc.seconds
     if proc.error is not None:
         state.status[METHOD] = proc.error

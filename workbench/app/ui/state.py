@@ -87,6 +87,11 @@ class ErrorPlot:
     matched_boards: dict = field(default_factory=dict)
     matched_message: str = ""
     metric: str = "rmse"
+    hover: str = ""
+    """The tooltip of the point under the mouse in the last frame (empty: none)."""
+    axes: dict = field(default_factory=dict)
+    """The last frame's plot: ``{"rect": [x, y, w, h] pixels of the plot area, "x"|"y":
+    {"limits": [lo, hi], "ticks": [[value, label, pixel along the axis, label's size]]}}``."""
     shown: int = -2
     gave_up: bool = False
     board: object = None
@@ -173,10 +178,23 @@ class AppState:
     """method -> (what its GL session was to be built from, one-line message) of a GL panel
     whose session could not be built (a user's model that does not compile): the message is
     shown, and the build is not tried again until what it is built from changes."""
+    progress: dict[str, dict] = field(default_factory=dict)
+    """method -> what a CPU or progressive panel's image is (done, refining at how many spp,
+    rendering how many rows, stale): :func:`.panel_refresh.shown_progress`; the export records
+    it."""
+    image_requests: dict[str, tuple] = field(default_factory=dict)
+    """method -> (camera, scene) its panel's image was made for (a GL panel's last draw, a CPU
+    job's request, or the previous one while a restart is pending); the difference view
+    pauses while its two differ (:func:`.panel_refresh.mismatch`)."""
     kinds: dict[str, str] = field(default_factory=dict)
     """method -> its renderer's ``ui_kind`` (:func:`method_kind`)."""
     cut: set = field(default_factory=set)
     """Widgets that ran past their window's right edge in the last frame (``panels.check_fits``)."""
+    window_size: tuple[int, int] = (0, 0)
+    """The window's size when it closed (GLFW), kept for the next run (:mod:`.window_size`)."""
+    wrapped: set = field(default_factory=set)
+    """Section titles too long for their window in the last frame, wrapped instead of cut
+    (:func:`.section.section`)."""
     quit: bool = False
     """Close the window at the end of this frame (scripts; SIGTERM and SIGINT)."""
     quit_signal: int = 0
