@@ -184,7 +184,9 @@ def main(argv=None) -> None:
             load = os.getloadavg()
             child = subprocess.run([sys.executable, __file__, "--child", "--script-out", out,
                                     *argv, "--out", str(a.out)], cwd=ROOT, timeout=600,
-                                   env={**os.environ, "DISPLAY": f":{n}"}, capture_output=True,
+                                   # its own config folder: the user's remembered window size stays
+                                   env={**os.environ, "DISPLAY": f":{n}", "WORKBENCH_CONFIG_DIR": out},
+                                   capture_output=True,
                                    text=True)
             if child.returncode != 0:  # the window's own error, not the wrapper's traceback
                 sys.exit(f"ui_drag_profile: the window failed (exit {child.returncode}):\n"

@@ -101,8 +101,9 @@ def measure(scene: str, size: int, window: str, cpu: bool, script: str) -> dict:
             subprocess.run([str(Path(sys.executable).with_name("workbench")), "ui", scene, "--methods",
                             methods, "--size", str(size), "--window", window,
                             "--script", f"{SESSIONS}:{script}", "--out", out],
-                           cwd=ROOT, env={**os.environ, "DISPLAY": f":{n}"}, check=True,
-                           timeout=900)
+                           cwd=ROOT, check=True, timeout=900,
+                           # a folder of its own for the remembered window size: not the user's
+                           env={**os.environ, "DISPLAY": f":{n}", "WORKBENCH_CONFIG_DIR": out})
             summary = json.loads(Path(out, "summary.json").read_text())
     finally:
         xvfb.terminate()
