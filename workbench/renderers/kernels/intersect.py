@@ -33,8 +33,8 @@ def row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, zero, eps, stack,
         lo = _to_object(xf, k, ox, oy, oz, dx, dy, dz)
         inv_s = 1.0 / math.sqrt(lo[3] * lo[3] + lo[4] * lo[4] + lo[5] * lo[5])
     if ptype[k] == CSGNODE:
-        t, code, f = csg_gate(geo.kinds, int(par[k, 0]), int(par[k, 1]), geo.prog, ptype, xf, par, aux,
-                              ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps, st, sp_, sf, sn, stack)
+        t, code, f = csg_gate(geo, int(par[k, 0]), int(par[k, 1]), ox, oy, oz, dx, dy, dz, tmin, tmax,
+                              zero, eps, (st, sp_, sf, sn), stack)
         return t, abs(code) - 1, f + (16 if code < 0 else 0)
     t, f = prim_hit(geo.kinds, k, ptype, par, geo.poly_v, aux, lo[0], lo[1], lo[2], lo[3], lo[4], lo[5],
                     lo[3] * inv_s, lo[4] * inv_s, lo[5] * inv_s, inv_s, tmin, tmax, zero,
@@ -65,22 +65,18 @@ def prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, sh
 # programs, the analytic primitives' tree, the triangles' tree.  A gate whose feature is absent
 # is never reached (its caller tests the same data first) and compiles to a miss.
 
-def csg_gate(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, zero,
-             eps, st, sp_, sf, sn, stack):
+def csg_gate(geo, start, length, ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps, levels, stack):
     """:func:`csg_hit` if the scene has CSG nodes."""
     raise TypeError("csg_gate is callable from numba-compiled code only")
 
 
 @overload(csg_gate, jit_options=GATE)
-def _csg_gate(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, zero,
-              eps, st, sp_, sf, sn, stack):
-    on = has(kinds, "csg")
+def _csg_gate(geo, start, length, ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps, levels, stack):
+    on = has(geo.types[-1], "csg")  # geo.kinds' type
 
-    def impl(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, zero,
-             eps, st, sp_, sf, sn, stack):
+    def impl(geo, start, length, ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps, levels, stack):
         if on:
-            return csg_hit(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy, dz, tmin,
-                           tmax, zero, eps, st, sp_, sf, sn, stack)
+            return csg_hit(geo, start, length, ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps, levels, stack)
         return np.inf, 0, 0
     return impl
 

@@ -325,12 +325,17 @@ def _op(op, a, b):
 
 
 @nb.njit(**NO_REFCOUNT)
-def combine(op, ta, pa, fa, na, tb, pb, fb, nb_, to, po, fo, eps):
+def combine(op, st, sp_, sf, sn, a, b, out, eps):
     """Combine two interval lists by a boolean ``op`` (the course's ``composite_intersect``):
     sweep the events of both lists in order, grouping events closer than ``eps`` (coincident
     surfaces), and emit an event wherever ``op(inside A, inside B)`` changes; intervals shorter
     than ``eps`` are dropped.  A difference flips the normals of B's surfaces (sign of the code).
+    The lists are levels ``a`` and ``b`` of the interval stack (``st`` t, ``sp_`` signed
+    primitive code, ``sf`` face, ``sn`` count per level); the result goes to level ``out``.
     Returns the number of output events."""
+    ta, pa, fa, na = st[a], sp_[a], sf[a], sn[a]
+    tb, pb, fb, nb_ = st[b], sp_[b], sf[b], sn[b]
+    to, po, fo = st[out], sp_[out], sf[out]
     i, j, m = 0, 0, 0
     ina, inb, state = False, False, False
     flip = -1 if op == CSG_DIFFERENCE else 1
@@ -367,10 +372,13 @@ def combine(op, ta, pa, fa, na, tb, pb, fb, nb_, to, po, fo, eps):
 
 
 @nb.njit(**NO_REFCOUNT)
-def csg_hit(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, zero,
-            eps, st, sp_, sf, sn, stack):
-    """Evaluate a CSG postfix program along a ray (the course's recursive ``intersect``, made
-    iterative).  Returns ``(t, code, face)`` of the first boundary in ``(tmin, tmax)``."""
+def csg_hit(geo, start, length, ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps, levels, stack):
+    """Evaluate a CSG postfix program (``geo.prog[start:start + length]``) along a ray (the
+    course's recursive ``intersect``, made iterative).  ``levels``: the interval stack
+    ``(st, sp_, sf, sn)`` (see :func:`combine`).  Returns ``(t, code, face)`` of the first
+    boundary in ``(tmin, tmax)``."""
+    kinds, prog, ptype, xf, par, aux = geo.kinds, geo.prog, geo.ptype, geo.xf, geo.par, geo.aux
+    st, sp_, sf, sn = levels
     top = 0
     for q in range(start, start + length):
         c = prog[q]
@@ -382,8 +390,7 @@ def csg_hit(kinds, start, length, prog, ptype, xf, par, aux, ox, oy, oz, dx, dy,
         else:
             a, b = top - 2, top - 1
             # write into the spare level, then move down
-            m = combine(c, st[a], sp_[a], sf[a], sn[a], st[b], sp_[b], sf[b], sn[b],
-                        st[top], sp_[top], sf[top], eps)
+            m = combine(c, st, sp_, sf, sn, a, b, top, eps)
             for e in range(m):
                 st[a, e], sp_[a, e], sf[a, e] = st[top, e], sp_[top, e], sf[top, e]
             sn[a] = m

@@ -24,6 +24,7 @@ each other.  Equations: see the docstrings of the reference's functions.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numba as nb
 import numpy as np
@@ -403,13 +404,38 @@ def shade_chunk(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim
 PIXEL_BLOCK = 64
 
 
-def render_pixels(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts, O, D, spp,
-                  fwd, cam, first, ncancel, image, depth_map, counts):
+class Shading(NamedTuple):
+    """What the fused driver shades with besides the geometry (``P`` primitive rows, ``M``
+    materials, ``L`` lights)."""
+
+    mat_of: np.ndarray      # (P,) int64 material row of each primitive row
+    mat_tab: np.ndarray     # (M, MAT_COLS) material table (columns ``kernels.columns.Mat``)
+    tex_tab: np.ndarray     # (M, TEX_COLS) fused checker textures (columns ``kernels.columns.Tex``)
+    lights: np.ndarray      # (L, LIGHT_COLS) point and directional lights (``kernels.columns.Light``)
+    ambient: np.ndarray     # (3,) ambient light
+    background: np.ndarray  # (3,) colour of a ray that leaves the scene
+    opts: np.ndarray        # option vector (``kernels.columns.WhittedOpt``)
+
+
+class Pixels(NamedTuple):
+    """The fused driver's primary rays and outputs for ``n`` pixels of ``spp`` samples."""
+
+    O: np.ndarray           # (n spp, 3) primary ray origins, or (0, 3): the camera's centre rays
+    D: np.ndarray           # (n spp, 3) their directions
+    fwd: np.ndarray         # (3,) unit view axis (depth along it)
+    cam: np.ndarray         # (16,) camera frame (``whitted.camera_frame``)
+    image: np.ndarray       # (n, 3) out: mean colour of each pixel's samples
+    depth_map: np.ndarray   # (n,) out: camera-space depth of the first sample's primary hit
+
+
+def render_pixels(geo, shading, pixels, spp, first, ncancel, counts):
     """Whole ray trees of every pixel (the fused path): each pixel's ``spp`` primary rays
-    (``O, D`` rows ``p spp ... p spp + spp - 1``; with ``O`` empty and ``spp = 1``, the centre
-    ray of image pixel ``first + p`` of the camera ``cam``, see ``whitted.camera_frame``) and
-    their reflected and refracted descendants are traced depth first (:func:`pixel_block`), so
-    no array crosses back to Python between ray generations.
+    (``pixels.O, pixels.D`` rows ``p spp ... p spp + spp - 1``; with ``O`` empty and
+    ``spp = 1``, the centre ray of image pixel ``first + p`` of the camera ``pixels.cam``, see
+    ``whitted.camera_frame``) and their reflected and refracted descendants are traced depth
+    first (:func:`pixel_block`), so no array crosses back to Python between ray generations.
+    ``geo``: :class:`..kernels.layout.Geometry`; ``shading``: :class:`Shading`; ``pixels``:
+    :class:`Pixels`.
 
     Writes ``image[p]`` (mean over the samples), ``depth_map[p]`` (camera-space depth of the
     first sample's primary hit, ``fwd`` the unit view axis, ``inf`` on a miss) and adds the
@@ -418,7 +444,7 @@ def render_pixels(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, op
     by :func:`..kernels.tasks.run_tasks`), so that each thread gets a fair share of the
     expensive parts of the image.
     """
-    nblocks = (image.shape[0] + PIXEL_BLOCK - 1) // PIXEL_BLOCK
+    nblocks = (pixels.image.shape[0] + PIXEL_BLOCK - 1) // PIXEL_BLOCK
     stride = 1
     if nblocks > 2:  # a stride coprime with nblocks: c -> c * stride % nblocks is a permutation
         stride = nblocks // 2 + 1
@@ -426,24 +452,21 @@ def render_pixels(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, op
             stride += 1
     nit = max(1, min(nblocks, MAX_TASKS))
     part = np.zeros((nit, 8), np.int64)  # a row per task (8: rows a cache line apart)
-    run_tasks(pixels_task, nit, geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts, O, D,
-              spp, fwd, cam, first, ncancel, image, depth_map, part, stride)
+    run_tasks(pixels_task, nit, geo, shading, pixels, spp, first, ncancel, part, stride)
     counts += part[:, :7].sum(axis=0)
 
 
 @nb.njit(cache=True, error_model="numpy", nogil=True)
-def pixels_task(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts, O, D, spp, fwd, cam,
-                first, ncancel, image, depth_map, part, stride, c, nit):
+def pixels_task(geo, shading, pixels, spp, first, ncancel, part, stride, c, nit):
     """Task ``c`` of ``nit`` of :func:`render_pixels`: blocks ``c, c + nit, ...`` in the
     scrambled order ``b = k stride mod nblocks``; its ray counts go to ``part[c]``."""
-    npix = image.shape[0]
+    npix = pixels.image.shape[0]
     nblocks = (npix + PIXEL_BLOCK - 1) // PIXEL_BLOCK
-    cap = 2 * int(opts[WhittedOpt.GENERATIONS]) + 2
+    cap = 2 * int(shading.opts[WhittedOpt.GENERATIONS]) + 2
     scr, bufs = scratch(), ray_stack(cap)
     for k in range(c, nblocks, nit):
         b = (k * stride) % nblocks
-        pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts, O, D, spp,
-                    fwd, cam, first, ncancel, image, depth_map, part[c], b * PIXEL_BLOCK,
+        pixel_block(geo, shading, pixels, spp, first, ncancel, part[c], b * PIXEL_BLOCK,
                     min(npix, (b + 1) * PIXEL_BLOCK), scr, bufs)
 
 
@@ -465,13 +488,14 @@ def ray_stack(cap):
 
 
 @nb.njit(**NO_REFCOUNT)
-def pixel_block(geo, mat_of, mat_tab, tex_tab, lights, ambient, background, opts, O, D, spp, fwd,
-                cam, first, ncancel, image, depth_map, counts, p0, p1, scr, bufs):
+def pixel_block(geo, shading, pixels, spp, first, ncancel, counts, p0, p1, scr, bufs):
     """Pixels ``p0 .. p1 - 1`` of :func:`render_pixels`: each primary ray and its descendants
     depth first with an explicit stack of pending rays (the course's ``raytrace`` recursion),
     shaded by :func:`shade_hit`; textured colours from the ``tex_tab`` checkers
     (:func:`checker_color`).  Adds the ray counts to ``counts`` (7,).  ``scr``:
     :func:`scratch`; ``bufs``: :func:`ray_stack`."""
+    mat_of, mat_tab, tex_tab, lights, ambient, background, opts = shading
+    O, D, fwd, cam, image, depth_map = pixels
     zero, rel_eps, extent = opts[WhittedOpt.ZERO], opts[WhittedOpt.RAY_OFFSET], opts[WhittedOpt.EXTENT]
     stack, st, sp_, sf, sn = scr
     (r_o, r_d, r_w, r_stk, r_n, r_kind, r_tmin, r_gen, c_o, c_d, c_w, c_stk, c_n, c_gen, h_t, h_p,

@@ -275,10 +275,10 @@ def ensure_compiled(sd: SceneData, fused: bool = False) -> float:
     geo = sd.kernel_args()
     kopts = kernel_options(1, extent=sd.extent)
     if fused:
-        k.render_pixels(geo, sd.mat, sd.mat_tab, np.zeros((len(sd.mat_tab), TEX_COLS)), sd.lights,
-                        np.zeros(3), np.zeros(3), kopts, O, D, 1, np.array([0.0, 0.0, 1.0]),
-                        np.zeros(16), 0, tol.normal_cancel, np.zeros((1, 3)), np.zeros(1),
-                        np.zeros(7, np.int64))
+        shading = k.Shading(sd.mat, sd.mat_tab, np.zeros((len(sd.mat_tab), TEX_COLS)), sd.lights,
+                            np.zeros(3), np.zeros(3), kopts)
+        k.render_pixels(geo, shading, k.Pixels(O, D, np.array([0.0, 0.0, 1.0]), np.zeros(16), np.zeros((1, 3)),
+                                               np.zeros(1)), 1, 0, tol.normal_cancel, np.zeros(7, np.int64))
         return time.perf_counter() - t0
     arr = _alloc(1)
     k.trace_batch(geo, O, D, np.zeros(1), np.full(1, np.inf), tol.zero, tol.ray_offset, 1.0,
@@ -408,9 +408,10 @@ class _Tracer:
         image = np.empty((n_pixels, 3))
         depth_map = np.empty(n_pixels)
         counts = np.zeros(7, np.int64)
-        _kernels().render_pixels(self.geo, sd.mat, sd.mat_tab, self.tex_tab, sd.lights, self.ambient,
-                                 self.col.bg, self.kopts, O, D, spp, fwd, cam, first,
-                                 tol.normal_cancel, image, depth_map, counts)
+        k = _kernels()
+        shading = k.Shading(sd.mat, sd.mat_tab, self.tex_tab, sd.lights, self.ambient, self.col.bg, self.kopts)
+        k.render_pixels(self.geo, shading, k.Pixels(O, D, fwd, cam, image, depth_map), spp, first,
+                        tol.normal_cancel, counts)
         self.stats["primary_rays"] += n_pixels * spp
         for key, v in zip(_COUNTS, counts):
             self.stats[key] += int(v)
