@@ -223,10 +223,10 @@ def _material_left_out(mat: m.Material, used_in_open: bool) -> list[Note]:
     if mat.opacity is not None and mat.opacity.kind != "constant":
         out.append(Note(F.OPACITY, f"{mat.opacity.kind} opacity maps not exported (opaque)"))
     if mat.kt > 0.0:
-        out.append(Note(F.REFRACTION, f"exact Fresnel split only (Mitsuba's dielectric): the ray tracer's "
+        out.append(Note(F.REFRACTION, "exact Fresnel split only (Mitsuba's dielectric): the ray tracer's "
                    "constant kr/kt split (fresnel = none) has no counterpart"))
         if used_in_open:
-            out.append(Note(F.REFRACTION, f"open surfaces with kt as Mitsuba's thindielectric "
+            out.append(Note(F.REFRACTION, "open surfaces with kt as Mitsuba's thindielectric "
                        "(inter-reflections inside the sheet included)"))
     if mat.environment:
         out.append(Note(F.ENVIRONMENT, MODEL_NOTES[F.ENVIRONMENT]))
@@ -291,7 +291,7 @@ class ShapeWriter:
             out.append(self.add_mesh(part.positions, part.faces, part.normals, material_bsdf(pm, open_surface),
                                      np.asarray(pm.emission) if pm.is_emitter else None, flat))
         if self.scene.materials[obj.material].is_emitter:
-            self.leave(F.EMITTERS, f"emissive surfaces emit from their front side only (Mitsuba's area "
+            self.leave(F.EMITTERS, "emissive surfaces emit from their front side only (Mitsuba's area "
                        "emitter); the workbench adds emission on both sides")
         return out
 

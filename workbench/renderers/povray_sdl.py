@@ -281,7 +281,7 @@ def export(scene: m.Scene, width: int, height: int, *, max_trace_level: int = 5,
                 "escaping rays see the background colour")
     for light in scene.point_lights():
         if isinstance(light, m.PointLight) and light.cosine_normal is not None:
-            w.leave(ft.AREA_LIGHTS, f"stand-in point lights without their cosine lobe "
+            w.leave(ft.AREA_LIGHTS, "stand-in point lights without their cosine lobe "
                     "(POV-Ray has no Lambertian point light)")
         parts.append(w.light(light))
     for light in scene.lights:

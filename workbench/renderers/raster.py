@@ -576,12 +576,14 @@ class RasterSession:
 
     def _report(self) -> tuple[list[sp.Note], list[str]]:
         """(``left_out`` notes, features used): shader features not compiled, the mode's
-        :data:`SUPPORT` table for the scene's needs, global effects no stand-in covers (with why),
+        :data:`SUPPORT` table for the scene's needs, stand-ins this scene or the options did not
+        draw (with why),
         objects with no triangle."""
         needs = ft.scene_needs(self.scene)
         left = [sp.Note(f, "not needed by the scene (not compiled)", sp.Status.NOT_NEEDED)
                 for f in SHADER_FEATURES if f not in needs]
-        left += sp.notes(SUPPORT[self.mode], needs - NOT_RASTER.keys())
+        table = SUPPORT[self.mode]
+        left += sp.notes(table, needs)
         covered = dict(self.plan.covered)
         if not self.env_maps:  # e.g. only environment-mapped mirrors: no dynamic map built
             covered.pop(ft.REFLECTION, None)
@@ -589,8 +591,8 @@ class RasterSession:
                 covered.pop(ft.REFRACTION, None)
         enabled = {ft.REFLECTION: self.plan.envmap, ft.REFRACTION: self.plan.envmap or self.plan.blend,
                    ft.SHADOWS: self.plan.shadows, ft.ABSORPTION: True}
-        for f, why in NOT_RASTER.items():
-            if f in needs and f not in covered:
+        for f, why in NOT_RASTER.items():  # a stand-in the mode has but did not draw here
+            if f in needs and f not in covered and table[f].status is sp.Status.APPROXIMATED:
                 left.append(sp.Note(f, why + ("" if enabled[f] else f" ({self.plan.off_reason})")))
         if self.empty_objects:
             left.append(sp.Note("objects", f"{', '.join(self.empty_objects)} tessellate(s) to no triangle "

@@ -200,7 +200,6 @@ def solve_scene(scene: Scene, opts: dict, method: str) -> Solution:
     extent = prepare(scene).extent  # patch sizes are fractions of the scene's diagonal
     patches, left_out = patches_from_scene(scene, opts["patch_size"] * extent)
     timings["patches"] = time.perf_counter() - t0
-    needs = ft.scene_needs(scene)
     if len(patches) == 0 or not (patches.emission > 0).any():
         raise NotApplicable(f"{method}: the scene has no emitters (no area light and no emissive "
                             "material): radiosity has nothing to distribute")
