@@ -15,6 +15,7 @@ from workbench.core.errors import NotApplicable
 from workbench.renderers import base
 from workbench.renderers.base import Knob, Option, RenderResult
 from workbench.renderers.local_model import shade
+from workbench.renderers.support import Note, declare
 
 
 def sphere_scene(width=48, height=36, shininess=20.0):
@@ -29,6 +30,7 @@ def sphere_scene(width=48, height=36, shininess=20.0):
 
 class Facets:
     name = "facets"
+    support = declare(left_out={"shadows": "not computed by this fake"})
     knob = Knob("n", (4, 8, 16, 32, 64), 8, "latitude bands")
     options = {"n": Option(int, 8, "latitude bands")}
     memory_options = ("n",)
@@ -54,11 +56,12 @@ class Facets:
         img[hit] = shade(P, N, -d[hit], np.asarray(mat.color), mat, scene.point_lights(), scene.ambient)
         return RenderResult(self.name, img.reshape(height, width, 3), timings={"compile": 0.0},
                             stats={"facets": 2 * n * n}, features_used=["spheres", "point_lights"],
-                            left_out=["shadows: not computed by this fake"])
+                            left_out=[Note("shadows", "not computed by this fake")])
 
 
 class Never:
     name = "never"
+    support = declare()
     knob = Knob("q", (1, 2), 1)
     options = {"q": Option(int, 1)}
     memory_options = ("q",)

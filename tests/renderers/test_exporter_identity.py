@@ -77,7 +77,7 @@ def mitsuba_record(name: str, folder: str) -> dict:
         if isinstance(v, str) and v.startswith(folder):
             return _ply_summary(v)
         return v
-    return json.loads(json.dumps({"dict": plain(ex.scene_dict), "left_out": ex.left_out,
+    return json.loads(json.dumps({"dict": plain(ex.scene_dict), "left_out": [str(x) for x in ex.left_out],
                                   "triangles": ex.triangles, "shapes": ex.shapes}))
 
 

@@ -80,7 +80,7 @@ def test_unattenuated_point_light_matches_at_the_scene_centre_and_says_so(tmp_pa
     ex = mx.export_scene(s, str(tmp_path), 4)
     r0 = 3.0  # light to the sphere's centre (the bounds' centre)
     assert np.allclose(ex.scene_dict["light_000"]["intensity"]["value"], np.pi * r0 * r0)
-    assert any(x.startswith("point_lights: falloff 'none'") for x in ex.left_out)
+    assert any(str(x).startswith("point_lights: falloff 'none'") for x in ex.left_out)
 
 
 def test_area_light_exports_its_radiance_on_a_front_facing_black_polygon(tmp_path):
@@ -147,7 +147,7 @@ def test_a_scene_without_light_is_not_applicable(tmp_path):
 def test_left_out_lists_what_is_dropped(tmp_path, name, expected):
     ex = mx.export_scene(workbench.load_scene(name), str(tmp_path), 2)
     for prefix in expected:
-        assert any(x.startswith(prefix) for x in ex.left_out), (prefix, ex.left_out)
+        assert any(str(x).startswith(prefix) for x in ex.left_out), (prefix, ex.left_out)
     if not expected:
         assert ex.left_out == []
 
@@ -161,5 +161,5 @@ def test_memory_estimate_covers_the_triangles_of_the_new_kinds(tmp_path):
     ex = mx.export_scene(scene, str(tmp_path), 4)
     est = get_renderer("mitsuba").estimate_bytes(scene, 16, 12, tessellation=4)
     assert est >= mm.CHILD_BASE_BYTES + mm.BYTES_PER_PIXEL * 16 * 12 + mm.BYTES_PER_TRIANGLE * ex.triangles
-    assert any(x.startswith("blobs: no blob primitive") for x in ex.left_out)
-    assert any(x.startswith("isosurfaces:") for x in ex.left_out) and any(x.startswith("lathes:") for x in ex.left_out)
+    assert any(str(x).startswith("blobs: no blob primitive") for x in ex.left_out)
+    assert {"isosurfaces", "lathes"} <= {x.feature for x in ex.left_out}

@@ -113,12 +113,12 @@ def test_csg_quadrics_meshes_and_lights_match_the_ray_tracer(name):
 
 def test_what_povray_cannot_express_is_left_out():
     pov = workbench.render(workbench.load_scene("bricks"), "povray", width=32, height=24)
-    assert any(x.startswith("bump:") for x in pov.left_out)
-    assert any(x.startswith("textures:") and "bricks" in x for x in pov.left_out)
+    assert any(x.feature == "bump" for x in pov.left_out)
+    assert any(x.feature == "textures" and "bricks" in x.reason for x in pov.left_out)
     assert "bump" not in pov.features_used
     env = workbench.load_scene("envmap")
     ex = povray_sdl.export(env, 32, 24)
-    assert any(x.startswith("environment:") for x in ex.left_out)
+    assert any(x.feature == "environment" for x in ex.left_out)
 
 
 def test_transmission_scales_ambient_and_diffuse_for_povray():

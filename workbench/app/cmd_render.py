@@ -68,7 +68,7 @@ def run(args) -> int:
     for k, v in stats.items():
         print(f"  {k}: {v}")
     if result.left_out:
-        print(f"  left out: {'; '.join(result.left_out)}")
+        print(f"  left out: {'; '.join(map(str, result.left_out))}")
     return 0
 
 

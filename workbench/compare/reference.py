@@ -350,13 +350,14 @@ class References:
         return self._matched[key]
 
 
-def physical_differences(result_left_out: list[str], reference_features: list[str]) -> list[str]:
-    """Features the reference builds that a method leaves out (``"feature: reason"`` entries).
+def physical_differences(result_left_out: list, reference_features: list[str]) -> list[str]:
+    """Features the reference builds that a method leaves out (its ``left_out`` notes,
+    :class:`workbench.renderers.support.Note`).
 
     A method with any such feature differs from the reference physically, not only by
     discretisation; its error measures the missing effect too.
     """
-    left = {entry.split(":", 1)[0].strip() for entry in result_left_out}
+    left = {note.feature for note in result_left_out}
     return sorted(left & set(reference_features))
 
 

@@ -51,11 +51,12 @@ from ..core.errors import WorkbenchError
 from ..core.imageio import atomic_write_bytes
 from ..core.jit_cache import code_fingerprint
 from ..renderers.base import RenderResult, convert_options, get_renderer, render
+from ..renderers.support import Note
 from ..scene.model import Scene
 from .outputs import jsonable
 
 #: Bumped whenever the entry layout or the key's content changes.
-CACHE_FORMAT = 2
+CACHE_FORMAT = 3
 ENV_VAR = "WORKBENCH_REFERENCE_CACHE"
 _VERSIONED = ("numpy", "numba", "mitsuba")
 _PATH_FIELDS = ("source", "path")
@@ -186,7 +187,7 @@ def load_entry(key: str, directory: Path | None = None) -> RenderResult | None:
     stats.update({k[len("stats."):]: v for k, v in arrays.items() if k.startswith("stats.")})
     stats["cache"] = "hit"
     return RenderResult(meta["method"], image, dict(meta["timings"]), stats, list(meta["features_used"]),
-                        list(meta["left_out"]), dict(meta["options"]), arrays.get("depth"),
+                        [Note.from_dict(n) for n in meta["left_out"]], dict(meta["options"]), arrays.get("depth"),
                         std_error=arrays.get("std_error"))
 
 
@@ -213,7 +214,7 @@ def store_entry(key: str, result: RenderResult, scene_name: str, options: dict,
     meta = {"format": CACHE_FORMAT, "key": key, "method": result.method, "options": options,
             "scene": scene_name, "width": int(image.shape[1]), "height": int(image.shape[0]),
             "image_sha256": _sha(image), "arrays": sorted(arrays), "timings": result.timings,
-            "stats": scalars, "left_out": result.left_out, "features_used": result.features_used,
+            "stats": scalars, "left_out": [n.as_dict() for n in result.left_out], "features_used": result.features_used,
             "noise": {"stderr_rms": scalars.get("stderr_rms")}, "created": time.strftime("%Y-%m-%dT%H:%M:%S")}
     text = json.dumps(jsonable(meta), indent=1, allow_nan=False)
     atomic_write_bytes(meta_p, text.encode("utf-8"))

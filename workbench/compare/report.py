@@ -187,7 +187,8 @@ def _standin_ladder(scene: Scene, run: MethodRun, w: int, h: int, ref_img: np.nd
 
 
 def _list(items) -> str:
-    return "; ".join(items) if items else "none"
+    """``left_out`` notes (or their printed forms, from a report's JSON) as one cell."""
+    return "; ".join(map(str, items)) if items else "none"
 
 
 def render_html(report: dict, stage: Path, out_dir: Path) -> str:

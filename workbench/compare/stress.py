@@ -223,7 +223,7 @@ class SceneRun:
         self.nonfinite = 0
         self.stats: dict = {}
         self.features_used: list[str] = []
-        self.left_out: list[str] = []
+        self.left_out: list = []  # support.Note records of the case's first render
 
     def options(self, method: str, table_: dict | None = None) -> dict:
         t = self.case.get("options", {}) if table_ is None else table_

@@ -392,5 +392,5 @@ def _features(points: list[dict]) -> list[list[str]]:
     for p in points:
         if p["status"] == "ok" and p["method"] not in seen:
             seen.add(p["method"])
-            rows.append([p["method"], ", ".join(p["features_used"]), "; ".join(p["left_out"]) or "none"])
+            rows.append([p["method"], ", ".join(p["features_used"]), "; ".join(map(str, p["left_out"])) or "none"])
     return rows

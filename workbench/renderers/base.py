@@ -29,6 +29,7 @@ from ..core.memory import ENV as MEMORY_ENV
 from ..core.memory import gib, memory_limit
 from ..scene.model import Scene
 from .registry import BUILTIN, OPT_IN, USER_SHADING
+from .support import Note, SupportTable
 
 
 @dataclass(frozen=True)
@@ -63,8 +64,10 @@ class RenderResult:
     timings : seconds; ``total`` (wall time of the call), ``compile`` (shader or JIT
         compilation, part of total), and method-specific phases.
     stats : counts and facts (rays, patches, GL_RENDERER, ...).
-    features_used / left_out : features of the scene this method built, and those it did not
-        (not needed by the scene, or not supported by the method: each with the reason).
+    features_used / left_out : features of the scene this method built, and notes
+        (:class:`.support.Note`: feature, status, reason; printed ``"feature: reason"``) on
+        those it did not (not needed by the scene, or left out or approximated by the method,
+        from its ``support`` table and the scene's content).
     depth : (H, W) float32 camera-space depth along the view axis (inf where nothing), if given.
     std_error : (H, W, 3) float32 per-pixel standard error of the mean of a Monte Carlo image
         (its own noise estimate), if given; its RMS is ``stats["noise_rmse"]``.
@@ -75,7 +78,7 @@ class RenderResult:
     timings: dict[str, float] = field(default_factory=dict)
     stats: dict[str, Any] = field(default_factory=dict)
     features_used: list[str] = field(default_factory=list)
-    left_out: list[str] = field(default_factory=list)
+    left_out: list[Note] = field(default_factory=list)
     options: dict[str, Any] = field(default_factory=dict)
     depth: np.ndarray | None = None
     std_error: np.ndarray | None = None
@@ -99,6 +102,7 @@ instead of listing methods by name:
 
 class Renderer(Protocol):
     name: str
+    support: SupportTable
     ui_kind: str
     knob: Knob
     options: dict[str, Option]

@@ -72,6 +72,7 @@ from ..scene import features as F
 from ..scene import model as m
 from ..scene.kinds import is_solid, kind_of
 from ..scene.tessellate import tessellate_object
+from .support import Note
 
 #: Alpha below which an opacity cuts a surface out (the workbench's rule, ``model.Opacity``).
 OPACITY_CUT = 0.5
@@ -97,13 +98,13 @@ class Export:
     """Result of :func:`export_scene`.
 
     scene_dict : the ``mi.load_dict`` dictionary (plain data; ``to_world`` as 4x4 lists).
-    left_out : ``"feature: reason"`` entries (deduplicated, sorted).
+    left_out : :class:`..support.Note` records (deduplicated, sorted; printed ``"feature: reason"``).
     triangles : number of triangles written as meshes.
     shapes : number of shapes (meshes and spheres).
     """
 
     scene_dict: dict
-    left_out: list[str] = field(default_factory=list)
+    left_out: list[Note] = field(default_factory=list)
     triangles: int = 0
     shapes: int = 0
 
@@ -215,20 +216,20 @@ def material_bsdf(mat: m.Material, open_surface: bool = False) -> dict:
     return bsdf
 
 
-def _material_left_out(mat: m.Material, used_in_open: bool) -> list[str]:
+def _material_left_out(mat: m.Material, used_in_open: bool) -> list[Note]:
     out = []
     for feat in sorted(F.material_needs(mat) & set(MODEL_NOTES)):
-        out.append(f"{feat}: {MODEL_NOTES[feat]}")
+        out.append(Note(feat, MODEL_NOTES[feat]))
     if mat.opacity is not None and mat.opacity.kind != "constant":
-        out.append(f"{F.OPACITY}: {mat.opacity.kind} opacity maps not exported (opaque)")
+        out.append(Note(F.OPACITY, f"{mat.opacity.kind} opacity maps not exported (opaque)"))
     if mat.kt > 0.0:
-        out.append(f"{F.REFRACTION}: exact Fresnel split only (Mitsuba's dielectric): the ray tracer's "
-                   "constant kr/kt split (fresnel = none) has no counterpart")
+        out.append(Note(F.REFRACTION, "exact Fresnel split only (Mitsuba's dielectric): the ray tracer's "
+                   "constant kr/kt split (fresnel = none) has no counterpart"))
         if used_in_open:
-            out.append(f"{F.REFRACTION}: open surfaces with kt as Mitsuba's thindielectric "
-                       "(inter-reflections inside the sheet included)")
+            out.append(Note(F.REFRACTION, "open surfaces with kt as Mitsuba's thindielectric "
+                       "(inter-reflections inside the sheet included)"))
     if mat.environment:
-        out.append(f"{F.ENVIRONMENT}: {MODEL_NOTES[F.ENVIRONMENT]}")
+        out.append(Note(F.ENVIRONMENT, MODEL_NOTES[F.ENVIRONMENT]))
     return out
 
 
@@ -244,14 +245,14 @@ class ShapeWriter:
     its own, e.g. ``sphere``), :meth:`similarity_scale` and :meth:`leave`; ``level`` is the
     export's tessellation level.  Shapes are named ``shape_00000``... in the order added."""
 
-    def __init__(self, scene: m.Scene, folder: str, d: dict, level: int, left: list[str]):
+    def __init__(self, scene: m.Scene, folder: str, d: dict, level: int, left: list[Note]):
         self.scene, self.folder, self.d, self.level, self.left = scene, folder, d, level, left
         self.pts: list[np.ndarray] = []
         self.shapes = self.triangles = 0
 
-    def leave(self, note: str) -> None:
-        """A ``"feature: reason"`` note for ``left_out``."""
-        self.left.append(note)
+    def leave(self, feature: str, reason: str) -> None:
+        """A note for ``left_out``."""
+        self.left.append(Note(feature, reason))
 
     def similarity_scale(self, M: np.ndarray) -> float | None:
         """The uniform scale of the linear part of ``M`` (4, 4), or None."""
@@ -289,7 +290,7 @@ class ShapeWriter:
             out.append(self.add_mesh(part.positions, part.faces, part.normals, material_bsdf(pm, open_surface),
                                      np.asarray(pm.emission) if pm.is_emitter else None, flat))
         if self.scene.materials[obj.material].is_emitter:
-            self.leave(f"{F.EMITTERS}: emissive surfaces emit from their front side only (Mitsuba's area "
+            self.leave(F.EMITTERS, "emissive surfaces emit from their front side only (Mitsuba's area "
                        "emitter); the workbench adds emission on both sides")
         return out
 
@@ -332,7 +333,7 @@ def export_scene(scene: m.Scene, folder: str, tessellation: int, spp: int = 16,
         raise NotApplicable("method 'mitsuba': the scene has no light (no lights, emissive materials "
                             "or background): the image would be black")
     cam = scene.camera
-    left: list[str] = []
+    left: list[Note] = []
     d: dict = {"type": "scene",
                "integrator": {"type": "path", "max_depth": -1, "rr_depth": RR_DEPTH, "hide_emitters": False}}
     sw = ShapeWriter(scene, folder, d, tessellation, left)
@@ -343,12 +344,12 @@ def export_scene(scene: m.Scene, folder: str, tessellation: int, spp: int = 16,
     for obj in scene.objects:
         mat = scene.materials[obj.material]
         if mat.opacity is not None and mat.opacity.kind == "constant" and mat.opacity.value < OPACITY_CUT:
-            left.append(f"{F.OPACITY}: object {obj.name or obj.kind!r} cut out (constant opacity "
-                        f"{mat.opacity.value} < {OPACITY_CUT})")
+            left.append(Note(F.OPACITY, f"object {obj.name or obj.kind!r} cut out (constant opacity "
+                        f"{mat.opacity.value} < {OPACITY_CUT})"))
             continue
         write = getattr(kind_of(obj), "mitsuba", None)  # optional for a plugin kind
         if write is None or write(obj, sw) is None:
-            left.append(f"{obj.kind}: object kind not exported to Mitsuba 3")
+            left.append(Note(kind_of(obj).FEATURE, f"{obj.kind} object kind not exported to Mitsuba 3"))
     # lights
     black = {"type": "diffuse", "reflectance": rgb((0.0, 0.0, 0.0))}
     for light in scene.lights:
@@ -371,21 +372,21 @@ def export_scene(scene: m.Scene, folder: str, tessellation: int, spp: int = 16,
             if light.falloff == "none":
                 r0 = float(np.linalg.norm(p - centre))
                 col = col * r0 * r0
-                left.append(f"{F.POINT_LIGHTS}: falloff 'none' has no physical counterpart: inverse-square "
-                            f"light matching it at the centre of the scene's bounds (r0 = {r0:.4g})")
+                left.append(Note(F.POINT_LIGHTS, f"falloff 'none' has no physical counterpart: inverse-square "
+                            f"light matching it at the centre of the scene's bounds (r0 = {r0:.4g})"))
             if light.cosine_normal is not None:
-                left.append(f"{F.POINT_LIGHTS}: a point light's cosine lobe is not exported (isotropic)")
+                left.append(Note(F.POINT_LIGHTS, "a point light's cosine lobe is not exported (isotropic)"))
             d[f"light_{k:03d}"] = {"type": "point", "position": [float(x) for x in p], "intensity": rgb(col)}
     if max(scene.background) > 0.0 and background_light:
         d["background"] = {"type": "constant", "radiance": rgb(scene.background)}
-        left.append("background: a constant environment emitter in Mitsuba, so it also lights the "
-                    "scene (the ray tracer only shows it)")
+        left.append(Note("background", "a constant environment emitter in Mitsuba, so it also lights the "
+                    "scene (the ray tracer only shows it)"))
     elif max(scene.background) > 0.0:
-        left.append("background: not exported (background_light = false): rays leaving the scene see black")
+        left.append(Note("background", "not exported (background_light = false): rays leaving the scene see black"))
     if scene.environment is not None:
-        left.append(f"{F.ENVIRONMENT}: {MODEL_NOTES[F.ENVIRONMENT]}")
+        left.append(Note(F.ENVIRONMENT, MODEL_NOTES[F.ENVIRONMENT]))
     if max(scene.ambient) > 0.0 and any(mt.ka > 0.0 for mt in scene.materials.values()):
-        left.append("ambient: no ambient term in a physically based renderer (interreflection replaces it)")
+        left.append(Note("ambient", "no ambient term in a physically based renderer (interreflection replaces it)"))
     dist = np.linalg.norm(corners - np.asarray(cam.position, dtype=np.float64), axis=1).max()
     far = float(cam.far or FAR_CLIP_MARGIN * max(dist, tol.zero))
     near = float(cam.near or far * NEAR_CLIP_RATIO)

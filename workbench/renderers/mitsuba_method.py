@@ -47,7 +47,9 @@ from ..scene.model import Scene
 from ..scene.tessellate import MAX_LEVEL
 from .base import Knob, Option, RenderResult
 from .estimates import triangle_bound
-from .mitsuba_export import RR_DEPTH, export_scene
+from . import support as sp
+from .mitsuba_export import MODEL_NOTES, RR_DEPTH, export_scene
+from ..scene import features as F
 from ..scene.features import scene_needs
 
 FALLBACK_VARIANT = "scalar_rgb"
@@ -150,6 +152,15 @@ class MitsubaRenderer:
 
     name = "mitsuba"
     ui_kind = "cpu"
+    support = sp.declare(
+        approximated={**{f: "exported as its raster tessellation (no such primitive in Mitsuba 3)"
+                         for f in (F.BLOBS, F.ISOSURFACES, F.LATHES)},
+                      F.OPACITY: "constant opacity cuts an object out or keeps it opaque; maps not exported",
+                      F.REFRACTION: "exact Fresnel split only (Mitsuba's dielectric)",
+                      F.POINT_LIGHTS: "isotropic, inverse-square (falloff 'none' matched at the scene's centre)",
+                      F.EMITTERS: "emissive surfaces emit from their front side only"},
+        left_out={**MODEL_NOTES, F.SOLID_TEXTURES: MODEL_NOTES[F.TEXTURES],
+                  F.IMAGE_TEXTURES: MODEL_NOTES[F.TEXTURES]})
     knob = Knob("spp", (4, 16, 64, 256, 1024, 4096), 64, "samples per pixel (two independent halves)")
     options = {
         "spp": Option(int, 64, "samples per pixel, >= 2 (two independent passes of spp/2: noise estimate)"),
@@ -240,5 +251,5 @@ class MitsubaRenderer:
                  "render_cpu_seconds": info["cpu"], "child_peak_rss_bytes": info["peak_rss_bytes"],
                  "stderr": stderr, "stderr_rms": float(np.sqrt(np.mean(stderr.astype(np.float64) ** 2)))}
         needs = scene_needs(scene)
-        used = sorted(f for f in needs if not any(x.startswith(f + ":") for x in ex.left_out))
-        return RenderResult(self.name, image, timings, stats, used, list(ex.left_out), std_error=stderr)
+        left = sp.complete(self.support, needs, ex.left_out)
+        return RenderResult(self.name, image, timings, stats, sp.used(needs, left), left, std_error=stderr)

@@ -31,6 +31,7 @@ from ..core.errors import WorkbenchError
 from ..scene import features as ft
 from ..scene.model import Mesh, Scene
 from . import povray_sdl
+from . import support as sp
 from .base import Knob, Option, RenderResult
 
 PROGRAM = "povray"
@@ -73,6 +74,15 @@ class PovrayRenderer:
 
     name = "povray"
     ui_kind = "cpu"
+    support = sp.declare(
+        approximated={ft.TEXTURES: "patterns POV-Ray cannot express are exported as their plain colour",
+                      ft.AREA_LIGHTS: "stand-in point lights without their cosine lobe",
+                      ft.SHADOWS: "transmissive occluders attenuate shadows by kt (filtered shadows)"},
+        left_out={ft.BUMP: "bump maps not exported to POV-Ray",
+                  ft.OPACITY: "opacity maps not exported to POV-Ray",
+                  ft.ENVIRONMENT: "environment mapping and the scene's environment not exported "
+                                  "(escaping rays see the background colour)",
+                  ft.ABSORPTION: "Beer-Lambert absorption not exported to POV-Ray"})
     knob = Knob("max_trace_level", (1, 2, 3, 4, 5, 6, 8, 12), 5,
                 "POV-Ray's max_trace_level (primary = 1, as the ray tracer's max_depth)")
     options = {
@@ -142,9 +152,11 @@ class PovrayRenderer:
                  "reflected_rays": int(_stat(log, r"Reflected Rays:\s+(\d+)")),
                  "refracted_rays": int(_stat(log, r"Refracted Rays:\s+(\d+)")),
                  "sdl_bytes": len(ex.sdl)}
-        left = list(ex.left_out)
-        if ft.SHADOWS in ft.scene_needs(scene) and any(mt.kt > 0 for mt in scene.materials.values()):
-            left.append(f"{ft.SHADOWS}: transmissive occluders attenuate shadows by kt (POV-Ray's filtered "
-                        "shadows: the ray tracer's transmissive_shadows = true)")
-        used = sorted(f for f in ft.scene_needs(scene) if not any(x.startswith(f + ":") for x in left))
+        needs = ft.scene_needs(scene)
+        left = sp.complete(self.support, needs, ex.left_out)
+        if ft.SHADOWS in needs and any(mt.kt > 0 for mt in scene.materials.values()):
+            left.append(sp.Note(ft.SHADOWS, "transmissive occluders attenuate shadows by kt (POV-Ray's "
+                                "filtered shadows: the ray tracer's transmissive_shadows = true)",
+                                sp.Status.APPROXIMATED))
+        used = sp.used(needs, left)
         return RenderResult(self.name, image, timings, stats, used, left)

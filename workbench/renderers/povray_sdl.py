@@ -58,6 +58,7 @@ import numpy as np
 from ..scene import features as ft
 from ..scene import model as m
 from ..scene.kinds import kind_of, leaves
+from .support import Note
 from .texturing import frame
 
 FADE_FRACTION = 1e-4
@@ -76,7 +77,7 @@ class Export:
 
     sdl: str
     files: dict[str, str] = field(default_factory=dict)
-    left_out: list[str] = field(default_factory=list)
+    left_out: list[Note] = field(default_factory=list)
 
 
 def _v(a) -> str:
@@ -114,15 +115,17 @@ class Writer:
     """Writes one scene's SDL; object kinds write theirs through it (``povray(obj, w,
     in_csg)``, see :mod:`workbench.scene.kinds`): :meth:`vec`, :meth:`num`, :meth:`matrix`,
     :meth:`texture` (pigment, finish, interior of a material by name), :meth:`leave` (a
-    ``"feature: reason"`` note) and :meth:`shape` (any object: CSG operands)."""
+    note for ``left_out``) and :meth:`shape` (any object: CSG operands)."""
 
     def __init__(self, scene: m.Scene, blinn: bool):
         self.scene, self.blinn = scene, blinn
         self.size = scene_size(scene)
         self.out = Export("")
-        self.noted: set[str] = set()
+        self.noted: set[Note] = set()
 
-    def leave(self, note: str):
+    def leave(self, feature: str, reason: str):
+        """A note for ``left_out`` (once)."""
+        note = Note(feature, reason)
         if note not in self.noted:
             self.noted.add(note)
             self.out.left_out.append(note)
@@ -151,7 +154,7 @@ class Writer:
                     A = np.diag([tex.scale, tex.scale, 1.0, 1.0])
                     return f"pigment {{ uv_mapping {img} {_affine_inverse_matrix(A)} }}"
                 return f"pigment {{ {img} {_affine_inverse_matrix(self.pattern_map(tex))} }}"
-        self.leave(f"{ft.TEXTURES}: {tex.kind} texture ({tex.projection} projection) of "
+        self.leave(ft.TEXTURES, f"{tex.kind} texture ({tex.projection} projection) of "
                    f"{mat.name!r} not expressed in POV-Ray (its plain colour used)")
         return plain
 
@@ -176,7 +179,7 @@ class Writer:
         t = mat.kt
         scale = 1.0 / (1.0 - t) if t < 1.0 else 0.0
         if t >= 1.0 and (mat.ka > 0 or mat.kd > 0 or mat.is_emitter):
-            self.leave(f"{ft.REFRACTION}: ambient, diffuse and emission of {mat.name!r} (kt = 1): "
+            self.leave(ft.REFRACTION, f"ambient, diffuse and emission of {mat.name!r} (kt = 1): "
                        "POV-Ray scales them by 1 - transmit")
         parts = [f"ambient {mat.ka * scale:.10g}", f"diffuse {mat.kd * scale:.10g}"]
         if mat.ks > 0:
@@ -190,7 +193,7 @@ class Writer:
             col = np.asarray(mat.color, dtype=np.float64)
             E = np.asarray(mat.emission, dtype=np.float64)
             if mat.texture is not None or np.any((E > 0) & (col <= 0)):
-                self.leave(f"{ft.EMITTERS}: emission of {mat.name!r} (POV-Ray multiplies emission by the "
+                self.leave(ft.EMITTERS, f"emission of {mat.name!r} (POV-Ray multiplies emission by the "
                            "pigment: a textured or black colour cannot carry it)")
             else:
                 parts.append(f"emission rgb {_v(np.where(col > 0, E / np.maximum(col, 1e-300), 0.0) * scale)}")
@@ -204,7 +207,7 @@ class Writer:
                            (ft.ENVIRONMENT, mat.environment, "environment mapping"),
                            (ft.ABSORPTION, mat.kt > 0 and max(mat.absorption) > 0, "Beer-Lambert absorption")):
             if on:
-                self.leave(f"{f}: {why} of {name!r} not exported to POV-Ray")
+                self.leave(f, f"{why} of {name!r} not exported to POV-Ray")
         s = f"texture {{ {self.pigment(mat)} {self.finish(mat)} {transform}}}"
         if mat.kt > 0:
             s += f" interior {{ ior {mat.ior:.10g} }}"
@@ -230,7 +233,7 @@ class Writer:
         write = getattr(kind_of(o), "povray", None)  # optional for a plugin kind
         sdl = None if write is None else write(o, self, in_csg)
         if sdl is None:
-            self.leave(f"{o.kind}: object kind not exported to POV-Ray")
+            self.leave(kind_of(o).FEATURE, f"{o.kind} object kind not exported to POV-Ray")
             return ""
         return sdl
 
@@ -274,11 +277,11 @@ def export(scene: m.Scene, width: int, height: int, *, max_trace_level: int = 5,
              f"background {{ color rgb {_v(scene.background)} }}",
              w.camera(width, height)]
     if scene.environment is not None:
-        w.leave(f"{ft.ENVIRONMENT}: the environment ({scene.environment.kind}) is not exported: "
+        w.leave(ft.ENVIRONMENT, f"the environment ({scene.environment.kind}) is not exported: "
                 "escaping rays see the background colour")
     for light in scene.point_lights():
         if isinstance(light, m.PointLight) and light.cosine_normal is not None:
-            w.leave(f"{ft.AREA_LIGHTS}: stand-in point lights without their cosine lobe "
+            w.leave(ft.AREA_LIGHTS, "stand-in point lights without their cosine lobe "
                     "(POV-Ray has no Lambertian point light)")
         parts.append(w.light(light))
     for light in scene.lights:

@@ -68,6 +68,7 @@ from ..scene.tessellate import (DEFAULT_LEVEL, MAX_LEVEL, NORMAL_RULES, area_lig
 from .estimates import raster_bytes
 from ..scene.tessellate_topology import closed_outward, provoking_layout
 from . import gl
+from . import support as sp
 from . import texturing as tx
 from .base import Knob, Option, RenderResult, check_memory, convert_options
 from .raster_shaders import (LIVE_MATERIAL_FIELDS, ProgramCache, base_defines, light_kind,
@@ -87,6 +88,26 @@ NOT_RASTER = {
     ft.REFLECTION: "mirror reflection needs ray tracing (environment-mapped materials reflect the environment map)",
     ft.REFRACTION: "refraction needs ray tracing (transmissive surfaces drawn with their local model)",
     ft.ABSORPTION: "absorption needs ray tracing",
+}
+_TESSELLATED = "drawn as its tessellation (the tessellation knob)"
+_STANDINS = {
+    ft.SHADOWS: "shadow-map stand-in (option standins)",
+    ft.REFLECTION: "environment-map stand-in (option standins)",
+    ft.REFRACTION: "environment-map or blended stand-in (option standins)",
+}
+_COMMON_APPROX = {**{f: _TESSELLATED for f in (ft.SPHERES, ft.QUADRICS, ft.CSG, ft.BLOBS, ft.ISOSURFACES,
+                                               ft.LATHES)},
+                  ft.AREA_LIGHTS: "stand-in point lights (the scene's area-light samples)",
+                  ft.EMITTERS: "emission drawn on the surface; it lights others only through area-light stand-ins"}
+#: The raster modes' support tables (:mod:`.support`): flat draws no stand-ins, and only Phong
+#: has a per-fragment normal for bump mapping.
+SUPPORT = {
+    "flat": sp.declare(_COMMON_APPROX, {**{f: f"{why} (flat draws no stand-ins)" for f, why in NOT_RASTER.items()},
+                                        ft.BUMP: "flat shading has no per-fragment normal to perturb"}),
+    "gouraud": sp.declare({**_COMMON_APPROX, **_STANDINS},
+                          {ft.ABSORPTION: NOT_RASTER[ft.ABSORPTION],
+                           ft.BUMP: "gouraud shading has no per-fragment normal to perturb"}),
+    "phong": sp.declare({**_COMMON_APPROX, **_STANDINS}, {ft.ABSORPTION: NOT_RASTER[ft.ABSORPTION]}),
 }
 
 
@@ -320,7 +341,7 @@ class RasterSession:
                                    - self.timings.get("standin_maps", 0.0))
 
     @property
-    def left_out(self) -> list[str]:
+    def left_out(self) -> list[sp.Note]:
         """Features of the scene this session does not draw, and why."""
         return self._reported()[0]
 
@@ -559,11 +580,16 @@ class RasterSession:
         camera is outside the solid and no front face is clipped open): back faces hidden."""
         return _beyond_near(camera, self.cull_boxes, near)
 
-    def _report(self) -> tuple[list[str], list[str]]:
+    def _report(self) -> tuple[list[sp.Note], list[str]]:
+        """(``left_out`` notes, features used): shader features not compiled, the mode's
+        :data:`SUPPORT` table for the scene's needs, stand-ins this scene or the options did not
+        draw (with why),
+        objects with no triangle."""
         needs = ft.scene_needs(self.scene)
-        left = [f"{f}: not needed by the scene (not compiled)" for f in SHADER_FEATURES if f not in needs]
-        if ft.BUMP in needs and self.mode != "phong":
-            left.append(f"bump: {self.mode} shading has no per-fragment normal to perturb")
+        left = [sp.Note(f, "not needed by the scene (not compiled)", sp.Status.NOT_NEEDED)
+                for f in SHADER_FEATURES if f not in needs]
+        table = SUPPORT[self.mode]
+        left += sp.notes(table, needs)
         covered = dict(self.plan.covered)
         if not self.env_maps:  # e.g. only environment-mapped mirrors: no dynamic map built
             covered.pop(ft.REFLECTION, None)
@@ -571,16 +597,14 @@ class RasterSession:
                 covered.pop(ft.REFRACTION, None)
         enabled = {ft.REFLECTION: self.plan.envmap, ft.REFRACTION: self.plan.envmap or self.plan.blend,
                    ft.SHADOWS: self.plan.shadows, ft.ABSORPTION: True}
-        for f, why in NOT_RASTER.items():
-            if f in needs and f not in covered:
-                left.append(f"{f}: {why}" + ("" if enabled[f] else f" ({self.plan.off_reason})"))
+        for f, why in NOT_RASTER.items():  # a stand-in the mode has but did not draw here
+            if f in needs and f not in covered and table[f].status is sp.Status.APPROXIMATED:
+                left.append(sp.Note(f, why + ("" if enabled[f] else f" ({self.plan.off_reason})")))
         if self.empty_objects:
-            left.append(f"objects: {', '.join(self.empty_objects)} tessellate(s) to no triangle "
-                        "(no surface: not drawn)")
-        used = sorted(f for f in needs if (f not in NOT_RASTER or f in covered)
-                      and not (f == ft.BUMP and self.mode != "phong"))
+            left.append(sp.Note("objects", f"{', '.join(self.empty_objects)} tessellate(s) to no triangle "
+                                "(no surface: not drawn)"))
         self._covered = covered
-        return left, used
+        return left, sp.used(needs, left)
 
     @property
     def standins_used(self) -> dict[str, str]:
@@ -1112,13 +1136,16 @@ class _RasterRenderer:
 
 class FlatRenderer(_RasterRenderer):
     name = "flat"
+    support = SUPPORT["flat"]
 
 
 class GouraudRenderer(_RasterRenderer):
     name = "gouraud"
+    support = SUPPORT["gouraud"]
     draws_standins = True
 
 
 class PhongRenderer(_RasterRenderer):
     name = "phong"
+    support = SUPPORT["phong"]
     draws_standins = True

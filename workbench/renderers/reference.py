@@ -57,12 +57,27 @@ from ..scene.model import AreaLight, DirectionalLight, Scene
 from ..scene.prepared import prepare
 from ..scene.tessellate import DEFAULT_LEVEL, MAX_LEVEL, tessellate_scene
 from .estimates import raster_bytes
+from . import support as sp
+from .support import Note, Status
 from . import gl
 from . import texturing as tx
 from .base import Knob, Option, RenderResult
 
 _WORKER = None
 _RENDERERS: dict = {}
+
+
+SUPPORT = sp.declare(
+    approximated={**{f: "drawn as its tessellation (the tessellation knob)"
+                     for f in (ft.SPHERES, ft.QUADRICS, ft.CSG, ft.BLOBS, ft.ISOSURFACES, ft.LATHES)},
+                  ft.SPECULAR: "glTF metallic-roughness lobe, roughness from the Phong exponent",
+                  ft.AREA_LIGHTS: "stand-ins as point lights without their cosine lobe",
+                  ft.OPACITY: "constant opacity as alpha; opacity maps not mapped"},
+    left_out={ft.SHADOWS: "shadow maps not enabled (the local models have none)",
+              ft.REFLECTION: "no mirror reflection in pyrender (kr mapped to metalness)",
+              ft.REFRACTION: "no refraction in pyrender", ft.ABSORPTION: "no refraction in pyrender",
+              ft.BUMP: "bump maps not mapped", ft.ENVIRONMENT: "no environment map in pyrender"})
+"""pyrender's support table (:mod:`.support`)."""
 
 
 def roughness_from_shininess(n: float, ks: float) -> float:
@@ -73,7 +88,8 @@ def roughness_from_shininess(n: float, ks: float) -> float:
 
 
 def build_scene(scene: Scene, level: int):
-    """A ``pyrender.Scene`` (meshes, lights, camera) for our scene; returns (scene, left_out)."""
+    """A ``pyrender.Scene`` (meshes, lights, camera) for our scene; returns (scene, left_out
+    notes)."""
     import pyrender
     left_out = []
     mats = scene.materials
@@ -92,7 +108,7 @@ def build_scene(scene: Scene, level: int):
             if mat.opacity.kind == "constant":
                 alpha = mat.opacity.value
             else:
-                left_out.append(f"opacity: {mat.opacity.kind} opacity map of {part.material!r} not mapped")
+                left_out.append(Note(ft.OPACITY, f"{mat.opacity.kind} opacity map of {part.material!r} not mapped"))
         pm = pyrender.MetallicRoughnessMaterial(
             baseColorFactor=(*(mat.kd * np.asarray(mat.color)), alpha),
             metallicFactor=float(mat.kr), roughnessFactor=roughness_from_shininess(mat.shininess, mat.ks),
@@ -133,7 +149,7 @@ def build_scene(scene: Scene, level: int):
             pose[:3, 3] = p
             ps.add(pyrender.PointLight(color=col, intensity=np.pi * light.intensity * scale), pose=pose)
     if any(isinstance(light, AreaLight) for light in scene.lights):
-        left_out.append("area_lights: stand-ins as point lights without their cosine lobe")
+        left_out.append(Note(ft.AREA_LIGHTS, SUPPORT[ft.AREA_LIGHTS].reason, Status.APPROXIMATED))
     return ps, left_out
 
 
@@ -288,6 +304,7 @@ def _child(scene_source: str, width: int, height: int, level: int, frames: int) 
             raise WorkbenchError(f"pyrender child process failed: {out.stderr.decode()[-2000:]}")
         with open(os.path.join(d, "result.json"), encoding="utf-8") as f:
             res = json.load(f)
+        res["left_out"] = [Note.from_dict(n) for n in res["left_out"]]
         res["image"] = np.load(os.path.join(d, "image.npy"))
         res["depth"] = np.load(os.path.join(d, "depth.npy"))
     return res
@@ -298,6 +315,7 @@ def _child_main(source: str, width: int, height: int, level: int, frames: int, o
     scene = load_scene(source)
     scene = scene.with_camera(scene.camera.with_resolution(width, height))
     res = _render_here(scene, width, height, level, frames)
+    res["left_out"] = [n.as_dict() for n in res["left_out"]]
     np.save(os.path.join(out_dir, "image.npy"), res.pop("image"))
     np.save(os.path.join(out_dir, "depth.npy"), res.pop("depth"))
     with open(os.path.join(out_dir, "result.json"), "w", encoding="utf-8") as f:
@@ -333,6 +351,7 @@ class PyrenderRenderer:
 
     name = "pyrender"
     ui_kind = "child"
+    support = SUPPORT
     knob = Knob("tessellation", (1, 2, 3, 4, 6, 8, 12, 16), DEFAULT_LEVEL,
                 "tessellation level of analytic primitives (as the raster methods)")
     options = {
@@ -362,14 +381,8 @@ class PyrenderRenderer:
         else:
             res = _in_worker(_render_here, scene, width, height, tessellation)
         needs = ft.scene_needs(scene)
-        left = list(res["left_out"])
-        for f, why in ((ft.SHADOWS, "shadow maps not enabled (the local models have none)"),
-                       (ft.REFLECTION, "no mirror reflection in pyrender (kr mapped to metalness)"),
-                       (ft.REFRACTION, "no refraction in pyrender"), (ft.BUMP, "bump maps not mapped"),
-                       (ft.ENVIRONMENT, "no environment map in pyrender")):
-            if f in needs:
-                left.append(f"{f}: {why}")
-        used = sorted(f for f in needs if not any(x.startswith(f + ":") for x in left))
+        left = list(res["left_out"]) + sp.notes(self.support, needs)
+        used = sp.used(needs, left)
         timings = {"build": res["build"], "draw": res["first_frame"], "compile": 0.0}
         stats = {"gl_renderer": res["gl_renderer"], "isolated": bool(isolate or _must_isolate()),
                  "near": res["near"], "far": res["far"]}

@@ -41,7 +41,7 @@ from ..core.errors import ShaderSourceError, WorkbenchError
 from ..core.resources import data_dir
 from ..scene.model import Scene
 from .base import USER_PREFIX as PREFIX, Option, RenderResult
-from .raster import RasterSession, _RasterRenderer
+from .raster import SUPPORT, RasterSession, _RasterRenderer
 from .raster_shaders import base_defines, build_source
 
 FUNCTION = "shade"
@@ -232,6 +232,7 @@ class UserShadingRenderer(_RasterRenderer):
     """The Phong method with a user's shading model (built per :func:`renderer_from_path`)."""
 
     mode = "phong"
+    support = SUPPORT["phong"]
 
     def __init__(self, model: ShadingModel, name: str):
         self.model = model

@@ -45,6 +45,7 @@ from ..scene.parts import Part
 from ..scene.prepared import prepare
 from ..scene.tessellate import (DEFAULT_LEVEL, MAX_LEVEL, NORMAL_RULES, area_light_parts, tessellate_scene,
                                 with_normal_rule)
+from . import support as sp
 from . import texturing as tx
 from .base import Knob, Option, RenderResult
 from .estimates import raster_bytes
@@ -59,15 +60,20 @@ WORLD, NORMAL, OBJ, UV, DIFFUSE, SPECULAR = (slice(0, 3), slice(3, 6), slice(6, 
 N_ATTRS = 17
 MAX_DEPTH_BITS = 32
 """Largest p: Z and 2^p - 1 are held in int64, and z (2^p - 1) stays exact in float64."""
-LEFT_OUT = {
-    ft.BUMP: "bump: the Z-buffer twin interpolates the course's normals only (no perturbation)",
-    ft.OPACITY: "opacity: the Z-buffer keeps the nearest surface only (drawn opaque, no cut-outs)",
-    ft.SHADOWS: "shadows: no shadow feelers in a raster local model",
-    ft.REFLECTION: "reflection: mirror reflection needs ray tracing (environment-mapped materials "
-                   "reflect the environment)",
-    ft.REFRACTION: "refraction: needs ray tracing (transmissive surfaces drawn with their local model)",
-    ft.ABSORPTION: "absorption: needs ray tracing",
-}
+SUPPORT = sp.declare(
+    approximated={**{f: "drawn as its tessellation (the tessellation knob)"
+                     for f in (ft.SPHERES, ft.QUADRICS, ft.CSG, ft.BLOBS, ft.ISOSURFACES, ft.LATHES)},
+                  ft.AREA_LIGHTS: "stand-in point lights (the scene's area-light samples)",
+                  ft.EMITTERS: "emission drawn on the surface; it lights others only through area-light stand-ins"},
+    left_out={
+        ft.BUMP: "the Z-buffer twin interpolates the course's normals only (no perturbation)",
+        ft.OPACITY: "the Z-buffer keeps the nearest surface only (drawn opaque, no cut-outs)",
+        ft.SHADOWS: "no shadow feelers in a raster local model",
+        ft.REFLECTION: "mirror reflection needs ray tracing (environment-mapped materials reflect the environment)",
+        ft.REFRACTION: "needs ray tracing (transmissive surfaces drawn with their local model)",
+        ft.ABSORPTION: "needs ray tracing",
+    })
+"""The Z-buffer's support table (:mod:`.support`)."""
 #: Optional features the method evaluates only when the scene has them.
 BUILT = (ft.TEXTURES, ft.SOLID_TEXTURES, ft.IMAGE_TEXTURES, ft.ENVIRONMENT)
 
@@ -277,6 +283,7 @@ class ZBufferRenderer:
 
     name = "zbuffer"
     ui_kind = "cpu"
+    support = SUPPORT
     knob = Knob("tessellation", (1, 2, 3, 4, 6, 8, 12, 16, 24, 32), DEFAULT_LEVEL,
                 "tessellation level of analytic primitives (sphere: 4L x 8L, see tessellate)")
     options = {
@@ -330,9 +337,10 @@ class ZBufferRenderer:
         if view == "depth":
             g = np.where(np.isfinite(depth), 1.0 - (depth - near) / (far - near), 0.0)
             image = np.repeat(np.clip(g, 0.0, 1.0)[..., None], 3, -1)
-        left = [f"{f}: not needed by the scene (not built)" for f in BUILT if f not in needs]
-        left += [why for f, why in LEFT_OUT.items() if f in needs]
-        used = sorted(f for f in needs if f not in LEFT_OUT)
+        left = [sp.Note(f, "not needed by the scene (not built)", sp.Status.NOT_NEEDED)
+                for f in BUILT if f not in needs]
+        left += sp.notes(SUPPORT, needs)
+        used = sp.used(needs, left)
         stats = {"triangles": sum(p.n_triangles for p, _ in pairs), "near_clipped": int(raster.clipped.sum()),
                  "near_clipped_pixels": int(near_clipped_pixels(raster).sum()), "near": near, "far": far,
                  "depth_bits": depth_bits, "fragments": int(frame.counts[0]),

@@ -60,7 +60,7 @@ def compare_scene(name: str, size: int, spp: int, block: int = 4, z: float = 4.0
                           variant=VARIANT)
     assert mi.stats["variant"] == VARIANT, mi.stats["variant_reason"]
     for method, res in (("pathtrace", pt), ("mitsuba", mi)):
-        extra = [x for x in res.left_out if not x.startswith(ALLOWED_LEFT_OUT[method])]
+        extra = [x for x in res.left_out if not str(x).startswith(ALLOWED_LEFT_OUT[method])]
         assert not extra, f"{method} leaves out part of {name}: {extra}"
     st = ag.noise_agreement(pt.image, pt.std_error, spp - 1, mi.image, mi.stats["stderr"], 1,
                             block=block, exclude=ag.light_pixels(scene, size, size), band_sd=z)

@@ -117,7 +117,7 @@ def check_diffuse_mode(seed: int, tmp_path) -> None:
     # the check can fail: the full transport of the shiny scene is another image
     full = workbench.render(shiny, "pathtrace", seed=2 * seed + 1, **kw)
     assert _consistent(full, lambert) > 5.0
-    assert any(e.startswith("point_lights: transport=diffuse") for e in diffuse.left_out)
+    assert any(str(e).startswith("point_lights: transport=diffuse") for e in diffuse.left_out)
 
 
 def test_pixel_filter_center_on_a_flat_lit_wall_and_at_the_pixel_centre(tmp_path):

@@ -78,7 +78,7 @@ def test_radiosity_of_curved_kinds_does_not_change_with_scale(gl_ctx):
     kinds = sorted(k for k in CURVED if k != "csg")
     scenes, sol = _solutions(kinds)
     p = sol[1.0].patches
-    assert not [s for s in sol[1.0].left_out if "not cut" in s], sol[1.0].left_out
+    assert not [s for s in sol[1.0].left_out if "not cut" in s.reason], sol[1.0].left_out
     seen = {p.surface_objects[s].kind for s in np.unique(p.surface[p.reflectance[:, 0] < 0.6])}
     assert seen == {CURVED[k]["type"] for k in kinds}, seen  # every kind cut into patches
     worst = _worst(sol)

@@ -154,7 +154,7 @@ def test_nothing_is_built_that_the_scene_does_not_need(gl_ctx):
     assert sti.standin_bytes(w, sti.StandinOptions(envmap_resolution=16, shadow_resolution=32), "phong") \
         == 2 * 6 * 16 ** 2 * 20 + 4 * 3 * 32 ** 2 * 4
     flat = workbench.render(w, "flat", width=16, height=12)
-    assert any(x.startswith("shadows:") and "flat" in x for x in flat.left_out) and flat.stats["standins"] == {}
+    assert any(x.feature == "shadows" and "flat" in x.reason for x in flat.left_out) and flat.stats["standins"] == {}
 
 
 def test_memory_is_estimated_before_the_maps_are_made():

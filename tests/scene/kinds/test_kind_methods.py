@@ -33,7 +33,7 @@ def test_radiosity_patches_and_lights_the_new_kinds(gl_ctx):
     alone = workbench.render(_scene([FLOOR]), "radiosity", width=64, height=48)
     r = workbench.render(_scene([FLOOR, *NEW]), "radiosity", width=64, height=48)
     assert np.isfinite(r.image).all()
-    assert not [x for x in r.left_out if x.split(":")[0] in ("blobs", "isosurfaces", "lathes", "prisms")]
+    assert not [x for x in r.left_out if x.feature in ("blobs", "isosurfaces", "lathes", "prisms")]
     assert r.stats["patches"] > alone.stats["patches"] + 4 * 50
     seen = coverage(_scene([FLOOR, *NEW]), "raycast", 64, 48)
     lit = r.image.max(-1) > 0.0

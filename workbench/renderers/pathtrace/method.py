@@ -20,6 +20,7 @@ import time
 from ...core.errors import WorkbenchError
 from ...scene import features as F
 from ...scene.model import Scene
+from .. import support as sp
 from ..base import Knob, Option, RenderResult
 from ..raytrace.accel import ACCELS
 from .session import FRESNEL, MIS, PIXEL_FILTER, TRANSPORT, PathTraceSession, estimate_bytes
@@ -40,6 +41,10 @@ class PathTraceRenderer:
 
     name = "pathtrace"
     ui_kind = "progressive"
+    support = sp.declare(
+        approximated={F.TEXTURES: "plain colours and planar or solid checkers only (others: plain colour)"},
+        left_out={f: "not evaluated by the path tracer's kernel (plain colour, unbumped, opaque, "
+                  "background colour)" for f in (F.IMAGE_TEXTURES, F.BUMP, F.OPACITY, F.ENVIRONMENT)})
     knob = Knob("spp", (2, 4, 16, 64, 256), 16, "samples per pixel")
     options = {
         "spp": Option(int, 16, "samples per pixel (uniform jitter: the box-filtered pixel; >= 2 for a noise estimate)"),
@@ -103,26 +108,31 @@ class PathTraceRenderer:
         return RenderResult(self.name, ses.image, timings, stats, *self._features(scene, ses), std_error=se)
 
     def _features(self, scene: Scene, ses: PathTraceSession):
+        """(features used, ``left_out`` notes): the :attr:`support` table for the scene's needs,
+        then what this render's options skip (``transport``), textures the kernel did not
+        evaluate, emitters it could not sample."""
         needs = F.scene_needs(scene)
-        left = ["ambient: off (the path tracer computes the indirect light it stands in for)"]
+        left = [sp.Note("ambient", "off (the path tracer computes the indirect light it stands in for)")]
+        left += sp.notes(self.support, needs)
+        noted = {n.feature for n in left}
+
+        def add(f, reason):
+            if f in needs and f not in noted:
+                left.append(sp.Note(f, reason))
+                noted.add(f)
         if ses.transport != "full":
             why = f"transport={ses.transport}: "
             for f, what in ((F.POINT_LIGHTS, "only emitting surfaces light the scene"),
                             (F.DIRECTIONAL_LIGHTS, "only emitting surfaces light the scene"),
                             (F.SPECULAR, "no Phong lobe (ks ignored)")):
-                if f in needs:
-                    left.append(f"{f}: {why}{what}")
+                add(f, why + what)
             for f in (F.REFLECTION, F.REFRACTION, F.ABSORPTION):
-                if f in needs:
-                    left.append(f"{f}: {why}" + ("Lambertian kd*color, opaque" if ses.transport == "diffuse"
-                                                 else "followed along the eye path only (no caustics)"))
+                add(f, why + ("Lambertian kd*color, opaque" if ses.transport == "diffuse"
+                              else "followed along the eye path only (no caustics)"))
         if not ses.textured:
             why = ("not evaluated by the path tracer's kernel" if ses.transport == "full"
                    else f"transport={ses.transport}: as radiosity")
             for f in (F.TEXTURES, F.BUMP, F.OPACITY, F.ENVIRONMENT):
-                if f in needs:
-                    left.append(f"{f}: {why} (plain colour, unbumped, opaque, background colour)")
-        left += [f"emitter sampling: {u}" for u in ses.emitters.unsampled]
-        missing = {x.split(":")[0] for x in left}
-        used = sorted(f for f in needs if f not in missing)
-        return used, left
+                add(f, f"{why} (plain colour, unbumped, opaque, background colour)")
+        left += [sp.Note("emitter sampling", u) for u in ses.emitters.unsampled]
+        return sp.used(needs, left), left

@@ -22,7 +22,19 @@ from ...scene import features as ft
 from ...scene import model as m
 from ..base import Knob, Option, RenderResult
 from ..base import render as render_method
+from .. import support as sp
+from .method import SUPPORT as RADIOSITY_SUPPORT
 from .method import check_camera_outside, common_options, estimate_solve_bytes, solve_scene
+
+_RAY_PASS = {ft.SPECULAR, ft.REFLECTION, ft.REFRACTION, ft.ABSORPTION}
+SUPPORT = sp.declare(
+    approximated={**{f: c.reason for f, c in RADIOSITY_SUPPORT.items()
+                     if c.status is sp.Status.APPROXIMATED},
+                  ft.REFLECTION: "ray-traced from the eye; caustics are not transported by the radiosity pass",
+                  ft.REFRACTION: "ray-traced from the eye; caustics are not transported by the radiosity pass"},
+    left_out={f: c.reason for f, c in RADIOSITY_SUPPORT.items()
+              if c.status is sp.Status.LEFT_OUT and f not in _RAY_PASS})
+"""Radiosity's table, with the specular effects the eye-ray pass adds (:mod:`..support`)."""
 
 RAYTRACE_OPTIONS = ("max_depth", "threshold", "spp", "fresnel")
 
@@ -66,6 +78,7 @@ class HybridRenderer:
 
     name = "hybrid"
     ui_kind = "cpu"
+    support = SUPPORT
     knob = Knob("patch_size", (0.2, 0.1, 0.05, 0.035, 0.025), 0.05,
                 "largest patch edge / scene diagonal")
     options = {**common_options(),
@@ -98,11 +111,10 @@ class HybridRenderer:
         stats["objects_as_radiosity_meshes"] = replaced
         stats.update({f"raytrace_{k}": v for k, v in rt.stats.items()})
         needs = ft.scene_needs(scene)
-        specular_ok = {ft.REFLECTION, ft.REFRACTION, ft.ABSORPTION, ft.SPECULAR}
-        used = sorted(set(sol.features_used) | (needs & specular_ok))
-        left_out = [e for e in sol.left_out if e.split(":")[0] not in specular_ok]
+        left_out = sp.notes(self.support, needs) + sol.left_out
         if needs & {ft.REFLECTION, ft.REFRACTION}:
-            left_out.append("caustics: light mirrored or refracted onto diffuse surfaces is not "
-                            "transported by the radiosity pass")
+            left_out.append(sp.Note("caustics", "light mirrored or refracted onto diffuse surfaces is not "
+                                    "transported by the radiosity pass"))
+        used = sp.used(needs | {ft.EMITTERS}, left_out)
         return RenderResult(self.name, rt.image, timings, stats, used, left_out, depth=rt.depth)
 

@@ -13,38 +13,33 @@ import numpy as np
 
 from ...core.errors import NotApplicable, WorkbenchError
 from ...scene import features as ft
-from ...scene.kinds import KINDS, containing, kind_of
+from ...scene.kinds import containing, kind_of
 from ...scene.model import Scene
 from ...scene.prepared import prepare
+from .. import support as sp
 from ..base import Knob, Option, RenderResult
 from . import solvers
 from .formfactors import FormFactors, compute
 from .patches import PatchSet, patches_from_scene
 
-#: features radiosity builds, and why it leaves out each of the others
-#: (and every object kind's feature: a kind is cut into patches, from its tessellation if it
-#: has no ``patch_surfaces``; :func:`handled`)
-HANDLED = {ft.EMITTERS, ft.AREA_LIGHTS, ft.TRANSFORMS, ft.SHADOWS}
-REASONS = {
-    ft.POINT_LIGHTS: "radiosity only knows emitting surfaces (area lights, emissive materials)",
-    ft.DIRECTIONAL_LIGHTS: "radiosity only knows emitting surfaces (area lights, emissive materials)",
-    ft.SPECULAR: "diffuse interreflection only (the hybrid method adds specular effects)",
-    ft.REFLECTION: "diffuse interreflection only (use the hybrid method for mirrors)",
-    ft.REFRACTION: "diffuse interreflection only (use the hybrid method for glass)",
-    ft.ABSORPTION: "no transmission in radiosity",
-    ft.TEXTURES: "a patch has one reflectance, the material's kd * color",
-    ft.SOLID_TEXTURES: "a patch has one reflectance, the material's kd * color",
-    ft.IMAGE_TEXTURES: "a patch has one reflectance, the material's kd * color",
-    ft.BUMP: "patches are flat",
-    ft.OPACITY: "patches are opaque",
-    ft.ENVIRONMENT: "radiosity has no environment light",
-}
-
-
-def handled() -> set[str]:
-    """:data:`HANDLED` and the features of every registered object kind."""
-    return HANDLED | {k.FEATURE for k in KINDS.values()}
-
+SUPPORT = sp.declare(
+    approximated={**{f: "one flat patch per triangle of its tessellation (patch_size)"
+                     for f in (ft.SPHERES, ft.QUADRICS, ft.CSG, ft.BLOBS, ft.ISOSURFACES, ft.LATHES)}},
+    left_out={
+        ft.POINT_LIGHTS: "radiosity only knows emitting surfaces (area lights, emissive materials)",
+        ft.DIRECTIONAL_LIGHTS: "radiosity only knows emitting surfaces (area lights, emissive materials)",
+        ft.SPECULAR: "diffuse interreflection only (the hybrid method adds specular effects)",
+        ft.REFLECTION: "diffuse interreflection only (use the hybrid method for mirrors)",
+        ft.REFRACTION: "diffuse interreflection only (use the hybrid method for glass)",
+        ft.ABSORPTION: "no transmission in radiosity",
+        ft.TEXTURES: "a patch has one reflectance, the material's kd * color",
+        ft.SOLID_TEXTURES: "a patch has one reflectance, the material's kd * color",
+        ft.IMAGE_TEXTURES: "a patch has one reflectance, the material's kd * color",
+        ft.BUMP: "patches are flat",
+        ft.OPACITY: "patches are opaque",
+        ft.ENVIRONMENT: "radiosity has no environment light",
+    })
+"""What radiosity builds, approximates and leaves out, with why (:mod:`..support`)."""
 
 def common_options() -> dict[str, Option]:
     """Options shared by ``radiosity`` and ``hybrid``."""
@@ -120,8 +115,7 @@ class Solution:
     radiance: np.ndarray         # (P, 3) what each patch shows
     stats: dict
     timings: dict
-    left_out: list
-    features_used: list
+    left_out: list  # per-scene notes (objects not cut into patches); the table's are the method's
 
 
 def _row_provider(hc, stats: dict):
@@ -205,9 +199,6 @@ def solve_scene(scene: Scene, opts: dict, method: str) -> Solution:
     extent = prepare(scene).extent  # patch sizes are fractions of the scene's diagonal
     patches, left_out = patches_from_scene(scene, opts["patch_size"] * extent)
     timings["patches"] = time.perf_counter() - t0
-    needs = ft.scene_needs(scene)
-    left_out = left_out + [f"{f}: {REASONS.get(f, 'not used by radiosity')}"
-                           for f in sorted(needs - handled())]
     if len(patches) == 0 or not (patches.emission > 0).any():
         raise NotApplicable(f"{method}: the scene has no emitters (no area light and no emissive "
                             "material): radiosity has nothing to distribute")
@@ -240,8 +231,7 @@ def solve_scene(scene: Scene, opts: dict, method: str) -> Solution:
     stats.update({"iterations": res.iterations, "converged": res.converged,
                   "solver_message": res.message, "error_bound": res.error_bound,
                   "residual_history": [float(x) for x in res.residuals[-50:]]})
-    used = sorted((needs & handled()) | {ft.EMITTERS})
-    return Solution(patches, np.asarray(res.display), stats, timings, left_out, used)
+    return Solution(patches, np.asarray(res.display), stats, timings, left_out)
 
 
 class RadiosityRenderer:
@@ -249,6 +239,7 @@ class RadiosityRenderer:
 
     name = "radiosity"
     ui_kind = "cpu"
+    support = SUPPORT
     knob = Knob("patch_size", (0.2, 0.1, 0.05, 0.035, 0.025), 0.05,
                 "largest patch edge / scene diagonal")
     options = common_options()
@@ -268,4 +259,6 @@ class RadiosityRenderer:
         sol.timings["compile"] += t["compile"]
         sol.timings["display"] = t["display"]
         sol.stats.setdefault("gl_renderer", gl.renderer_name())
-        return RenderResult(self.name, img, sol.timings, sol.stats, sol.features_used, sol.left_out)
+        needs = ft.scene_needs(scene)
+        left = sp.notes(self.support, needs) + sol.left_out
+        return RenderResult(self.name, img, sol.timings, sol.stats, sp.used(needs | {ft.EMITTERS}, left), left)

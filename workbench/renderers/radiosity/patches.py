@@ -29,6 +29,7 @@ from ...scene import model as m
 from ...scene.kinds import kind_of
 from ...scene.kinds.mesh import edge_max
 from ...scene.tessellate import tessellate_object
+from ..support import Note
 
 MAX_CURVED_LEVEL = 24   # finest tessellation level asked of workbench.scene.tessellate
 
@@ -248,7 +249,7 @@ def _surfaces(scene: m.Scene, h: float) -> tuple[list, list[str]]:
     """World-space surfaces of a scene, each ``(kind, geometry, material or None, emission,
     object, name)``: kind ``"polygon"`` (a planar convex polygon (k, 3), cut later) or
     ``"mesh"`` (vertices (V, 3), faces (F, 3): one patch per triangle, shared vertices).
-    Also returns the ``left_out`` entries."""
+    Also returns the ``left_out`` notes (:class:`..support.Note`)."""
     out, left_out = [], []
     for i, obj in enumerate(scene.objects):
         name = obj.name or f"{obj.kind}_{i}"
@@ -260,7 +261,7 @@ def _surfaces(scene: m.Scene, h: float) -> tuple[list, list[str]]:
             try:
                 parts = _curved(obj, h)
             except WorkbenchError as e:
-                left_out.append(f"{obj.kind} ({name}): not cut into patches ({e})")
+                left_out.append(Note(kind_of(obj).FEATURE, f"{obj.kind} {name!r} not cut into patches ({e})"))
                 continue
             for k, (P, F, mname) in enumerate(parts):
                 pm = scene.materials[mname]

@@ -42,6 +42,7 @@ from ...core.tol import tol
 from ...scene import features as F
 from ...scene.model import Mesh, Scene
 from ...scene.prepared import prepare
+from .. import support as sp
 from ..base import Knob, Option, RenderResult
 from ..kernels.columns import CHECKER_PLANAR, CHECKER_SOLID, TEX_COLS, Mat, Tex, WhittedOpt, pack
 from .accel import ACCELS, accel_extra_bytes
@@ -207,15 +208,14 @@ class _Colorizer:
         self.base = sd.mat_tab[:, Mat.COLOR:Mat.COLOR + 3]
         needs = F.scene_needs(scene)
         self.tex = None
-        self.missing: list[str] = []
+        self.missing: list[str] = []  # features wanted but not evaluated
         wanted = [f for f in (F.TEXTURES, F.BUMP, F.OPACITY, F.ENVIRONMENT) if f in needs]
         if wanted:
             try:
                 from .. import texturing
                 self.tex = texturing
             except ImportError:
-                self.missing = [f"{f}: texturing module not available yet (untextured colour used)"
-                                for f in wanted]
+                self.missing = wanted
         self.bg = np.asarray(scene.background, dtype=np.float64)
 
     def _groups(self, prim, attr):
@@ -620,23 +620,33 @@ class _WhittedBase:
         return estimate_trace_bytes(scene, width, height, o, self.recursive)
 
     def _features(self, scene, tr):
+        """(features used, ``left_out`` notes): the class's :attr:`support` table for the scene's
+        needs, then the paths this render skipped (no lights, option off, no such material)."""
         needs = F.scene_needs(scene)
-        left = list(tr.col.missing)
-        if not tr.do_shadow:
-            left.append(f"{F.SHADOWS}: no lights (no shadow rays traced)" if not len(tr.sd.lights)
-                        else f"{F.SHADOWS}: disabled by option (no shadow rays traced)")
-        if not tr.do_refr:
-            left.append(f"{F.REFRACTION}: " + ("raycast traces no secondary rays" if not self.recursive
-                                               else "no transmissive material (no refraction rays traced)"))
-        if not tr.do_refl:
-            left.append(f"{F.REFLECTION}: " + ("raycast traces no secondary rays" if not self.recursive
-                                               else "no reflective material (no reflection rays traced)"))
-        if F.MESHES not in needs:
-            left.append(f"{F.MESHES}: no meshes (no BVH built or traversed)")
-        missing_names = {x.split(":")[0] for x in left}
-        used = sorted(f for f in needs if f not in missing_names)
-        return used, left
+        left = sp.notes(self.support, needs)
+        declared = {n.feature for n in left}
 
+        def skipped(f, reason):
+            if f not in declared:
+                left.append(sp.Note(f, reason, sp.Status.LEFT_OUT if f in needs else sp.Status.NOT_NEEDED))
+        left += [sp.Note(f, "texturing module not available (untextured colour used)") for f in tr.col.missing]
+        if not tr.do_shadow:
+            skipped(F.SHADOWS, "no lights (no shadow rays traced)" if not len(tr.sd.lights)
+                    else "disabled by option (no shadow rays traced)")
+        if not tr.do_refr:
+            skipped(F.REFRACTION, "no transmissive material (no refraction rays traced)")
+        if not tr.do_refl:
+            skipped(F.REFLECTION, "no reflective material (no reflection rays traced)")
+        if F.MESHES not in needs:
+            left.append(sp.Note(F.MESHES, "no meshes (no BVH built or traversed)", sp.Status.NOT_NEEDED))
+        return sp.used(needs, left), left
+
+
+_APPROXIMATED = {
+    F.AREA_LIGHTS: "stand-in point lights (the scene's area-light samples), hard shadows per sample",
+    F.EMITTERS: "emission seen directly; emitting surfaces light others only through area-light stand-ins",
+}
+"""What both Whitted methods stand in for (their ``support`` tables, :mod:`..support`)."""
 
 _COMMON = {
     "spp": Option(int, 1, "samples per pixel (stratified jitter; 1 = pixel centres)"),
@@ -661,6 +671,9 @@ class RaycastRenderer(_WhittedBase):
     name = "raycast"
     ui_kind = "cpu"
     recursive = False
+    support = sp.declare(approximated=_APPROXIMATED, left_out={
+        F.REFLECTION: "raycast traces no secondary rays", F.REFRACTION: "raycast traces no secondary rays",
+        F.ABSORPTION: "raycast traces no secondary rays (no path through a medium)"})
     knob = Knob("spp", (1, 2, 4, 8, 16), 1, "samples per pixel")
     options = dict(_COMMON)
     memory_options = ("spp",)
@@ -671,6 +684,7 @@ class RaytraceRenderer(_WhittedBase):
 
     name = "raytrace"
     ui_kind = "cpu"
+    support = sp.declare(approximated=_APPROXIMATED)
     knob = Knob("max_depth", (1, 2, 3, 4, 5, 6, 8, 12), 5,
                 "maximum number of ray generations in a path (primary = 1)")
     options = {**_COMMON,

@@ -76,14 +76,14 @@ Functions (``W`` and ``M`` are (4, 4) ``world_from_object`` including any CSG pa
     space, texture, ``matrix``) through the exporter's writer ``w``
     (:class:`workbench.renderers.povray_sdl.Writer`): ``w.vec(a)``, ``w.num(x)`` (10
     significant digits), ``w.matrix(W)``, ``w.texture(material)`` (pigment, finish, interior),
-    ``w.leave("feature: reason")`` and, for CSG operands, ``w.shape(child, True)``;
+    ``w.leave(feature, reason)`` and, for CSG operands, ``w.shape(child, True)``;
     ``in_csg``: it is a CSG operand (a cut quadric becomes a capped solid, an isosurface
     keeps all its crossings).  None: POV-Ray cannot express it (the writer notes it).
 ``mitsuba(obj, x) -> list[dict] | None``  its Mitsuba 3 shapes, added through the exporter's
     shape writer ``x`` (:class:`workbench.renderers.mitsuba_export.ShapeWriter`):
     ``x.tessellated(obj, level, flat=, open_surface=)`` (its raster tessellation as PLY
     meshes), ``x.analytic(shape_dict, material, lo, hi)`` (a Mitsuba primitive of its own),
-    ``x.similarity_scale(W)``, ``x.leave(note)`` (an approximation, in ``left_out``) and
+    ``x.similarity_scale(W)``, ``x.leave(feature, reason)`` (an approximation, in ``left_out``) and
     ``x.level`` (the export's tessellation level).  Returns the shape dicts added; None: not
     exported (noted).
 

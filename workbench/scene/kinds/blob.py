@@ -285,6 +285,6 @@ def mitsuba(b: Blob, x) -> list[dict]:
     """No blob in Mitsuba 3: its raster tessellation (marching cubes) at the export's level,
     noted in ``left_out``."""
     level = b.tessellation or x.level
-    x.leave(f"{FEATURE}: no blob primitive in Mitsuba 3: exported as its raster tessellation "
+    x.leave(FEATURE, f"no blob primitive in Mitsuba 3: exported as its raster tessellation "
             f"(marching cubes, {LEVEL_CELLS} x level cells along the longest side; level {level})")
     return x.tessellated(b, level)

@@ -351,6 +351,6 @@ def mitsuba(s: Isosurface, x) -> list[dict]:
     """No implicit surface in Mitsuba 3: its raster tessellation (marching cubes, closed on
     the bounds) at the export's level, noted in ``left_out``."""
     level = s.tessellation or x.level
-    x.leave(f"{FEATURE}: no implicit surface in Mitsuba 3: exported as its raster tessellation "
+    x.leave(FEATURE, f"no implicit surface in Mitsuba 3: exported as its raster tessellation "
             f"(marching cubes, {LEVEL_CELLS} x level cells along the bounds' longest side; level {level})")
     return x.tessellated(s, level)

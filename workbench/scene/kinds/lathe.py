@@ -391,6 +391,6 @@ def mitsuba(la: Lathe, x) -> list[dict]:
     """No lathe in Mitsuba 3: its raster tessellation (``LEVEL_STEPS`` x level angular steps)
     at the export's level, an open surface when its profile is open; noted in ``left_out``."""
     level = la.tessellation or x.level
-    x.leave(f"{FEATURE}: no lathe primitive in Mitsuba 3: exported as its raster tessellation "
+    x.leave(FEATURE, f"no lathe primitive in Mitsuba 3: exported as its raster tessellation "
             f"({LEVEL_STEPS} x level angular steps; level {level})")
     return x.tessellated(la, level, open_surface=not la.closed)

@@ -153,7 +153,7 @@ def povray(o: m.Mesh, w, in_csg: bool) -> str:
     normals before its transform: not the same under a non-uniform scale); the texture
     carries ``W``.  Per-vertex emission is left out (noted)."""
     if o.vertex_emission is not None:
-        w.leave(f"emitters: per-vertex emission of mesh {o.name or o.source!r} not exported")
+        w.leave("emitters", f"per-vertex emission of mesh {o.name or o.source!r} not exported")
     W = np.asarray(o.world_from_object, dtype=np.float64)
     V = np.asarray(o.vertices, dtype=np.float64) @ W[:3, :3].T + W[:3, 3]
     F = np.asarray(o.faces)
@@ -173,5 +173,5 @@ def mitsuba(o: m.Mesh, x) -> list[dict]:
     """Its triangles with its own vertex normals (flat without them); per-vertex emission
     (hybrid's radiosity hand-over) is left out (noted)."""
     if o.vertex_emission is not None:
-        x.leave("emitters: mesh vertex emission (hybrid's radiosity hand-over) not exported")
+        x.leave("emitters", "mesh vertex emission (hybrid's radiosity hand-over) not exported")
     return x.tessellated(o, x.level, flat=o.normals is None)

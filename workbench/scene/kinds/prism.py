@@ -271,5 +271,5 @@ def povray(p: Prism, w, in_csg: bool) -> str:
 def mitsuba(p: Prism, x) -> list[dict]:
     """No prism in Mitsuba 3: its raster tessellation (exact: walls and ear-clipped caps),
     flat normals, noted in ``left_out``."""
-    x.leave(f"{FEATURE}: no prism primitive in Mitsuba 3: exported as its triangles (exact)")
+    x.leave(FEATURE, "no prism primitive in Mitsuba 3: exported as its triangles (exact)")
     return x.tessellated(p, 1, flat=True)
