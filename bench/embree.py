@@ -234,8 +234,8 @@ def tables(res: dict) -> str:
                      _ms(be.get(f"mesh_{x}_s")), ratio(bo[f"{x}_s"], be.get(f"{x}_s"))]
                     for k, x in (("wall", "wall"), ("CPU", "cpu"))]),
              "The commit is Embree's BVH build; embreex's `TriangleMesh` copies the vertex and face "
-             "arrays into Embree's buffers one element at a time in its wrapper, a cost of the binding "
-             "rather than of Embree, shown apart.", "",
+             "arrays into Embree's buffers in the wrapper's own loops (no Embree work): a cost of the "
+             "binding, shown apart.", "",
              "## Primary rays (closest hit)", "",
              table(["", "ours: trace_batch", f"{anchor}: run(output=1)", "ours / Embree"],
                    [["M rays per CPU-second", ro["mrays_per_cpu_s"], re_.get("mrays_per_cpu_s"),
