@@ -27,6 +27,12 @@ import numpy as np
 from ..kernels.layout import MAX_DEPTH
 
 N_BINS = 16
+SMALL_NODE = 16
+"""Items up to which a node bins its centroids into :data:`SMALL_NODE_BINS` bins only: such a
+node holds at most four leaves' worth (``4 MAX_LEAF``), its items fall into few of sixteen bins,
+and clearing and sweeping the empty ones was most of its cost; the trees differ in a few small
+nodes and their SAH cost hardly at all (``bench/embree.py``, ``bench/accel.py`` compare it)."""
+SMALL_NODE_BINS = 8
 BIN_SAMPLES = 256
 """Items binned per node, about: a node of more bins a regular sample of them (see :func:`_build`)."""
 MAX_LEAF = 4
@@ -102,7 +108,8 @@ def _build_nodes(tb, idx, s0, e0, depth0, bounds0, limit):
     node's range reads memory in sequence; a box's centroid (its centre) is recomputed where
     needed rather than stored and swapped beside it (less memory traffic, the same values); a
     node's box and centroid bounds come from its parent's partition, and one pass bins the
-    centroids along the three axes at once.  A node of more than ``2 BIN_SAMPLES`` items bins
+    centroids along the three axes at once (into :data:`SMALL_NODE_BINS` bins for a node of at most
+    :data:`SMALL_NODE` items).  A node of more than ``2 BIN_SAMPLES`` items bins
     every ``(n // BIN_SAMPLES)``-th of them only (the SAH estimated from a regular sample,
     Wald 2007; the partition is exact): on the mesh scene the binary tree's SAH cost rises
     0.1 % and the build's CPU time falls by about a sixth."""
@@ -141,9 +148,10 @@ def _build_nodes(tb, idx, s0, e0, depth0, bounds0, limit):
             meta[node, 0], meta[node, 1], meta[node, 2] = s, n, -1
             continue
         # bin the centroids along the three axes in one pass
+        nb_ = N_BINS if n > SMALL_NODE else SMALL_NODE_BINS
         for ax in range(3):
-            scale[ax] = N_BINS * (1.0 - 1e-9) / ext[ax] if ext[ax] > 0.0 else 0.0
-            for b in range(N_BINS):
+            scale[ax] = nb_ * (1.0 - 1e-9) / ext[ax] if ext[ax] > 0.0 else 0.0
+            for b in range(nb_):
                 bin_cnt[ax, b] = 0
                 for a in range(3):
                     bin_box[ax, b, a], bin_box[ax, b, 3 + a] = np.inf, -np.inf
@@ -166,8 +174,8 @@ def _build_nodes(tb, idx, s0, e0, depth0, bounds0, limit):
             for a in range(3):
                 sweep[a], sweep[3 + a] = np.inf, -np.inf
             cnt = 0
-            for b in range(N_BINS - 1, 0, -1):
-                if bin_cnt[ax, b] == 0 and b < N_BINS - 1:  # an empty bin changes nothing
+            for b in range(nb_ - 1, 0, -1):
+                if bin_cnt[ax, b] == 0 and b < nb_ - 1:  # an empty bin changes nothing
                     right_area[b], right_cnt[b] = right_area[b + 1], cnt
                     continue
                 for a in range(3):
@@ -179,7 +187,7 @@ def _build_nodes(tb, idx, s0, e0, depth0, bounds0, limit):
             for a in range(3):
                 sweep[a], sweep[3 + a] = np.inf, -np.inf
             cnt = 0
-            for b in range(N_BINS - 1):
+            for b in range(nb_ - 1):
                 if bin_cnt[ax, b] == 0:  # the split of the bin before, at the same cost: not a new one
                     continue
                 for a in range(3):
