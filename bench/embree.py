@@ -17,14 +17,18 @@ the bundled ``mesh`` scene's 81,920 triangles and camera, in one run (issue #28,
    public ``workbench.raytrace.intersect`` calls it, on numba's threads, warm.  Embree:
    ``EmbreeScene.run(origins, directions, output=1)`` (distance, barycentrics, geometric
    normal and triangle of each ray, one ``rtcIntersect1`` per ray on one thread), the same
-   rays in float32.  The hits are compared (hit or miss per ray; distance within a relative
+   rays in float32.  Also ours without the surface data: ``kernels.intersect.closest`` alone
+   over the rays (:func:`closest_kernel`), the traversal nearer to what ``run`` does.  The hits are compared (hit or miss per ray; distance within a relative
    ``T_RTOL``; geometric normals parallel), so that both answer the same question.
 
 Each quantity is measured ``--runs`` times, Embree's and ours alternating (A B A B: the
 machine is shared and its load comes and goes), wall and CPU seconds (``time.process_time``:
 every thread of this process, so Embree's TBB threads and numba's alike); the tables give the
 medians and their ratios.  Rays per CPU-second is the fair figure on a loaded machine with
-threads on one side and one thread on the other.  Timing is never a pass/fail test.
+threads on one side and one thread on the other; on an idle one the CPU seconds also count the
+time thread pools spend waiting actively for work (numba's OpenMP workers, Embree's TBB workers
+after a build), so that CPU can exceed wall times the threads at work.  Timing is never a
+pass/fail test.
 
 Writes ``bench/results/embree.json`` and ``docs/benchmarks/embree.md``.  Run:
 ``.venv/bin/python bench/embree.py [--size 640x480] [--runs 7]``.  Without ``embreex`` our side
@@ -118,6 +122,15 @@ class OurSide:
         self.sd = flatten(scene)
         self.geo = self.sd.kernel_args()
 
+    def closest(self, O, D):
+        """:func:`closest_kernel` over the rays: ``(t, triangle)``."""
+        if not hasattr(self, "_closest"):
+            self._closest = closest_kernel()
+        n = len(O)
+        t, tri = np.empty(n), np.empty(n, np.int64)
+        self._closest(self.geo, O, D, self.tol.zero, self.tol.ray_offset, self.sd.extent, t, tri)
+        return t, tri
+
     def trace(self, O, D):
         n = len(O)
         h = self.alloc(n)
@@ -125,6 +138,31 @@ class OurSide:
                                  self.tol.ray_offset, self.sd.extent, self.tol.normal_cancel, False, h["t"],
                                  h["prim"], h["ng"], h["ns"], h["uv"], h["po"], h["ev"])
         return h
+
+
+def closest_kernel():
+    """A numba kernel of the closest hits alone: ``kernels.intersect.closest`` (the function
+    ``trace_batch`` calls for each ray) over the rays on numba's threads, writing ``t`` and the
+    triangle, without the surface data.  Built here (not cached: a few seconds to compile)."""
+    import numba as nb
+    from numba import prange
+
+    from workbench.renderers.kernels.intersect import closest, scratch
+
+    @nb.njit(parallel=True, error_model="numpy")
+    def closest_only(geo, O, D, zero, rel_eps, extent, t_out, tri_out):
+        n = O.shape[0]
+        nch = (n + 63) // 64
+        for c in prange(64):
+            stack, st, sp_, sf, sn = scratch()
+            for q in range(c, nch, 64):
+                for i in range(q * 64, min(n, q * 64 + 64)):
+                    ox, oy, oz = O[i, 0], O[i, 1], O[i, 2]
+                    eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
+                    t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, D[i, 0], D[i, 1], D[i, 2], 0.0, np.inf,
+                                                   np.bool_(False), np.bool_(False), zero, eps, stack, st, sp_, sf, sn)
+                    t_out[i], tri_out[i] = t, tri
+    return closest_only
 
 
 def compare_hits(ours: dict, emb: dict) -> dict:
@@ -198,11 +236,13 @@ def main(argv=None) -> dict:
     # ---- 2. primary rays, alternating (both warm: one untimed pass first)
     ours = OurSide(mesh_scene)
     h_ours = ours.trace(O, D)
+    t_c, _ = ours.closest(O, D)
+    res["closest_only_same_t"] = bool(np.array_equal(t_c, np.where(h_ours["prim"] >= 0, h_ours["t"], np.inf)))
     if emb:
         sc = emb.build(V32, F32)[0]
         h_emb = emb.trace(sc, O32, D32)
         res["hits"] = compare_hits(h_ours, h_emb)
-    r_ours, r_emb = [], []
+    r_ours, r_emb, r_cl = [], [], []
     n = len(O)
     for _ in range(args.runs):
         if emb:
@@ -212,8 +252,12 @@ def main(argv=None) -> dict:
         _, wall, cpu = timed(lambda: ours.trace(O, D))
         r_ours.append(dict(wall_s=wall, cpu_s=cpu, mrays_per_s=n / wall / 1e6,
                            mrays_per_cpu_s=n / max(cpu, 1e-9) / 1e6))
+        _, wall, cpu = timed(lambda: ours.closest(O, D))
+        r_cl.append(dict(wall_s=wall, cpu_s=cpu, mrays_per_s=n / wall / 1e6,
+                         mrays_per_cpu_s=n / max(cpu, 1e-9) / 1e6))
     res["primary"] = dict(ours=median_of(r_ours), ours_runs=r_ours,
-                       embree=median_of(r_emb) if emb else None, embree_runs=r_emb)
+                       embree=median_of(r_emb) if emb else None, embree_runs=r_emb,
+                       ours_closest=median_of(r_cl), ours_closest_runs=r_cl)
     print(tables(res), flush=True)
     return PAGE.write(args, res)
 
@@ -244,6 +288,16 @@ def tables(res: dict) -> str:
                      ratio(ro["mrays_per_s"], re_.get("mrays_per_s"))],
                     ["wall (ms)", 1e3 * ro["wall_s"], 1e3 * re_["wall_s"] if re_ else None, ratio(ro["wall_s"], re_.get("wall_s"))],
                     ["CPU (ms)", 1e3 * ro["cpu_s"], 1e3 * re_["cpu_s"] if re_ else None, ratio(ro["cpu_s"], re_.get("cpu_s"))]])]
+    rc = res["primary"].get("ours_closest")
+    if rc:
+        lines += ["The closest hits alone (`kernels.intersect.closest`, the function `trace_batch` calls for "
+                  "each ray, without the surface data: normals, uv; the same distances: "
+                  f"{fmt(res.get('closest_only_same_t'))}):", "",
+                  table(["", "ours: closest only", "Embree", "ours / Embree"],
+                        [["M rays per CPU-second", rc["mrays_per_cpu_s"], re_.get("mrays_per_cpu_s"),
+                          ratio(rc["mrays_per_cpu_s"], re_.get("mrays_per_cpu_s"))],
+                         ["M rays per second (wall)", rc["mrays_per_s"], re_.get("mrays_per_s"),
+                          ratio(rc["mrays_per_s"], re_.get("mrays_per_s"))]])]
     hits = res.get("hits")
     if hits:
         lines += ["## Same hits?", "",
