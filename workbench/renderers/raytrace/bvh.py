@@ -31,7 +31,7 @@ SMALL_NODE = 16
 """Items up to which a node bins its centroids into :data:`SMALL_NODE_BINS` bins only: such a
 node holds at most four leaves' worth (``4 MAX_LEAF``), its items fall into few of sixteen bins,
 and clearing and sweeping the empty ones was most of its cost; the trees differ in a few small
-nodes and their SAH cost hardly at all (``bench/embree.py``, ``bench/accel.py`` compare it)."""
+nodes and their SAH cost hardly at all (``bench/accel.py`` gives the tree's SAH cost)."""
 SMALL_NODE_BINS = 8
 BIN_SAMPLES = 256
 """Items binned per node, about: a node of more bins a regular sample of them (see :func:`_build`)."""
