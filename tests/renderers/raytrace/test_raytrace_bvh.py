@@ -130,8 +130,10 @@ def _readable_sah(tri_v):
     first order, left child first.  A node of ``n >= 2 BIN_SAMPLES`` triangles estimates the SAH
     from every ``(n // BIN_SAMPLES)``-th of them in the build's order (after its partitions'
     swaps): this plain build keeps the input order, so it is the same only where no node
-    below the root is sampled (asserted)."""
-    from workbench.renderers.raytrace.bvh import BIN_SAMPLES, MAX_DEPTH, MAX_LEAF, N_BINS, TRAVERSAL_COST
+    below the root is sampled (asserted).  A node of at most ``SMALL_NODE`` triangles uses
+    ``SMALL_NODE_BINS`` bins."""
+    from workbench.renderers.raytrace.bvh import (BIN_SAMPLES, MAX_DEPTH, MAX_LEAF, N_BINS, SMALL_NODE,
+                                                  SMALL_NODE_BINS, TRAVERSAL_COST)
     t = tri_v.reshape(-1, 3, 3)
     tb = np.concatenate([t.min(1), t.max(1)], 1)
     cen = 0.5 * (tb[:, :3] + tb[:, 3:])
@@ -155,12 +157,13 @@ def _readable_sah(tri_v):
             rec[2] = set(ids.tolist())
             return
         best, best_b, axis = np.inf, -1, 0
+        nbins = N_BINS if len(ids) > SMALL_NODE else SMALL_NODE_BINS
         for ax in range(3):
             if not ext[ax] > 0.0:
                 continue
             smp = ids[::max(1, len(ids) // BIN_SAMPLES)]
-            bins = ((cen[smp, ax] - cmin[ax]) * (N_BINS * (1.0 - 1e-9) / ext[ax])).astype(int)
-            for b in range(N_BINS - 1):
+            bins = ((cen[smp, ax] - cmin[ax]) * (nbins * (1.0 - 1e-9) / ext[ax])).astype(int)
+            for b in range(nbins - 1):
                 left, right = smp[bins <= b], smp[bins > b]
                 if len(left) and len(right):
                     c = area(union(tb[left])) * len(left) + area(union(tb[right])) * len(right)
@@ -170,7 +173,7 @@ def _readable_sah(tri_v):
             rec[2] = set(ids.tolist())
             return
         rec[1] = axis
-        bins = ((cen[ids, axis] - cmin[axis]) * (N_BINS * (1.0 - 1e-9) / ext[axis])).astype(int)
+        bins = ((cen[ids, axis] - cmin[axis]) * (nbins * (1.0 - 1e-9) / ext[axis])).astype(int)
         node(ids[bins <= best_b], depth + 1)
         node(ids[bins > best_b], depth + 1)
 

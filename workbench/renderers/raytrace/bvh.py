@@ -27,6 +27,12 @@ import numpy as np
 from ..kernels.layout import MAX_DEPTH
 
 N_BINS = 16
+SMALL_NODE = 16
+"""Items up to which a node bins its centroids into :data:`SMALL_NODE_BINS` bins only: such a
+node holds at most four leaves' worth (``4 MAX_LEAF``), its items fall into few of sixteen bins,
+and clearing and sweeping the empty ones was most of its cost; the trees differ in a few small
+nodes and their SAH cost hardly at all (``bench/accel.py`` gives the tree's SAH cost)."""
+SMALL_NODE_BINS = 8
 BIN_SAMPLES = 256
 """Items binned per node, about: a node of more bins a regular sample of them (see :func:`_build`)."""
 MAX_LEAF = 4
@@ -78,6 +84,18 @@ def _root_bounds(tb):
     return acc
 
 
+@nb.njit(cache=True, forceinline=True)
+def _bin_item(bin_box, bin_cnt, ax, b, l0, l1, l2, h0, h1, h2):
+    """Add the box ``(l0, l1, l2, h0, h1, h2)`` to bin ``b`` of axis ``ax`` (:func:`_build_nodes`)."""
+    bin_cnt[ax, b] += 1
+    bin_box[ax, b, 0] = min(bin_box[ax, b, 0], l0)
+    bin_box[ax, b, 1] = min(bin_box[ax, b, 1], l1)
+    bin_box[ax, b, 2] = min(bin_box[ax, b, 2], l2)
+    bin_box[ax, b, 3] = max(bin_box[ax, b, 3], h0)
+    bin_box[ax, b, 4] = max(bin_box[ax, b, 4], h1)
+    bin_box[ax, b, 5] = max(bin_box[ax, b, 5], h2)
+
+
 @nb.njit(cache=True, nogil=True)
 def _build_nodes(tb, idx, s0, e0, depth0, bounds0, limit):
     """The binned SAH build (module docstring) of the items ``[s0, e0)`` of ``tb`` (T, 6) and
@@ -90,7 +108,8 @@ def _build_nodes(tb, idx, s0, e0, depth0, bounds0, limit):
     node's range reads memory in sequence; a box's centroid (its centre) is recomputed where
     needed rather than stored and swapped beside it (less memory traffic, the same values); a
     node's box and centroid bounds come from its parent's partition, and one pass bins the
-    centroids along the three axes at once.  A node of more than ``2 BIN_SAMPLES`` items bins
+    centroids along the three axes at once (into :data:`SMALL_NODE_BINS` bins for a node of at most
+    :data:`SMALL_NODE` items).  A node of more than ``2 BIN_SAMPLES`` items bins
     every ``(n // BIN_SAMPLES)``-th of them only (the SAH estimated from a regular sample,
     Wald 2007; the partition is exact): on the mesh scene the binary tree's SAH cost rises
     0.1 % and the build's CPU time falls by about a sixth."""
@@ -129,21 +148,24 @@ def _build_nodes(tb, idx, s0, e0, depth0, bounds0, limit):
             meta[node, 0], meta[node, 1], meta[node, 2] = s, n, -1
             continue
         # bin the centroids along the three axes in one pass
+        nb_ = N_BINS if n > SMALL_NODE else SMALL_NODE_BINS
         for ax in range(3):
-            scale[ax] = N_BINS * (1.0 - 1e-9) / ext[ax] if ext[ax] > 0.0 else 0.0
-            for b in range(N_BINS):
+            scale[ax] = nb_ * (1.0 - 1e-9) / ext[ax] if ext[ax] > 0.0 else 0.0
+            for b in range(nb_):
                 bin_cnt[ax, b] = 0
                 for a in range(3):
                     bin_box[ax, b, a], bin_box[ax, b, 3 + a] = np.inf, -np.inf
+        # (the box, origins and scales in local variables: the compiler cannot keep them in
+        # registers across the stores into the bins, which might alias them)
+        m0, m1, m2, q0, q1, q2 = cmin[0], cmin[1], cmin[2], scale[0], scale[1], scale[2]
         for k in range(s, e, max(1, n // BIN_SAMPLES)):
-            for ax in range(3):
-                if scale[ax] == 0.0:
-                    continue
-                b = int((0.5 * (tb[k, ax] + tb[k, 3 + ax]) - cmin[ax]) * scale[ax])
-                bin_cnt[ax, b] += 1
-                for a in range(3):
-                    bin_box[ax, b, a] = min(bin_box[ax, b, a], tb[k, a])
-                    bin_box[ax, b, 3 + a] = max(bin_box[ax, b, 3 + a], tb[k, 3 + a])
+            l0, l1, l2, h0, h1, h2 = tb[k, 0], tb[k, 1], tb[k, 2], tb[k, 3], tb[k, 4], tb[k, 5]
+            if q0 != 0.0:
+                _bin_item(bin_box, bin_cnt, 0, int((0.5 * (l0 + h0) - m0) * q0), l0, l1, l2, h0, h1, h2)
+            if q1 != 0.0:
+                _bin_item(bin_box, bin_cnt, 1, int((0.5 * (l1 + h1) - m1) * q1), l0, l1, l2, h0, h1, h2)
+            if q2 != 0.0:
+                _bin_item(bin_box, bin_cnt, 2, int((0.5 * (l2 + h2) - m2) * q2), l0, l1, l2, h0, h1, h2)
         # sweep each axis from the right, then from the left
         best, best_b, axis = np.inf, -1, 0
         for ax in range(3):
@@ -152,8 +174,8 @@ def _build_nodes(tb, idx, s0, e0, depth0, bounds0, limit):
             for a in range(3):
                 sweep[a], sweep[3 + a] = np.inf, -np.inf
             cnt = 0
-            for b in range(N_BINS - 1, 0, -1):
-                if bin_cnt[ax, b] == 0 and b < N_BINS - 1:  # an empty bin changes nothing
+            for b in range(nb_ - 1, 0, -1):
+                if bin_cnt[ax, b] == 0 and b < nb_ - 1:  # an empty bin changes nothing
                     right_area[b], right_cnt[b] = right_area[b + 1], cnt
                     continue
                 for a in range(3):
@@ -165,7 +187,7 @@ def _build_nodes(tb, idx, s0, e0, depth0, bounds0, limit):
             for a in range(3):
                 sweep[a], sweep[3 + a] = np.inf, -np.inf
             cnt = 0
-            for b in range(N_BINS - 1):
+            for b in range(nb_ - 1):
                 if bin_cnt[ax, b] == 0:  # the split of the bin before, at the same cost: not a new one
                     continue
                 for a in range(3):
@@ -185,22 +207,32 @@ def _build_nodes(tb, idx, s0, e0, depth0, bounds0, limit):
             continue
         # partition [s, e) by bin (idx and boxes swapped together), growing each
         # side's box and centroid bounds as its triangles are placed
+        # (the two running boxes and centroid bounds in local variables, as the bins above)
         sc, cm = scale[axis], cmin[axis]
-        for a in range(3):
-            for o in (0, 12):
-                acc[o + a], acc[o + 3 + a], acc[o + 6 + a], acc[o + 9 + a] = np.inf, -np.inf, np.inf, -np.inf
+        La0 = La1 = La2 = Lc0 = Lc1 = Lc2 = Ra0 = Ra1 = Ra2 = Rc0 = Rc1 = Rc2 = np.inf
+        Lb0 = Lb1 = Lb2 = Ld0 = Ld1 = Ld2 = Rb0 = Rb1 = Rb2 = Rd0 = Rd1 = Rd2 = -np.inf
         lo, hi = s, e - 1
         while lo <= hi:
-            if int((0.5 * (tb[lo, axis] + tb[lo, 3 + axis]) - cm) * sc) <= best_b:
-                _grow(acc, 0, tb, lo)
+            l0, l1, l2, h0, h1, h2 = tb[lo, 0], tb[lo, 1], tb[lo, 2], tb[lo, 3], tb[lo, 4], tb[lo, 5]
+            c0, c1, c2 = 0.5 * (l0 + h0), 0.5 * (l1 + h1), 0.5 * (l2 + h2)
+            c = c0 if axis == 0 else (c1 if axis == 1 else c2)
+            if int((c - cm) * sc) <= best_b:
+                La0, La1, La2, Lb0, Lb1, Lb2 = min(La0, l0), min(La1, l1), min(La2, l2), max(Lb0, h0), max(Lb1, h1), max(Lb2, h2)
+                Lc0, Lc1, Lc2, Ld0, Ld1, Ld2 = min(Lc0, c0), min(Lc1, c1), min(Lc2, c2), max(Ld0, c0), max(Ld1, c1), max(Ld2, c2)
                 lo += 1
-            else:
+            else:  # to the right end: the item there comes here and is tested next
                 idx[lo], idx[hi] = idx[hi], idx[lo]
                 for a in range(6):
-                    tb[lo, a], tb[hi, a] = tb[hi, a], tb[lo, a]
-                _grow(acc, 12, tb, hi)
+                    tb[lo, a] = tb[hi, a]
+                tb[hi, 0], tb[hi, 1], tb[hi, 2], tb[hi, 3], tb[hi, 4], tb[hi, 5] = l0, l1, l2, h0, h1, h2
+                Ra0, Ra1, Ra2, Rb0, Rb1, Rb2 = min(Ra0, l0), min(Ra1, l1), min(Ra2, l2), max(Rb0, h0), max(Rb1, h1), max(Rb2, h2)
+                Rc0, Rc1, Rc2, Rd0, Rd1, Rd2 = min(Rc0, c0), min(Rc1, c1), min(Rc2, c2), max(Rd0, c0), max(Rd1, c1), max(Rd2, c2)
                 hi -= 1
         mid = lo
+        acc[0], acc[1], acc[2], acc[3], acc[4], acc[5] = La0, La1, La2, Lb0, Lb1, Lb2
+        acc[6], acc[7], acc[8], acc[9], acc[10], acc[11] = Lc0, Lc1, Lc2, Ld0, Ld1, Ld2
+        acc[12], acc[13], acc[14], acc[15], acc[16], acc[17] = Ra0, Ra1, Ra2, Rb0, Rb1, Rb2
+        acc[18], acc[19], acc[20], acc[21], acc[22], acc[23] = Rc0, Rc1, Rc2, Rd0, Rd1, Rd2
         meta[node, 1], meta[node, 2] = 0, axis
         # push right then left: the left child is popped next and gets index node + 1 (at most
         # one pending right child per level: the stack holds MAX_DEPTH + 2)
