@@ -142,15 +142,15 @@ def refresh_cpu(state: AppState, method: str) -> None:
     elif job.done:
         state.timings[method] = job.seconds
         state.status[method] = (f"done: {job.spp} spp, noise {job.noise:.3g}"
-                                if job.progressive and job.noise is not None else "done")
-    elif job.progressive:
-        from ...renderers.base import get_renderer
-        target = state.options[method][get_renderer(method).knob.name]
-        state.status[method] = (f"refining: {job.spp}/{target} spp" +
-                                ("" if job.noise is None else f", noise {job.noise:.3g}"))
+                                if job.progressive and job.noise is not None
+                                else f"done: {job.meter.text()}" if job.passes and job.meter.first
+                                else "done")
+    elif job.meter is not None and job.meter.first is not None:
+        # samples per pixel, rows or shooting rounds done, and the time left
+        state.status[method] = ("refining: " if job.progressive or job.passes
+                                else "rendering: ") + job.meter.text()
     else:
-        state.status[method] = (f"rendering: {job.rows_done}/{state.camera.height} rows"
-                                if tiled(method) else "rendering...")
+        state.status[method] = "rendering..."
     shape = (state.camera.height, state.camera.width, 3)
     if stale(state, f"{method} job", (id(job), job.version, shape)) or method not in state.images:
         image = job.snapshot()
@@ -158,6 +158,14 @@ def refresh_cpu(state: AppState, method: str) -> None:
         # size (a scene switch changed the panels' aspect): then black until the new one comes
         state.images[method] = (over_stale(state, method, job, image)
                                 if image.shape == shape else np.zeros(shape, np.float32))
+
+
+def running_meter(job):
+    """``job``'s :class:`.meter.Meter` while it runs and has reported progress (its panel shows
+    a progress bar), else None (done, failed, cancelled, or no report yet)."""
+    if job.done or job.cancelled.is_set() or job.meter is None or job.meter.first is None:
+        return None
+    return job.meter
 
 
 def over_stale(state: AppState, method: str, job, image: np.ndarray) -> np.ndarray:
@@ -173,8 +181,8 @@ def over_stale(state: AppState, method: str, job, image: np.ndarray) -> np.ndarr
     back = held[1]
     if job.done or back is None or back.shape != image.shape:
         return image
-    if job.progressive:
-        return image if job.spp > 0 else back
+    if job.progressive or job.passes:  # a whole image once the first pass has landed
+        return image if job.meter.first is not None else back
     out = back.copy()
     out[:job.rows_done] = image[:job.rows_done]
     return out
