@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 
 
 def clock_text(seconds: float) -> str:
-    """``75.0`` -> ``"1:15"``; ``3725`` -> ``"1:02:05"`` (whole seconds, rounded up)."""
-    s = int(-(-seconds // 1))
+    """``75.0`` -> ``"1:15"``; ``3725`` -> ``"1:02:05"`` (to the nearest second)."""
+    s = int(round(seconds))
     h, rest = divmod(s, 3600)
     m, s = divmod(rest, 60)
     return f"{h}:{m:02d}:{s:02d}" if h else f"{m}:{s:02d}"
