@@ -38,7 +38,7 @@ def test_each_round_is_reported_and_the_last_is_the_image(gl_ctx):
         rounds.append((shots, image.copy(), unshot, progress))
 
     r = workbench.render(scene, "radiosity", width=24, height=24, patch_size=0.1,
-                         solver="progressive", on_pass=on_pass)
+                         solver="progressive", on_pass=on_pass, pass_seconds=0.0)
     assert len(rounds) >= 3
     shots, _, unshot, progress = map(list, zip(*[(s, None, u, p) for s, _, u, p in rounds]))
     assert shots == sorted(set(shots)) and shots[-1] == r.stats["iterations"]
@@ -49,3 +49,14 @@ def test_each_round_is_reported_and_the_last_is_the_image(gl_ctx):
     # another solver never calls it
     workbench.render(scene, "radiosity", width=24, height=24, patch_size=0.1, solver="direct",
                      on_pass=lambda *a: pytest.fail("on_pass called by the direct solver"))
+
+
+def test_rounds_closer_than_pass_seconds_are_not_drawn_but_the_last_is_reported(gl_ctx):
+    scene = workbench.load_scene("cornell")
+    rounds = []
+    r = workbench.render(scene, "radiosity", width=24, height=24, patch_size=0.1,
+                         solver="progressive", pass_seconds=1e9,
+                         on_pass=lambda shots, image, unshot, progress: rounds.append((shots, image)))
+    # the first round (nothing shown yet) and, though within the interval, the last one
+    assert len(rounds) == 2 and rounds[0][0] < rounds[1][0] == r.stats["iterations"]
+    assert np.array_equal(rounds[1][1], r.image)

@@ -107,7 +107,8 @@ class Job:
         self.spp, self.noise = 0, None
         # a non-progressive method with on_pass (radiosity's shooting) shows each round
         self.passes = not self.progressive and "on_pass" in r.options
-        self.meter = (Meter("spp", int(convert_options(r, options)[r.knob.name])) if self.progressive
+        target = options.get(r.knob.name, r.knob.default)  # checked in the thread
+        self.meter = (Meter("spp", int(target)) if self.progressive
                       else Meter("shots") if self.passes
                       else Meter("rows", camera.height) if tiled else None)
         self.cached = None

@@ -285,7 +285,10 @@ class RadiosityRenderer:
                "on_pass": Option(_callback, None, "progressive refinement: callback on_pass(shots, "
                                  "image, unshot, progress) after each round of shots: the image so "
                                  "far, the unshot share of the emitted power and the way done to the "
-                                 "stopping rule in [0, 1]")}
+                                 "stopping rule in [0, 1]"),
+               "pass_seconds": Option(float, 0.25, "on_pass: least time between two reported rounds "
+                                      "(each draws its image; the last round is always reported)",
+                                      low=0.0)}
     memory_options = ("patch_size", "hemicube_resolution", "solver", "row_cache_mb")
 
     def estimate_bytes(self, scene: Scene, width: int, height: int, **opts) -> int:
@@ -297,13 +300,20 @@ class RadiosityRenderer:
     def render(self, scene: Scene, width: int, height: int, **opts) -> RenderResult:
         from .display import draw
         from .. import gl
-        on_pass = opts.get("on_pass")
-        if on_pass is not None:
-            def on_round(patches, shots, radiance, unshot, progress):
+        on_pass = opts["on_pass"]
+        last = {"at": -np.inf, "round": None, "shown": None}
+
+        def on_round(patches, shots, radiance, unshot, progress):
+            last["round"] = (shots, unshot, progress)
+            if time.perf_counter() - last["at"] >= opts["pass_seconds"]:
                 on_pass(shots, draw(patches, radiance, scene.camera, scene.background)[0],
                         unshot, progress)
+                last["at"], last["shown"] = time.perf_counter(), last["round"]
         sol = solve_scene(scene, opts, self.name, None if on_pass is None else on_round)
         img, t = draw(sol.patches, sol.radiance, scene.camera, scene.background)
+        if last["round"] is not None and last["shown"] is not last["round"]:
+            shots, unshot, progress = last["round"]  # the last round, skipped for time: shown
+            on_pass(shots, img, unshot, progress)
         sol.timings["compile"] += t["compile"]
         sol.timings["display"] = t["display"]
         sol.stats.setdefault("gl_renderer", gl.renderer_name())
