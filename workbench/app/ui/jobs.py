@@ -144,7 +144,7 @@ class Job:
             raise Cancelled
         with self.lock:
             self.partial = np.asarray(image, np.float32)
-            self.rows_done = self.partial.shape[0]
+            self.rows_done = self.partial.shape[0]  # every row holds this round
             self.meter.update(shots, progress, f"unshot {100 * unshot:.2g} %")
             self.version += 1
         self._notify()
