@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from workbench.app.ui.panel_refresh import running_meter
+from workbench.app.ui.plot import reference_meter
 from workbench.app.ui.state import AppState
 
 WAIT_SECONDS = 400.0
@@ -23,7 +24,7 @@ class Progress:
 
     def __init__(self, out: Path):
         self.out, self.t0 = out, time.perf_counter()
-        self.log = {"frames": {}, "images": {}, "finished": False}
+        self.log = {"frames": {}, "images": {}, "finished": False, "reference_bar": []}
         self.seen: dict[str, tuple] = {}
 
     def __call__(self, state: AppState) -> None:
@@ -45,6 +46,10 @@ class Progress:
                 self.log["images"][m].append({"frame": state.frame, "job_done": job.done,
                                               "status": state.status.get(m, "")})
         plot = state.errors
+        meter = reference_meter(plot)
+        if meter is not None:  # the error plot draws the reference's progress bar
+            self.log["reference_bar"].append({"frame": state.frame, "fraction": meter.fraction,
+                                              "message": plot.message})
         ready = plot.ref_image is not None
         if ready or time.perf_counter() - self.t0 > WAIT_SECONDS:
             if not state.jobs.busy() or time.perf_counter() - self.t0 > WAIT_SECONDS:

@@ -91,6 +91,10 @@ def test_radiosity_shows_each_shooting_round_and_the_reference_is_the_panels_job
     # own, the very image the panel shows
     assert log["reference"] == "pathtrace" and log["reference_shared"]
     assert log["reference_jobs_started"] == 0
+    # while it refines the plot shows its bar: done/target and the time left
+    bars = log["reference_bar"]
+    assert bars and all("/256 spp" in b["message"] for b in bars)
+    assert any(b["message"].endswith(" left") for b in bars)
     final = np.load(out / f"pathtrace_{len(log['images']['pathtrace']) - 1}.npy")
     assert np.array_equal(np.load(out / "reference.npy"), final)
 

@@ -101,6 +101,13 @@ def _reference(state: AppState, plot: ErrorPlot) -> np.ndarray | None:
     return plot.ref_image
 
 
+def reference_meter(plot: ErrorPlot):
+    """The meter of the reference's job while it renders and reports progress, else None."""
+    from .panel_refresh import running_meter
+    job = None if plot.board is None or plot.ref_image is not None else plot.board.current.get(plot.reference)
+    return None if job is None else running_meter(job)
+
+
 def options_text(options: dict) -> str:
     """``{"max_depth": 12}`` -> ``"max_depth=12"`` (the plot's header and labels)."""
     return ", ".join(f"{k}={v}" for k, v in options.items())
@@ -306,7 +313,11 @@ def error_plot(state: AppState) -> None:
         plot.metric = METRICS[k]
     imgui.same_line()
     imgui.push_text_wrap_pos(0.0)
-    imgui.text_disabled(plot.message)
+    meter = reference_meter(plot)
+    if meter is not None:  # the reference's done/target and time left, as the panels' bars
+        imgui.progress_bar(meter.fraction, imgui.ImVec2(-1, 0), plot.message)
+    else:
+        imgui.text_disabled(plot.message)
     if plot.matched_message:
         imgui.text_disabled(plot.matched_message)
     elif plot.matched_pending:
