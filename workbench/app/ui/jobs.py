@@ -113,6 +113,8 @@ class Job:
                       else Meter("rows", camera.height) if tiled else None)
         self.cached = None
         self.options = dict(options)
+        self.holders: set[int] = set()
+        """Ids of the boards whose current job this is (two when shared)."""
         self.cancelled = threading.Event()
         self.lock = threading.Lock()
         self.notify = notify
@@ -262,7 +264,8 @@ class JobBoard:
     or an error (the window wakes its loop with it), or None; ``count``: jobs started so far;
     ``cached``: its jobs go through the reference cache (:meth:`Job._cached`; the error plot's
     reference boards); ``share``: another board (the panels') whose current job of the same
-    request is taken instead of starting one (not cancelled: its render goes on)."""
+    request is taken instead of starting one; a job two boards hold is not cancelled when one
+    of them moves on to another request (the other still wants its image)."""
 
     def __init__(self, settle: float = 0.0, notify=None, cached: bool = False, share=None):
         self.settle = settle
@@ -294,6 +297,10 @@ class JobBoard:
         seen = self.waiting.get(method)
         if seen is None or seen[0] != key:
             seen = self.waiting[method] = (key, now)
+        if job is not None and job.holders - {id(self)}:
+            # another board still wants it (a reference taken from a panel): it runs on there
+            job.holders.discard(id(self))
+            job = None
         if job is not None:
             job.cancelled.set()
             if job.thread.is_alive() or now - seen[1] < self.settle:
@@ -302,8 +309,10 @@ class JobBoard:
         theirs = None if self.share is None else self.share.current.get(method)
         if theirs is not None and theirs.key == key and not theirs.cancelled.is_set():
             self.current[method] = theirs  # the panel renders this very request: shared
+            theirs.holders.add(id(self))
             return theirs
         job = Job(scene, camera, method, options, tiled, self.notify, self.cached)
+        job.holders.add(id(self))
         self.current[method] = job
         current = set(map(id, self.current.values()))
         self.started = [j for j in self.started if j.thread.is_alive() or id(j) in current]
@@ -315,7 +324,10 @@ class JobBoard:
         """Cancel and forget the jobs of methods no longer shown (a removed panel's render
         must not run on to its end)."""
         for m in [m for m in self.current if m not in methods]:
-            self.current.pop(m).cancelled.set()
+            job = self.current.pop(m)
+            job.holders.discard(id(self))
+            if not job.holders:  # else another board (the error plot's reference) still wants it
+                job.cancelled.set()
             self.waiting.pop(m, None)
 
     def busy(self) -> bool:
