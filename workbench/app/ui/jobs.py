@@ -83,6 +83,8 @@ class Job:
     error of the pixel means; None before two samples).
     meter : :class:`.meter.Meter` of a job that reports its progress (progressive, tiled or
     with ``on_pass``), else None.
+    shoots : the method is not progressive but reports rounds through ``on_pass``
+    (radiosity's progressive refinement): each round's image is shown whole.
     cached : ``stats["cache"]`` of a job rendered through the reference cache (``"hit"``:
     loaded, not rendered; ``"miss"``...), else None.
     """
@@ -106,10 +108,10 @@ class Job:
         self.progressive = r.ui_kind == "progressive"
         self.spp, self.noise = 0, None
         # a non-progressive method with on_pass (radiosity's shooting) shows each round
-        self.passes = not self.progressive and "on_pass" in r.options
+        self.shoots = not self.progressive and "on_pass" in r.options
         target = options.get(r.knob.name, r.knob.default)  # checked in the thread
         self.meter = (Meter("spp", int(target)) if self.progressive
-                      else Meter("shots") if self.passes
+                      else Meter("shots") if self.shoots
                       else Meter("rows", camera.height) if tiled else None)
         self.cached = None
         self.options = dict(options)
@@ -121,7 +123,7 @@ class Job:
         opts = dict(options)
         if tiled:
             opts["on_tile"] = self._on_tile
-        if self.passes:
+        if self.shoots:
             opts["on_pass"] = self._on_round
         self.thread = threading.Thread(
             target=self._run, args=(replace(scene, camera=camera), method, opts, cached),

@@ -143,11 +143,11 @@ def refresh_cpu(state: AppState, method: str) -> None:
         state.timings[method] = job.seconds
         state.status[method] = (f"done: {job.spp} spp, noise {job.noise:.3g}"
                                 if job.progressive and job.noise is not None
-                                else f"done: {job.meter.text()}" if job.passes and job.meter.first
+                                else f"done: {job.meter.text()}" if job.shoots and job.meter.first
                                 else "done")
     elif job.meter is not None and job.meter.first is not None:
         # samples per pixel, rows or shooting rounds done, and the time left
-        state.status[method] = ("refining: " if job.progressive or job.passes
+        state.status[method] = ("refining: " if job.progressive or job.shoots
                                 else "rendering: ") + job.meter.text()
     else:
         state.status[method] = "rendering..."
@@ -181,7 +181,7 @@ def over_stale(state: AppState, method: str, job, image: np.ndarray) -> np.ndarr
     back = held[1]
     if job.done or back is None or back.shape != image.shape:
         return image
-    if job.progressive or job.passes:  # a whole image once the first pass has landed
+    if job.progressive or job.shoots:  # a whole image once the first pass has landed
         return image if job.meter.first is not None else back
     out = back.copy()
     out[:job.rows_done] = image[:job.rows_done]
