@@ -160,6 +160,8 @@ def progress_note(method: str, record: dict) -> str:
     """One phrase on a panel exported before its render was done (empty when done)."""
     if record["state"] == "refining":
         return f"{method} at {record['spp']}/{record['target_spp']} spp (not converged)"
+    if record["state"] == "shooting":
+        return f"{method} after {record['shots']} shots ({100 * record['unshot']:.2g} % of the power unshot)"
     if record["state"] == "rendering":
         return f"{method} partial ({record['rows_done']}/{record['rows']} rows)"
     if record["state"] != "done":

@@ -22,6 +22,19 @@ a slider is let go): a ray trace restarted at every frame of a drag is cancelled
 band, so it never shows more than one band, yet each restart sets the scene up again (flat
 arrays, BVH, the primary rays of every sample) on the cores the window needs.  Meanwhile the
 panel shows its previous image marked stale.
+
+Every long job reports how far it is (``Job.meter``, a :class:`.meter.Meter`: a progressive
+job's samples per pixel of its target, a tiled job's rows, a shooting radiosity's rounds with
+the unshot share of the emitted power), which the panel shows as a progress bar with the time
+left.  A method whose options include ``on_pass`` and that is not progressive (radiosity's
+progressive refinement) is rendered with ``on_pass(shots, image, unshot, progress)``: each
+round's image is shown as it lands.
+
+The error plot's boards render references (``JobBoard(cached=True, share=...)``): a reference
+is first looked up in the CLI's disk cache (:mod:`workbench.compare.reference_cache`, keyed by
+the scene as data, the method, its options, the size and the code), stored there once
+rendered, and a panel's job of the very same request (the path tracer's panel at its finest
+knob is the emitter scenes' reference) is shared rather than rendered twice.
 """
 from __future__ import annotations
 
@@ -33,6 +46,7 @@ from dataclasses import replace
 import numpy as np
 
 from ...renderers.base import check_memory, convert_options, get_renderer
+from .meter import Meter
 
 PASS_SAMPLES = 1 << 16
 """Samples (over the whole image) per pass of a progressive job: a 256 x 192 panel gets one
@@ -68,9 +82,16 @@ class Job:
     spp, noise : a progressive job's samples per pixel so far and its noise (RMS standard
     error of the pixel means; None before two samples).
     passes : a progressive job's passes done so far.
+    meter : :class:`.meter.Meter` of a job that reports its progress (progressive, tiled or
+    with ``on_pass``), else None.
+    shoots : the method is not progressive but reports rounds through ``on_pass``
+    (radiosity's progressive refinement): each round's image is shown whole.
+    cached : ``stats["cache"]`` of a job rendered through the reference cache (``"hit"``:
+    loaded, not rendered; ``"miss"``...), else None.
     """
 
-    def __init__(self, scene, camera, method: str, options: dict, tiled: bool, notify=None):
+    def __init__(self, scene, camera, method: str, options: dict, tiled: bool, notify=None,
+                 cached: bool = False):
         # the job keeps its scene: while the job is current no later scene can reuse the id
         # in its key (every material or light edit builds a new Scene)
         self.scene = scene
@@ -85,16 +106,30 @@ class Job:
         # a progressive method's job refines one image pass after pass (a session with
         # add_samples(n), image, samples and noise_rmse): the panel shows the running image, its
         # samples per pixel and noise, and the job ends at the method's spp option
-        self.progressive = get_renderer(method).ui_kind == "progressive"
+        r = get_renderer(method)
+        self.progressive = r.ui_kind == "progressive"
         self.spp, self.noise, self.passes = 0, None, 0
+        self.shots, self.unshot = 0, 1.0  # a shooting job's rounds so far (radiosity)
+        # a non-progressive method with on_pass (radiosity's shooting) shows each round
+        self.shoots = not self.progressive and "on_pass" in r.options
+        target = options.get(r.knob.name, r.knob.default)  # checked in the thread
+        self.meter = (Meter("spp", int(target)) if self.progressive
+                      else Meter("shots") if self.shoots
+                      else Meter("rows", camera.height) if tiled else None)
+        self.cached = None
+        self.options = dict(options)
+        self.holders: set[int] = set()
+        """Ids of the boards whose current job this is (two when shared)."""
         self.cancelled = threading.Event()
         self.lock = threading.Lock()
         self.notify = notify
         opts = dict(options)
         if tiled:
             opts["on_tile"] = self._on_tile
+        if self.shoots:
+            opts["on_pass"] = self._on_round
         self.thread = threading.Thread(
-            target=self._run, args=(replace(scene, camera=camera), method, opts),
+            target=self._run, args=(replace(scene, camera=camera), method, opts, cached),
             name=f"ui-job-{method}", daemon=False)
         self.thread.start()
 
@@ -104,6 +139,32 @@ class Job:
         with self.lock:
             self.partial[y0:y1, x0:x1] = tile
             self.rows_done = max(self.rows_done, y1)
+            self.meter.update(self.rows_done)
+            self.version += 1
+        self._notify()
+
+    def _on_round(self, shots, image, unshot, progress):
+        """A shooting round of progressive refinement (radiosity's ``on_pass``): its image
+        shown, ``unshot`` (share of the emitted power still unshot) and ``progress`` (the way
+        done to the stopping rule, in [0, 1]) in the meter."""
+        if self.cancelled.is_set():
+            raise Cancelled
+        with self.lock:
+            self.partial = np.asarray(image, np.float32)
+            self.rows_done = self.partial.shape[0]  # every row holds this round
+            self.meter.update(shots, progress, f"unshot {100 * unshot:.2g} %")
+            self.shots, self.unshot = shots, unshot
+            self.version += 1
+        self._notify()
+
+    def _on_spp(self, spp, image, std_error):
+        """A pass of a progressive method rendered by ``render`` (a reference job): the
+        running image and the meter."""
+        if self.cancelled.is_set():
+            raise Cancelled
+        with self.lock:
+            self.partial, self.spp = np.asarray(image, np.float32), int(spp)
+            self.meter.update(self.spp)
             self.version += 1
         self._notify()
 
@@ -111,7 +172,7 @@ class Job:
         if self.notify is not None:
             self.notify()
 
-    def _run(self, scene, method, opts):
+    def _run(self, scene, method, opts, cached):
         import numba
 
         from ...renderers.base import render
@@ -121,7 +182,9 @@ class Job:
             os.setpriority(os.PRIO_PROCESS, tid, min(19, os.getpriority(os.PRIO_PROCESS, tid) + JOB_NICE))
         t0 = time.perf_counter()
         try:
-            if self.progressive:
+            if cached:
+                image = self._cached(scene, method, opts)
+            elif self.progressive:
                 image = self._refine(scene, method, opts)
             else:
                 image = render(scene, method, width=scene.camera.width,
@@ -159,19 +222,46 @@ class Job:
             with self.lock:
                 self.partial, self.spp, self.noise = image, session.samples, noise
                 self.passes += 1
+                self.meter.update(self.spp, detail="" if noise is None else f"noise {noise:.3g}")
                 self.version += 1
             self._notify()
         return session.image
 
+    def _cached(self, scene, method: str, opts: dict) -> np.ndarray:
+        """The render through the reference cache (:mod:`workbench.compare.reference_cache`,
+        the CLI's): loaded if stored for this scene (as data), size, method and options, else
+        rendered (a progressive method through ``render`` with ``on_pass``, so the meter
+        moves) and stored; ``self.cached`` says which."""
+        from ...compare.reference_cache import cache_key, load_entry, store_entry
+        from ...renderers.base import render
+        w, h = scene.camera.width, scene.camera.height
+        key = cache_key(scene, method, w, h, **self.options)
+        hit = load_entry(key)
+        if hit is not None:
+            self.cached = "hit"
+            return hit.image
+        if self.progressive:
+            opts = {**opts, "on_pass": self._on_spp}
+        result = render(scene, method, width=w, height=h, **opts)
+        try:
+            store_entry(key, result, scene.name, convert_options(get_renderer(method), self.options))
+            self.cached = "miss"
+        except OSError as e:  # a read-only or full disk costs the cache, not the render
+            self.cached = f"miss (not stored: {e})"
+        return result.image
+
     def snapshot(self) -> tuple[np.ndarray, dict]:
         """The finished image, else a copy of the partial one, with what it holds, read in the
-        same lock as the image (the thread goes on meanwhile): ``done``, ``rows_done`` and a
-        progressive job's ``spp``, ``passes`` and ``noise``."""
+        same lock as the image (the thread goes on meanwhile): ``done``, ``rows_done``, a
+        progressive job's ``spp``, ``passes`` and ``noise``, a shooting job's ``shots`` and
+        ``unshot``."""
         with self.lock:
             image = self.image if self.image is not None else self.partial.copy()
             held = {"done": self.image is not None, "rows_done": self.rows_done}
             if self.progressive:
                 held.update(spp=self.spp, passes=self.passes, noise=self.noise)
+            if self.shoots:
+                held.update(shots=self.shots, unshot=self.unshot)
             return image, held
 
     @property
@@ -187,11 +277,17 @@ class JobBoard:
     ``settle``: seconds a changed request must stay the same before its job starts (the old
     job is cancelled at once); ``waiting[method]`` is (request key, when it was first seen);
     ``notify``: called with no argument from a job's thread when it has new tiles, its image
-    or an error (the window wakes its loop with it), or None; ``count``: jobs started so far."""
+    or an error (the window wakes its loop with it), or None; ``count``: jobs started so far;
+    ``cached``: its jobs go through the reference cache (:meth:`Job._cached`; the error plot's
+    reference boards); ``share``: another board (the panels') whose current job of the same
+    request is taken instead of starting one; a job two boards hold is not cancelled when one
+    of them moves on to another request (the other still wants its image)."""
 
-    def __init__(self, settle: float = 0.0, notify=None):
+    def __init__(self, settle: float = 0.0, notify=None, cached: bool = False, share=None):
         self.settle = settle
         self.notify = notify
+        self.cached = cached
+        self.share = share
         self.current: dict[str, Job] = {}
         self.started: list[Job] = []
         self.waiting: dict[str, tuple] = {}
@@ -217,12 +313,22 @@ class JobBoard:
         seen = self.waiting.get(method)
         if seen is None or seen[0] != key:
             seen = self.waiting[method] = (key, now)
+        if job is not None and job.holders - {id(self)}:
+            # another board still wants it (a reference taken from a panel): it runs on there
+            job.holders.discard(id(self))
+            job = None
         if job is not None:
             job.cancelled.set()
             if job.thread.is_alive() or now - seen[1] < self.settle:
                 return job
         del self.waiting[method]
-        job = Job(scene, camera, method, options, tiled, self.notify)
+        theirs = None if self.share is None else self.share.current.get(method)
+        if theirs is not None and theirs.key == key and not theirs.cancelled.is_set():
+            self.current[method] = theirs  # the panel renders this very request: shared
+            theirs.holders.add(id(self))
+            return theirs
+        job = Job(scene, camera, method, options, tiled, self.notify, self.cached)
+        job.holders.add(id(self))
         self.current[method] = job
         current = set(map(id, self.current.values()))
         self.started = [j for j in self.started if j.thread.is_alive() or id(j) in current]
@@ -234,7 +340,10 @@ class JobBoard:
         """Cancel and forget the jobs of methods no longer shown (a removed panel's render
         must not run on to its end)."""
         for m in [m for m in self.current if m not in methods]:
-            self.current.pop(m).cancelled.set()
+            job = self.current.pop(m)
+            job.holders.discard(id(self))
+            if not job.holders:  # else another board (the error plot's reference) still wants it
+                job.cancelled.set()
             self.waiting.pop(m, None)
 
     def busy(self) -> bool:

@@ -143,15 +143,15 @@ def refresh_cpu(state: AppState, method: str) -> None:
     elif job.done:
         state.timings[method] = job.seconds
         state.status[method] = (f"done: {job.spp} spp, noise {job.noise:.3g}"
-                                if job.progressive and job.noise is not None else "done")
-    elif job.progressive:
-        from ...renderers.base import get_renderer
-        target = state.options[method][get_renderer(method).knob.name]
-        state.status[method] = (f"refining: {job.spp}/{target} spp" +
-                                ("" if job.noise is None else f", noise {job.noise:.3g}"))
+                                if job.progressive and job.noise is not None
+                                else f"done: {job.meter.text()}" if job.shoots and job.meter.first
+                                else "done")
+    elif job.meter is not None and job.meter.first is not None:
+        # samples per pixel, rows or shooting rounds done, and the time left
+        state.status[method] = ("refining: " if job.progressive or job.shoots
+                                else "rendering: ") + job.meter.text()
     else:
-        state.status[method] = (f"rendering: {job.rows_done}/{state.camera.height} rows"
-                                if tiled(method) else "rendering...")
+        state.status[method] = "rendering..."
     shape = (state.camera.height, state.camera.width, 3)
     key = (id(job), job.version, shape, job.cancelled.is_set())
     if stale(state, f"{method} job", key) or method not in state.images:
@@ -161,7 +161,7 @@ def refresh_cpu(state: AppState, method: str) -> None:
         if image.shape == shape:
             state.images[method] = over_stale(state, method, job, image)
             state.progress[method] = shown_progress(state, method, job, held)
-            if state.progress[method]["state"] in ("done", "refining") or method not in state.image_requests:
+            if state.progress[method]["state"] in ("done", "refining", "shooting") or method not in state.image_requests:
                 state.image_requests[method] = (job.camera, job.scene)
             # else: the previous image (or its rows not yet rendered again) still shows
         else:
@@ -194,7 +194,9 @@ def shown_progress(state: AppState, method: str, job, held: dict) -> dict:
     recorded the target spp of a panel still refining).
 
     ``state``: ``"done"`` (the finished render of the current request), ``"refining"`` (a
-    progressive job's running image), ``"rendering"`` (``rows_done`` of ``rows`` rendered, over
+    progressive job's running image), ``"shooting"`` (radiosity's progressive refinement after
+    ``shots`` rounds, ``unshot`` the share of the emitted power still unshot), ``"rendering"``
+    (``rows_done`` of ``rows`` rendered, over
     the previous image), ``"stale"`` (the previous request's image: a restart is pending, or
     nothing of the new render has come yet).  A progressive job's also ``spp`` (samples per
     pixel in the image), ``target_spp`` (its knob), ``passes``, ``noise`` (RMS standard error of
@@ -207,6 +209,9 @@ def shown_progress(state: AppState, method: str, job, held: dict) -> dict:
         out = {"state": "done"}
     elif job.progressive:
         out = {"state": "refining" if held["spp"] > 0 else "stale"}
+    elif job.shoots:
+        out = ({"state": "shooting", "shots": held["shots"], "unshot": held["unshot"]}
+               if held["shots"] > 0 else {"state": "stale"})
     elif held["rows_done"] > 0:
         out = {"state": "rendering", "rows_done": held["rows_done"], "rows": rows}
     else:
@@ -216,6 +221,14 @@ def shown_progress(state: AppState, method: str, job, held: dict) -> dict:
         out.update(spp=held["spp"], target_spp=target, passes=held["passes"],
                    noise=held["noise"], converged=held["done"] and held["spp"] >= target)
     return out
+
+
+def running_meter(job):
+    """``job``'s :class:`.meter.Meter` while it runs and has reported progress (its panel shows
+    a progress bar), else None (done, failed, cancelled, or no report yet)."""
+    if job.done or job.cancelled.is_set() or job.meter is None or job.meter.first is None:
+        return None
+    return job.meter
 
 
 def over_stale(state: AppState, method: str, job, image: np.ndarray) -> np.ndarray:
@@ -231,8 +244,8 @@ def over_stale(state: AppState, method: str, job, image: np.ndarray) -> np.ndarr
     back = held[1]
     if job.done or back is None or back.shape != image.shape:
         return image
-    if job.progressive:
-        return image if job.spp > 0 else back
+    if job.progressive or job.shoots:  # a whole image once the first pass has landed
+        return image if job.meter.first is not None else back
     out = back.copy()
     out[:job.rows_done] = image[:job.rows_done]
     return out

@@ -262,7 +262,12 @@ def image_panels(state: AppState) -> None:
                     focus("Patch view")
         else:
             imgui.dummy(imgui.ImVec2(w, h))
-        text_in_width(state.status.get(m, ""), w, disabled=True)
+        from .panel_refresh import running_meter
+        job = state.jobs.current.get(m)
+        if job is not None and running_meter(job) is not None:  # done/target, time left
+            imgui.progress_bar(job.meter.fraction, imgui.ImVec2(w, 0), state.status.get(m, ""))
+        else:
+            text_in_width(state.status.get(m, ""), w, disabled=True)
         mode = state.display.get(m, "direct24")
         modes = list(DISPLAY_MODES) if mode in DISPLAY_MODES else [mode, *DISPLAY_MODES]
         imgui.set_next_item_width(w)

@@ -72,7 +72,7 @@ def _reference(state: AppState, plot: ErrorPlot) -> np.ndarray | None:
     if time.perf_counter() - plot.since < SETTLE_SECONDS:
         return None
     if plot.board is None:
-        plot.board = JobBoard()
+        plot.board = JobBoard(cached=True, share=state.jobs)
     if not plot.candidates:
         plot.candidates = [m for m, _ in candidates(state.scene)]
     while plot.candidates:
@@ -89,12 +89,20 @@ def _reference(state: AppState, plot: ErrorPlot) -> np.ndarray | None:
         plot.message, plot.gave_up = "no reference: no method renders this scene", True
         return None
     if job.image is None:
-        plot.message = f"rendering the reference: {plot.reference} ({options_text(plot.ref_options)})..."
+        plot.message = (f"rendering the reference: {plot.reference} ({options_text(plot.ref_options)})"
+                        + (f": {job.meter.text()}" if job.meter is not None and job.meter.first else "..."))
         return None
     plot.ref_image = job.image
     plot.message = (f"reference: {plot.reference} ({options_text(plot.ref_options)}), "
-                    f"{job.seconds:.2f} s")
+                    + ("from the cache" if job.cached == "hit" else f"{job.seconds:.2f} s"))
     return plot.ref_image
+
+
+def reference_meter(plot: ErrorPlot):
+    """The meter of the reference's job while it renders and reports progress, else None."""
+    from .panel_refresh import running_meter
+    job = None if plot.board is None or plot.ref_image is not None else plot.board.current.get(plot.reference)
+    return None if job is None else running_meter(job)
 
 
 def options_text(options: dict) -> str:
@@ -187,7 +195,7 @@ def _matched(state: AppState, plot: ErrorPlot, method: str):
         return plot.ref_image, ""
     board = plot.matched_boards.get((ref_m, tuple(sorted(opts.items()))))
     if board is None:
-        board = plot.matched_boards[(ref_m, tuple(sorted(opts.items())))] = JobBoard()
+        board = plot.matched_boards[(ref_m, tuple(sorted(opts.items())))] = JobBoard(cached=True, share=state.jobs)
     job = board.request(state.scene, state.camera, ref_m, opts, tiled=tiled(ref_m))
     what = f"{ref_m} ({options_text(opts)})"
     if job.cancelled.is_set():  # the previous key's job, still ending
@@ -196,8 +204,7 @@ def _matched(state: AppState, plot: ErrorPlot, method: str):
         plot.matched[method] = False
         return False, ""
     if job.image is None:
-        done = (f"{job.spp} spp" if job.progressive else
-                f"{job.rows_done}/{state.camera.height} rows" if tiled(ref_m) else "started")
+        done = job.meter.text() if job.meter is not None and job.meter.first else "started"
         return None, f"{what}: {done}"
     plot.matched[method] = job.image
     return job.image, ""
@@ -294,7 +301,11 @@ def error_plot(state: AppState) -> None:
         plot.metric = METRICS[k]
     imgui.same_line()
     imgui.push_text_wrap_pos(0.0)
-    imgui.text_disabled(plot.message)
+    meter = reference_meter(plot)
+    if meter is not None:  # the reference's done/target and time left, as the panels' bars
+        imgui.progress_bar(meter.fraction, imgui.ImVec2(-1, 0), plot.message)
+    else:
+        imgui.text_disabled(plot.message)
     if plot.matched_message:
         imgui.text_disabled(plot.matched_message)
     elif plot.matched_pending:

@@ -228,12 +228,14 @@ def default_options(method: str) -> dict:
     ``"progressive"``) at its most accurate, which it refines towards pass by pass; for a
     method that draws the raster's stand-ins (Gouraud, Phong: ``draws_standins``) also their
     options (:data:`~workbench.renderers.raster_standins.OPTIONS`) at the CLI's defaults, so a
-    panel draws what ``workbench render`` draws."""
+    panel draws what ``workbench render`` draws; then the renderer's ``ui_options`` if it has
+    any (radiosity's ``solver="progressive"``: each shooting round shown as it lands)."""
     from ...renderers.raster_standins import OPTIONS
     r = get_renderer(method)
     opts = {r.knob.name: r.knob.values[-1] if r.ui_kind == "progressive" else r.knob.default}
     if getattr(r, "draws_standins", False):
         opts.update({k: r.options[k].default for k in OPTIONS})
+    opts.update(getattr(r, "ui_options", {}))
     return opts
 
 

@@ -69,6 +69,12 @@ def common_options() -> dict[str, Option]:
     }
 
 
+def _callback(v):
+    if v is None or callable(v):
+        return v
+    raise ValueError("expected a callable on_pass(shots, image, unshot, progress) or None")
+
+
 _BYTES_PER_PATCH = 4096
 """A patch's corners, vertices, triangles, geometry record and outline (about 1.8 kB, measured)."""
 _MATRIX_COPIES = {"direct": 6, "jacobi": 6, "gauss_seidel": 10, "progressive": 6}
@@ -129,8 +135,26 @@ def _row_provider(hc, stats: dict):
     return rows
 
 
-def _shoot_hemicube(geom, E, R, opts, stats, timings, tol, cap) -> solvers.SolveResult:
-    """Matrix-free progressive refinement, one hemicube per shooting patch (rows cached)."""
+def _rounds(on_round, E, R, areas, ambient: bool, q: float, tol: float):
+    """``progressive_rows``'s ``on_batch`` that reports each round of shots to
+    ``on_round(shots, radiance, unshot, progress)``: the radiance shown so far (P, 3) (with
+    Cohen et al. 1988's ambient term when ``ambient``, as the final display), the unshot share
+    of the emitted power (:func:`.solvers.unshot_fraction`) and the way done to the stopping
+    rule (:func:`.solvers.shooting_progress`); None when ``on_round`` is None."""
+    if on_round is None:
+        return None
+    stop = solvers._stop_level(q, tol)
+
+    def on_batch(B, dB, shots):
+        shown = B + R * solvers._ambient(dB, R, areas) if ambient else B.copy()
+        on_round(shots, shown, solvers.unshot_fraction(dB, E, areas),
+                 solvers.shooting_progress(B, dB, stop))
+    return on_batch
+
+
+def _shoot_hemicube(geom, E, R, opts, stats, timings, tol, cap, on_round=None) -> solvers.SolveResult:
+    """Matrix-free progressive refinement, one hemicube per shooting patch (rows cached);
+    ``on_round``: see :func:`_rounds`."""
     from .hemicube import Hemicube
     t1 = time.perf_counter()
     hc = Hemicube(geom, opts["hemicube_resolution"], rotate=opts["hemicube_rotate"],
@@ -140,7 +164,9 @@ def _shoot_hemicube(geom, E, R, opts, stats, timings, tol, cap) -> solvers.Solve
         q = float(R.max()) * max(1.0, hc.info()["weight_sum"])
         rows = solvers.RowCache(_row_provider(hc, stats), opts["row_cache_mb"])
         res = solvers.progressive_rows(rows, geom.areas, E, R, tol=tol, max_shots=cap, q=q,
-                                       ambient=opts["ambient"], relax=opts["relax"])
+                                       ambient=opts["ambient"], relax=opts["relax"],
+                                       on_batch=_rounds(on_round, E, R, geom.areas,
+                                                        opts["ambient"], q, tol))
         info = hc.info()
     finally:
         hc.release()
@@ -155,17 +181,20 @@ def _shoot_hemicube(geom, E, R, opts, stats, timings, tol, cap) -> solvers.Solve
     return res
 
 
-def _shoot_raycast(geom, E, R, opts, stats, timings, tol, cap) -> solvers.SolveResult:
+def _shoot_raycast(geom, E, R, opts, stats, timings, tol, cap, on_round=None) -> solvers.SolveResult:
     """Matrix-free progressive refinement with ray-cast rows (receivers' exact factors times
-    ray-cast visibility, :class:`.raycast.RayRows`; rows cached)."""
+    ray-cast visibility, :class:`.raycast.RayRows`; rows cached); ``on_round``: see
+    :func:`_rounds`."""
     from .raycast import RayRows
     t1 = time.perf_counter()
     rr = RayRows(geom)
     rr.rows(np.zeros(0, dtype=np.int64))      # the numba kernel's compile (or cache load), apart
     timings["compile"] += time.perf_counter() - t1
     rows = solvers.RowCache(rr.rows, opts["row_cache_mb"])
-    res = solvers.progressive_rows(rows, geom.areas, E, R, tol=tol, max_shots=cap,
-                                   q=float(R.max()), ambient=opts["ambient"], relax=opts["relax"])
+    q = float(R.max())
+    res = solvers.progressive_rows(rows, geom.areas, E, R, tol=tol, max_shots=cap, q=q,
+                                   ambient=opts["ambient"], relax=opts["relax"],
+                                   on_batch=_rounds(on_round, E, R, geom.areas, opts["ambient"], q, tol))
     stats.update({"matrix_stored": False, "shot_rows": "raycast", "rows_cached": len(rows.rows),
                   "row_cache_hits": rows.hits, "rows_computed": rows.computed,
                   "visibility_rays": rr.rays_cast, "reciprocity_error": None,
@@ -186,9 +215,12 @@ def check_camera_outside(scene: Scene, method: str) -> None:
                                 "(move the camera out, or use pathtrace)")
 
 
-def solve_scene(scene: Scene, opts: dict, method: str) -> Solution:
+def solve_scene(scene: Scene, opts: dict, method: str, on_round=None) -> Solution:
     """Patches, form factors and solution of ``scene`` with the ``common_options``
-    (:func:`check_camera_outside` first)."""
+    (:func:`check_camera_outside` first).  ``on_round(patches, shots, radiance, unshot,
+    progress)`` is called after each round of shots of matrix-free progressive refinement
+    (``solver="progressive"`` with hemicube form factors; :func:`_rounds`), never by the other
+    solvers."""
     check_camera_outside(scene, method)
     if opts["max_iterations"] < 0:
         raise WorkbenchError(f"{method}: max_iterations must be >= 0 (0: automatic), got {opts['max_iterations']}")
@@ -210,7 +242,8 @@ def solve_scene(scene: Scene, opts: dict, method: str) -> Solution:
     cap = opts["max_iterations"] or None
     if opts["solver"] == "progressive" and opts["form_factors"] == "hemicube":
         shoot = _shoot_raycast if opts["shot_rows"] == "raycast" else _shoot_hemicube
-        res = shoot(geom, E, R, opts, stats, timings, tol, cap)
+        res = shoot(geom, E, R, opts, stats, timings, tol, cap,
+                    None if on_round is None else (lambda *a: on_round(patches, *a)))
         timings["form_factors"] = res.seconds   # rows and shots interleave
         timings["solve"] = 0.0
     else:
@@ -240,9 +273,19 @@ class RadiosityRenderer:
     name = "radiosity"
     ui_kind = "cpu"
     support = SUPPORT
+    ui_options = {"solver": "progressive"}
+    """The window's radiosity shoots (Cohen et al. 1988) and shows each round as it lands
+    (``on_pass``)."""
     knob = Knob("patch_size", (0.2, 0.1, 0.05, 0.035, 0.025), 0.05,
                 "largest patch edge / scene diagonal")
-    options = common_options()
+    options = {**common_options(),
+               "on_pass": Option(_callback, None, "progressive refinement: callback on_pass(shots, "
+                                 "image, unshot, progress) after each round of shots: the image so "
+                                 "far, the unshot share of the emitted power and the way done to the "
+                                 "stopping rule in [0, 1]"),
+               "pass_seconds": Option(float, 0.25, "on_pass: least time between two reported rounds "
+                                      "(each draws its image; the last round is always reported)",
+                                      low=0.0)}
     memory_options = ("patch_size", "hemicube_resolution", "solver", "row_cache_mb")
 
     def estimate_bytes(self, scene: Scene, width: int, height: int, **opts) -> int:
@@ -254,8 +297,20 @@ class RadiosityRenderer:
     def render(self, scene: Scene, width: int, height: int, **opts) -> RenderResult:
         from .display import draw
         from .. import gl
-        sol = solve_scene(scene, opts, self.name)
+        on_pass = opts["on_pass"]
+        last = {"at": -np.inf, "round": None, "shown": None}
+
+        def on_round(patches, shots, radiance, unshot, progress):
+            last["round"] = (shots, unshot, progress)
+            if time.perf_counter() - last["at"] >= opts["pass_seconds"]:
+                on_pass(shots, draw(patches, radiance, scene.camera, scene.background)[0],
+                        unshot, progress)
+                last["at"], last["shown"] = time.perf_counter(), last["round"]
+        sol = solve_scene(scene, opts, self.name, None if on_pass is None else on_round)
         img, t = draw(sol.patches, sol.radiance, scene.camera, scene.background)
+        if last["round"] is not None and last["shown"] is not last["round"]:
+            shots, unshot, progress = last["round"]  # the last round, skipped for time: shown
+            on_pass(shots, img, unshot, progress)
         sol.timings["compile"] += t["compile"]
         sol.timings["display"] = t["display"]
         sol.stats.setdefault("gl_renderer", gl.renderer_name())
