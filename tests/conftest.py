@@ -18,14 +18,10 @@ os.environ.setdefault("NUMBA_CACHE_DIR", str(Path(__file__).resolve().parents[1]
 @pytest.fixture(scope="session", autouse=True)
 def reference_cache(tmp_path_factory):
     """One reference cache for the whole run (warm within it, nothing left in ~/.cache)."""
-    folder = tmp_path_factory.mktemp("reference-cache")
-    old = os.environ.get("WORKBENCH_REFERENCE_CACHE")
-    os.environ["WORKBENCH_REFERENCE_CACHE"] = str(folder)
-    yield folder
-    if old is None:
-        os.environ.pop("WORKBENCH_REFERENCE_CACHE", None)
-    else:
-        os.environ["WORKBENCH_REFERENCE_CACHE"] = old
+    with pytest.MonkeyPatch.context() as mp:
+        folder = tmp_path_factory.mktemp("reference-cache")
+        mp.setenv("WORKBENCH_REFERENCE_CACHE", str(folder))
+        yield folder
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -33,14 +29,10 @@ def config_dir(tmp_path_factory):
     """The window's remembered size (``workbench.app.ui.window_size``) kept in a folder of the
     run, not in ~/.config; removed after each test (:func:`fresh_window_size`), so a window
     closed at one size does not open the next test's at it."""
-    folder = tmp_path_factory.mktemp("config")
-    old = os.environ.get("WORKBENCH_CONFIG_DIR")
-    os.environ["WORKBENCH_CONFIG_DIR"] = str(folder)
-    yield folder
-    if old is None:
-        os.environ.pop("WORKBENCH_CONFIG_DIR", None)
-    else:
-        os.environ["WORKBENCH_CONFIG_DIR"] = old
+    with pytest.MonkeyPatch.context() as mp:
+        folder = tmp_path_factory.mktemp("config")
+        mp.setenv("WORKBENCH_CONFIG_DIR", str(folder))
+        yield folder
 
 
 @pytest.fixture(autouse=True)

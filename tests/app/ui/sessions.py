@@ -579,12 +579,17 @@ class PlotHover:
             self.moved = state.frame
 
 
+RESIZE_WAIT_SECONDS = 20.0
+"""How long :class:`Resize` waits for the X server to apply the new size."""
+
+
 class Resize:
     """Log the window's size at frame 1, resize it at frame 2 to ``size`` (GLFW, as a user's
-    drag of its corner), log it again at frame 6 and quit."""
+    drag of its corner), log it again once the X server has applied it (at most
+    :data:`RESIZE_WAIT_SECONDS` later: a loaded machine applies it frames later) and quit."""
 
     def __init__(self, out: Path, size: tuple[int, int] = (900, 560)):
-        self.out, self.size, self.log = out, size, {}
+        self.out, self.size, self.log, self.asked = out, size, {}, None
 
     def __call__(self, state: AppState) -> None:
         from workbench.app.ui.glfw_title import glfw_library, window_size
@@ -594,7 +599,9 @@ class Resize:
             glfw = glfw_library()
             glfw.glfwSetWindowSize.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_int]
             glfw.glfwSetWindowSize(glfw.glfwGetCurrentContext(), *self.size)
-        elif state.frame == 6:
+            self.asked = time.perf_counter()
+        elif state.frame >= 6 and (tuple(window_size()) == tuple(self.size)
+                                   or time.perf_counter() - self.asked > RESIZE_WAIT_SECONDS):
             self.log["resized"] = list(window_size())
             state.quit = True
 

@@ -5,6 +5,7 @@ a kind module that breaks the contract is refused in one line naming what is wro
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 import types
@@ -77,9 +78,7 @@ def renders(tmp_path_factory):
     """Every method's image of the toy scene, rendered by a user's script in a new process."""
     d = tmp_path_factory.mktemp("toy_disk")
     (d / "disk.toml").write_text(SCENE)
-    env_path = f"{TESTS}"
-    import os
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([env_path, os.environ.get("PYTHONPATH", "")]))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(TESTS), os.environ.get("PYTHONPATH", "")]))
     p = subprocess.run([sys.executable, "-c", SCRIPT, str(d / "disk.toml"), str(d)], capture_output=True,
                        text=True, env=env, timeout=1200)
     assert p.returncode == 0, p.stderr[-3000:]
