@@ -43,6 +43,13 @@ class Knob:
     description: str = ""
 
 
+def callback(v):
+    """The converter of a progress option (``on_tile``, ``on_pass``): a callable, or None."""
+    if v is None or callable(v):
+        return v
+    raise ValueError("expected a callable or None")
+
+
 @dataclass(frozen=True)
 class Option:
     """An accepted option: converter (``int``, ``float``, ``bool``, ``str`` or a callable that

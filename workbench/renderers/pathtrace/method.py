@@ -21,19 +21,13 @@ from ...core.errors import WorkbenchError
 from ...scene import features as F
 from ...scene.model import Scene
 from .. import support as sp
-from ..base import Knob, Option, RenderResult
+from ..base import Knob, Option, RenderResult, callback
 from ..raytrace.accel import ACCELS
 from .session import FRESNEL, MIS, PIXEL_FILTER, TRANSPORT, PathTraceSession, estimate_bytes
 
 _SAMPLES_PER_PASS = 1 << 20
 """Samples (pixels x spp) per kernel call: passes short enough for a progress bar and a UI."""
 MAX_SPP = 1 << 20
-
-
-def _callback(v):
-    if v is None or callable(v):
-        return v
-    raise ValueError("expected a callable on_pass(samples_per_pixel, image, std_error) or None")
 
 
 class PathTraceRenderer:
@@ -63,7 +57,7 @@ class PathTraceRenderer:
         "accel": Option(str, "bvh", "acceleration structure over the triangles and the bounded analytic "
                         "primitives: bvh, octree or none (every one tested); same image", ACCELS),
         "progress": Option(bool, False, "show a tqdm progress bar (CLI)"),
-        "on_pass": Option(_callback, None, "callback on_pass(spp_so_far, image, std_error) after each pass"),
+        "on_pass": Option(callback, None, "callback on_pass(spp_so_far, image, std_error) after each pass"),
     }
 
     memory_options = ()  # memory grows with the image size only (sums per pixel), not with spp

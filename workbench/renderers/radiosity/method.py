@@ -17,7 +17,7 @@ from ...scene.kinds import containing, kind_of
 from ...scene.model import Scene
 from ...scene.prepared import prepare
 from .. import support as sp
-from ..base import Knob, Option, RenderResult
+from ..base import Knob, Option, RenderResult, callback
 from . import solvers
 from .formfactors import FormFactors, compute
 from .patches import PatchSet, patches_from_scene
@@ -67,12 +67,6 @@ def common_options() -> dict[str, Option]:
                         "in (0, 2) (1: plain shooting; 1.2 needs ~40 % fewer shots on the "
                         "Cornell box)"),
     }
-
-
-def _callback(v):
-    if v is None or callable(v):
-        return v
-    raise ValueError("expected a callable on_pass(shots, image, unshot, progress) or None")
 
 
 _BYTES_PER_PATCH = 4096
@@ -279,7 +273,7 @@ class RadiosityRenderer:
     knob = Knob("patch_size", (0.2, 0.1, 0.05, 0.035, 0.025), 0.05,
                 "largest patch edge / scene diagonal")
     options = {**common_options(),
-               "on_pass": Option(_callback, None, "progressive refinement: callback on_pass(shots, "
+               "on_pass": Option(callback, None, "progressive refinement: callback on_pass(shots, "
                                  "image, unshot, progress) after each round of shots: the image so "
                                  "far, the unshot share of the emitted power and the way done to the "
                                  "stopping rule in [0, 1]"),

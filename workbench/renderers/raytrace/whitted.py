@@ -43,18 +43,12 @@ from ...scene import features as F
 from ...scene.model import Mesh, Scene
 from ...scene.prepared import prepare
 from .. import support as sp
-from ..base import Knob, Option, RenderResult
+from ..base import Knob, Option, RenderResult, callback
 from ..kernels.columns import CHECKER_PLANAR, CHECKER_SOLID, TEX_COLS, Mat, Tex, WhittedOpt, pack
 from .accel import ACCELS, accel_extra_bytes
 from .flatten import MAX_CUTOUTS, OPACITY_CUT, SHADOW_CROSSINGS, SceneData, flatten, flatten_bytes
 
 _RAYS_PER_BAND = 1 << 16
-
-
-def _callback(v):
-    if v is None or callable(v):
-        return v
-    raise ValueError("expected a callable on_tile(y0, y1, x0, x1, tile) or None")
 
 
 _BYTES_PER_PRIMARY_RAY = 160
@@ -656,7 +650,7 @@ _COMMON = {
     "blinn": Option(bool, False, "Blinn's half-vector specular instead of Phong's"),
     "fresnel": Option(str, "none", "reflection/transmission split: none (constant kr, kt), schlick or exact dielectric", ("none", "schlick", "exact")),
     "progress": Option(bool, False, "show a tqdm progress bar (CLI)"),
-    "on_tile": Option(_callback, None, "callback on_tile(y0, y1, x0, x1, tile) after each band of rows"),
+    "on_tile": Option(callback, None, "callback on_tile(y0, y1, x0, x1, tile) after each band of rows"),
     "accel": Option(str, "bvh", "acceleration structure over the triangles and the bounded analytic "
                     "primitives: bvh (4-wide binned SAH), octree (the course's arbre octal) or none (every "
                     "triangle and primitive tested); same images", ACCELS),
