@@ -42,26 +42,30 @@ _IMPORT = re.compile(rb"^[ \t]*(?:from[ \t]+(\.*)([\w.]*)[ \t]+import[ \t]+(\([^
 _NUMBA = re.compile(rb"^[ \t]*(?:import|from)[ \t]+numba\b", re.M)
 
 
-def _imports(path: Path, text: bytes, root: Path) -> set[Path]:
-    """The workbench modules a module's source ``text`` imports (``workbench.*`` and relative
-    imports, at any depth of the file), as source paths that exist."""
-    here = path.relative_to(root.parent).parts[:-1]     # the module's package, as a path
+def _module_names(root: Path) -> dict[str, Path]:
+    """Dotted name -> source file of every module of the package (``workbench.core.tol``; a
+    package by its ``__init__.py``)."""
+    out = {}
+    for p in root.rglob("*.py"):
+        parts = p.relative_to(root.parent).with_suffix("").parts
+        out[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = p
+    return out
+
+
+def _imports(name: str, is_package: bool, text: bytes, modules: dict[str, Path]) -> set[str]:
+    """The package's modules (dotted names, keys of ``modules``) that module ``name``'s source
+    ``text`` imports (absolute and relative imports, at any depth of the file)."""
+    here = name.split(".") if is_package else name.split(".")[:-1]   # its package
     found = set()
     for dots, module, names, plain in _IMPORT.findall(text):
         if plain:
-            targets = [n.strip().split(b" ")[0].decode().split(".") for n in plain.split(b",")]
+            targets = [n.split()[0].decode() for n in plain.split(b",") if n.split()]
         else:
-            base = list(here[:len(here) - len(dots) + 1]) if dots else []
-            mod = base + (module.decode().split(".") if module else [])
-            words = names.strip(b"()").replace(b"\n", b" ").split(b",")
-            targets = [mod] + [mod + [w.split()[0].decode()] for w in words if w.split()]
-        for parts in targets:
-            if not parts or parts[0] != root.name:
-                continue
-            target = root.parent.joinpath(*parts)
-            for candidate in (target.with_suffix(".py"), target / "__init__.py"):
-                if candidate.is_file():
-                    found.add(candidate)
+            base = ".".join(here[:len(here) - len(dots) + 1]) if dots else ""
+            mod = ".".join(x for x in (base, module.decode()) if x)
+            words = names.strip(b"()").split(b",")
+            targets = [mod] + [f"{mod}.{w.split()[0].decode()}" for w in words if w.split()]
+        found.update(t for t in targets if t in modules)
     return found
 
 
@@ -70,18 +74,18 @@ def kernel_sources() -> list[Path]:
     (:data:`CODE_PACKAGES`) that imports numba, and, transitively, every workbench module
     those import (their constants are compiled in), sorted."""
     root = Path(__file__).resolve().parents[1]
-    text = {p: p.read_bytes() for pkg in CODE_PACKAGES for p in (root / pkg).rglob("*.py")}
-    todo = [p for p, t in text.items() if _NUMBA.search(t)]
-    seen: set[Path] = set()
+    modules = _module_names(root)
+    layers = tuple(f"{root.name}.{pkg}" for pkg in CODE_PACKAGES)
+    text = {n: p.read_bytes() for n, p in modules.items() if n.startswith(layers)}
+    todo = [n for n, t in text.items() if b"numba" in t and _NUMBA.search(t)]
+    seen: set[str] = set()
     while todo:
-        p = todo.pop()
-        if p in seen:
-            continue
-        seen.add(p)
-        if p not in text:
-            text[p] = p.read_bytes()
-        todo.extend(_imports(p, text[p], root) - seen)
-    return sorted(seen)
+        n = todo.pop()
+        if n not in seen:
+            seen.add(n)
+            t = text[n] if n in text else modules[n].read_bytes()
+            todo.extend(_imports(n, modules[n].name == "__init__.py", t, modules) - seen)
+    return sorted(modules[n] for n in seen)
 
 
 def kernel_fingerprint() -> str:
