@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from workbench.core.columns import Columns, pack
 from workbench.scene import model as m, readers as rd
 from workbench.scene.parts import make_part, polygons
 
@@ -55,9 +56,15 @@ def tessellate(d: Disk, level: int, M: np.ndarray) -> list:
     return [make_part(d, M, *polygons([outline(d, level)], 1))]
 
 
+class Par(Columns):
+    """Its columns of the primitive table's ``par``."""
+
+    RADIUS = 0
+
+
 def flatten(b, d: Disk, index: int, W: np.ndarray, top: bool) -> int:
-    """Primitive row ``par = (r,)``."""
-    return b.add(PTYPE, index, d, W, (d.radius,), top=top, solid=SOLID)
+    """Primitive row (``par``: :class:`Par`)."""
+    return b.add(PTYPE, index, d, W, pack(Par, radius=d.radius), top=top, solid=SOLID)
 
 
 def hits(d: Disk, O, D, solid: bool = False) -> list[tuple[float, int]]:

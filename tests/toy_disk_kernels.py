@@ -5,6 +5,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+from toy_disk import Par
 from workbench.renderers.kernels.flags import NO_REFCOUNT
 
 
@@ -15,7 +16,7 @@ def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
         return np.inf, 0
     t = -oy / dy
     x, z = ox + t * dx, oz + t * dz
-    if tmin < t < tmax and x * x + z * z <= par[k, 0] * par[k, 0]:
+    if tmin < t < tmax and x * x + z * z <= par[k, Par.RADIUS] * par[k, Par.RADIUS]:
         return t, 0
     return np.inf, 0
 

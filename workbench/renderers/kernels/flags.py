@@ -22,6 +22,11 @@ links a callee's whole module, with everything it calls, into each caller's modu
 optimises it and generates its machine code again; inlined, these kernels would be copied into
 each call site, and the copies compiled again at each level above (the path tracer's
 ``trace_path`` would be one function holding every kind's code)."""
+TASK = dict(NO_REFCOUNT, nogil=True)
+"""Options of the drivers that :func:`.tasks.run_tasks` runs on Python threads: :data:`NO_REFCOUNT`
+and the GIL released.  Such a driver is handed its scratch arrays by its caller, and walks its
+pixel blocks itself: one compiled level fewer between the thread and the per-ray kernels (each
+level links and compiles again the whole module below it)."""
 INLINE = dict(NO_REFCOUNT, forceinline=True)
 """Options of the small helpers: compiled once per signature (and cached) as functions of their
 own, marked ``alwaysinline`` for LLVM, which inlines them into every caller when it links the

@@ -12,7 +12,7 @@ import numpy as np
 from numba.extending import overload
 
 from ...scene.kinds import CSGNODE
-from ...scene.kinds.csg import CSG_DEPTH
+from ...scene.kinds.csg import CSG_DEPTH, Par as CsgPar
 from ...scene.kinds.expression import MAX_STACK
 from .flags import GATE, INLINE
 from .shapes import CSG_EVENTS, _normalize, _to_object, csg_hit, object_normal, prim_hit
@@ -33,8 +33,8 @@ def row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, zero, eps, stack,
         lo = _to_object(xf, k, ox, oy, oz, dx, dy, dz)
         inv_s = 1.0 / math.sqrt(lo[3] * lo[3] + lo[4] * lo[4] + lo[5] * lo[5])
     if ptype[k] == CSGNODE:
-        t, code, f = csg_gate(geo, int(par[k, 0]), int(par[k, 1]), ox, oy, oz, dx, dy, dz, tmin, tmax,
-                              zero, eps, (st, sp_, sf, sn), stack)
+        t, code, f = csg_gate(geo, int(par[k, CsgPar.START]), int(par[k, CsgPar.LENGTH]), ox, oy, oz, dx, dy, dz,
+                              tmin, tmax, zero, eps, (st, sp_, sf, sn), stack)
         return t, abs(code) - 1, f + (16 if code < 0 else 0)
     t, f = prim_hit(geo.kinds, k, ptype, par, geo.poly_v, aux, lo[0], lo[1], lo[2], lo[3], lo[4], lo[5],
                     lo[3] * inv_s, lo[4] * inv_s, lo[5] * inv_s, inv_s, tmin, tmax, zero,
@@ -131,7 +131,7 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, s
     bp, bf, found = -1, 0, -1
     base = PRIM_STACK_BASE
     top_ = stack.shape[0] - 1
-    code, sp = 0, base
+    code, sp = np.int64(0), np.int64(base)  # int64, not literals (see walks.LANE)
     while True:
         while code >= 0:
             if count:
@@ -195,7 +195,7 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
     negative ``face`` is never returned (a flipped CSG normal is ``face + 16``)."""
     pfree, shadow = geo.pfree, geo.shadow
     best, bp, bf, btri, bb1, bb2 = tmax, -1, 0, -1, 0.0, 0.0
-    brow = -1
+    brow = np.int64(-1)  # int64, not a literal (see walks.LANE)
     inv_w = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
     w = eps * inv_w
     for q in range(pfree.shape[0]):

@@ -12,7 +12,12 @@ import numpy as np
 
 from ...core.tol import tol
 from ...scene.kinds import BOX, KERNEL_PTYPES_FROM, POLYGON, QUADRIC, RECT, SPHERE
+from ...scene.kinds.box import Par as BoxPar
 from ...scene.kinds.csg import CSG_DIFFERENCE, CSG_INTERSECTION, CSG_UNION
+from ...scene.kinds.plane import Par as RectPar
+from ...scene.kinds.polygon import Par as PolygonPar
+from ...scene.kinds.quadric import Par as QuadricPar
+from ...scene.kinds.sphere import Par as SpherePar
 from .flags import INLINE, NO_REFCOUNT
 from .specialise import exotic_events, exotic_first, exotic_normal
 
@@ -78,8 +83,9 @@ def sphere_roots_unit(par, k, ox, oy, oz, ux, uy, uz, inv_s):
     "Precision improvements for ray/sphere intersection" (Ray Tracing Gems, 2019):
     ``disc = r^2 - |f - (f.d) d|^2`` with ``f = O - C`` and ``d`` the unit direction.  A sphere
     entirely behind the origin reports no roots (no ray or CSG query needs ``t < 0``)."""
-    fx, fy, fz = ox - par[k, 0], oy - par[k, 1], oz - par[k, 2]
-    r = par[k, 3]
+    c = SpherePar.CENTER
+    fx, fy, fz = ox - par[k, c], oy - par[k, c + 1], oz - par[k, c + 2]
+    r = par[k, SpherePar.RADIUS]
     b = fx * ux + fy * uy + fz * uz
     ff = fx * fx + fy * fy + fz * fz
     if b > 0.0 and ff > r * r:  # outside and moving away: both roots behind the origin
@@ -135,8 +141,10 @@ def slab(lo0, lo1, lo2, hi0, hi1, hi2, ox, oy, oz, dx, dy, dz):
 def quadric_coeffs(par, k, ox, oy, oz, dx, dy, dz):
     """``A = D^T Q D``, ``B = 2 D^T Q P0``, ``C = P0^T Q P0`` with D lifted with w = 0 and P0
     with w = 1 (errata 2: the cross terms of C carry their factor 2)."""
-    q00, q01, q02, q03, q11, q12, q13, q22, q23, q33 = (par[k, 0], par[k, 1], par[k, 2], par[k, 3], par[k, 4],
-                                                         par[k, 5], par[k, 6], par[k, 7], par[k, 8], par[k, 9])
+    q = QuadricPar.Q
+    q00, q01, q02, q03, q11, q12, q13, q22, q23, q33 = (par[k, q], par[k, q + 1], par[k, q + 2], par[k, q + 3],
+                                                         par[k, q + 4], par[k, q + 5], par[k, q + 6], par[k, q + 7],
+                                                         par[k, q + 8], par[k, q + 9])
     # Q P0 and Q D (first three rows)
     qp0 = q00 * ox + q01 * oy + q02 * oz + q03
     qp1 = q01 * ox + q11 * oy + q12 * oz + q13
@@ -153,23 +161,25 @@ def quadric_coeffs(par, k, ox, oy, oz, dx, dy, dz):
 
 @nb.njit(**INLINE)
 def _in_bounds(par, k, x, y, z, slack):
-    return (par[k, 10] - slack <= x <= par[k, 13] + slack and par[k, 11] - slack <= y <= par[k, 14] + slack
-            and par[k, 12] - slack <= z <= par[k, 15] + slack)
+    lo, hi = QuadricPar.BOUNDS_MIN, QuadricPar.BOUNDS_MAX
+    return (par[k, lo] - slack <= x <= par[k, hi] + slack and par[k, lo + 1] - slack <= y <= par[k, hi + 1] + slack
+            and par[k, lo + 2] - slack <= z <= par[k, hi + 2] + slack)
 
 
 @nb.njit(**INLINE)
 def _polygon_hit(k, par, poly_v, ox, oy, oz, dx, dy, dz, tmin, tmax):
     """Planar convex polygon ``k``: plane hit inside every edge.  Not inlined (a rarely used
     path: one compiled copy instead of one per call site of :func:`closest`)."""
-    nx, ny, nz = par[k, 0], par[k, 1], par[k, 2]
+    n_ = PolygonPar.NORMAL
+    nx, ny, nz = par[k, n_], par[k, n_ + 1], par[k, n_ + 2]
     den = nx * dx + ny * dy + nz * dz
     if den == 0.0:
         return np.inf, 0
-    t = (par[k, 3] - (nx * ox + ny * oy + nz * oz)) / den
+    t = (par[k, PolygonPar.OFFSET] - (nx * ox + ny * oy + nz * oz)) / den
     if not (tmin < t < tmax):
         return np.inf, 0
     qx, qy, qz = ox + t * dx, oy + t * dy, oz + t * dz
-    s, n = int(par[k, 4]), int(par[k, 5])
+    s, n = int(par[k, PolygonPar.FIRST]), int(par[k, PolygonPar.COUNT])
     for i in range(n):
         j = s + (i + 1) % n
         ax, ay, az = poly_v[s + i, 0], poly_v[s + i, 1], poly_v[s + i, 2]
@@ -217,19 +227,23 @@ def prim_hit(kinds, k, ptype, par, poly_v, aux, ox, oy, oz, dx, dy, dz, ux, uy, 
                 return t1, 0
         return np.inf, 0
     if kind == RECT:
-        nx, ny, nz = par[k, 9], par[k, 10], par[k, 11]
+        p0, u, v, n_ = RectPar.POINT, RectPar.U, RectPar.V, RectPar.N
+        nx, ny, nz = par[k, n_], par[k, n_ + 1], par[k, n_ + 2]
         den = nx * dx + ny * dy + nz * dz
         if den == 0.0:
             return np.inf, 0
-        t = ((par[k, 0] - ox) * nx + (par[k, 1] - oy) * ny + (par[k, 2] - oz) * nz) / den
+        t = ((par[k, p0] - ox) * nx + (par[k, p0 + 1] - oy) * ny + (par[k, p0 + 2] - oz) * nz) / den
         if not (tmin < t < tmax):
             return np.inf, 0
-        qx, qy, qz = ox + t * dx - par[k, 0], oy + t * dy - par[k, 1], oz + t * dz - par[k, 2]
-        if abs(qx * par[k, 3] + qy * par[k, 4] + qz * par[k, 5]) <= par[k, 12] and abs(qx * par[k, 6] + qy * par[k, 7] + qz * par[k, 8]) <= par[k, 13]:
+        qx, qy, qz = ox + t * dx - par[k, p0], oy + t * dy - par[k, p0 + 1], oz + t * dz - par[k, p0 + 2]
+        if (abs(qx * par[k, u] + qy * par[k, u + 1] + qz * par[k, u + 2]) <= par[k, RectPar.HALF_U]
+                and abs(qx * par[k, v] + qy * par[k, v + 1] + qz * par[k, v + 2]) <= par[k, RectPar.HALF_V]):
             return t, 0
         return np.inf, 0
     if kind == BOX:
-        ok, tn, fn, tf, ff = slab(par[k, 0], par[k, 1], par[k, 2], par[k, 3], par[k, 4], par[k, 5], ox, oy, oz, dx, dy, dz)
+        b0, b1 = BoxPar.MIN, BoxPar.MAX
+        ok, tn, fn, tf, ff = slab(par[k, b0], par[k, b0 + 1], par[k, b0 + 2], par[k, b1], par[k, b1 + 1],
+                                   par[k, b1 + 2], ox, oy, oz, dx, dy, dz)
         if ok:
             if tmin < tn < tmax:
                 return tn, fn
@@ -259,7 +273,9 @@ def leaf_events(kinds, k, ptype, par, aux, ox, oy, oz, dx, dy, dz, zero, et, ep,
         ef[0], ef[1] = 0, 0
         return 2
     if kind == BOX:
-        ok, tn, fn, tf, ff = slab(par[k, 0], par[k, 1], par[k, 2], par[k, 3], par[k, 4], par[k, 5], ox, oy, oz, dx, dy, dz)
+        b0, b1 = BoxPar.MIN, BoxPar.MAX
+        ok, tn, fn, tf, ff = slab(par[k, b0], par[k, b0 + 1], par[k, b0 + 2], par[k, b1], par[k, b1 + 1],
+                                   par[k, b1 + 2], ox, oy, oz, dx, dy, dz)
         if not ok or not tn < tf:
             return 0
         et[0], et[1] = tn, tf
@@ -267,7 +283,9 @@ def leaf_events(kinds, k, ptype, par, aux, ox, oy, oz, dx, dy, dz, zero, et, ep,
         ef[0], ef[1] = fn, ff
         return 2
     if kind == QUADRIC:
-        ok, sn, sfn, sf, sff = slab(par[k, 10], par[k, 11], par[k, 12], par[k, 13], par[k, 14], par[k, 15], ox, oy, oz, dx, dy, dz)
+        q0, q1 = QuadricPar.BOUNDS_MIN, QuadricPar.BOUNDS_MAX
+        ok, sn, sfn, sf, sff = slab(par[k, q0], par[k, q0 + 1], par[k, q0 + 2], par[k, q1], par[k, q1 + 1],
+                                     par[k, q1 + 2], ox, oy, oz, dx, dy, dz)
         if not ok or not sn < sf:
             return 0
         A, B, C = quadric_coeffs(par, k, ox, oy, oz, dx, dy, dz)
@@ -414,14 +432,17 @@ def object_normal(kinds, k, face, ptype, par, aux, x, y, z, stack):
         s = 1.0 if (face - 1) % 2 == 1 else -1.0
         return (s if a == 0 else 0.0), (s if a == 1 else 0.0), (s if a == 2 else 0.0)
     if kind == SPHERE:
-        return x - par[k, 0], y - par[k, 1], z - par[k, 2]
+        c = SpherePar.CENTER
+        return x - par[k, c], y - par[k, c + 1], z - par[k, c + 2]
     if kind == RECT:
-        return par[k, 9], par[k, 10], par[k, 11]
+        return par[k, RectPar.N], par[k, RectPar.N + 1], par[k, RectPar.N + 2]
     if kind == POLYGON:
-        return par[k, 0], par[k, 1], par[k, 2]
-    if kind == QUADRIC:  # gradient of P^T Q P (halved)
-        return (par[k, 0] * x + par[k, 1] * y + par[k, 2] * z + par[k, 3], par[k, 1] * x + par[k, 4] * y + par[k, 5] * z + par[k, 6],
-                par[k, 2] * x + par[k, 5] * y + par[k, 7] * z + par[k, 8])
+        return par[k, PolygonPar.NORMAL], par[k, PolygonPar.NORMAL + 1], par[k, PolygonPar.NORMAL + 2]
+    if kind == QUADRIC:  # gradient of P^T Q P (halved): rows of Q (upper triangle in QuadricPar.Q)
+        q = QuadricPar.Q
+        return (par[k, q] * x + par[k, q + 1] * y + par[k, q + 2] * z + par[k, q + 3],
+                par[k, q + 1] * x + par[k, q + 4] * y + par[k, q + 5] * z + par[k, q + 6],
+                par[k, q + 2] * x + par[k, q + 5] * y + par[k, q + 7] * z + par[k, q + 8])
     return 0.0, 1.0, 0.0
 
 

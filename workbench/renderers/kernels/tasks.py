@@ -12,17 +12,21 @@ from __future__ import annotations
 from concurrent.futures import ThreadPoolExecutor
 
 
-def run_tasks(kernel, ntasks: int, *args) -> None:
-    """Call ``kernel(*args, c, ntasks)`` for ``c = 0 .. ntasks - 1``, on as many threads as
+def run_tasks(kernel, ntasks: int, *args, per_task=None) -> None:
+    """Call ``kernel(*args, *per_task(c), c, ntasks)`` for ``c = 0 .. ntasks - 1`` (``per_task``:
+    the task's own arguments, its scratch arrays; none when omitted), on as many threads as
     numba is set to use (``numba.set_num_threads``), and wait for all; an exception of any
     call is raised here."""
     import numba
 
+    def task_args(c):
+        return (*args, *(per_task(c) if per_task is not None else ()), c, ntasks)
+
     threads = max(1, min(ntasks, numba.get_num_threads()))
     if threads == 1:
         for c in range(ntasks):
-            kernel(*args, c, ntasks)
+            kernel(*task_args(c))
         return
     with ThreadPoolExecutor(max_workers=threads) as pool:
-        for f in [pool.submit(kernel, *args, c, ntasks) for c in range(ntasks)]:
+        for f in [pool.submit(kernel, *task_args(c)) for c in range(ntasks)]:
             f.result()

@@ -15,6 +15,11 @@ BVH_STACK = 3 * MAX_DEPTH + 4
 # Slab exits are enlarged by 1 + 2 gamma_3 (gamma_n = n u / (1 - n u), u = 2^-53) so that
 # rounding never culls a box the ray touches (Ize, "Robust BVH ray traversal", JCGT 2013).
 BOX_GAMMA = 1.0 + 2.0 * 3.0 * 2.0 ** -53 / (1.0 - 3.0 * 2.0 ** -53)
+LANE = (np.int64(0), np.int64(1), np.int64(2), np.int64(3))
+"""The lane arguments of the 4-wide helpers' calls, and the walks' starting values, are int64, not
+Python literals: numba compiles a callee once per value of a literal argument (and, typing a
+loop, once more for a literal start value before it widens to int64), for the same machine code
+once the helper is inlined."""
 
 
 @nb.njit(**INLINE)
@@ -146,10 +151,10 @@ def open_node(tree, code, ray, best, stack, sp, top):
     node, child = tree
     pl, ox, oy, oz, ix, iy, iz, tmin = ray
     nd = np.uint64(code)
-    t0 = box_lane(node, nd, 0, pl, ox, oy, oz, ix, iy, iz, tmin, best)
-    t1 = box_lane(node, nd, 1, pl, ox, oy, oz, ix, iy, iz, tmin, best)
-    t2 = box_lane(node, nd, 2, pl, ox, oy, oz, ix, iy, iz, tmin, best)
-    t3 = box_lane(node, nd, 3, pl, ox, oy, oz, ix, iy, iz, tmin, best)
+    t0 = box_lane(node, nd, LANE[0], pl, ox, oy, oz, ix, iy, iz, tmin, best)
+    t1 = box_lane(node, nd, LANE[1], pl, ox, oy, oz, ix, iy, iz, tmin, best)
+    t2 = box_lane(node, nd, LANE[2], pl, ox, oy, oz, ix, iy, iz, tmin, best)
+    t3 = box_lane(node, nd, LANE[3], pl, ox, oy, oz, ix, iy, iz, tmin, best)
     base, code, tn = sp, -1, np.inf
     if t0 < np.inf:
         code, tn = child[nd, 0], t0
@@ -224,9 +229,9 @@ def bvh_walk(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack, count, cnt
     okx, oky, okz = o[kx], o[ky], o[kz]
     pk = (np.uint64(kx), np.uint64(ky), np.uint64(kz), np.uint64(3 + kx), np.uint64(3 + ky),
           np.uint64(3 + kz), np.uint64(6 + kx), np.uint64(6 + ky), np.uint64(6 + kz))
-    best, bg, bl = tmax, -1, 0
+    best, bg, bl = tmax, np.int64(-1), LANE[0]
     top = stack.shape[0] - 1  # never reached (BVH_STACK); a bound all the same
-    code, sp = 0, 0
+    code, sp = LANE[0], LANE[0]  # int64 (see LANE)
     while True:
         while code >= 0:  # a 4-wide node
             if count:
@@ -237,10 +242,10 @@ def bvh_walk(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack, count, cnt
             for g in range(leaf[lf, 0], leaf[lf, 0] + leaf[lf, 1]):
                 if count:
                     cnt[1] += 4
-                u0 = tri_lane(tv4, g, 0, pk, okx, oky, okz, sx, sy, sz, tmin, best)
-                u1 = tri_lane(tv4, g, 1, pk, okx, oky, okz, sx, sy, sz, tmin, best)
-                u2 = tri_lane(tv4, g, 2, pk, okx, oky, okz, sx, sy, sz, tmin, best)
-                u3 = tri_lane(tv4, g, 3, pk, okx, oky, okz, sx, sy, sz, tmin, best)
+                u0 = tri_lane(tv4, g, LANE[0], pk, okx, oky, okz, sx, sy, sz, tmin, best)
+                u1 = tri_lane(tv4, g, LANE[1], pk, okx, oky, okz, sx, sy, sz, tmin, best)
+                u2 = tri_lane(tv4, g, LANE[2], pk, okx, oky, okz, sx, sy, sz, tmin, best)
+                u3 = tri_lane(tv4, g, LANE[3], pk, okx, oky, okz, sx, sy, sz, tmin, best)
                 m = min(min(u0, u1), min(u2, u3))
                 if m < best:  # the lowest lane of the nearest (a padding lane repeats an earlier one)
                     best, bg = m, g

@@ -18,8 +18,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...core.columns import cell
 from ...core.tol import tol
 from ...scene.kinds import BOX, KINDS, MESH, POLYGON, RECT
+from ...scene.kinds.box import Par as BoxPar
+from ...scene.kinds.plane import Par as RectPar
+from ...scene.kinds.polygon import Par as PolygonPar
 from ..kernels.columns import Mat
 from ..raytrace.flatten import SceneData
 
@@ -79,15 +83,15 @@ def _prim_triangles(sd: SceneData, k: int):
     """World triangles (n, 9) of analytic primitive ``k``, or None if it is not sampled."""
     W, par, kind = sd.wfo[k], sd.par[k], sd.ptype[k]
     if kind == POLYGON:
-        s, n = int(par[4]), int(par[5])
+        s, n = int(cell(par, PolygonPar.FIRST)), int(cell(par, PolygonPar.COUNT))
         tris = fan_triangles(_world(W, sd.poly_v[s:s + n]))
         return tris
     if kind == RECT:
-        p, u, v, hu, hv = par[0:3], par[3:6], par[6:9], par[12], par[13]
+        p, u, v, hu, hv = (cell(par, c) for c in (RectPar.POINT, RectPar.U, RectPar.V, RectPar.HALF_U, RectPar.HALF_V))
         c = _world(W, [p - hu * u - hv * v, p + hu * u - hv * v, p + hu * u + hv * v, p - hu * u + hv * v])
         return np.stack([np.r_[c[0], c[1], c[2]], np.r_[c[0], c[2], c[3]]])
     if kind == BOX:
-        lo, hi = par[0:3], par[3:6]
+        lo, hi = cell(par, BoxPar.MIN), cell(par, BoxPar.MAX)
         corners = _world(W, [np.where([(c >> a) & 1 for a in range(3)], hi, lo) for c in range(8)])
         out = []
         for q in _BOX_QUADS:

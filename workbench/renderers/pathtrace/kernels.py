@@ -64,9 +64,9 @@ import math
 import numba as nb
 import numpy as np
 
-from ..kernels.columns import Light, Mat, PathOpt
+from ..kernels.columns import PATH_COUNTS, Light, Mat, PathCount, PathOpt
 from ..kernels.tasks import run_tasks
-from ..kernels.flags import INLINE, NO_REFCOUNT
+from ..kernels.flags import INLINE, NO_REFCOUNT, TASK
 from ..kernels.intersect import closest, scratch, surface
 from ..kernels.optics import _feeler, _light_dir, checker_color, fresnel_reflectance
 from ..kernels.shapes import _normalize
@@ -75,13 +75,11 @@ from ..raytrace.kernels import MAX_TASKS
 
 BLOCK = 32
 """Pixels per work item of :func:`render_samples`."""
-NCOUNTS = 7
-"""Columns of the counts: camera rays, extension rays, shadow rays, paths ended by Russian
-roulette, paths that escaped, non-finite samples (recorded as 0), paths stopped at
-``max_bounces``."""
 INV_PI = 1.0 / math.pi
 INV_2PI = 0.5 / math.pi
 _G = np.uint64(0x9E3779B97F4A7C15)
+JITTER_U, JITTER_V = np.int64(0), np.int64(1)
+"""The random dimensions of the pixel jitter, as int64 (not literals: see ``kernels.walks.LANE``)."""
 _M1 = np.uint64(0xBF58476D1CE4E5B9)
 _M2 = np.uint64(0x94D049BB133111EB)
 _S30, _S27, _S31, _S11 = np.uint64(30), np.uint64(27), np.uint64(31), np.uint64(11)
@@ -200,52 +198,46 @@ def render_samples(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sum
         BVH triangles (1: no top-level analytic primitive, see :func:`cast`).
     seed, s0, nsamp : int.
     sums, sumsq : (H*W, 3) float64, updated: sum and sum of squares of the sample radiances.
-    counts : (NCOUNTS,) int64, updated (see ``NCOUNTS``).
+    counts : (PATH_COUNTS,) int64, updated (see ``PATH_COUNTS``).
     """
     nblocks = (sums.shape[0] + BLOCK - 1) // BLOCK
     nit = max(1, min(nblocks, MAX_TASKS))
     part = np.zeros((nit, 8), np.int64)
-    run_tasks(samples_task, nit, geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq, part)
-    counts += part[:, :NCOUNTS].sum(axis=0)
+    run_tasks(samples_task, nit, geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq, part,
+              per_task=lambda c: (scratch(), hit_rows()))
+    counts += part[:, :PATH_COUNTS].sum(axis=0)
 
 
-@nb.njit(cache=True, error_model="numpy", nogil=True)
-def samples_task(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq, part, c, nit):
-    """Task ``c`` of ``nit`` of :func:`render_samples`: pixel blocks ``c, c + nit, ...``; its
-    counts go to ``part[c]``."""
-    npix = sums.shape[0]
-    nblocks = (npix + BLOCK - 1) // BLOCK
-    scr, rows = scratch(), hit_rows()
-    for b in range(c, nblocks, nit):
-        pixel_block(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq, part[c],
-                    b * BLOCK, min(npix, (b + 1) * BLOCK), scr, rows)
-
-
-@nb.njit(**NO_REFCOUNT)
-def pixel_block(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq, counts, p0, p1,
-                scr, rows):
-    """Pixels ``p0 .. p1 - 1`` of :func:`render_samples`, each sample's path in turn."""
+@nb.njit(**TASK)
+def samples_task(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq, part, scr, rows, c, nit):
+    """Task ``c`` of ``nit`` of :func:`render_samples`: pixel blocks ``c, c + nit, ...``, each
+    sample's path in turn; its counts go to ``part[c]``.  ``scr``: :func:`scratch`, ``rows``:
+    :func:`hit_rows`, the task's own (made by the caller: this kernel allocates nothing)."""
     width = int(cam[14])
     centre = opts[PathOpt.PIXEL_FILTER] > 0.5
-    for p in range(p0, p1):
-        i, j = p // width, p % width
-        for s in range(s0, s0 + nsamp):
-            key = path_key(seed, p, s)
-            if centre:
-                dx, dy, dz = camera_ray_at(cam, i, j, 0.5, 0.5)
-            else:
-                dx, dy, dz = camera_ray_at(cam, i, j, rand(key, 0), rand(key, 1))
-            r, g, b = trace_path(geo, shading, emitters, opts, key, cam[0], cam[1], cam[2], dx, dy, dz,
-                                 counts, scr, rows)
-            if not (math.isfinite(r) and math.isfinite(g) and math.isfinite(b)):
-                counts[5] += 1
-                r, g, b = 0.0, 0.0, 0.0
-            sums[p, 0] += r
-            sums[p, 1] += g
-            sums[p, 2] += b
-            sumsq[p, 0] += r * r
-            sumsq[p, 1] += g * g
-            sumsq[p, 2] += b * b
+    npix = sums.shape[0]
+    nblocks = (npix + BLOCK - 1) // BLOCK
+    counts = part[c]
+    for blk in range(c, nblocks, nit):
+        for p in range(blk * BLOCK, min(npix, (blk + 1) * BLOCK)):
+            i, j = p // width, p % width
+            for s in range(s0, s0 + nsamp):
+                key = path_key(seed, p, s)
+                if centre:
+                    dx, dy, dz = camera_ray_at(cam, i, j, 0.5, 0.5)
+                else:
+                    dx, dy, dz = camera_ray_at(cam, i, j, rand(key, JITTER_U), rand(key, JITTER_V))
+                r, g, b = trace_path(geo, shading, emitters, opts, key, cam[0], cam[1], cam[2], dx, dy, dz,
+                                     counts, scr, rows)
+                if not (math.isfinite(r) and math.isfinite(g) and math.isfinite(b)):
+                    counts[PathCount.NONFINITE_SAMPLES] += 1
+                    r, g, b = 0.0, 0.0, 0.0
+                sums[p, 0] += r
+                sums[p, 1] += g
+                sums[p, 2] += b
+                sumsq[p, 0] += r * r
+                sumsq[p, 1] += g * g
+                sumsq[p, 2] += b * b
 
 
 @nb.njit(**NO_REFCOUNT)
@@ -303,13 +295,13 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
     eye = True                             # only the camera and delta lobes before this hit
     pdf_prev = 0.0                         # solid-angle density of the BSDF sample that led here
     tmin = 0.0
-    counts[0] += 1
+    counts[PathCount.CAMERA_RAYS] += 1
     for bounce in range(max_bounces):
         dim = 2 + 8 * bounce
         eps = ray_off * max(max(abs(ox), abs(oy), abs(oz)), extent)
         t, k, f, tri, b1, b2 = cast(geo, bvh, tri_prim, only_tris, ox, oy, oz, dx, dy, dz, tmin, np.inf, np.bool_(False), zero, eps, scr)
         if k < 0:
-            counts[4] += 1
+            counts[PathCount.ESCAPED_PATHS] += 1
             if transport == 0 or eye:  # diffuse transport: the background is seen, it lights nothing
                 Lr += br * opts[PathOpt.BACKGROUND]
                 Lg += bg_ * opts[PathOpt.BACKGROUND + 1]
@@ -471,7 +463,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                             wx, wy, wz = qx - sx_, qy - sy_, qz - sz_
                             wd = math.sqrt(wx * wx + wy * wy + wz * wz)
                             kb = -1
-                            counts[2] += 1
+                            counts[PathCount.SHADOW_RAYS] += 1
                             if wd > 2.0 * off:
                                 _, kb, _, _, _, _ = cast(geo, bvh, tri_prim, only_tris, sx_, sy_, sz_, wx / wd,
                                                          wy / wd, wz / wd, tmin_here, wd - 2.0 * off,
@@ -487,7 +479,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                 if cos_s <= 0.0 or sc == 0.0 or fx * lx + fy * ly + fz * lz <= 0.0:
                     continue
                 sx_, sy_, sz_, tmx = _feeler(px, py, pz, gx, gy, gz, lx, ly, lz, dist, off)
-                counts[2] += 1
+                counts[PathCount.SHADOW_RAYS] += 1
                 _, kb, _, _, _, _ = cast(geo, bvh, tri_prim, only_tris, sx_, sy_, sz_, lx, ly, lz, tmin_here, tmx, np.bool_(True), zero, off, scr)
                 if kb >= 0:
                     continue
@@ -500,7 +492,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
         if bounce + 1 >= rr_start:
             q_rr = min(0.95, max(br, bg_, bb))
             if rand(key, dim + 3) >= q_rr:
-                counts[3] += 1
+                counts[PathCount.ENDED_BY_ROULETTE] += 1
                 return Lr, Lg, Lb
             br, bg_, bb = br / q_rr, bg_ / q_rr, bb / q_rr
         # ---- next direction
@@ -550,6 +542,6 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                         stk[q] = stk[q + 1]
                     nstk -= 1
         tmin = tmin_here
-        counts[1] += 1
-    counts[6] += 1
+        counts[PathCount.EXTENSION_RAYS] += 1
+    counts[PathCount.ENDED_BY_BOUNCE_CAP] += 1
     return Lr, Lg, Lb

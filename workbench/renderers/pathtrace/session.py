@@ -16,12 +16,13 @@ import time
 
 import numpy as np
 
+from ...core.columns import pack
 from ...core.errors import NotApplicable, WorkbenchError
 from ...core.tol import tol
 from ...scene import model as m
 from ...scene.prepared import prepare
 from ..raytrace.flatten import flatten, light_rows
-from ..kernels.columns import LIGHT_COLS, TEX_COLS, Mat, PathOpt, pack
+from ..kernels.columns import LIGHT_COLS, PATH_COUNTS, TEX_COLS, Mat, PathCount, PathOpt
 from ..raytrace.whitted import camera_frame, fused_textures
 from .emitters import build_emitters
 from .geometry import FRONT_ONLY, triangulated
@@ -140,7 +141,7 @@ class PathTraceSession:
         npix = self.width * self.height
         self.sums = np.zeros((npix, 3))
         self.sumsq = np.zeros((npix, 3))
-        self.counts = np.zeros(_kernels().NCOUNTS, np.int64)
+        self.counts = np.zeros(PATH_COUNTS, np.int64)
         self.samples = 0
         self.timings = {"build": time.perf_counter() - t0, "bvh_build": sd.bvh_build_time, "trace": 0.0,
                         "trace_cpu": 0.0}
@@ -151,7 +152,7 @@ class PathTraceSession:
         k = _kernels()
         t0 = time.perf_counter()
         k.render_samples(self.geo, self.shading, self.emitters.arrays(), self.cam, self.opts, 0, 0, 0,
-                         np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(k.NCOUNTS, np.int64))
+                         np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(PATH_COUNTS, np.int64))
         return time.perf_counter() - t0
 
     def add_samples(self, n: int) -> np.ndarray:
@@ -194,10 +195,9 @@ class PathTraceSession:
         c = self.counts
         n = self.samples * self.width * self.height
         trace = self.timings["trace"]
-        return {"samples_per_pixel": self.samples, "samples": n, "camera_rays": int(c[0]),
-                "extension_rays": int(c[1]), "shadow_rays": int(c[2]), "ended_by_roulette": int(c[3]),
-                "escaped_paths": int(c[4]), "nonfinite_samples": int(c[5]), "ended_by_bounce_cap": int(c[6]),
-                "mean_path_length": float(c[0] + c[1]) / max(int(c[0]), 1),
+        return {"samples_per_pixel": self.samples, "samples": n, **{col.name.lower(): int(c[col]) for col in PathCount},
+                "mean_path_length": float(c[PathCount.CAMERA_RAYS] + c[PathCount.EXTENSION_RAYS])
+                / max(int(c[PathCount.CAMERA_RAYS]), 1),
                 "samples_per_s": n / trace if trace > 0 else 0.0,
                 "samples_per_cpu_s": n / self.timings["trace_cpu"] if self.timings["trace_cpu"] > 0 else 0.0,
                 "noise_rmse": self.noise_rmse, "emitter_triangles": len(self.emitters.cdf),

@@ -29,13 +29,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ...core.columns import pack
 from ...core.tol import tol
 from ...core.transform import transform_normals
 from ...scene import model as m
 from ...scene.kinds import PACKAGE_KINDS, kernel_kinds, kind_of
 from ...scene.kinds.csg import CSGNODE
 from ...scene.prepared import PreparedScene, prepare
-from ..kernels.columns import LIGHT_COLS, Light, Mat, pack
+from ..kernels.columns import LIGHT_COLS, Light, Mat
 from ..kernels.layout import Geometry, kinds_marker, marker_name
 
 if TYPE_CHECKING:

@@ -30,8 +30,8 @@ import numba as nb
 import numpy as np
 from numba import prange
 
-from ..kernels.columns import Light, Mat, WhittedOpt
-from ..kernels.flags import INLINE, NO_REFCOUNT
+from ..kernels.columns import RAY_COUNTS, Light, Mat, RayCount, WhittedOpt
+from ..kernels.flags import INLINE, NO_REFCOUNT, TASK
 from ..kernels.intersect import closest, scratch, surface
 from ..kernels.optics import (_facing, _feeler, _ior, _light_dir, _pow, camera_ray, checker_color,
                               fresnel_reflectance)
@@ -167,7 +167,7 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
 
     ``opts``: columns :class:`..kernels.columns.WhittedOpt` (a miss adds ``background`` if
     ``WhittedOpt.BACKGROUND``, else nothing here: an environment map is evaluated by the
-    caller; the media around the camera are read by :func:`pixel_block`).
+    caller; the media around the camera are read by :func:`pixels_task`).
     """
     O, D, w, depth, stk, nstk = rays
     t, prim, ng, nsh, col, ev, vis_in = hits
@@ -184,11 +184,11 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
     nl = lights.shape[0]
     solid = geo.solid
     out_kind[s0], out_kind[s0 + 1] = 0, 0
-    for q in range(7):
+    for q in range(RAY_COUNTS):
         counts[i, q] = 0
     k = prim[i]
     if k < 0:
-        counts[i, 6] = 1
+        counts[i, RayCount.ESCAPED_RAYS] = 1
         for q in range(3):
             contrib[i, q] = w[i, q] * background[q] if add_bg else 0.0
         return
@@ -259,7 +259,7 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
         lg += lights[li, Light.POWER + 1] * f * (kd * cg * ndl + spec)
         lb += lights[li, Light.POWER + 2] * f * (kd * cb * ndl + spec)
     contrib[i, 0], contrib[i, 1], contrib[i, 2] = w0 * lr, w1 * lg, w2 * lb
-    counts[i, 0] = nshadow
+    counts[i, RayCount.SHADOW_RAYS] = nshadow
     # ---- reflection / transmission weights (Whitted 1980; Fresnel optional)
     kr, kt = mat_tab[mi, Mat.KR], mat_tab[mi, Mat.KT]
     if not do_refl:
@@ -300,7 +300,7 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
         kk = 1.0 - eta * eta * (1.0 - cosi * cosi)
         if kk <= 0.0:  # total internal reflection (or exactly critical): all to reflection
             wr, wt = kr + kt, 0.0
-            counts[i, 3] = 1
+            counts[i, RayCount.TOTAL_INTERNAL_REFLECTIONS] = 1
         else:
             cost = math.sqrt(kk)
             tx, ty, tz = _normalize(eta * dx + (eta * cosi - cost) * fx,
@@ -314,11 +314,11 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
         if kb <= 0.0:
             continue
         if depth[i] + 1 >= max_depth:
-            counts[i, 1] += 1
+            counts[i, RayCount.ENDED_BY_DEPTH] += 1
             continue
         b0, b1_, b2_ = w0 * kb, w1 * kb, w2 * kb
         if max(b0, b1_, b2_) <= threshold:
-            counts[i, 2] += 1
+            counts[i, RayCount.ENDED_BY_THRESHOLD] += 1
             continue
         s = s0 + branch
         if branch == 0:
@@ -336,7 +336,7 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
                 out_stk[s, q] = stk[i, q]
             out_nstk[s] = ns_
             out_kind[s] = 1
-            counts[i, 4] += 1
+            counts[i, RayCount.REFLECTED_RAYS] += 1
         else:
             out_o[s, 0], out_o[s, 1], out_o[s, 2] = px - off * fx, py - off * fy, pz - off * fz
             out_d[s, 0], out_d[s, 1], out_d[s, 2] = tx, ty, tz
@@ -360,7 +360,7 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
                             q2 += 1
                     out_nstk[s] = ns_ - 1
             out_kind[s] = 2
-            counts[i, 5] += 1
+            counts[i, RayCount.REFRACTED_RAYS] += 1
         out_w[s, 0], out_w[s, 1], out_w[s, 2] = b0, b1_, b2_
         out_tmin[s] = t_min * max(max(abs(out_o[s, 0]), abs(out_o[s, 1]), abs(out_o[s, 2])), extent)
         out_gen[s] = depth[i] + 1
@@ -433,13 +433,13 @@ def render_pixels(geo, shading, pixels, spp, first, ncancel, counts):
     (``pixels.O, pixels.D`` rows ``p spp ... p spp + spp - 1``; with ``O`` empty and
     ``spp = 1``, the centre ray of image pixel ``first + p`` of the camera ``pixels.cam``, see
     ``whitted.camera_frame``) and their reflected and refracted descendants are traced depth
-    first (:func:`pixel_block`), so no array crosses back to Python between ray generations.
+    first (:func:`pixels_task`), so no array crosses back to Python between ray generations.
     ``geo``: :class:`..kernels.layout.Geometry`; ``shading``: :class:`Shading`; ``pixels``:
     :class:`Pixels`.
 
     Writes ``image[p]`` (mean over the samples), ``depth_map[p]`` (camera-space depth of the
     first sample's primary hit, ``fwd`` the unit view axis, ``inf`` on a miss) and adds the
-    ray counts of :func:`shade_hit` to ``counts`` (7,).  Blocks of ``PIXEL_BLOCK`` pixels are
+    ray counts of :func:`shade_hit` to ``counts`` (``RAY_COUNTS``,).  Blocks of ``PIXEL_BLOCK`` pixels are
     dealt to a few tasks per thread in a scrambled order (:func:`pixels_task`, run on threads
     by :func:`..kernels.tasks.run_tasks`), so that each thread gets a fair share of the
     expensive parts of the image.
@@ -452,27 +452,15 @@ def render_pixels(geo, shading, pixels, spp, first, ncancel, counts):
             stride += 1
     nit = max(1, min(nblocks, MAX_TASKS))
     part = np.zeros((nit, 8), np.int64)  # a row per task (8: rows a cache line apart)
-    run_tasks(pixels_task, nit, geo, shading, pixels, spp, first, ncancel, part, stride)
-    counts += part[:, :7].sum(axis=0)
-
-
-@nb.njit(cache=True, error_model="numpy", nogil=True)
-def pixels_task(geo, shading, pixels, spp, first, ncancel, part, stride, c, nit):
-    """Task ``c`` of ``nit`` of :func:`render_pixels`: blocks ``c, c + nit, ...`` in the
-    scrambled order ``b = k stride mod nblocks``; its ray counts go to ``part[c]``."""
-    npix = pixels.image.shape[0]
-    nblocks = (npix + PIXEL_BLOCK - 1) // PIXEL_BLOCK
     cap = 2 * int(shading.opts[WhittedOpt.GENERATIONS]) + 2
-    scr, bufs = scratch(), ray_stack(cap)
-    for k in range(c, nblocks, nit):
-        b = (k * stride) % nblocks
-        pixel_block(geo, shading, pixels, spp, first, ncancel, part[c], b * PIXEL_BLOCK,
-                    min(npix, (b + 1) * PIXEL_BLOCK), scr, bufs)
+    run_tasks(pixels_task, nit, geo, shading, pixels, spp, first, ncancel, part, stride,
+              per_task=lambda c: (scratch(), ray_stack(cap)))
+    counts += part[:, :RAY_COUNTS].sum(axis=0)
 
 
 @nb.njit(cache=True, error_model="numpy")
 def ray_stack(cap):
-    """Work arrays of :func:`pixel_block`: ``cap`` pending rays (origin, direction, weight,
+    """Work arrays of :func:`pixels_task`: ``cap`` pending rays (origin, direction, weight,
     media stack and its size, kind, tmin, generation), then the current ray and its hit (one
     row each: origin, direction, weight, media stack and size, generation, t, primitive,
     normals, uv, object-space point, emission, colour, contribution, counts), the block's
@@ -483,17 +471,19 @@ def ray_stack(cap):
             np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 3)), np.zeros((1, 4), np.int64),
             np.zeros(1, np.int64), np.zeros(1, np.int64), np.empty(1), np.empty(1, np.int64),
             np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 2)), np.empty((1, 3)), np.empty((1, 3)),
-            np.zeros((1, 3)), np.empty((1, 3)), np.zeros((1, 7), np.int64), np.zeros(7, np.int64),
+            np.zeros((1, 3)), np.empty((1, 3)), np.zeros((1, RAY_COUNTS), np.int64), np.zeros(RAY_COUNTS, np.int64),
             np.empty((0, 1)))
 
 
-@nb.njit(**NO_REFCOUNT)
-def pixel_block(geo, shading, pixels, spp, first, ncancel, counts, p0, p1, scr, bufs):
-    """Pixels ``p0 .. p1 - 1`` of :func:`render_pixels`: each primary ray and its descendants
-    depth first with an explicit stack of pending rays (the course's ``raytrace`` recursion),
-    shaded by :func:`shade_hit`; textured colours from the ``tex_tab`` checkers
-    (:func:`checker_color`).  Adds the ray counts to ``counts`` (7,).  ``scr``:
-    :func:`scratch`; ``bufs``: :func:`ray_stack`."""
+@nb.njit(**TASK)
+def pixels_task(geo, shading, pixels, spp, first, ncancel, part, stride, scr, bufs, c, nit):
+    """Task ``c`` of ``nit`` of :func:`render_pixels`: pixel blocks ``c, c + nit, ...`` in the
+    scrambled order ``b = k stride mod nblocks``, each primary ray and its descendants depth
+    first with an explicit stack of pending rays (the course's ``raytrace`` recursion), shaded
+    by :func:`shade_hit`; textured colours from the ``tex_tab`` checkers
+    (:func:`checker_color`).  Adds the ray counts to ``part[c]`` (``RAY_COUNTS``,).  ``scr``:
+    :func:`scratch`; ``bufs``: :func:`ray_stack`, the task's own (made by the caller: this
+    kernel allocates nothing, so it is compiled without reference counting)."""
     mat_of, mat_tab, tex_tab, lights, ambient, background, opts = shading
     O, D, fwd, cam, image, depth_map = pixels
     zero, rel_eps, extent = opts[WhittedOpt.ZERO], opts[WhittedOpt.RAY_OFFSET], opts[WhittedOpt.EXTENT]
@@ -504,66 +494,71 @@ def pixel_block(geo, shading, pixels, spp, first, ncancel, counts, p0, p1, scr, 
     cur = (c_o, c_d, c_w, c_gen, c_stk, c_n)
     hits = (h_t, h_p, h_ng, h_ns, h_col, h_ev, h_vis)
     pending = (r_o, r_d, r_w, r_stk, r_n, r_kind, r_tmin, r_gen)
-    for p in range(p0, p1):
-        ar, ag, ab = 0.0, 0.0, 0.0
-        for s in range(spp):
-            i = p * spp + s
-            if O.shape[0] > 0:
+    npix = image.shape[0]
+    nblocks = (npix + PIXEL_BLOCK - 1) // PIXEL_BLOCK
+    counts = part[c]
+    for kb in range(c, nblocks, nit):
+        b = (kb * stride) % nblocks
+        for p in range(b * PIXEL_BLOCK, min(npix, (b + 1) * PIXEL_BLOCK)):
+            ar, ag, ab = 0.0, 0.0, 0.0
+            for s in range(spp):
+                i = p * spp + s
+                if O.shape[0] > 0:
+                    for q in range(3):
+                        r_o[0, q], r_d[0, q] = O[i, q], D[i, q]
+                else:
+                    camera_ray(cam, first + p, r_o, r_d)
                 for q in range(3):
-                    r_o[0, q], r_d[0, q] = O[i, q], D[i, q]
-            else:
-                camera_ray(cam, first + p, r_o, r_d)
-            for q in range(3):
-                r_w[0, q] = 1.0
-            r_n[0], r_tmin[0], r_gen[0] = int(opts[WhittedOpt.N_MEDIA]), 0.0, 0  # the media around the camera
-            for q in range(4):
-                r_stk[0, q] = int(opts[WhittedOpt.MEDIA + q])
-            top = 1
-            while top > 0:
-                top -= 1
-                for q in range(3):
-                    c_o[0, q], c_d[0, q], c_w[0, q] = r_o[top, q], r_d[top, q], r_w[top, q]
+                    r_w[0, q] = 1.0
+                r_n[0], r_tmin[0], r_gen[0] = int(opts[WhittedOpt.N_MEDIA]), 0.0, 0  # the media around the camera
                 for q in range(4):
-                    c_stk[0, q] = r_stk[top, q]
-                c_n[0], c_gen[0] = r_n[top], r_gen[top]
-                ox, oy, oz = c_o[0, 0], c_o[0, 1], c_o[0, 2]
-                dx, dy, dz = c_d[0, 0], c_d[0, 1], c_d[0, 2]
-                eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
-                t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, r_tmin[top], np.inf,
-                                               np.bool_(False), np.bool_(False), zero, eps, stack, st, sp_, sf, sn)
-                h_t[0], h_p[0] = t, k
-                if c_gen[0] == 0 and s == 0:
-                    depth_map[p] = t * (dx * fwd[0] + dy * fwd[1] + dz * fwd[2]) if k >= 0 else np.inf
-                if k >= 0:
-                    surface(geo, k, f, tri, b1, b2, ox + t * dx, oy + t * dy, oz + t * dz, ncancel,
-                            h_ng, h_ns, h_uv, h_po, h_ev, 0, stack)
-                    mi = mat_of[k]
-                    if mat_tab[mi, Mat.TEXTURED] > 0.5:
-                        tr_, tg_, tb_ = checker_color(tex_tab, mi, h_po[0, 0], h_po[0, 1], h_po[0, 2])
-                        h_col[0, 0] = mat_tab[mi, Mat.COLOR] * tr_
-                        h_col[0, 1] = mat_tab[mi, Mat.COLOR + 1] * tg_
-                        h_col[0, 2] = mat_tab[mi, Mat.COLOR + 2] * tb_
-                shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, cur, row, hits,
-                          contrib, pending, top, cnt, scr)
-                ar += contrib[0, 0]
-                ag += contrib[0, 1]
-                ab += contrib[0, 2]
-                for q in range(7):
-                    tot[q] += cnt[0, q]
-                # keep the children that exist on the stack
-                if r_kind[top] != 0:
-                    top += 1
+                    r_stk[0, q] = int(opts[WhittedOpt.MEDIA + q])
+                top = 1
+                while top > 0:
+                    top -= 1
+                    for q in range(3):
+                        c_o[0, q], c_d[0, q], c_w[0, q] = r_o[top, q], r_d[top, q], r_w[top, q]
+                    for q in range(4):
+                        c_stk[0, q] = r_stk[top, q]
+                    c_n[0], c_gen[0] = r_n[top], r_gen[top]
+                    ox, oy, oz = c_o[0, 0], c_o[0, 1], c_o[0, 2]
+                    dx, dy, dz = c_d[0, 0], c_d[0, 1], c_d[0, 2]
+                    eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
+                    t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, r_tmin[top], np.inf,
+                                                   np.bool_(False), np.bool_(False), zero, eps, stack, st, sp_, sf, sn)
+                    h_t[0], h_p[0] = t, k
+                    if c_gen[0] == 0 and s == 0:
+                        depth_map[p] = t * (dx * fwd[0] + dy * fwd[1] + dz * fwd[2]) if k >= 0 else np.inf
+                    if k >= 0:
+                        surface(geo, k, f, tri, b1, b2, ox + t * dx, oy + t * dy, oz + t * dz, ncancel,
+                                h_ng, h_ns, h_uv, h_po, h_ev, 0, stack)
+                        mi = mat_of[k]
+                        if mat_tab[mi, Mat.TEXTURED] > 0.5:
+                            tr_, tg_, tb_ = checker_color(tex_tab, mi, h_po[0, 0], h_po[0, 1], h_po[0, 2])
+                            h_col[0, 0] = mat_tab[mi, Mat.COLOR] * tr_
+                            h_col[0, 1] = mat_tab[mi, Mat.COLOR + 1] * tg_
+                            h_col[0, 2] = mat_tab[mi, Mat.COLOR + 2] * tb_
+                    shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, cur, row, hits,
+                              contrib, pending, top, cnt, scr)
+                    ar += contrib[0, 0]
+                    ag += contrib[0, 1]
+                    ab += contrib[0, 2]
+                    for q in range(RAY_COUNTS):
+                        tot[q] += cnt[0, q]
+                    # keep the children that exist on the stack
                     if r_kind[top] != 0:
                         top += 1
-                elif r_kind[top + 1] != 0:
-                    for q in range(3):
-                        r_o[top, q], r_d[top, q], r_w[top, q] = r_o[top + 1, q], r_d[top + 1, q], r_w[top + 1, q]
-                    for q in range(4):
-                        r_stk[top, q] = r_stk[top + 1, q]
-                    r_n[top], r_tmin[top], r_gen[top] = r_n[top + 1], r_tmin[top + 1], r_gen[top + 1]
-                    top += 1
-        image[p, 0], image[p, 1], image[p, 2] = ar / spp, ag / spp, ab / spp
-    for q in range(7):
+                        if r_kind[top] != 0:
+                            top += 1
+                    elif r_kind[top + 1] != 0:
+                        for q in range(3):
+                            r_o[top, q], r_d[top, q], r_w[top, q] = r_o[top + 1, q], r_d[top + 1, q], r_w[top + 1, q]
+                        for q in range(4):
+                            r_stk[top, q] = r_stk[top + 1, q]
+                        r_n[top], r_tmin[top], r_gen[top] = r_n[top + 1], r_tmin[top + 1], r_gen[top + 1]
+                        top += 1
+            image[p, 0], image[p, 1], image[p, 2] = ar / spp, ag / spp, ab / spp
+    for q in range(RAY_COUNTS):
         counts[q] += tot[q]
         tot[q] = 0
 

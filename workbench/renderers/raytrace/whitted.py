@@ -37,6 +37,7 @@ import time
 
 import numpy as np
 
+from ...core.columns import pack
 from ...core.errors import WorkbenchError
 from ...core.tol import tol
 from ...scene import features as F
@@ -44,7 +45,7 @@ from ...scene.model import Mesh, Scene
 from ...scene.prepared import prepare
 from .. import support as sp
 from ..base import Knob, Option, RenderResult, callback
-from ..kernels.columns import CHECKER_PLANAR, CHECKER_SOLID, TEX_COLS, Mat, Tex, WhittedOpt, pack
+from ..kernels.columns import CHECKER_PLANAR, CHECKER_SOLID, RAY_COUNTS, TEX_COLS, Mat, RayCount, Tex, WhittedOpt
 from .accel import ACCELS, accel_extra_bytes
 from .flatten import MAX_CUTOUTS, OPACITY_CUT, SHADOW_CROSSINGS, SceneData, flatten, flatten_bytes
 
@@ -272,7 +273,7 @@ def ensure_compiled(sd: SceneData, fused: bool = False) -> float:
         shading = k.Shading(sd.mat, sd.mat_tab, np.zeros((len(sd.mat_tab), TEX_COLS)), sd.lights,
                             np.zeros(3), np.zeros(3), kopts)
         k.render_pixels(geo, shading, k.Pixels(O, D, np.array([0.0, 0.0, 1.0]), np.zeros(16), np.zeros((1, 3)),
-                                               np.zeros(1)), 1, 0, tol.normal_cancel, np.zeros(7, np.int64))
+                                               np.zeros(1)), 1, 0, tol.normal_cancel, np.zeros(RAY_COUNTS, np.int64))
         return time.perf_counter() - t0
     arr = _alloc(1)
     k.trace_batch(geo, O, D, np.zeros(1), np.full(1, np.inf), tol.zero, tol.ray_offset, 1.0,
@@ -287,11 +288,11 @@ def ensure_compiled(sd: SceneData, fused: bool = False) -> float:
                   np.empty((0, nl)), np.ones((1, 3)), np.zeros(1, np.int64), np.zeros((1, 4), np.int64),
                   np.zeros(1, np.int64), np.zeros(1, np.int64), kopts, np.zeros((1, 3)),
                   ch["o"], ch["d"], ch["w"], ch["stk"], ch["nstk"], ch["kind"], ch["tmin"], ch["pix"],
-                  ch["gen"], np.zeros((1, 7), np.int64))
+                  ch["gen"], np.zeros((1, RAY_COUNTS), np.int64))
     k.accumulate(np.zeros((1, 3)), np.zeros(1, np.int64), np.zeros((1, 3)))
     k.compact(ch["kind"], ch["o"], ch["d"], ch["w"], ch["stk"], ch["nstk"], ch["tmin"], ch["pix"],
               ch["gen"])
-    k.column_sums(np.zeros((1, 7), np.int64))
+    k.column_sums(np.zeros((1, RAY_COUNTS), np.int64))
     return time.perf_counter() - t0
 
 
@@ -353,8 +354,8 @@ def _alloc_children(n):
 
 
 # the columns of shade_batch's counts
-_COUNTS = ("shadow_rays", "ended_by_depth", "ended_by_threshold", "total_internal_reflections",
-           "reflected_rays", "refracted_rays", "escaped_rays")
+_COUNTS = tuple(c.name.lower() for c in RayCount)
+"""The ``stats`` keys of the kernels' ray counts, in column order."""
 
 
 class _Tracer:
@@ -401,7 +402,7 @@ class _Tracer:
         sd = self.sd
         image = np.empty((n_pixels, 3))
         depth_map = np.empty(n_pixels)
-        counts = np.zeros(7, np.int64)
+        counts = np.zeros(RAY_COUNTS, np.int64)
         k = _kernels()
         shading = k.Shading(sd.mat, sd.mat_tab, self.tex_tab, sd.lights, self.ambient, self.col.bg, self.kopts)
         k.render_pixels(self.geo, shading, k.Pixels(O, D, fwd, cam, image, depth_map), spp, first,
@@ -446,7 +447,7 @@ class _Tracer:
                 w = w * alpha[:, None]
             contrib = np.empty((n, 3))
             ch = _alloc_children(n)
-            counts = np.empty((n, 7), np.int64)
+            counts = np.empty((n, RAY_COUNTS), np.int64)
             vis = (self._visibility(O, D, h, ns) if self.has_opacity and self.do_shadow
                    else np.empty((0, len(sd.lights))))
             k.shade_batch(self.geo, sd.mat, sd.mat_tab, sd.lights, self.ambient, self.col.bg, O, D,

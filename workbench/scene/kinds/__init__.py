@@ -58,9 +58,12 @@ Functions (``W`` and ``M`` are (4, 4) ``world_from_object`` including any CSG pa
     the patch builder cuts from its tessellation at triangles about ``h`` long.
 ``flatten(b, obj, index, W, top) -> row``  its rows of the kernels' primitive table, through
     the ray tracer's builder ``b``: ``b.add(PTYPE, index, obj, W, par, top=, solid=,
-    shadow=)`` (``par``: at most ``NPAR`` floats, the kernel functions' parameters), and for
-    kinds with variable-length data the builder's arrays (``b.poly_v``, ``b.meshes``,
-    ``b.add_aux``).
+    shadow=)`` (``par``: a row of the kind's ``Par``, a :class:`workbench.core.columns.Columns`
+    of at most ``NPAR`` columns that its kernels read by name, written with
+    :func:`~workbench.core.columns.pack`), and for kinds with variable-length data the builder's
+    arrays (``b.poly_v``, ``b.meshes``, ``b.add_aux``).
+``Par``  the columns of its ``par`` (every kind but the mesh, which has none); a kind with
+    ``params`` starts it with ``OFFSET = AUX_OFFSET`` (:mod:`.aux_rows`).
 ``params(obj, aux_offset) -> (head, aux)``  kinds with variable-length data (blob, isosurface,
     lathe, prism): the parameter row's head and the numbers that go to the ``aux`` array
     (:func:`.aux_rows.flatten_aux`); the ray tracer's memory estimate counts ``aux``

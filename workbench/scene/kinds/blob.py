@@ -32,10 +32,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.polynomial import Polynomial
 
+from ...core.columns import Columns, pack
 from .. import model as m
 from ..parts import make_part
 from . import values as val
-from .aux_rows import flatten_aux
+from .aux_rows import AUX_OFFSET, flatten_aux
+from .crossing_events import BISECTIONS
 from .marching_cubes import grid_cells, marching_cubes, shade_normals
 
 TYPE = "blob"
@@ -53,8 +55,6 @@ LEVEL_CELLS = 8
 """Marching-cubes cells along the longest side of the bounds per tessellation level."""
 MAX_COMPONENTS = 256
 """Most components a blob may have (the kernels' cost per ray is quadratic in their number)."""
-BISECTIONS = 200
-"""Bisection steps cap: enough to reach adjacent floats from any bracket of finite width."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -258,14 +258,24 @@ def patch_surfaces(obj: Blob, W: np.ndarray, h: float):
 # --------------------------------------------------------------------------- kernel rows
 # (the numba entry points, in .blob_kernels: see .crossing_events for their signatures)
 
+
+class Par(Columns):
+    """Its columns of the primitive table's ``par``: ``COUNT`` components of 5 numbers
+    (centre, radius, strength) in ``aux``, and the field's threshold."""
+
+    OFFSET = AUX_OFFSET
+    COUNT = 1
+    THRESHOLD = 2
+
+
 def flatten(b, obj, index: int, W: np.ndarray, top: bool) -> int:
     """Its row of the ray tracer's primitive table (:func:`.aux_rows.flatten_aux`)."""
     return flatten_aux(b, obj, index, W, top, PTYPE, params(obj, 0), SOLID)
 
 
 def params(b: Blob, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
-    """Parameter row head ``[aux offset, n, T]`` (3,) and aux (5 n,)."""
-    return (np.array([aux_offset, len(b.components), b.threshold], dtype=np.float64),
+    """Parameter row head (:class:`Par`) and aux (5 n,)."""
+    return (pack(Par, offset=aux_offset, count=len(b.components), threshold=b.threshold),
             np.ascontiguousarray(b.components, dtype=np.float64).reshape(-1))
 
 

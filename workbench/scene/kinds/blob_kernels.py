@@ -8,7 +8,8 @@ import math
 import numba as nb
 import numpy as np
 
-from .blob import BISECTIONS
+from .blob import Par
+from .illinois import change
 
 
 @nb.njit(cache=True, error_model="numpy", forceinline=True)
@@ -17,33 +18,10 @@ def _poly(p0, p1, p2, p3, p4, v):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def _change(p0, p1, p2, p3, p4, a, b):
-    """The end past the change of ``poly > 0`` in ``[a, b]`` (where it differs at the ends),
-    narrowed to adjacent floats by the Illinois method (regula falsi that halves the value kept
-    at an end that stays twice; Dowell & Jarratt, BIT 11, 1971): superlinear, and a
-    bisection step wherever the secant point is not strictly inside the bracket."""
-    fa, fb = _poly(p0, p1, p2, p3, p4, a), _poly(p0, p1, p2, p3, p4, b)
-    sa = fa > 0.0
-    side = 0
-    for _ in range(BISECTIONS):
-        m = 0.5 * (a + b)
-        if m <= a or m >= b:
-            break
-        c = (a * fb - b * fa) / (fb - fa)
-        if not (a < c < b):
-            c = m
-        fc = _poly(p0, p1, p2, p3, p4, c)
-        if (fc > 0.0) == sa:
-            a, fa = c, fc
-            if side == -1:
-                fb *= 0.5
-            side = -1
-        else:
-            b, fb = c, fc
-            if side == 1:
-                fa *= 0.5
-            side = 1
-    return b
+def _poly_at(p, v):
+    """The quartic of coefficients ``p = (p0, ..., p4)`` at ``v`` (:func:`.illinois.change`'s
+    function)."""
+    return _poly(p[0], p[1], p[2], p[3], p[4], v)
 
 
 @nb.njit(cache=True, error_model="numpy")
@@ -60,7 +38,8 @@ def _first_change(p0, p1, p2, p3, p4, lo, hi, c1, c2, c3):
         if c <= a:
             continue
         if (_poly(p0, p1, p2, p3, p4, c) > 0.0) != s0:
-            return _change(p0, p1, p2, p3, p4, a, c)
+            p = (p0, p1, p2, p3, p4)
+            return change(_poly_at, p, a, _poly_at(p, a), c, _poly_at(p, c))
         a = c
     return np.inf
 
@@ -161,7 +140,7 @@ def blob_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out, cap):
     ``out`` (at most ``cap``; ``cap = 1`` gives the first hit).  Returns their count.  The
     intervals between chord endpoints are visited in order without sorting (each next endpoint
     is a minimum search), so nothing is allocated."""
-    off, n, T = int(par[k, 0]), int(par[k, 1]), par[k, 2]
+    off, n, T = int(par[k, Par.OFFSET]), int(par[k, Par.COUNT]), par[k, Par.THRESHOLD]
     s = math.sqrt(dx * dx + dy * dy + dz * dz)
     ux, uy, uz = dx / s, dy / s, dz / s
     lo_t, hi_t = tmin * s, tmax * s
@@ -213,7 +192,7 @@ def events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
 @nb.njit(cache=True, error_model="numpy")
 def normal(par, k, aux, face, x, y, z, stack):
     """Outward normal -grad F at the object-space point (not normalised)."""
-    off, n = int(par[k, 0]), int(par[k, 1])
+    off, n = int(par[k, Par.OFFSET]), int(par[k, Par.COUNT])
     nx, ny, nz = 0.0, 0.0, 0.0
     for i in range(n):
         j = off + 5 * i
@@ -231,11 +210,11 @@ def normal(par, k, aux, face, x, y, z, stack):
 @nb.njit(cache=True, error_model="numpy")
 def inside(par, k, aux, x, y, z, stack):
     """F(x, y, z) > T."""
-    off, n = int(par[k, 0]), int(par[k, 1])
+    off, n = int(par[k, Par.OFFSET]), int(par[k, Par.COUNT])
     F = 0.0
     for i in range(n):
         j = off + 5 * i
         q = 1.0 - ((x - aux[j]) ** 2 + (y - aux[j + 1]) ** 2 + (z - aux[j + 2]) ** 2) / (aux[j + 3] * aux[j + 3])
         if q > 0.0:
             F += aux[j + 4] * q * q
-    return F > par[k, 2]
+    return F > par[k, Par.THRESHOLD]

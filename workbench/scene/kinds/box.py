@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...core import transform as tf
+from ...core.columns import Columns, pack
 from .. import model as m, readers as rd
 from ..parts import make_part, polygons
 
@@ -84,9 +85,16 @@ def patch_surfaces(b: m.Box, W: np.ndarray, h: float):
 
 
 # --------------------------------------------------------------------------- ray tracing
+class Par(Columns):
+    """Its columns of the primitive table's ``par``."""
+
+    MIN = 0, 3
+    MAX = 3, 3
+
+
 def flatten(bld, b: m.Box, index: int, W: np.ndarray, top: bool) -> int:
-    """Primitive row: ``par = (min (3), max (3))``."""
-    return bld.add(PTYPE, index, b, W, (*b.min, *b.max), top=top, solid=SOLID)
+    """Primitive row (``par``: :class:`Par`)."""
+    return bld.add(PTYPE, index, b, W, pack(Par, min=b.min, max=b.max), top=top, solid=SOLID)
 
 
 def slab(lo, hi, O, D) -> list[tuple[float, int]]:

@@ -27,6 +27,11 @@ from __future__ import annotations
 
 import numpy as np
 
+BISECTIONS = 200
+"""Steps cap of the kinds' bracketed root searches (the readable twins' bisections and the
+kernels' :func:`.illinois.change`): enough to reach adjacent floats from any bracket of finite
+width."""
+
 
 def alternate(hits: list[tuple[float, int]], inside_at) -> list[tuple[float, int]]:
     """Readable: ``hits`` (t, face) of the line with every piece, and ``inside_at(t)`` the

@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from ...core import transform as tf
+from ...core.columns import Columns, pack
 from ...core.errors import WorkbenchError
 from .. import model as m, readers as rd
 from ..parts import Part, triangle_normals
@@ -172,6 +173,13 @@ def patch_surfaces(node: m.CSG, W: np.ndarray, h: float):
 
 
 # --------------------------------------------------------------------------- ray tracing
+class Par(Columns):
+    """Its columns of the primitive table's ``par``: its postfix program in ``prog``."""
+
+    START = 0
+    LENGTH = 1
+
+
 def flatten(b, node: m.CSG, index: int, W: np.ndarray, top: bool) -> int:
     """The tree as a postfix program over its leaves' rows (``b.leaf``, not intersected on
     their own) and one row ``par = (program start, program length)``."""
@@ -184,7 +192,8 @@ def flatten(b, node: m.CSG, index: int, W: np.ndarray, top: bool) -> int:
     if depth > CSG_DEPTH:
         raise WorkbenchError(f"CSG object {node.name or index + 1}: its tree needs {depth} interval lists "
                              f"at once, the ray tracer holds {CSG_DEPTH} (nest it more evenly)")
-    return b.add(PTYPE, index, node, np.eye(4), (start, len(b.prog) - start), top=True, solid=SOLID)
+    return b.add(PTYPE, index, node, np.eye(4), pack(Par, start=start, length=len(b.prog) - start), top=True,
+                 solid=SOLID)
 
 
 def _program(b, node: m.CSG, index: int, W: np.ndarray):

@@ -25,10 +25,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...core.columns import Columns, pack
 from .. import model as m
 from ..parts import make_part
 from . import values as val
-from .aux_rows import flatten_aux
+from .aux_rows import AUX_OFFSET, flatten_aux
+from .crossing_events import BISECTIONS
 from .expression import Program, compile_expression, evaluate_numpy, gradient_numpy, povray_function
 from .marching_cubes import closed_grid, grid_cells, marching_cubes, pad_outside, shade_normals
 
@@ -48,8 +50,6 @@ LEVEL_CELLS = 8
 MIN_STEP = 2.0 ** -16
 """Smallest marching step, as a fraction of the ray's chord through the bounds (bounds the
 work per ray by 2^16 steps)."""
-BISECTIONS = 200
-"""Bisection steps cap: enough to reach adjacent floats from any bracket of finite width."""
 GRADIENT_CHECK = 17
 """Samples per axis of the grid on which the function and its declared ``max_gradient`` are
 checked at load (:func:`check_samples`)."""
@@ -314,15 +314,31 @@ def patch_surfaces(obj: Isosurface, W: np.ndarray, h: float):
 # --------------------------------------------------------------------------- kernel rows
 # (the numba entry points, in .isosurface_kernels: see .crossing_events for their signatures)
 
+
+class Par(Columns):
+    """Its columns of the primitive table's ``par``: its expression's program (``LENGTH``
+    codes in ``aux``, an operand stack ``DEPTH`` deep), the level, the bound on the field's
+    gradient, and the bounds box."""
+
+    OFFSET = AUX_OFFSET
+    LENGTH = 1
+    THRESHOLD = 2
+    MAX_GRADIENT = 3
+    BOUNDS_MIN = 4, 3
+    BOUNDS_MAX = 7, 3
+    DEPTH = 10
+
+
 def flatten(b, obj, index: int, W: np.ndarray, top: bool) -> int:
     """Its row of the ray tracer's primitive table (:func:`.aux_rows.flatten_aux`)."""
     return flatten_aux(b, obj, index, W, top, PTYPE, params(obj, 0), SOLID)
 
 
 def params(s: Isosurface, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
-    """Parameter row head (11,) and aux (the program's code)."""
-    return (np.array([aux_offset, s.program.length, s.threshold, s.max_gradient, *s.bounds_min,
-                      *s.bounds_max, s.program.depth], dtype=np.float64),
+    """Parameter row head (:class:`Par`) and aux (the program's code)."""
+    return (pack(Par, offset=aux_offset, length=s.program.length, threshold=s.threshold,
+                 max_gradient=s.max_gradient, bounds_min=s.bounds_min, bounds_max=s.bounds_max,
+                 depth=s.program.depth),
             np.ascontiguousarray(s.program.code))
 
 

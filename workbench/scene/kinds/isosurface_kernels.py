@@ -8,43 +8,23 @@ import math
 import numba as nb
 import numpy as np
 
-from .isosurface import BISECTIONS, MIN_STEP
+from .illinois import change
+from .isosurface import MIN_STEP, Par
 from .expression_kernels import evaluate, evaluate_gradient
 
 
 @nb.njit(cache=True, error_model="numpy")
 def _g(par, k, aux, ox, oy, oz, dx, dy, dz, t, stack):
-    return evaluate(aux, int(par[k, 0]), int(par[k, 1]), ox + t * dx, oy + t * dy, oz + t * dz,
-                    stack) - par[k, 2]
+    return evaluate(aux, int(par[k, Par.OFFSET]), int(par[k, Par.LENGTH]), ox + t * dx, oy + t * dy, oz + t * dz,
+                    stack) - par[k, Par.THRESHOLD]
 
 
 @nb.njit(cache=True, error_model="numpy")
-def _narrow(par, k, aux, ox, oy, oz, dx, dy, dz, a, fa, b, fb, stack):
-    """The end past the change of ``g < 0`` in ``[a, b]`` (values ``fa``, ``fb``), narrowed to
-    adjacent floats by the Illinois method (regula falsi halving the value kept at an end that
-    stays twice; Dowell & Jarratt, BIT 11, 1971), bisecting wherever the secant point is not
-    strictly inside the bracket (a NaN value, a flat stretch)."""
-    sa = fa < 0.0
-    side = 0
-    for _ in range(BISECTIONS):
-        m = 0.5 * (a + b)
-        if m <= a or m >= b:
-            break
-        c = (a * fb - b * fa) / (fb - fa)
-        if not (a < c < b):
-            c = m
-        fc = _g(par, k, aux, ox, oy, oz, dx, dy, dz, c, stack)
-        if (fc < 0.0) == sa:
-            a, fa = c, fc
-            if side == -1:
-                fb *= 0.5
-            side = -1
-        else:
-            b, fb = c, fc
-            if side == 1:
-                fa *= 0.5
-            side = 1
-    return b
+def _minus_g(ray, t):
+    """``-g`` at ``t`` (exactly: ``T - F`` is ``-(F - T)`` in floating point), so that the
+    inside ``g < 0`` is :func:`.illinois.change`'s ``> 0``; ``ray = (par, k, aux, o, d, stack)``."""
+    par, k, aux, ox, oy, oz, dx, dy, dz, stack = ray
+    return -_g(par, k, aux, ox, oy, oz, dx, dy, dz, t, stack)
 
 
 @nb.njit(cache=True, error_model="numpy")
@@ -56,7 +36,7 @@ def iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f,
     for a in range(3):
         o = ox if a == 0 else (oy if a == 1 else oz)
         d = dx if a == 0 else (dy if a == 1 else dz)
-        lo, hi = par[k, 4 + a], par[k, 7 + a]
+        lo, hi = par[k, Par.BOUNDS_MIN + a], par[k, Par.BOUNDS_MAX + a]
         if d == 0.0:
             if not lo <= o <= hi:
                 return 0
@@ -71,7 +51,7 @@ def iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f,
             t1, f1 = tb, fb
     if not t0 < t1:
         return 0
-    L = par[k, 3] * math.sqrt(dx * dx + dy * dy + dz * dz)
+    L = par[k, Par.MAX_GRADIENT] * math.sqrt(dx * dx + dy * dy + dz * dz)
     h_min = MIN_STEP * (t1 - t0)
     m = 0
     t = t0
@@ -85,7 +65,7 @@ def iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f,
         tn = min(t + max(h, h_min), t1)
         gn = _g(par, k, aux, ox, oy, oz, dx, dy, dz, tn, stack)
         if (gn < 0.0) != status:
-            b = _narrow(par, k, aux, ox, oy, oz, dx, dy, dz, t, gt, tn, gn, stack)
+            b = change(_minus_g, (par, k, aux, ox, oy, oz, dx, dy, dz, stack), t, -gt, tn, -gn)
             if tmin < b < tmax:
                 out_t[m], out_f[m] = b, 0
                 m += 1
@@ -120,7 +100,7 @@ def normal(par, k, aux, face, x, y, z, stack):
         a = (face - 1) // 2
         sgn = 1.0 if (face - 1) % 2 == 1 else -1.0
         return (sgn if a == 0 else 0.0), (sgn if a == 1 else 0.0), (sgn if a == 2 else 0.0)
-    _, gx, gy, gz = evaluate_gradient(aux, int(par[k, 0]), int(par[k, 1]), x, y, z, stack)
+    _, gx, gy, gz = evaluate_gradient(aux, int(par[k, Par.OFFSET]), int(par[k, Par.LENGTH]), x, y, z, stack)
     if not (math.isfinite(gx) and math.isfinite(gy) and math.isfinite(gz)):
         return 0.0, 0.0, 0.0      # no gradient there (sqrt(0)...): the kernels' zero normal
     return gx, gy, gz
@@ -129,6 +109,8 @@ def normal(par, k, aux, face, x, y, z, stack):
 @nb.njit(cache=True, error_model="numpy")
 def inside(par, k, aux, x, y, z, stack):
     """f(x, y, z) < threshold inside the bounds."""
-    if not (par[k, 4] <= x <= par[k, 7] and par[k, 5] <= y <= par[k, 8] and par[k, 6] <= z <= par[k, 9]):
+    lo, hi = Par.BOUNDS_MIN, Par.BOUNDS_MAX
+    if not (par[k, lo] <= x <= par[k, hi] and par[k, lo + 1] <= y <= par[k, hi + 1]
+            and par[k, lo + 2] <= z <= par[k, hi + 2]):
         return False
-    return evaluate(aux, int(par[k, 0]), int(par[k, 1]), x, y, z, stack) < par[k, 2]
+    return evaluate(aux, int(par[k, Par.OFFSET]), int(par[k, Par.LENGTH]), x, y, z, stack) < par[k, Par.THRESHOLD]

@@ -33,12 +33,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...core.columns import Columns, pack
 from ...core.tol import tol
 from .. import model as m
 from ..parts import make_part
 from . import lathe_spline as spl
 from . import values as val
-from .aux_rows import flatten_aux
+from .aux_rows import AUX_OFFSET, flatten_aux
 from .crossing_events import alternate
 from .outline import first_crossing
 
@@ -360,19 +361,33 @@ def analytic_normals(obj: Lathe, P: np.ndarray):
 # --------------------------------------------------------------------------- kernel rows
 # (the numba entry points, in .lathe_kernels: see .crossing_events for their signatures)
 
+
+class Par(Columns):
+    """Its columns of the primitive table's ``par``: its profile's ``POINTS`` in ``aux`` (a
+    polyline's points, or a spline's ``SEGMENTS`` of :func:`.lathe_spline.aux`), whether it is
+    closed, its orientation, and the spline's code (0: a polyline)."""
+
+    OFFSET = AUX_OFFSET
+    POINTS = 1
+    CLOSED = 2
+    ORIENTATION = 3
+    SPLINE = 4
+    SEGMENTS = 5
+
+
 def flatten(b, obj, index: int, W: np.ndarray, top: bool) -> int:
     """Its row of the ray tracer's primitive table (:func:`.aux_rows.flatten_aux`)."""
     return flatten_aux(b, obj, index, W, top, PTYPE, params(obj, 0), solid(obj))
 
 
 def params(la: Lathe, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
-    """Parameter row head ``[aux offset, points, closed, orientation, spline code, segments]``
-    and aux: (2 k,) the points of a polyline, :func:`.lathe_spline.aux` of a smooth profile."""
+    """Parameter row head (:class:`Par`) and aux: (2 k,) the points of a polyline,
+    :func:`.lathe_spline.aux` of a smooth profile."""
+    head = dict(offset=aux_offset, points=len(la.points), closed=float(la.closed), orientation=la.orientation)
     if la.smooth:
         segs = la.segments
-        return (np.array([aux_offset, len(la.points), float(la.closed), la.orientation,
-                          spl.CODE[la.spline], len(segs)]), spl.aux(segs))
-    return (np.array([aux_offset, len(la.points), float(la.closed), la.orientation, 0.0, len(la.points) - 1]),
+        return pack(Par, **head, spline=spl.CODE[la.spline], segments=len(segs)), spl.aux(segs)
+    return (pack(Par, **head, spline=0.0, segments=len(la.points) - 1),
             np.ascontiguousarray(la.points, dtype=np.float64).reshape(-1))
 
 

@@ -8,8 +8,8 @@ import math
 import numba as nb
 import numpy as np
 
-from .blob import BISECTIONS
-from .lathe import TOL_CUT, TOL_ZERO
+from .illinois import change
+from .lathe import TOL_CUT, TOL_ZERO, Par
 from .lathe_spline import NEWTON, SEED_MARGIN, SEG_FLOATS, SIGMA, STEEP
 
 
@@ -71,9 +71,9 @@ def _segment_roots(aux, j, ox, oy, oz, dx, dy, dz, zero):
 @nb.njit(cache=True, error_model="numpy")
 def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
     """Nearest hit ``tmin < t < tmax``: ``(t, segment)``, ``(inf, 0)`` on a miss."""
-    if par[k, 4] != 0.0:
+    if par[k, Par.SPLINE] != 0.0:
         return _spline_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, stack)
-    off, n = int(par[k, 0]), int(par[k, 1])
+    off, n = int(par[k, Par.OFFSET]), int(par[k, Par.POINTS])
     best, bf = tmax, -1
     for i in range(n - 1):
         cnt, t0, t1 = _segment_roots(aux, off + 2 * i, ox, oy, oz, dx, dy, dz, TOL_ZERO)
@@ -89,11 +89,11 @@ def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
 @nb.njit(cache=True, error_model="numpy")
 def inside(par, k, aux, x, y, z, stack):
     """Even-odd test of ``(rho, y)`` against the closed profile."""
-    if par[k, 2] == 0.0:
+    if par[k, Par.CLOSED] == 0.0:
         return False
-    if par[k, 4] != 0.0:
+    if par[k, Par.SPLINE] != 0.0:
         return _spline_inside(par, k, aux, x, y, z, stack)
-    off, n = int(par[k, 0]), int(par[k, 1])
+    off, n = int(par[k, Par.OFFSET]), int(par[k, Par.POINTS])
     rho = math.hypot(x, z)
     res = False
     for i in range(n):
@@ -110,9 +110,9 @@ def events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
     """Interval list of a closed lathe along the whole line (entering / leaving alternate),
     written to ``out_t``, ``out_f`` (segment); returns the count (hits past ``cap`` are
     dropped: a line meets at most two per segment)."""
-    off, n = int(par[k, 0]), int(par[k, 1])
+    off, n = int(par[k, Par.OFFSET]), int(par[k, Par.POINTS])
     m = 0
-    if par[k, 4] != 0.0:
+    if par[k, Par.SPLINE] != 0.0:
         m = _spline_collect(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack)
     else:
         for i in range(n - 1):
@@ -140,10 +140,10 @@ def events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
 @nb.njit(cache=True, error_model="numpy")
 def normal(par, k, aux, face, x, y, z, stack):
     """Normal of segment ``face`` at the object-space point (unit)."""
-    if par[k, 4] != 0.0:
+    if par[k, Par.SPLINE] != 0.0:
         return _spline_normal(par, k, aux, face, x, y, z, stack)
-    j = int(par[k, 0]) + 2 * face
-    o = par[k, 3]
+    j = int(par[k, Par.OFFSET]) + 2 * face
+    o = par[k, Par.ORIENTATION]
     nr, ny = o * (aux[j + 3] - aux[j + 1]), -o * (aux[j + 2] - aux[j])
     rho = math.hypot(x, z)
     if rho == 0.0:
@@ -182,31 +182,10 @@ def _peval(st, base, deg, s):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def _illinois(st, base, deg, a, b):
-    """The end past the change of ``poly > 0`` in ``[a, b]``, narrowed to adjacent floats by the
-    Illinois method (as :func:`.blob_kernels._change`)."""
-    fa, fb = _peval(st, base, deg, a), _peval(st, base, deg, b)
-    sa = fa > 0.0
-    side = 0
-    for _ in range(BISECTIONS):
-        m = 0.5 * (a + b)
-        if m <= a or m >= b:
-            break
-        c = (a * fb - b * fa) / (fb - fa)
-        if not (a < c < b):
-            c = m
-        fc = _peval(st, base, deg, c)
-        if (fc > 0.0) == sa:
-            a, fa = c, fc
-            if side == -1:
-                fb *= 0.5
-            side = -1
-        else:
-            b, fb = c, fc
-            if side == 1:
-                fa *= 0.5
-            side = 1
-    return b
+def _peval_at(poly, s):
+    """:func:`_peval` of ``poly = (st, base, deg)`` (:func:`.illinois.change`'s function)."""
+    st, base, deg = poly
+    return _peval(st, base, deg, s)
 
 
 @nb.njit(cache=True, error_model="numpy")
@@ -229,7 +208,8 @@ def _roots_in(st, deg, lo, hi):
             b = _get(st, _CRIT + j) if j < nc else hi
             fb = _peval(st, base, d, b) > 0.0
             if b > a and fa != fb:
-                _put(st, _NEW + nn, _illinois(st, base, d, a, b))
+                poly = (st, base, d)
+                _put(st, _NEW + nn, change(_peval_at, poly, a, _peval_at(poly, a), b, _peval_at(poly, b)))
                 nn += 1
             a, fa = b, fb
         for j in range(nn):
@@ -345,7 +325,7 @@ def _spline_segment_hits(aux, j, ox, oy, oz, dx, dy, dz, st):
 
 @nb.njit(cache=True, error_model="numpy")
 def _spline_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, st):
-    off, nseg = int(par[k, 0]), int(par[k, 5])
+    off, nseg = int(par[k, Par.OFFSET]), int(par[k, Par.SEGMENTS])
     best, bf = tmax, -1
     for i in range(nseg):
         j = off + SEG_FLOATS * i
@@ -363,7 +343,7 @@ def _spline_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, st):
 
 @nb.njit(cache=True, error_model="numpy")
 def _spline_collect(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, st):
-    off, nseg = int(par[k, 0]), int(par[k, 5])
+    off, nseg = int(par[k, Par.OFFSET]), int(par[k, Par.SEGMENTS])
     m = 0
     for i in range(nseg):
         j = off + SEG_FLOATS * i
@@ -380,7 +360,7 @@ def _spline_collect(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, st):
 @nb.njit(cache=True, error_model="numpy")
 def _spline_inside(par, k, aux, x, y, z, st):
     """Even-odd count of :func:`.lathe_spline.inside`."""
-    off, nseg = int(par[k, 0]), int(par[k, 5])
+    off, nseg = int(par[k, Par.OFFSET]), int(par[k, Par.SEGMENTS])
     rho = math.hypot(x, z)
     res = False
     for i in range(nseg):
@@ -419,8 +399,8 @@ def _spline_param(aux, j, x, y, z, st):
 
 @nb.njit(cache=True, error_model="numpy")
 def _spline_normal(par, k, aux, face, x, y, z, st):
-    j = int(par[k, 0]) + SEG_FLOATS * face
-    o = par[k, 3]
+    j = int(par[k, Par.OFFSET]) + SEG_FLOATS * face
+    o = par[k, Par.ORIENTATION]
     s = _spline_param(aux, j, x, y, z, st)
     nr, ny = o * _dcubic(aux, j + 4, s), -o * _dcubic(aux, j, s)
     rho = math.hypot(x, z)

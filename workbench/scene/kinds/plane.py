@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...core import transform as tf
+from ...core.columns import Columns, pack
 from .. import model as m, readers as rd
 from ..parts import make_part, polygons
 
@@ -43,11 +44,23 @@ def patch_surfaces(p: m.Plane, W: np.ndarray, h: float):
     return [("polygon", tf.transform_points(W, np.asarray(p.corners())))]
 
 
+class Par(Columns):
+    """Its columns of the primitive table's ``par``: the rectangle's centre, its unit axes
+    ``u``, ``v`` and normal ``n``, and its half sizes along ``u`` and ``v``."""
+
+    POINT = 0, 3
+    U = 3, 3
+    V = 6, 3
+    N = 9, 3
+    HALF_U = 12
+    HALF_V = 13
+
+
 def flatten(b, p: m.Plane, index: int, W: np.ndarray, top: bool) -> int:
-    """Primitive row: ``par = (point (3), u (3), v (3), n (3), w/2, h/2)``."""
+    """Primitive row (``par``: :class:`Par`)."""
     u, v, n = p.frame()
-    return b.add(PTYPE, index, p, W, (*p.point, *u, *v, *n, p.size[0] / 2, p.size[1] / 2), top=top,
-                 solid=SOLID)
+    return b.add(PTYPE, index, p, W, pack(Par, point=p.point, u=u, v=v, n=n, half_u=p.size[0] / 2,
+                                          half_v=p.size[1] / 2), top=top, solid=SOLID)
 
 
 def hits(p: m.Plane, O, D, solid: bool) -> list[tuple[float, int]]:

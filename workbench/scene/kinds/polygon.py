@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...core import transform as tf
+from ...core.columns import Columns, pack
 from ...core.errors import NotApplicable
 from .. import model as m, readers as rd
 from ..parts import make_part, polygons
@@ -45,9 +46,18 @@ def patch_surfaces(p: m.Polygon, W: np.ndarray, h: float):
 
 
 # --------------------------------------------------------------------------- ray tracing
+class Par(Columns):
+    """Its columns of the primitive table's ``par`` (one row per convex piece): the unit
+    normal ``n``, the plane's offset ``n . centroid``, and the piece's vertices in ``poly_v``."""
+
+    NORMAL = 0, 3
+    OFFSET = 3
+    FIRST = 4
+    COUNT = 5
+
+
 def flatten(b, p: m.Polygon, index: int, W: np.ndarray, top: bool, *, shadow: bool = True) -> int:
-    """One primitive row per convex piece: ``par = (n (3), n . centroid, first vertex in
-    poly_v, vertex count, 0)``; returns the last row."""
+    """One primitive row per convex piece (``par``: :class:`Par`); returns the last row."""
     pieces = convex_pieces(p.vertices)
     if len(pieces) > 1 and not top:
         raise NotApplicable(f"object {p.name or index}: a concave polygon inside a CSG "
@@ -59,8 +69,8 @@ def _convex_row(b, verts, index, p, W, top, shadow) -> int:
     v = np.asarray(verts, dtype=np.float64)
     n = np.cross(v[1:-1] - v[0], v[2:] - v[0]).sum(0)
     n = n / np.linalg.norm(n)
-    row = b.add(PTYPE, index, p, W, (*n, float(n @ v.mean(0)), b.n_poly, len(v), 0.0), top=top,
-                solid=SOLID, shadow=shadow)
+    row = b.add(PTYPE, index, p, W, pack(Par, normal=n, offset=float(n @ v.mean(0)), first=b.n_poly, count=len(v)),
+                top=top, solid=SOLID, shadow=shadow)
     b.poly_v.append(v)
     b.n_poly += len(v)
     return row

@@ -19,11 +19,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...core.tol import tol
+from ...core.columns import Columns, pack
 from .. import model as m
 from ..parts import make_part
 from ..polygon_pieces import convex_pieces, ear_triangles
 from . import values as val
-from .aux_rows import flatten_aux
+from .aux_rows import AUX_OFFSET, flatten_aux
 from .crossing_events import alternate
 from .lathe import weld
 from .outline import first_crossing
@@ -246,14 +247,26 @@ def analytic_normals(obj: Prism, P: np.ndarray):
 # --------------------------------------------------------------------------- kernel rows
 # (the numba entry points, in .prism_kernels: see .crossing_events for their signatures)
 
+
+class Par(Columns):
+    """Its columns of the primitive table's ``par``: its polygon's ``VERTICES`` (x, z) pairs in
+    ``aux``, its heights and its orientation (the sign of the polygon's area)."""
+
+    OFFSET = AUX_OFFSET
+    VERTICES = 1
+    Y0 = 2
+    Y1 = 3
+    ORIENTATION = 4
+
+
 def flatten(b, obj, index: int, W: np.ndarray, top: bool) -> int:
     """Its row of the ray tracer's primitive table (:func:`.aux_rows.flatten_aux`)."""
     return flatten_aux(b, obj, index, W, top, PTYPE, params(obj, 0), SOLID)
 
 
 def params(p: Prism, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
-    """Parameter row head ``[aux offset, vertices, y0, y1, orientation]`` and aux (2 k,)."""
-    return (np.array([aux_offset, len(p.polygon), p.y0, p.y1, p.orientation]),
+    """Parameter row head (:class:`Par`) and aux (2 k,)."""
+    return (pack(Par, offset=aux_offset, vertices=len(p.polygon), y0=p.y0, y1=p.y1, orientation=p.orientation),
             np.ascontiguousarray(p.polygon, dtype=np.float64).reshape(-1))
 
 

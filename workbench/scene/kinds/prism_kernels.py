@@ -8,7 +8,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .prism import TOL_CUT
+from .prism import TOL_CUT, Par
 from .lathe_kernels import sort_hits
 
 
@@ -25,7 +25,8 @@ def _in_polygon_nb(aux, off, n, x, z):
 
 @nb.njit(cache=True, error_model="numpy")
 def inside(par, k, aux, x, y, z, stack):
-    return par[k, 2] < y < par[k, 3] and _in_polygon_nb(aux, int(par[k, 0]), int(par[k, 1]), x, z)
+    return (par[k, Par.Y0] < y < par[k, Par.Y1]
+            and _in_polygon_nb(aux, int(par[k, Par.OFFSET]), int(par[k, Par.VERTICES]), x, z))
 
 
 @nb.njit(cache=True, error_model="numpy")
@@ -48,7 +49,7 @@ def _wall(aux, off, n, i, y0, y1, ox, oy, oz, dx, dy, dz):
 @nb.njit(cache=True, error_model="numpy")
 def prism_hits(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, tmin, tmax):
     """Every wall and cap hit ``tmin < t < tmax`` (unsorted), at most ``cap``; returns the count."""
-    off, n, y0, y1 = int(par[k, 0]), int(par[k, 1]), par[k, 2], par[k, 3]
+    off, n, y0, y1 = int(par[k, Par.OFFSET]), int(par[k, Par.VERTICES]), par[k, Par.Y0], par[k, Par.Y1]
     m = 0
     if dy != 0.0:
         for face in range(2):
@@ -67,7 +68,7 @@ def prism_hits(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, tmin, tma
 @nb.njit(cache=True, error_model="numpy")
 def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
     """Nearest hit ``tmin < t < tmax``: ``(t, face)``, ``(inf, 0)`` on a miss."""
-    off, n, y0, y1 = int(par[k, 0]), int(par[k, 1]), par[k, 2], par[k, 3]
+    off, n, y0, y1 = int(par[k, Par.OFFSET]), int(par[k, Par.VERTICES]), par[k, Par.Y0], par[k, Par.Y1]
     best, bf = tmax, -1
     if dy != 0.0:
         for face in range(2):
@@ -108,10 +109,10 @@ def normal(par, k, aux, face, x, y, z, stack):
     """Unit outward normal of ``face``."""
     if face < 2:
         return 0.0, (1.0 if face == 1 else -1.0), 0.0
-    off, n = int(par[k, 0]), int(par[k, 1])
+    off, n = int(par[k, Par.OFFSET]), int(par[k, Par.VERTICES])
     i = face - 2
     j, jn = off + 2 * i, off + 2 * ((i + 1) % n)
     ex, ez = aux[jn] - aux[j], aux[jn + 1] - aux[j + 1]
     ln = math.hypot(ex, ez)
-    o = par[k, 4]
+    o = par[k, Par.ORIENTATION]
     return o * ez / ln, 0.0, -o * ex / ln

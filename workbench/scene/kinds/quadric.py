@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...core.columns import Columns, pack
 from ...core.errors import WorkbenchError
 from ...core.tol import tol
 from .. import model as m, readers as rd
@@ -324,13 +325,20 @@ def patch_surfaces(q: m.Quadric, W: np.ndarray, h: float):
 
 
 # --------------------------------------------------------------------------- ray tracing
+class Par(Columns):
+    """Its columns of the primitive table's ``par``: the upper triangle of the symmetric
+    ``Q`` row by row (``Q00 Q01 Q02 Q03 Q11 Q12 Q13 Q22 Q23 Q33``), then its bounds box."""
+
+    Q = 0, 10
+    BOUNDS_MIN = 10, 3
+    BOUNDS_MAX = 13, 3
+
+
 def flatten(b, q: m.Quadric, index: int, W: np.ndarray, top: bool) -> int:
-    """Primitive row: ``par = (Q00 Q01 Q02 Q03 Q11 Q12 Q13 Q22 Q23 Q33, bounds min (3),
-    bounds max (3))``."""
+    """Primitive row (``par``: :class:`Par`)."""
     Q = np.asarray(q.Q)
-    return b.add(PTYPE, index, q, W, (Q[0, 0], Q[0, 1], Q[0, 2], Q[0, 3], Q[1, 1], Q[1, 2], Q[1, 3],
-                                      Q[2, 2], Q[2, 3], Q[3, 3], *q.bounds_min, *q.bounds_max),
-                 top=top, solid=SOLID)
+    return b.add(PTYPE, index, q, W, pack(Par, q=Q[np.triu_indices(4)], bounds_min=q.bounds_min,
+                                          bounds_max=q.bounds_max), top=top, solid=SOLID)
 
 
 def is_linear(A: float, B: float, C: float) -> bool:

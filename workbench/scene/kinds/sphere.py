@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...core import transform as tf
+from ...core.columns import Columns, pack
 from .. import model as m, readers as rd
 from ..parts import make_part
 
@@ -75,9 +76,16 @@ def patch_surfaces(s: m.Sphere, W: np.ndarray, h: float):
 
 
 # --------------------------------------------------------------------------- ray tracing
+class Par(Columns):
+    """Its columns of the primitive table's ``par``."""
+
+    CENTER = 0, 3
+    RADIUS = 3
+
+
 def flatten(b, s: m.Sphere, index: int, W: np.ndarray, top: bool) -> int:
-    """Primitive row: ``par = (cx, cy, cz, r)``."""
-    return b.add(PTYPE, index, s, W, (*s.center, s.radius), top=top, solid=SOLID)
+    """Primitive row (``par``: :class:`Par`)."""
+    return b.add(PTYPE, index, s, W, pack(Par, center=s.center, radius=s.radius), top=top, solid=SOLID)
 
 
 def hits(s: m.Sphere, O, D, solid: bool) -> list[tuple[float, int]]:
