@@ -270,7 +270,7 @@ def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_
     out_ns[i, 0], out_ns[i, 1], out_ns[i, 2] = gx, gy, gz
 
 
-@nb.njit(error_model="numpy")
+@nb.njit(cache=True, error_model="numpy")
 def scratch():
     """Per-thread work arrays of :func:`closest`: the traversal stack (rows: entry distance,
     child code: a 4-wide node or a leaf; the triangles' traversal uses it from row 0, the
