@@ -20,7 +20,8 @@ is the work of a frame); without it a stage's time is what it waits for.
 
 Usage: python bench/ui_drag_profile.py [--sync] [--step 0] [--display indexed16-kmeans-fs]
        [--seconds 6] [--window 1600x900] [--size 512] [--methods flat,gouraud,phong]
-Writes ``bench/results/ui_drag_profile[_sync][_MODE].json`` and ``docs/benchmarks/ui_drag_profile.md``
+       [--drag-resolution full|adaptive]
+Writes ``bench/results/ui_drag_profile[_sync][_MODE][_adaptive].json`` and ``docs/benchmarks/ui_drag_profile.md``
 (every variant found beside the result) and prints a table.  Needs ``Xvfb``.  ``--smoke``: 0.5 s of
 counted frames, 64 px panels in an 800 x 500 window.
 """
@@ -122,6 +123,7 @@ def run(args) -> dict:
 
     immapp.run = patched
     state = new_state(args.scene, args.methods.split(","), args.size)
+    state.drag.enabled = args.drag_resolution == "adaptive"
     w, h = (int(x) for x in args.window.split("x"))
     t0, c0 = time.perf_counter(), time.process_time()
     main.run(state, None, counting_script, (w, h))
@@ -163,6 +165,9 @@ def main(argv=None) -> None:
     p.add_argument("--sync", action="store_true", help="glFinish at the end of every stage")
     p.add_argument("--step", type=float, default=0.002, help="radians of orbit per frame (0: "
                    "a static camera, the frame without panel draws)")
+    p.add_argument("--drag-resolution", choices=("full", "adaptive"), default="full",
+                   help="the GL panels' resolution during the drag (workbench ui's option; "
+                        "default full: the drag this page has profiled since before the adaptation)")
     p.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     p.add_argument("--script-out", default="", help=argparse.SUPPRESS)
     argv = sys.argv[1:] if argv is None else list(argv)
@@ -197,7 +202,8 @@ def main(argv=None) -> None:
         xvfb.wait(10)
     result = {"load_average_1_5_15_before": load, **json.loads(res.strip().splitlines()[-1])}
     name = ("ui_drag_profile" + ("_sync" if a.sync else "") + ("_static" if not a.step else "")
-            + (f"_{a.display}" if a.display else ""))
+            + (f"_{a.display}" if a.display else "")
+            + ("_adaptive" if a.drag_resolution == "adaptive" else ""))
     PAGE.write(a, result, stem=name)
     log = result["fps_script"]
     print(f"{result['frames']} frames, {log.get('fps', 0):.1f} fps, "

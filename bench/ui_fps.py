@@ -16,7 +16,15 @@ frames) and the results go to ``bench/results/ui_fps.json``:
   drag's first frame and restarts once the camera has rested for
   ``jobs.RESTART_SETTLE_SECONDS``, so during the drag its panel keeps its stale image
   (``cpu_jobs_started`` counts the restarts during the count: 0);
-* ``drag_gl_only``: the same drag with the three GL panels only;
+* ``drag_gl_only``: the same drag with the three GL panels only, at full resolution
+  (``--drag-resolution full``, as every case but the next: their numbers compare with the
+  runs before the adaptive resolution);
+* ``drag_gl_adaptive``: the same drag with the GL panels' resolution adapted to hold 30 fps
+  (``--drag-resolution adaptive``, the window's default, ``ui/drag_resolution.py``);
+  ``drag_scale_median`` is the scale of the panels' sides the drag settled at (median over
+  the counted frames; ``drag_panel_px_median`` in pixels) and ``full_resolution_after_s``
+  the time from the drag's last move until the panels show it at full resolution (both
+  cases log both);
 * ``raytrace_without_window``: the same 512 x 512, 16 spp ray trace rendered by the library in
   a plain process (numba's default threads), for the completion-time comparison;
 * ``material_drag``: the camera rests while the chosen material's ``kd`` slider moves every
@@ -85,8 +93,10 @@ def free_display() -> int:
     raise RuntimeError("no free X display number")
 
 
-def measure(scene: str, size: int, window: str, cpu: bool, script: str) -> dict:
-    """Run ``script`` in the window (three GL panels, plus the ray tracer with ``cpu``)."""
+def measure(scene: str, size: int, window: str, cpu: bool, script: str,
+            drag: str = "full") -> dict:
+    """Run ``script`` in the window (three GL panels, plus the ray tracer with ``cpu``;
+    ``drag``: the ``--drag-resolution``)."""
     n = free_display()
     w, h = (int(x) for x in window.split("x"))
     xvfb = subprocess.Popen(["Xvfb", f":{n}", "-screen", "0", f"{w + 64}x{h + 64}x24",
@@ -100,7 +110,8 @@ def measure(scene: str, size: int, window: str, cpu: bool, script: str) -> dict:
             load = os.getloadavg()
             subprocess.run([str(Path(sys.executable).with_name("workbench")), "ui", scene, "--methods",
                             methods, "--size", str(size), "--window", window,
-                            "--script", f"{SESSIONS}:{script}", "--out", out],
+                            "--drag-resolution", drag, "--script", f"{SESSIONS}:{script}",
+                            "--out", out],
                            cwd=ROOT, check=True, timeout=900,
                            # a folder of its own for the remembered window size: not the user's
                            env={**os.environ, "DISPLAY": f":{n}", "WORKBENCH_CONFIG_DIR": out})
@@ -140,6 +151,12 @@ def soak(result: dict) -> dict:
     return result
 
 
+def fmt_load(case: dict):
+    """The 1-minute load average before the case ran, where recorded."""
+    load = case.get("load_average_1_5_15_before")
+    return None if not load else round(load[0], 2)
+
+
 def tables(res: dict) -> str:
     cpu = f"{res.get('cpu_count')} CPUs, {res.get('processor') or res.get('machine')}"
     rows = []
@@ -148,11 +165,13 @@ def tables(res: dict) -> str:
             continue
         rows.append([name, c.get("window"), c.get("panel_size"), ", ".join(c.get("methods", [])), c["fps"],
                      c.get("cpu_ms_per_frame"), c.get("gui_ms_mean"), c.get("frames"), c.get("gl_panel_draws"),
-                     c.get("raytrace_seconds"), c.get("note", "")[:80]])
+                     c.get("drag_resolution"), c.get("drag_scale_median"), c.get("full_resolution_after_s"),
+                     c.get("raytrace_seconds"), fmt_load(c), c.get("note", "")[:80]])
     out = [f"{cpu}; Xvfb + llvmpipe.  No outside anchor: the plain-process ray trace "
            "(`raytrace_without_window`) is the baseline of the window's background job.", "",
            table(["case", "window", "panel px", "methods", "fps", "CPU ms/frame", "GUI ms (mean)", "frames",
-                  "GL panel draws", "ray trace with the window open (s)", "note"], rows)]
+                  "GL panel draws", "drag resolution", "drag scale (median)", "full resolution after (s)",
+                  "ray trace with the window open (s)", "load (1 min)", "note"], rows)]
     rw = res.get("raytrace_without_window")
     if rw:
         out.append(f"Ray trace without the window ({rw['size']} px, {rw['spp']} spp): {fmt(rw['seconds'])} s on "
@@ -187,6 +206,7 @@ def main(argv=None) -> None:
     cases = {"static_camera_raytrace_running": lambda: measure(a.scene, a.size, a.window, True, "fps_static"),
              "drag_with_raytrace_panel": lambda: measure(a.scene, a.size, a.window, True, "Fps"),
              "drag_gl_only": lambda: measure(a.scene, a.size, a.window, False, "Fps"),
+             "drag_gl_adaptive": lambda: measure(a.scene, a.size, a.window, False, "Fps", "adaptive"),
              "drag_indexed": lambda: measure(a.scene, a.size, a.window, False, "fps_indexed"),
              "drag_gl_bare": lambda: measure(a.scene, a.size, a.window, False, "fps_bare"),
              "material_drag": lambda: measure(a.scene, a.size, a.window, False, "fps_material_drag"),

@@ -35,6 +35,11 @@ def add_parser(sub) -> None:
     p.add_argument("--window", type=size, default=None, metavar="WxH",
                    help="window size in pixels, at least 320x240 (default: the size the window "
                         "had when last closed, else %dx%d)" % WINDOW_SIZE)
+    p.add_argument("--drag-resolution", choices=("adaptive", "full"), default="adaptive",
+                   help="while the camera moves, the GL panels render at the largest resolution "
+                        "that holds 30 frames per second and at full resolution once it rests "
+                        "(adaptive, the default; the Scene window's 'drag at 30 fps'), or always "
+                        "at full resolution (full)")
     p.add_argument("--frames", type=int, default=None, metavar="N",
                    help="close the window after N frames")
     p.add_argument("--script", default=None, metavar="FILE.py:NAME",
@@ -80,6 +85,7 @@ def run(args) -> int:
     from .ui.state import new_state
     from .ui.main import run
     state = new_state(args.scene, args.methods or None, args.size)
+    state.drag.enabled = args.drag_resolution == "adaptive"
     script = make_session(out) if args.script is not None else None
     code = run(state, frames=args.frames, script=script, window=window or WINDOW_SIZE, out=out)
     if code and threading.active_count() > 1:

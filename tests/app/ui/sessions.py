@@ -280,14 +280,28 @@ class Fps:
     job runs any more (the rate is the one *while* a job runs), then the session stays open
     until the jobs end and logs the ray trace's run time with the window open.  ``display``
     sets every panel's display mode first (e.g. an indexed CLUT); ``standins`` the ``standins``
-    option of every panel that has it (``"off"``: the bare local models)."""
+    option of every panel that has it (``"off"``: the bare local models).  The GL panels'
+    render scale over the count is logged (:meth:`_scales`); after a drag the camera rests
+    and the session logs the seconds from its last move to the start of the frame after the
+    one whose GL panels drew it at full resolution (``full_resolution_after_s``: on screen)."""
 
     def __init__(self, out: Path, seconds: float = 10.0, warmup: int = 10, step: float = 0.002,
                  raytrace_spp: int | None = None, wait_cpu: bool = False,
                  display: str | None = None, standins: str | None = None):
         self.out, self.seconds, self.warmup, self.step, self.log = out, seconds, warmup, step, {}
         self.spp, self.wait_cpu, self.t0, self.display = raytrace_spp, wait_cpu, None, display
-        self.standins = standins
+        self.standins, self.full_frame = standins, None
+
+    def _scales(self, state: AppState) -> dict:
+        """The GL panels' render scale over the counted frames (:mod:`~workbench.app.ui.drag_resolution`):
+        whether it adapted, its median (the resolution the drag settled at, also in pixels)
+        and 10th and 90th percentiles."""
+        median = float(np.median(self.scales))
+        return {"drag_resolution": "adaptive" if state.drag.enabled else "full",
+                "drag_scale_median": median,
+                "drag_scale_p10_p90": np.percentile(self.scales, [10, 90]).round(3).tolist(),
+                "drag_panel_px_median": [round(state.camera.width * median),
+                                         round(state.camera.height * median)]}
 
     def __call__(self, state: AppState) -> None:
         if state.frame == 0 and self.spp is not None:
@@ -301,10 +315,12 @@ class Fps:
                 if "standins" in state.options[m]:
                     set_option(state, m, "standins", self.standins)
             self.log["standins"] = self.standins
-        if self.step:
+        if self.step and "fps" not in self.log:
             state.camera = cam.orbit(state.camera, self.step, 0.0)
+            self.t_moved = time.perf_counter()
         if state.frame == self.warmup:
             self.t0, self.busy_frames, self.gui, self.frame_ms = time.perf_counter(), 0, 0.0, []
+            self.scales = []
             self.counts, self.starts = _gpu_counts(state), state.jobs.count
             self.cpu0 = process_cpu_seconds()
         elif self.t0 is not None and "fps" not in self.log:
@@ -312,6 +328,7 @@ class Fps:
             self.busy_frames += busy
             self.gui += state.gui_seconds
             self.frame_ms.append(state.frame_seconds * 1e3)
+            self.scales.append(state.drag.scale)
             dt = time.perf_counter() - self.t0
             if dt >= self.seconds or (self.wait_cpu and not busy):
                 n = state.frame - self.warmup
@@ -325,9 +342,21 @@ class Fps:
                                 cpu_jobs_started=state.jobs.count - self.starts,
                                 panels_window=window_report()["Panels"].get("size"),
                                 raster_ms={m: state.timings.get(m, 0) * 1e3
-                                           for m in state.methods if method_kind(state, m) == "gl"})
+                                           for m in state.methods if method_kind(state, m) == "gl"},
+                                **self._scales(state))
                 self.t_wait = time.perf_counter()
-                state.quit = not self.wait_cpu
+                state.quit = not (self.wait_cpu or self.step)
+        elif "fps" in self.log and self.step and not self.wait_cpu:
+            # the drag has ended: the first frame after the one whose GL panels drew the
+            # camera at full resolution shows them (its buffer swapped)
+            if self.full_frame is not None and state.frame > self.full_frame:
+                self.log["full_resolution_after_s"] = state.drag.now - self.t_moved  # frame start
+                state.quit = True
+            elif self.full_frame is None and all(p.drawn == state.camera
+                                                 for p in state.gpu.raster.values()):
+                self.full_frame = state.frame
+            elif time.perf_counter() - self.t_moved > CPU_WAIT_SECONDS:
+                state.quit = True
         elif "fps" in self.log and (not state.jobs.busy()
                                     or time.perf_counter() - self.t_wait > CPU_WAIT_SECONDS):
             job = state.jobs.current.get("raytrace")
@@ -886,7 +915,8 @@ class Idle:
 
 class Soak:
     """A long session in a loop: ``rounds`` rounds of a scene switch (through ``scenes``),
-    a method added or removed, a knob change, camera orbits and a difference pair change,
+    a method added or removed, a knob change, camera orbits (at full resolution) and a
+    difference pair change,
     waiting between rounds until the background jobs have ended (``rounds`` rounds, or rounds
     until ``seconds`` have passed).  Logs, every round, its time since the start, the
     process RSS, the jobs the board keeps, and the GL textures, framebuffers, buffers and
@@ -899,7 +929,10 @@ class Soak:
         self.seconds, self.t_start = seconds, time.perf_counter()
 
     def __call__(self, state: AppState) -> None:
+        from workbench.app.ui.drag_resolution import set_adaptive
         from workbench.app.ui.state import set_scene
+        if state.frame == 0:  # drags at full resolution: the framebuffers a drag at adapted
+            set_adaptive(state, False)  # scales leaves (one per scale) depend on the machine's speed
         if state.frame < 2:
             return
         if self.phase < 6:  # a few frames of orbiting (every panel redraws, jobs restart)

@@ -4,7 +4,8 @@ The GPU pass of ``workbench.app.ui.display_modes`` is checked in the test proces
 context against ``core.display`` (the CLI's numbers); the drag itself runs in the window under
 Xvfb (``sessions.DragCheck``, a subprocess as in test_ui.py).  Before: every frame of a drag
 ran the indexed mode on the CPU (0.3-3 s for a 512 px panel: 1-6 fps), and a restarted ray
-trace blanked its panel until its bands came."""
+trace blanked its panel until its bands came.  The drag runs at full resolution
+(``--drag-resolution full``: the probe compares pixels of the panels' size)."""
 from __future__ import annotations
 
 import json
@@ -88,7 +89,7 @@ def test_gpu_indexed_drag_view_uses_the_clut_within_one_cell(gl_ctx):
 @pytest.mark.gl
 def test_drag_with_an_indexed_mode_and_a_ray_traced_panel(xvfb, tmp_path):
     p = subprocess.run([*ui_command(), "whitted",
-                        "--methods", "flat,phong,raytrace", "--size", "96",
+                        "--methods", "flat,phong,raytrace", "--size", "96", "--drag-resolution", "full",
                         "--script", script_of("DragCheck"), "--out", str(tmp_path)],
                        cwd=ROOT, env={**os.environ, "DISPLAY": xvfb}, capture_output=True,
                        text=True, timeout=400)

@@ -7,7 +7,8 @@ rests each panel is drawn once more, timed, and shown from its display texture. 
 ``drag_rest`` script (``sessions.DragRest``, a subprocess under Xvfb as in test_ui.py) drags
 for six frames; here the panels' linear images, the window as the X server showed it in the
 drag's last frame and the rested window are compared with the CLI's render at the final
-camera."""
+camera.  The drag runs at full resolution (``--drag-resolution full``); the adapted
+resolution's drag is checked by test_ui_drag_resolution.py."""
 from __future__ import annotations
 
 import json
@@ -42,7 +43,7 @@ pytestmark = pytest.mark.gl
 def drag(xvfb, tmp_path_factory):
     out = tmp_path_factory.mktemp("ui_drag_rest")
     p = subprocess.run([*ui_command(), "whitted",
-                        "--methods", ",".join(RASTER), "--size", str(SIZE),
+                        "--methods", ",".join(RASTER), "--size", str(SIZE), "--drag-resolution", "full",
                         "--script", script_of("drag_rest"), "--out", str(out), "--frames", "100"],
                        cwd=ROOT, env={**os.environ, "DISPLAY": xvfb}, capture_output=True,
                        text=True, timeout=300)

@@ -181,6 +181,7 @@ def _loop(state: AppState, max_frames: int | None, script, window: tuple[int, in
         if clock["t"] is not None:
             state.frame_seconds = now - clock["t"]
         clock["t"] = now
+        state.drag.frame(state.camera, now, state.frame_seconds)  # the GL panels' scale
         update_images(state)
         track(state)
         if window_title(state) != clock["title"]:  # the scene changed: so does the title

@@ -15,7 +15,9 @@ per frame before the widgets).
 * During a drag (a panel drawn in consecutive frames) the frame does not wait for the GPU
   after a panel's draw (no ``glFinish``): it is timed once the camera rests, by one more draw
   of the same image (:func:`timed_draw`).  llvmpipe itself still waits where a pass reads a
-  panel whose draw is not done.
+  panel whose draw is not done.  While the camera moves a panel draws at the resolution
+  :mod:`.drag_resolution` chooses for the frame budget (its image is then smaller, shown
+  scaled up in the same rectangle), never timed; at full resolution once the camera rests.
 * CPU and progressive methods are requested from the :class:`~.jobs.JobBoard`; their image is
   taken when the job reports new tiles (``Job.version``), drawn over the panel's previous
   image until done (:func:`over_stale`).
@@ -27,6 +29,7 @@ import time
 
 import numpy as np
 
+from .drag_resolution import render_camera
 from .panel_gpu import PanelGPU, RasterPanel, gpu, read_pixel, stale, take_gpu_stats
 from .state import AppState, method_kind
 
@@ -80,17 +83,19 @@ def refresh_raster(state: AppState, method: str) -> bool:
         g.settle_frame = state.frame
         panel.session.settle(budget=1)
         panel.drawn = None
-    cam = state.camera
+    cam = render_camera(state.drag, state.camera)  # smaller while the camera moves
+    full = cam is state.camera
     if panel.drawn == cam and method in state.images:
-        if not panel.timed:  # the drag has ended: time a draw of the image shown
+        if not panel.timed and full:  # the drag has ended: time a draw of the image shown
             timed_draw(state, panel, method)
             panel.draws += 1
         return False
     fbo = panel.session.framebuffer(cam.width, cam.height)
-    if panel.drawn_frame == state.frame - 1:
-        # drawn last frame too (a drag): no wait for the draw to end, so that llvmpipe's
-        # threads rasterise it while this thread goes on with the frame; it is timed once
-        # the camera rests
+    if panel.drawn_frame == state.frame - 1 or not (full and panel.timed):
+        # drawn last frame too (a drag), at the drag's smaller resolution or back at full
+        # resolution after it: no wait for the draw to end, so that llvmpipe's threads
+        # rasterise it while this thread goes on with the frame; it is timed once the camera
+        # rests at full resolution (the next frame)
         panel.session.draw_to(fbo, cam, *shared_near_far(g, panel.session, cam))
         state.ctx.screen.use()  # back to the window's framebuffer for imgui
         panel.timed = False

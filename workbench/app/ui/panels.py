@@ -7,6 +7,7 @@ from imgui_bundle import imgui
 from . import camera as cam
 from .colours import colour_scale, hot_table
 from .display_passes import SCALE_FLOOR
+from .drag_resolution import render_camera, set_adaptive
 from .export import export
 from .gl_sessions import KNOB_VALUES, STANDIN_CHOICES, draws_standins
 from .inspect import pixel_under_mouse, probe_tooltip, select_ray_tree
@@ -65,7 +66,8 @@ def label_room(*labels: str) -> float:
 
 
 def scene_picker(state: AppState) -> None:
-    """Combo over the bundled scenes (a scene opened from a file is listed first)."""
+    """Combo over the bundled scenes (a scene opened from a file is listed first), the camera
+    and zoom resets, the export and the drag's adaptive resolution (:mod:`.drag_resolution`)."""
     from ...scene.library import bundled
     paths = bundled()
     if state.scene_path not in paths:
@@ -84,6 +86,14 @@ def scene_picker(state: AppState) -> None:
     same_line_if_fits(button_width("export"))
     clicked = imgui.button("export")
     check_fits(state, "export")
+    changed, on = imgui.checkbox("drag at 30 fps", state.drag.enabled)
+    if imgui.is_item_hovered():
+        imgui.set_tooltip("While the camera moves, the GL panels render at the largest resolution\n"
+                          "that holds 30 frames per second, at full resolution once it rests\n"
+                          "(workbench ui --drag-resolution adaptive|full)")
+    check_fits(state, "drag at 30 fps")
+    if changed:
+        set_adaptive(state, on)
     if clicked:
         folder = (state.export_dir / f"{state.scene_path.stem}_{state.frame:06d}").resolve()
         export(state, folder)  # its message (the folder, panels skipped) in status["export"]
@@ -307,8 +317,9 @@ def difference_panel(state: AppState) -> None:
     a, b = state.diff_pair
     if a not in state.images or b not in state.images:
         return
-    shape = (state.camera.height, state.camera.width)
-    if not all(state.images.has_shape(m, shape) for m in (a, b)):
+    # the panels' size, or the GL panels' smaller one during a drag (:mod:`.drag_resolution`)
+    shapes = {(c.height, c.width) for c in (state.camera, render_camera(state.drag, state.camera))}
+    if not all(any(state.images.has_shape(m, s) for s in shapes) for m in (a, b)):
         imgui.text_disabled("waiting for both images at the panels' size")
         return  # one is still the previous scene's (another size): nothing to compare yet
     why = mismatch(state, a, b)
@@ -369,11 +380,13 @@ def colour_wheel(state: AppState) -> None:
 
 
 def status_text(state: AppState) -> str:
-    """GL_RENDERER, frame time (and rate) and each shown method's last run time."""
+    """GL_RENDERER, frame time (and rate), the GL panels' scale while a drag lowers it
+    (:mod:`.drag_resolution`) and each shown method's last run time."""
     parts = [f"{m} {state.timings[m] * 1e3:.0f} ms" for m in state.methods if m in state.timings]
     fps = 1.0 / state.frame_seconds if state.frame_seconds > 0 else 0.0
+    scale = [f"GL panels at {state.drag.scale * 100:.0f} %"] if state.drag.scale < 1.0 else []
     return " | ".join([state.gl_renderer, f"frame {state.frame_seconds * 1e3:.1f} ms "
-                       f"({fps:.0f} fps)", *parts])
+                       f"({fps:.0f} fps)", *scale, *parts])
 
 
 def status_bar(state: AppState) -> None:

@@ -16,6 +16,7 @@ import numpy as np
 
 from ...renderers.base import USER_PREFIX, available, check_methods, get_renderer
 from ...scene.model import Camera, Scene
+from .drag_resolution import DragResolution
 from .images import PanelImages
 from ...scene.features import scene_needs
 from .jobs import RESTART_SETTLE_SECONDS, JobBoard
@@ -199,6 +200,8 @@ class AppState:
     """Close the window at the end of this frame (scripts; SIGTERM and SIGINT)."""
     quit_signal: int = 0
     """The signal that closed the window (0: none)."""
+    drag: DragResolution = field(default_factory=DragResolution)
+    """The GL panels' render resolution while the camera moves (:mod:`.drag_resolution`)."""
 
 
 def choosable_methods() -> list[str]:
