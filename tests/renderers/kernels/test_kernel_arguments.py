@@ -17,15 +17,14 @@ from numba.core.registry import CPUDispatcher
 import workbench
 
 LIMIT = 8
-KNOWN = {"compact", "feeler_batch", "shade_batch", "shade_chunk", "trace_batch", "trace_chunk",
-         "receiver_rows"}
+KNOWN = {"compact", "feeler_batch", "shade_batch", "shade_chunk", "trace_batch", "trace_chunk"}
 """Kernels still over the limit, named so that the list can only shrink: the Whitted wavefront
-drivers (``raytrace/kernels.py``; the kernel-layer issue asks for one Whitted, the fused one)
-and radiosity's ray-cast form-factor rows (``radiosity/kernels.py``, its own intersector, which
-the issue asks to replace by the kernel layer's)."""
+drivers (``raytrace/kernels.py``; the kernel-layer issue asks for one Whitted, the fused one)."""
 RENDERS = [("kinds", "raytrace", {}), ("csg", "raycast", {}), ("mesh", "raytrace", {}),
            ("cornell", "pathtrace", {"spp": 2}), ("cornell", "radiosity", {}),
-           ("cornell", "radiosity", {"form_factors": "raycast", "patch_size": 0.2}), ("whitted", "raytrace", {})]
+           ("cornell", "radiosity", {"form_factors": "raycast", "patch_size": 0.2}),
+           ("cornell", "radiosity", {"solver": "progressive", "shot_rows": "raycast", "patch_size": 0.2}),
+           ("whitted", "raytrace", {})]
 
 
 def _dispatchers():

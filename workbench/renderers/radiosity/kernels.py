@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ..kernels.layout import MAX_DEPTH
+from ..kernels.walks import BVH_STACK, bvh_hit
 
 TWO_PI = 2.0 * np.pi
 
@@ -115,48 +115,14 @@ def analytic_matrix(points, weights, owner, normals, flat, offsets, P, zero):
     return F
 
 
-@njit(cache=True)
-def _hit(o, d, tris, t_min):
-    """Nearest triangle hit by the ray (Moller & Trumbore 1997): (index or -1, front-facing)."""
-    best = np.inf
-    idx = -1
-    front = False
-    for k in range(tris.shape[0]):
-        e1x = tris[k, 1, 0] - tris[k, 0, 0]
-        e1y = tris[k, 1, 1] - tris[k, 0, 1]
-        e1z = tris[k, 1, 2] - tris[k, 0, 2]
-        e2x = tris[k, 2, 0] - tris[k, 0, 0]
-        e2y = tris[k, 2, 1] - tris[k, 0, 1]
-        e2z = tris[k, 2, 2] - tris[k, 0, 2]
-        px, py, pz = _cross(d[0], d[1], d[2], e2x, e2y, e2z)
-        det = e1x * px + e1y * py + e1z * pz
-        if det == 0.0:
-            continue
-        inv = 1.0 / det
-        tx = o[0] - tris[k, 0, 0]
-        ty = o[1] - tris[k, 0, 1]
-        tz = o[2] - tris[k, 0, 2]
-        u = (tx * px + ty * py + tz * pz) * inv
-        if u < 0.0 or u > 1.0:
-            continue
-        qx, qy, qz = _cross(tx, ty, tz, e1x, e1y, e1z)
-        v = (d[0] * qx + d[1] * qy + d[2] * qz) * inv
-        if v < 0.0 or u + v > 1.0:
-            continue
-        t = (e2x * qx + e2y * qy + e2z * qz) * inv
-        if t > t_min and t < best:
-            best = t
-            idx = k
-            # det = -d . (e1 x e2): the counter-clockwise front faces the ray when det > 0
-            front = det > 0.0
-    return idx, front
-
-
 @njit(cache=True, parallel=True)
-def raycast_rows(tris, tri_patch, first_tri, normals, rays, seed, t_min, offset):
+def raycast_rows(tris, tri_patch, first_tri, normals, bvh, bvh_tri, rays, seed, t_min, offset):
     """F (P, P) by Malley's method: for each patch, ``rays`` cosine-distributed rays from
     stratified points (an m x m jittered grid, m^2 = rays, paired with a shuffled jittered
-    grid of directions); F_ij = (rays whose nearest hit is the front of j) / rays."""
+    grid of directions); F_ij = (rays whose nearest hit is the front of j) / rays.  The
+    nearest hit is the kernels' closest-hit walk of the 4-wide BVH of ``tris``
+    (:func:`workbench.renderers.kernels.walks.bvh_hit`; ``bvh_tri``: the row of ``tris`` of
+    each of the BVH's triangles)."""
     P = normals.shape[0]
     F = np.zeros((P, P))
     m = int(np.sqrt(rays))
@@ -186,6 +152,7 @@ def raycast_rows(tris, tri_patch, first_tri, normals, rays, seed, t_min, offset)
         perm = np.random.permutation(nr)
         o = np.empty(3)
         d = np.empty(3)
+        stack = np.empty((BVH_STACK, 4))
         for s in range(nr):
             a = ((s // m) + np.random.random()) / m * cdf[-1]
             b = ((s % m) + np.random.random()) / m
@@ -207,10 +174,15 @@ def raycast_rows(tris, tri_patch, first_tri, normals, rays, seed, t_min, offset)
             d[0] = x * ux + y * vx + z * n[0]
             d[1] = x * uy + y * vy + z * n[1]
             d[2] = x * uz + y * vz + z * n[2]
-            hit, front = _hit(o, d, tris, t_min)
-            if hit >= 0 and front:
-                j = tri_patch[hit]
-                if j != i:
+            _, hit, _, _ = bvh_hit(bvh, o[0], o[1], o[2], d[0], d[1], d[2], t_min, np.inf, np.bool_(False), stack)
+            if hit >= 0:
+                h = bvh_tri[hit]
+                gx, gy, gz = _cross(tris[h, 1, 0] - tris[h, 0, 0], tris[h, 1, 1] - tris[h, 0, 1],
+                                    tris[h, 1, 2] - tris[h, 0, 2], tris[h, 2, 0] - tris[h, 0, 0],
+                                    tris[h, 2, 1] - tris[h, 0, 1], tris[h, 2, 2] - tris[h, 0, 2])
+                # the counter-clockwise front faces the ray when d . (e1 x e2) < 0
+                j = tri_patch[h]
+                if d[0] * gx + d[1] * gy + d[2] * gz < 0.0 and j != i:
                     F[i, j] += 1.0
         for j in range(P):
             F[i, j] /= nr
@@ -332,76 +304,27 @@ def shoot_rows(rows, shooters, areas, rho, B, dB, relax, stop, history, start):
     return len(shooters)
 
 
-@njit(cache=True, forceinline=True)
-def _seg_blocked(tv, box, meta, ox, oy, oz, dx, dy, dz, t0, t1, stack):
-    """Whether any triangle (``tv`` (T, 9), BVH ``box``/``meta`` of
-    :func:`workbench.renderers.raytrace.bvh.build_bvh`) crosses the segment o + t d,
-    t0 < t < t1 (Moller & Trumbore 1997 against each leaf triangle; any hit ends it)."""
-    ix = 1.0 / dx if dx != 0.0 else 1e300
-    iy = 1.0 / dy if dy != 0.0 else 1e300
-    iz = 1.0 / dz if dz != 0.0 else 1e300
-    sp = 0
-    nd = 0
-    while True:
-        a0 = (box[nd, 0] - ox) * ix
-        a1 = (box[nd, 3] - ox) * ix
-        tn, tf = min(a0, a1), max(a0, a1)
-        a0 = (box[nd, 1] - oy) * iy
-        a1 = (box[nd, 4] - oy) * iy
-        tn, tf = max(tn, min(a0, a1)), min(tf, max(a0, a1))
-        a0 = (box[nd, 2] - oz) * iz
-        a1 = (box[nd, 5] - oz) * iz
-        tn, tf = max(tn, min(a0, a1)), min(tf, max(a0, a1))
-        hit_box = tn <= tf * (1.0 + 1e-12) + 1e-300 and tf >= t0 and tn <= t1
-        if hit_box and meta[nd, 1] > 0:
-            for k in range(meta[nd, 0], meta[nd, 0] + meta[nd, 1]):
-                e1x, e1y, e1z = tv[k, 3] - tv[k, 0], tv[k, 4] - tv[k, 1], tv[k, 5] - tv[k, 2]
-                e2x, e2y, e2z = tv[k, 6] - tv[k, 0], tv[k, 7] - tv[k, 1], tv[k, 8] - tv[k, 2]
-                px, py, pz = _cross(dx, dy, dz, e2x, e2y, e2z)
-                det = e1x * px + e1y * py + e1z * pz
-                if det == 0.0:
-                    continue
-                inv = 1.0 / det
-                qx, qy, qz = ox - tv[k, 0], oy - tv[k, 1], oz - tv[k, 2]
-                u = (qx * px + qy * py + qz * pz) * inv
-                if u < 0.0 or u > 1.0:
-                    continue
-                rx, ry, rz = _cross(qx, qy, qz, e1x, e1y, e1z)
-                v = (dx * rx + dy * ry + dz * rz) * inv
-                if v < 0.0 or u + v > 1.0:
-                    continue
-                t = (e2x * rx + e2y * ry + e2z * rz) * inv
-                if t0 < t < t1:
-                    return True
-            nd = -1
-        elif hit_box:
-            if sp < stack.shape[0]:
-                stack[sp] = meta[nd, 0]
-                sp += 1
-            nd = nd + 1
-        else:
-            nd = -1
-        if nd < 0:
-            if sp == 0:
-                return False
-            sp -= 1
-            nd = stack[sp]
-
-
 @njit(cache=True, parallel=True)
-def receiver_rows(shooters, flat, offsets, centres, normals, areas, samples, sample_w,
-                  sample_first, tv, box, meta, offset, t_edge, zero, out):
+def receiver_rows(shooters, polys, patches, samples, bvh, offset, t_edge, zero, out):
     """Ray-cast rows for progressive refinement (Wallace, Elmquist & Haines 1989): for each
     shooter i and every receiver j, the exact point-to-polygon factor F_{dA_j -> A_i} from
-    j's centre (Lambert's formula, :func:`_ff_one`) times the fraction (weighted by
-    ``sample_w``) of segments from j's centre to i's sample points that no triangle blocks;
-    returned in row form ``out[s, j] = F_ji A_j / A_i`` (progressive refinement takes
-    F_ji = F_ij A_i / A_j back), so that shooting uses the receivers' own factors (the
-    gathering system, as the hemicube at j would estimate it) without reciprocity.
+    j's centre (Lambert's formula, :func:`_ff_one`) times the fraction (weighted by the
+    samples' weights) of segments from j's centre to i's sample points that no triangle
+    blocks (the kernels' any-hit walk of the 4-wide BVH,
+    :func:`workbench.renderers.kernels.walks.bvh_hit`); returned in row form
+    ``out[s, j] = F_ji A_j / A_i`` (progressive refinement takes F_ji = F_ij A_i / A_j back),
+    so that shooting uses the receivers' own factors (the gathering system, as the hemicube
+    at j would estimate it) without reciprocity.
 
-    flat/offsets: polygons' vertices concatenated; samples (S, 3), sample_w (S,) and
-    sample_first (P + 1,): points on each patch, already moved off it by ``offset`` along
-    its normal; ``t_edge``: the segment's ends left out, as a fraction of it."""
+    ``polys = (flat, offsets)``: the patches' polygons, vertices concatenated;
+    ``patches = (centres (P, 3), normals (P, 3), areas (P,))``; ``samples = (points (S, 3),
+    weights (S,), first (P + 1,))``: points on each patch, already moved off it by ``offset``
+    along its normal; ``bvh``: the patches' triangles (:func:`..raytrace.bvh.build_bvh4`:
+    ``(node, child, leaf, first, tv4)``); ``t_edge``: the segment's ends left out, as a
+    fraction of it."""
+    flat, offsets = polys
+    centres, normals, areas = patches
+    points, sample_w, sample_first = samples
     P = centres.shape[0]
     scale = 1.0
     for c in range(3):
@@ -418,7 +341,7 @@ def receiver_rows(shooters, flat, offsets, centres, normals, areas, samples, sam
         f = _ff_one(centres[j], normals[j], flat[offsets[i]:offsets[i + 1]], eps, scale)
         if f <= 0.0:
             continue
-        stack = np.empty(MAX_DEPTH + 1, dtype=np.int64)  # a pending child per level
+        stack = np.empty((BVH_STACK, 4))
         ox = centres[j, 0] + offset * normals[j, 0]
         oy = centres[j, 1] + offset * normals[j, 1]
         oz = centres[j, 2] + offset * normals[j, 2]
@@ -426,9 +349,9 @@ def receiver_rows(shooters, flat, offsets, centres, normals, areas, samples, sam
         total = 0.0
         for k in range(sample_first[i], sample_first[i + 1]):
             total += sample_w[k]
-            if not _seg_blocked(tv, box, meta, ox, oy, oz, samples[k, 0] - ox,
-                                samples[k, 1] - oy, samples[k, 2] - oz, t_edge,
-                                1.0 - t_edge, stack):
+            _, tri, _, _ = bvh_hit(bvh, ox, oy, oz, points[k, 0] - ox, points[k, 1] - oy, points[k, 2] - oz,
+                                   t_edge, 1.0 - t_edge, np.bool_(True), stack)
+            if tri < 0:
                 seen += sample_w[k]
         if total > 0.0:
             out[s, j] = f * (seen / total) * areas[j] / Ai

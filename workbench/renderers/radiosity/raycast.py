@@ -1,7 +1,7 @@
 """Ray-cast form factors with occlusion (Malley's method), the independent cross-check of the
 hemicube: cosine-distributed rays leave stratified points of patch i, and F_ij is the
 fraction whose nearest hit is the front face of patch j (Sillion & Puech 1994, sec. 4.9).
-Unbiased; relative noise ~ 1 / sqrt(rays * F_ij).  Brute-force nearest hit: O(P^2 rays).
+Unbiased; relative noise ~ 1 / sqrt(rays * F_ij).  Nearest hits through the kernels' 4-wide BVH.
 
 :class:`RayRows`: rows for matrix-free progressive refinement, by rays from every receiver to
 the shooter (Wallace et al. 1989).
@@ -19,6 +19,7 @@ def raycast(geom: Geometry, rays: int = 4096, seed: int = 0) -> np.ndarray:
     """F (P, P) by ray casting ``rays`` rays per patch (rounded down to a square)."""
     if rays < 1:
         raise WorkbenchError(f"raycast form factors need at least one ray per patch, got {rays}")
+    from ..raytrace.bvh import build_bvh4
     from .kernels import raycast_rows
     order = np.argsort(geom.tri_patch, kind="stable")
     tris = np.ascontiguousarray(geom.tris[order])
@@ -26,8 +27,10 @@ def raycast(geom: Geometry, rays: int = 4096, seed: int = 0) -> np.ndarray:
     P = len(geom)
     first = np.searchsorted(owner, np.arange(P + 1)).astype(np.int64)
     ext = geom.extent
-    return raycast_rows(tris, owner, first, np.ascontiguousarray(geom.normals), int(rays),
-                        int(seed), tol.t_min * ext, offset_scale(0.0, ext))
+    bvh_tri, bvh = build_bvh4(tris.reshape(-1, 9))
+    return raycast_rows(tris, owner, first, np.ascontiguousarray(geom.normals),
+                        (bvh.node, bvh.child, bvh.leaf, bvh.first, bvh.tv4), bvh_tri.astype(np.int64),
+                        int(rays), int(seed), tol.t_min * ext, offset_scale(0.0, ext))
 
 
 class RayRows:
@@ -35,8 +38,8 @@ class RayRows:
     Elmquist & Haines 1989, "A ray tracing algorithm for progressive radiosity"): when patch
     i shoots, every receiver j takes the exact point-to-polygon factor from its centre to
     patch i (Lambert's formula, unoccluded) times the visible fraction of i, found by rays
-    from j's centre to ``4**level`` points per triangle of i through a BVH of the patches'
-    triangles (:func:`.kernels.receiver_rows`, numba, parallel over receivers); level 0, one
+    from j's centre to ``4**level`` points per triangle of i through the kernels' 4-wide BVH of the
+    patches' triangles (:func:`.kernels.receiver_rows`, numba, parallel over receivers); level 0, one
     ray per triangle (two per quad patch), gives the Cornell box the same solution as level 1
     (1.75 % RMS from the hemicube matrix's) at a third of the cost.
 
@@ -47,7 +50,7 @@ class RayRows:
     """
 
     def __init__(self, geom: Geometry, level: int = 0):
-        from ..raytrace.bvh import build_bvh
+        from ..raytrace.bvh import build_bvh4
         if not (0 <= level <= 3):
             raise WorkbenchError(f"ray-cast rows: level must be 0..3 (1 to 64 rays per triangle), got {level}")
         self.geom, self.level = geom, int(level)
@@ -55,8 +58,8 @@ class RayRows:
         ext = geom.extent
         self.offset = offset_scale(0.0, ext)
         tv = np.ascontiguousarray(geom.tris.reshape(-1, 9), dtype=np.float64)
-        order, self.box, self.meta = build_bvh(tv)
-        self.tv = np.ascontiguousarray(tv[order])
+        _, bvh = build_bvh4(tv)
+        self.bvh = (bvh.node, bvh.child, bvh.leaf, bvh.first, bvh.tv4)
         polys = geom.polygons
         self.offsets = np.zeros(self.P + 1, dtype=np.int64)
         self.offsets[1:] = np.cumsum([len(p) for p in polys])
@@ -88,9 +91,10 @@ class RayRows:
         patches = np.asarray(patches, dtype=np.int64).ravel()
         out = np.zeros((len(patches), self.P))
         g = self.geom
-        receiver_rows(patches, self.flat, self.offsets, np.ascontiguousarray(g.centres),
-                      np.ascontiguousarray(g.normals), np.ascontiguousarray(g.areas, dtype=np.float64),
-                      self.samples, self.sample_w, self.sample_first, self.tv, self.box, self.meta,
+        receiver_rows(patches, (self.flat, self.offsets),
+                      (np.ascontiguousarray(g.centres), np.ascontiguousarray(g.normals),
+                       np.ascontiguousarray(g.areas, dtype=np.float64)),
+                      (self.samples, self.sample_w, self.sample_first), self.bvh,
                       self.offset, tol.t_min, tol.zero, out)
         per = np.diff(self.sample_first)[patches]
         self.rays_cast += int((per * self.P).sum())
