@@ -93,7 +93,7 @@ def main(argv=None) -> None:
     import workbench
     from workbench.renderers.pathtrace import kernels as K
     from workbench.renderers.pathtrace.session import PathTraceSession
-    from workbench.renderers.kernels.columns import PathOpt
+    from workbench.renderers.kernels.columns import PathCount, PathOpt
     from workbench.renderers.kernels.flags import NO_REFCOUNT
     # the module, not its functions: numba's cache key hashes a kernel's closure variables, and a
     # dispatcher pickles differently in every process (the cache would never hit)
@@ -180,7 +180,7 @@ def main(argv=None) -> None:
             for s in range(nsamp):
                 r, g, b = 0.25 + 1e-9 * s, 0.5, 0.125 + 1e-9 * p
                 if not (math.isfinite(r) and math.isfinite(g) and math.isfinite(b)):
-                    counts[5] += 1
+                    counts[PathCount.NONFINITE_SAMPLES] += 1
                     r, g, b = 0.0, 0.0, 0.0
                 sums[p, 0] += r
                 sums[p, 1] += g
