@@ -103,6 +103,7 @@ class Job:
         self.error = None
         self.rows_done = 0
         self.version = 0
+        self.begun = time.perf_counter()  # the elapsed time a job that reports no progress shows
         # a progressive method's job refines one image pass after pass (a session with
         # add_samples(n), image, samples and noise_rmse): the panel shows the running image, its
         # samples per pixel and noise, and the job ends at the method's spp option

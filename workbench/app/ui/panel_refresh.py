@@ -156,7 +156,7 @@ def refresh_cpu(state: AppState, method: str) -> None:
         state.status[method] = ("refining: " if job.progressive or job.shoots
                                 else "rendering: ") + job.meter.text()
     else:
-        state.status[method] = "rendering..."
+        state.status[method] = waiting_text(method, job)
     shape = (state.camera.height, state.camera.width, 3)
     key = (id(job), job.version, shape, job.cancelled.is_set())
     if stale(state, f"{method} job", key) or method not in state.images:
@@ -226,6 +226,18 @@ def shown_progress(state: AppState, method: str, job, held: dict) -> dict:
         out.update(spp=held["spp"], target_spp=target, passes=held["passes"],
                    noise=held["noise"], converged=held["done"] and held["spp"] >= target)
     return out
+
+
+def waiting_text(method: str, job) -> str:
+    """The status of a job that has reported no progress yet: its elapsed time, and whether
+    progress will come (bands of rows, passes; the hybrid's rows come after its radiosity
+    solve) or the method reports none (it renders in one piece: POV-Ray and Mitsuba in a
+    child process)."""
+    from .meter import clock_text
+    elapsed = clock_text(time.perf_counter() - job.begun)
+    if job.meter is None:
+        return f"rendering, {elapsed} elapsed ({method} reports no progress: one piece)"
+    return f"rendering, {elapsed} elapsed, no {job.meter.unit} yet"
 
 
 def running_meter(job):

@@ -20,7 +20,7 @@ import numpy as np
 
 from ...scene import features as ft
 from ...scene import model as m
-from ..base import Knob, Option, RenderResult
+from ..base import Knob, Option, RenderResult, callback
 from ..base import render as render_method
 from .. import support as sp
 from .method import SUPPORT as RADIOSITY_SUPPORT
@@ -85,6 +85,8 @@ class HybridRenderer:
                "max_depth": Option(int, 5, "ray tracer: maximum ray generations per path"),
                "threshold": Option(float, 1e-3, "ray tracer: weight below which a child ray is not traced", low=0.0),
                "spp": Option(int, 1, "ray tracer: samples per pixel"),
+               "on_tile": Option(callback, None, "callback on_tile(y0, y1, x0, x1, tile) after each band of "
+                                 "rows of the ray-tracing pass (the window's progress)"),
                "fresnel": Option(str, "none", "ray tracer: reflection/transmission split",
                                  ("none", "schlick", "exact"))}
     memory_options = ("patch_size", "hemicube_resolution", "solver", "row_cache_mb",
@@ -103,7 +105,7 @@ class HybridRenderer:
         sol = solve_scene(scene, opts, self.name)
         derived, replaced = derived_scene(scene, sol.patches, sol.radiance)
         rt = render_method(derived, "raytrace", width=width, height=height,
-                           **{k: opts[k] for k in RAYTRACE_OPTIONS})
+                           on_tile=opts["on_tile"], **{k: opts[k] for k in RAYTRACE_OPTIONS})
         timings = dict(sol.timings)
         timings["compile"] += rt.timings.get("compile", 0.0)
         timings["raytrace"] = rt.timings["total"]
