@@ -124,3 +124,18 @@ def test_ray_tracer_and_radiosity_use_the_prepared_extent():
     assert workbench.render(sc, "raycast", width=8, height=6).stats["scene_extent"] == p.extent
     st = workbench.render(sc, "radiosity", width=8, height=6, patch_size=0.5, hemicube_resolution=16).stats
     assert st["patch_size_world"] == 0.5 * p.extent
+
+
+@pytest.mark.parametrize("method", ["radiosity", "raycast", "flat"])
+def test_a_render_builds_its_prepared_scene_once(monkeypatch, method):
+    """The prepared scene is built once per render (issue 27, item 1): the memory estimate and
+    the renderer (radiosity asked twice before) read the one kept on the sized scene."""
+    from workbench.scene import prepared
+
+    built = []
+    real = prepared.build
+    monkeypatch.setattr(prepared, "build", lambda s: built.append(s) or real(s))
+    sc = _far_light_scene()
+    workbench.render(sc, method, width=16, height=12)
+    assert len(built) == 1, [s.camera.width for s in built]
+    assert prepared.prepare(built[0]) is prepared.prepare(built[0])

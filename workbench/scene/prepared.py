@@ -2,8 +2,9 @@
 once per render (issue 14; pbrt-v4's split of the scene description from what the renderer
 builds from it).
 
-Every method's ``render`` (and each long-lived session) calls :func:`prepare` once and reads
-the result: the world bounds of every object and of the whole scene, its extent (the scale of
+Every method's ``render`` (and each long-lived session) calls :func:`prepare`, which builds
+the prepared scene once per scene object and keeps it there, so that a render's estimate, its
+renderer and what it calls read one object: the world bounds of every object and of the whole scene, its extent (the scale of
 every relative tolerance in :mod:`workbench.core.tol`), the area lights as emissive polygons,
 the camera's automatic near and far planes (:mod:`.clip_planes`) and the media holding the
 camera (:mod:`.media`).  Before this step the ray tracer took the extent from its primitive
@@ -114,7 +115,23 @@ def world_points(obj: m.SceneObject, parent: np.ndarray) -> list[np.ndarray]:
 
 
 def prepare(scene: m.Scene) -> PreparedScene:
-    """Build the :class:`PreparedScene` of ``scene`` (for its camera)."""
+    """The :class:`PreparedScene` of ``scene`` (for its camera), built once per scene object and
+    kept on it: a scene is immutable (an edit, a camera or a resolution makes a new one), so a
+    render's memory estimate, its renderer and the renderers it calls in turn (the hybrid's ray
+    tracer on its own derived scene excepted) all read the one built for it."""
+    kept = scene.__dict__.get(_KEPT)
+    if kept is None:
+        kept = build(scene)
+        scene.__dict__[_KEPT] = kept  # a frozen dataclass's __dict__: no field, no __setattr__
+    return kept
+
+
+_KEPT = "_prepared"
+"""The attribute of a :class:`~.model.Scene` that keeps its prepared scene."""
+
+
+def build(scene: m.Scene) -> PreparedScene:
+    """Build the :class:`PreparedScene` of ``scene`` (:func:`prepare` keeps it)."""
     objects = [world_points(o, np.eye(4)) for o in scene.objects]
     area_lights = tuple(scene.area_light_polygons())
     lights = [world_points(polygon, np.eye(4)) for _, polygon, _ in area_lights]
