@@ -11,7 +11,9 @@ at 25 % with 0.98.
 from __future__ import annotations
 
 import importlib
+import sys
 from math import comb
+from pathlib import Path
 
 import pytest
 
@@ -22,7 +24,14 @@ FIRST_SEED = 100
 
 
 def _comparison(name: str):
+    """The seeded comparison ``SEEDED[name]`` (``module:function``, a test module anywhere under
+    tests/), imported from its file: whether pytest has put its folder on ``sys.path`` depends
+    on what else this run collected."""
     module, function = SEEDED[name].split(":")
+    if module not in sys.modules:
+        (path,) = Path(__file__).resolve().parents[1].rglob(f"{module}.py")
+        if str(path.parent) not in sys.path:
+            sys.path.insert(0, str(path.parent))
     return getattr(importlib.import_module(module), function)
 
 
