@@ -274,12 +274,15 @@ def new_state(scene_name: str, methods: list[str] | None = None,
                              f"{USER_PREFIX}FILE (got {', '.join(methods)})")
     check_methods(user)  # a user's shading model file that cannot be used: one line
     examples = Path.cwd() / "examples" / "shading"
+    errors = ErrorPlot()
+    # a panel takes the error plot's reference job of its very request (issue #29)
+    jobs = JobBoard(RESTART_SETTLE_SECONDS, share=errors.boards)
     return AppState(scene=scene, scene_path=path, base_scene=scene,
                     camera=panel_camera(scene.camera, panel_size), methods=methods,
                     options={m: default_options(m) for m in [*allowed, *user]},
                     material=next(iter(scene.materials)), panel_size=panel_size,
-                    diff_pair=(methods[0], methods[min(1, len(methods) - 1)]), jobs=JobBoard(RESTART_SETTLE_SECONDS),
-                    browser=Browser(path.parent), errors=ErrorPlot(), user_methods=user,
+                    diff_pair=(methods[0], methods[min(1, len(methods) - 1)]), jobs=jobs,
+                    browser=Browser(path.parent), errors=errors, user_methods=user,
                     shading_browser=Browser(examples if examples.is_dir() else Path.cwd(),
                                             pattern="*.glsl"))
 
