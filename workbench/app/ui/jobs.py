@@ -174,6 +174,13 @@ class Job:
             self.notify()
 
     def _run(self, scene, method, opts, cached):
+        from ...renderers import gl
+        try:
+            self._render(scene, method, opts, cached)
+        finally:  # a GL context the render made in this thread would outlive it (leaked)
+            gl.end_thread()
+
+    def _render(self, scene, method, opts, cached):
         import numba
 
         from ...renderers.base import render
@@ -269,6 +276,12 @@ class Job:
     def done(self) -> bool:
         return self.image is not None or self.error is not None
 
+    def nbytes(self) -> int:
+        """Bytes of the images the job holds (the partial one and the finished one)."""
+        with self.lock:
+            image = 0 if self.image is None or self.image is self.partial else self.image.nbytes
+            return self.partial.nbytes + image
+
 
 class JobBoard:
     """The current job of each CPU method plus the threads started and not yet ended (joined
@@ -360,6 +373,14 @@ class JobBoard:
             if not job.holders:  # else another board (the error plot's reference) still wants it
                 job.cancelled.set()
             self.waiting.pop(m, None)
+
+    def nbytes(self) -> int:
+        """Bytes of the images its current jobs hold (:meth:`Job.nbytes`)."""
+        return sum(j.nbytes() for j in self.current.values())
+
+    def alive(self) -> bool:
+        """A thread it started has not ended."""
+        return any(j.thread.is_alive() for j in self.started)
 
     def busy(self) -> bool:
         """A job is running or its result is stale (a restart is pending)."""

@@ -195,7 +195,8 @@ def _matched(state: AppState, plot: ErrorPlot, method: str):
         return plot.ref_image, ""
     board = plot.matched_boards.get((ref_m, tuple(sorted(opts.items()))))
     if board is None:
-        board = plot.matched_boards[(ref_m, tuple(sorted(opts.items())))] = JobBoard(cached=True, share=state.jobs)
+        board = JobBoard(cached=True, share=state.jobs)
+        plot.matched_boards.put((ref_m, tuple(sorted(opts.items()))), board)
     job = board.request(state.scene, state.camera, ref_m, opts, tiled=tiled(ref_m))
     what = f"{ref_m} ({options_text(opts)})"
     if job.cancelled.is_set():  # the previous key's job, still ending
@@ -252,6 +253,7 @@ def track(state: AppState) -> None:
         plot.matched, plot.matched_points, plot.matched_pending = {}, {}, {}
         plot.matched_options = {}
         plot.matched_message = ""
+    plot.matched_boards.trim()  # a board's images came since it was put
     _collect(plot, plot.pending, plot.points, "error")
     _collect(plot, plot.matched_pending, plot.matched_points, "matched error")
     if plot.shown < state.frame - 1:  # the plot's window is hidden: no reference render
