@@ -1042,11 +1042,6 @@ def idle_quick(out: Path) -> Idle:
     return Idle(out, seconds=3.0)
 
 
-def soak_quick(out: Path) -> Soak:
-    """:class:`Soak` for 10 rounds."""
-    return Soak(out, rounds=10)
-
-
 def soak_memory(out: Path) -> Soak:
     """:class:`Soak` for 150 s and at least three times its warm-up rounds (the test of the
     window's memory over a session)."""
