@@ -138,3 +138,16 @@ def test_threads_that_make_gl_contexts_do_not_grow_the_process():
     before = _rss()
     threads(20)
     assert _rss() - before < 15 * 2**20  # without end_thread: about 50 MB
+
+
+def test_an_entry_in_use_is_not_evicted():
+    """The error plot's boards of the current view are pinned: evicted, one would be asked for
+    again in the next frame, its render cancelled and started over and over."""
+    in_use = {"a", "b"}
+    cache = LruCache(2, max_bytes=10**9, pinned=in_use.__contains__)
+    for k in "abcd":
+        cache.put(k, k)
+    assert cache.keys() == ["a", "b", "d"]  # c evicted; a and b in use, d used last
+    in_use.clear()
+    cache.trim()
+    assert cache.keys() == ["b", "d"]

@@ -31,7 +31,9 @@ class LruCache:
     (an entry may grow after it was put: a board whose reference render finished); ``on_evict(key,
     value)`` frees what an evicted entry holds.  :meth:`put` and :meth:`trim` evict the least
     recently used entries until at most ``max_items`` remain holding at most ``max_bytes``
-    together; the entry used last is never evicted (alone above ``max_bytes``, it stays alone).
+    together; the entry used last is never evicted (alone above ``max_bytes``, it stays alone),
+    nor one that ``pinned(key)`` says is in use (the cache then holds more than its bounds until
+    it is not).
 
     Attributes
     ----------
@@ -40,12 +42,13 @@ class LruCache:
 
     def __init__(self, max_items: int, max_bytes: int | None = None,
                  size_of: Callable[[object], int] = lambda value: 0,
-                 on_evict: Callable[[object, object], None] | None = None):
+                 on_evict: Callable[[object, object], None] | None = None,
+                 pinned: Callable[[object], bool] = lambda key: False):
         if max_items < 1:
             raise ValueError(f"max_items must be at least 1, got {max_items}")
         self.max_items = int(max_items)
         self.max_bytes = cache_budget() if max_bytes is None else int(max_bytes)
-        self.size_of, self.on_evict = size_of, on_evict
+        self.size_of, self.on_evict, self.pinned = size_of, on_evict, pinned
         self._entries: OrderedDict = OrderedDict()
         self.evictions = 0
 
@@ -72,13 +75,16 @@ class LruCache:
 
     def trim(self) -> None:
         """Evict the least recently used entries beyond ``max_items`` or ``max_bytes``."""
-        sizes = [int(self.size_of(v)) for v in self._entries.values()]
-        total = sum(sizes)
-        k = 0
-        while len(self._entries) > 1 and (len(self._entries) > self.max_items or total > self.max_bytes):
-            key, value = self._entries.popitem(last=False)
-            total -= sizes[k]
-            k += 1
+        sizes = {k: int(self.size_of(v)) for k, v in self._entries.items()}
+        total = sum(sizes.values())
+        last = next(reversed(self._entries), None)
+        for key in list(self._entries):  # least recently used first
+            if len(self._entries) <= self.max_items and total <= self.max_bytes:
+                break
+            if key == last or self.pinned(key):
+                continue
+            value = self._entries.pop(key)
+            total -= sizes[key]
             self.evictions += 1
             if self.on_evict is not None:
                 self.on_evict(key, value)

@@ -72,8 +72,9 @@ class ErrorPlot:
     matched reference follows their stand-ins); ``matched_boards`` render them, one :class:`~.jobs.JobBoard` per (reference method,
     options) (a board runs one job per method), the :data:`MATCHED_BOARDS_KEPT` used last
     within the window's cache budget (:class:`~.bounded.LruCache`: an evicted board's jobs are
-    cancelled, and it is joined at exit from ``retired``); ``matched_message`` says which are
-    still rendering.
+    cancelled, and it is joined at exit from ``retired``), never one the current key uses
+    (``matched_in_use``: evicted, it would be asked for again at once); ``matched_message``
+    says which are still rendering.
     """
 
     key: tuple | None = None
@@ -92,6 +93,7 @@ class ErrorPlot:
     matched_pending: dict = field(default_factory=dict)
     matched_boards: LruCache = None
     retired: list = field(default_factory=list)
+    matched_in_use: set = field(default_factory=set)
     matched_message: str = ""
     metric: str = "rmse"
     hover: str = ""
@@ -107,7 +109,7 @@ class ErrorPlot:
     def __post_init__(self):
         if self.matched_boards is None:
             self.matched_boards = LruCache(MATCHED_BOARDS_KEPT, size_of=lambda board: board.nbytes(),
-                                           on_evict=self._retire)
+                                           on_evict=self._retire, pinned=self.matched_in_use.__contains__)
 
     def _retire(self, _key, board) -> None:
         """An evicted matched board: its jobs cancelled (unless a panel shares one), kept in
