@@ -151,3 +151,24 @@ def test_an_entry_in_use_is_not_evicted():
     in_use.clear()
     cache.trim()
     assert cache.keys() == ["b", "d"]
+
+
+def test_only_the_panels_hidden_last_keep_their_images():
+    from workbench.app.ui.panel_memory import HIDDEN_PANELS_KEPT, keep_hidden, window_bytes
+    from workbench.app.ui.state import new_state
+    state = new_state("whitted", ["phong"], panel_size=32)
+    image = np.zeros((24, 32, 3), np.float32)
+    hidden = ["flat", "gouraud", "raycast", "raytrace"]
+    for m in ["phong", *hidden]:  # each shown, then hidden, in turn
+        state.methods[:] = [m]
+        state.images[m] = image.copy()
+        state.image_requests[m] = (state.camera, state.scene)
+        keep_hidden(state)
+    kept = hidden[-1 - HIDDEN_PANELS_KEPT:-1]
+    assert state.hidden_panels.keys() == kept
+    assert set(state.images) == {"raytrace", *kept}  # the older ones' images freed
+    assert set(state.image_requests) == {"raytrace", *kept}
+    assert window_bytes(state)["hidden"] == HIDDEN_PANELS_KEPT * image.nbytes
+    state.methods[:] = [kept[0]]  # shown again: no longer hidden, its image still there
+    keep_hidden(state)
+    assert kept[0] not in state.hidden_panels and kept[0] in state.images
