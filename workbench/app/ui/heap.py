@@ -8,8 +8,8 @@ job, display-mode and numba threads allocate and free images of 0.5 to 30 MB all
 threshold soon sits above the images' size: they then come from the arenas, whose freed holes
 between live blocks are kept, and the resident size grows with the session (issue #29, item 3).
 Setting the threshold fixes it (glibc then stops adjusting it): the images are mapped again, and
-the arenas keep only small blocks.  Measured on the scripted soak session (``bench/ui_fps.py``,
-docs/benchmarks/ui_fps.md): the resident size and the arenas' free bytes stop growing.
+the arenas keep only small blocks (the soak session before and after: docs/benchmarks/history.md,
+"Memory over a long session").
 """
 from __future__ import annotations
 
