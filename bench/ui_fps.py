@@ -36,11 +36,16 @@ frames) and the results go to ``bench/results/ui_fps.json``:
   (the ray trace, the error plot's reference and evaluations), the frames drawn and the process
   CPU time (every thread) over 10 s (``sessions.Idle``; hello_imgui idles at ``main.IDLE_FPS``),
   then a knob change from the script whose job must still deliver its image;
-* ``soak``: 24 rounds of a scene switch (whitted, csg, cornell, quadrics), a method toggle, knob
-  changes and a short camera drag, each round waiting for the jobs (``sessions.Soak``, 256 px
-  panels): the process RSS, the jobs kept and the GL objects alive after each round;
-  ``soak_10min``: the same rounds for 10 minutes (``rss_growth_mb_round4_to_last``: from round 4,
-  every scene seen once, to the last);
+* ``soak``: 24 rounds of a scene switch (whitted, csg, cornell, quadrics, each with its first
+  view of methods plus Gouraud or the ray caster in turn), knob changes, a short camera drag,
+  the difference view and the error plot shown, each round waiting for the jobs and the plot,
+  then exporting (``sessions.Soak``, 256 px panels, a fresh reference cache): the process RSS,
+  the C heap, the bytes the window holds, the jobs kept and the GL objects alive after each
+  round; ``soak_10min`` and ``soak_30min`` (issue #29, item 3): the same rounds for 10 and 30
+  minutes.  ``rss_mb_warmup_end`` is the highest RSS over the warm-up's last cycle of scenes
+  (by then every scene was seen with each added method), ``rss_mb_last_cycle`` the highest over
+  the last cycle, ``rss_ratio`` the second over the first; ``rss_mb_first_minute_end`` the RSS
+  of the first round logged after 60 s and of the last round;
 * ``drag_indexed``: the ``drag_gl_only`` drag with every GL panel shown through
   ``indexed16-kmeans-fs`` (``sessions.Fps`` with ``display``: during the drag the panels map to
   the CLUT of their last exact image on the GPU, the exact mode is computed once the camera
@@ -93,10 +98,11 @@ def free_display() -> int:
     raise RuntimeError("no free X display number")
 
 
-def measure(scene: str, size: int, window: str, cpu: bool, script: str,
-            drag: str = "full") -> dict:
-    """Run ``script`` in the window (three GL panels, plus the ray tracer with ``cpu``;
-    ``drag``: the ``--drag-resolution``)."""
+def measure(scene: str, size: int, window: str, cpu: bool, script: str, drag: str = "full",
+            methods: str | None = None) -> dict:
+    """Run ``script`` in the window (three GL panels, plus the ray tracer with ``cpu``; or the
+    ``methods`` given, "" for the scene's first view; ``drag``: the ``--drag-resolution``), with
+    a reference cache of its own."""
     n = free_display()
     w, h = (int(x) for x in window.split("x"))
     xvfb = subprocess.Popen(["Xvfb", f":{n}", "-screen", "0", f"{w + 64}x{h + 64}x24",
@@ -105,21 +111,25 @@ def measure(scene: str, size: int, window: str, cpu: bool, script: str,
     try:
         while not Path(f"/tmp/.X11-unix/X{n}").exists():
             time.sleep(0.05)
-        methods = "flat,gouraud,phong" + (",raytrace" if cpu else "")
+        if methods is None:
+            methods = "flat,gouraud,phong" + (",raytrace" if cpu else "")
         with tempfile.TemporaryDirectory() as out:
             load = os.getloadavg()
-            subprocess.run([str(Path(sys.executable).with_name("workbench")), "ui", scene, "--methods",
-                            methods, "--size", str(size), "--window", window,
-                            "--drag-resolution", drag, "--script", f"{SESSIONS}:{script}",
-                            "--out", out],
-                           cwd=ROOT, check=True, timeout=900,
-                           # a folder of its own for the remembered window size: not the user's
-                           env={**os.environ, "DISPLAY": f":{n}", "WORKBENCH_CONFIG_DIR": out})
+            subprocess.run([str(Path(sys.executable).with_name("workbench")), "ui", scene,
+                            *(["--methods", methods] if methods else []),
+                            "--size", str(size), "--window", window, "--drag-resolution", drag,
+                            "--script", f"{SESSIONS}:{script}", "--out", out],
+                           cwd=ROOT, check=True, timeout=2400,
+                           # folders of its own for the remembered window size and the
+                           # references: not the user's
+                           env={**os.environ, "DISPLAY": f":{n}", "WORKBENCH_CONFIG_DIR": out,
+                                "WORKBENCH_REFERENCE_CACHE": str(Path(out, "references"))})
             summary = json.loads(Path(out, "summary.json").read_text())
     finally:
         xvfb.terminate()
         xvfb.wait(10)
-    return {"scene": scene, "panel_size": size, "window": window, "methods": methods.split(","),
+    return {"scene": scene, "panel_size": size, "window": window,
+            "methods": methods.split(",") if methods else summary["methods"],
             "gl_renderer": summary["gl_renderer"], "load_average_1_5_15_before": load,
             **summary["script"]}
 
@@ -142,10 +152,17 @@ print(json.dumps({{"seconds": time.perf_counter() - t0, "numba_threads": numba.g
 
 
 def soak(result: dict) -> dict:
-    """The soak session's rounds summed up: RSS at rounds 4 (every scene seen once) and last."""
-    rounds = result["rounds"]
-    result["rss_mb_round4_last"] = [rounds[4]["rss_mb"], rounds[-1]["rss_mb"]]
-    result["rss_growth_mb_round4_to_last"] = rounds[-1]["rss_mb"] - rounds[4]["rss_mb"]
+    """The soak session's rounds summed up (see the module docstring)."""
+    rounds, warm = result["rounds"], result["warmup_rounds"]
+    cycle = warm // 2  # the scenes' count
+    result["rss_mb_warmup_end"] = max(r["rss_mb"] for r in rounds[warm - cycle + 1:warm + 1])
+    result["rss_mb_last_cycle"] = max(r["rss_mb"] for r in rounds[-cycle:])
+    result["rss_ratio"] = result["rss_mb_last_cycle"] / result["rss_mb_warmup_end"]
+    minute = next((r for r in rounds if r["seconds"] >= 60.0), rounds[-1])
+    result["rss_mb_first_minute_end"] = [minute["rss_mb"], rounds[-1]["rss_mb"]]
+    result["rss_mb_peak"] = max(r["rss_mb"] for r in rounds)
+    result["heap_free_mb_warmup_end_last"] = [rounds[warm].get("heap_free_mb"), rounds[-1].get("heap_free_mb")]
+    result["window_mb_max"] = max(r["window_bytes"]["total"] for r in rounds) / 2**20
     result["session_seconds"] = rounds[-1].get("seconds")
     result["jobs_kept_max"] = max(r["jobs_kept"] for r in rounds)
     return result
@@ -180,9 +197,16 @@ def tables(res: dict) -> str:
     if idle and "idle" in idle:
         i = idle["idle"]
         out.append(f"Idle: {fmt(i['fps'])} fps, {fmt(i['cpu_percent_of_a_core'])} % of a core over {fmt(i['seconds'])} s.\n")
-    for k in ("soak", "soak_10min"):
+    for k in ("soak", "soak_10min", "soak_30min"):
         sk = res.get(k)
-        if sk and "rss_mb_round4_last" in sk:
+        if sk and "rss_ratio" in sk:
+            a, b = sk["rss_mb_first_minute_end"]
+            out.append(f"{k}: {len(sk['rounds'])} rounds in {fmt(sk['session_seconds'])} s; RSS (highest over a cycle of "
+                       f"scenes) {fmt(sk['rss_mb_warmup_end'])} MB at the end of the warm-up -> "
+                       f"{fmt(sk['rss_mb_last_cycle'])} MB over the last cycle (x{fmt(sk['rss_ratio'])}); "
+                       f"{fmt(a)} MB after the first minute -> {fmt(b)} MB at the end; peak {fmt(sk['rss_mb_peak'])} MB; "
+                       f"the window's caches at most {fmt(sk['window_mb_max'])} MB; jobs kept at most {sk.get('jobs_kept_max')}.\n")
+        elif sk and "rss_mb_round4_last" in sk:  # a run before issue #29's soak rounds
             out.append(f"{k}: {len(sk['rounds'])} rounds, RSS {fmt(sk['rss_mb_round4_last'][0])} MB at round 4 -> "
                        f"{fmt(sk['rss_mb_round4_last'][1])} MB at the last; jobs kept at most {sk.get('jobs_kept_max')}.\n")
     return "\n".join(out)
@@ -213,8 +237,9 @@ def main(argv=None) -> None:
              "slider_drag": lambda: measure(a.scene, a.size, a.window, False, "fps_slider_drag"),
              "raytrace_without_window": lambda: raytrace_without_window(a.scene, a.size),
              "idle": lambda: measure(a.scene, a.size, a.window, True, "Idle"),
-             "soak": lambda: soak(measure(a.scene, 256, a.window, True, "Soak")),
-             "soak_10min": lambda: soak(measure(a.scene, 256, a.window, True, "soak_10min"))}
+             "soak": lambda: soak(measure(a.scene, 256, a.window, True, "Soak", methods="")),
+             "soak_10min": lambda: soak(measure(a.scene, 256, a.window, True, "soak_10min", methods="")),
+             "soak_30min": lambda: soak(measure(a.scene, 256, a.window, True, "soak_30min", methods=""))}
     chosen = [c for c in a.cases.split(",") if c] or list(cases)
     bad = [c for c in chosen if c not in cases]
     if bad:

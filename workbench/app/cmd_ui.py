@@ -82,8 +82,10 @@ def run(args) -> int:
         window, note = remembered()
         if note:
             print(note, file=sys.stderr)
+    from .ui.heap import map_large_blocks
     from .ui.state import new_state
     from .ui.main import run
+    map_large_blocks()  # images in mappings of their own, not in the arenas (issue #29)
     state = new_state(args.scene, args.methods or None, args.size)
     state.drag.enabled = args.drag_resolution == "adaptive"
     script = make_session(out) if args.script is not None else None

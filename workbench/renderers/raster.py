@@ -752,6 +752,15 @@ class RasterSession:
         self._uniforms_of, self._camera_of = {}, {}
         self.draws, self.background = [], None
 
+    def gl_bytes(self) -> int:
+        """Bytes of GL memory the session holds (:func:`.gl.object_bytes`): geometry buffers,
+        images, the stand-ins' maps and its framebuffers."""
+        objs = [*self._gl_objects, *self._gl_images.values(), *(f for f, _ in self._fbos.values())]
+        for m in [*self.env_maps.values(), self.shadow_atlas]:
+            if m is not None:
+                objs += [getattr(m, "color", None), m.depth]
+        return sum(gl.object_bytes(o) for o in objs if o is not None)
+
     # ------------------------------------------------------------------ drawing
     def near_far(self, camera: Camera) -> tuple[float, float]:
         return self.prepared.clip_planes(camera)

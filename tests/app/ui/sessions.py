@@ -914,23 +914,41 @@ class Idle:
 
 
 class Soak:
-    """A long session in a loop: ``rounds`` rounds of a scene switch (through ``scenes``),
-    a method added or removed, a knob change, camera orbits (at full resolution) and a
-    difference pair change,
-    waiting between rounds until the background jobs have ended (``rounds`` rounds, or rounds
-    until ``seconds`` have passed).  Logs, every round, its time since the start, the
-    process RSS, the jobs the board keeps, and the GL textures, framebuffers, buffers and
-    programs alive in the window's context (:func:`gl_object_counts`)."""
+    """A long session in a loop (issue #29, item 3: scene switches, drags, method changes and
+    exports): each round switches the scene (through ``scenes``) and shows its first view of
+    methods (``state.first_view``: whitted's Phong and ray tracer; cornell's also radiosity and
+    the path tracer) plus, in turn every ``len(scenes)`` rounds, Gouraud or the ray caster;
+    changes knobs (Phong's tessellation, the ray tracer's depth, the path tracer's samples per
+    pixel, radiosity's patch size); shows the difference between the first and last panels;
+    drags the camera for a few frames and puts it back (the error plot's references of a
+    scene seen before then come from the reference cache); waits until the background jobs,
+    the error plot's reference and its points are done (at most :data:`CPU_WAIT_SECONDS`);
+    exports the comparison into ``out/export``; and logs a round.  The error plot and the
+    difference view are the windows shown in front at start (``layout.windows``).
+
+    The session ends after ``rounds`` rounds, or once ``seconds`` have passed and at least
+    ``min_rounds`` rounds were done.  Each round's log: its time since the start, the process
+    RSS, the C heap (:func:`heap_info`), the jobs the board keeps, the bytes the window holds
+    by kind (:func:`workbench.app.ui.panel_memory.window_bytes`), the hidden panels kept, the
+    error plot's points, the files exported and the GL objects alive in the window's context
+    (:func:`gl_object_counts`).  ``warmup_rounds`` (``2 * len(scenes)``: every scene seen with
+    each added method) is logged: the rounds after it are the session's steady state."""
 
     def __init__(self, out: Path, rounds: int | None = 24,
-                 scenes=("whitted", "csg", "cornell", "quadrics"), seconds: float | None = None):
-        self.out, self.rounds, self.scenes, self.log = out, rounds, scenes, {"rounds": []}
+                 scenes=("whitted", "csg", "cornell", "quadrics"), seconds: float | None = None,
+                 min_rounds: int = 0):
+        self.out, self.rounds, self.scenes = out, rounds, scenes
+        self.seconds, self.min_rounds, self.t_start = seconds, min_rounds, time.perf_counter()
+        self.log = {"rounds": [], "warmup_rounds": 2 * len(scenes)}
         self.round, self.t_wait, self.phase = 0, time.perf_counter(), 0
-        self.seconds, self.t_start = seconds, time.perf_counter()
+
+    def _busy(self, state: AppState) -> bool:
+        return state.jobs.busy() or state.errors.busy(state.frame)
 
     def __call__(self, state: AppState) -> None:
         from workbench.app.ui.drag_resolution import set_adaptive
-        from workbench.app.ui.state import set_scene
+        from workbench.app.ui.panel_memory import window_bytes
+        from workbench.app.ui.state import first_view, choosable_methods, panel_camera, set_scene
         if state.frame == 0:  # drags at full resolution: the framebuffers a drag at adapted
             set_adaptive(state, False)  # scales leaves (one per scale) depend on the machine's speed
         if state.frame < 2:
@@ -939,29 +957,63 @@ class Soak:
             state.camera = cam.orbit(state.camera, 0.05, 0.01)
             self.phase += 1
             return
-        if state.jobs.busy() and time.perf_counter() - self.t_wait < CPU_WAIT_SECONDS:
+        if self.phase == 6:  # the camera put back (as the scene's camera)
+            state.camera = panel_camera(state.scene.camera, state.panel_size)
+            self.phase += 1
             return
-        counts = gl_object_counts(state)
-        self.log["rounds"].append({"round": self.round, "rss_mb": rss_bytes() / 2**20,
-                                   "jobs_kept": len(state.jobs.started),
-                                   "scene": state.scene_path.stem, "methods": list(state.methods),
-                                   **counts})
-        self.log["rounds"][-1]["seconds"] = time.perf_counter() - self.t_start
+        if self._busy(state) and time.perf_counter() - self.t_wait < CPU_WAIT_SECONDS:
+            return
+        exported = export(state, self.out / "export")
+        hidden = state.hidden_panels
+        self.log["rounds"].append({
+            "round": self.round, "seconds": time.perf_counter() - self.t_start,
+            "rss_mb": rss_bytes() / 2**20, **heap_info(), "jobs_kept": len(state.jobs.started),
+            "scene": state.scene_path.stem, "methods": list(state.methods),
+            "window_bytes": window_bytes(state),
+            "hidden_panels": [] if hidden is None else hidden.keys(),
+            "hidden_budget": None if hidden is None else hidden.max_bytes,
+            "plot_points": sum(map(len, state.errors.points.values())),
+            "reference": state.errors.ref_image is not None, "exported": len(exported),
+            "timed_out": self._busy(state), **gl_object_counts(state)})
+        elapsed = time.perf_counter() - self.t_start
         if ((self.rounds is not None and self.round >= self.rounds) or (
-                self.seconds is not None and time.perf_counter() - self.t_start >= self.seconds)):
+                self.seconds is not None and elapsed >= self.seconds and self.round >= self.min_rounds)):
             state.quit = True
             return
-        k = self.round
+        k = self.round + 1
         set_scene(state, self.scenes[k % len(self.scenes)])
-        extra = ("raycast", "gouraud")[k % 2]
-        if extra in state.methods and len(state.methods) > 1:
-            state.methods.remove(extra)
-        elif len(state.methods) < 6:
-            state.methods.append(extra)
+        extra = ("gouraud", "raycast")[(k // len(self.scenes)) % 2]
+        state.methods[:] = [m for m in (*first_view(state.scene, choosable_methods()), extra)
+                            if m in choosable_methods()]
         set_option(state, "phong", "tessellation", (2, 3, 4)[k % 3])
         set_option(state, "raytrace", "max_depth", (2, 3)[k % 2])
+        set_option(state, "pathtrace", "spp", (4, 16)[k % 2])
+        set_option(state, "radiosity", "patch_size", (0.2, 0.1)[k % 2])
         state.diff_pair = (state.methods[0], state.methods[-1])
-        self.round, self.phase, self.t_wait = k + 1, 0, time.perf_counter()
+        self.round, self.phase, self.t_wait = k, 0, time.perf_counter()
+
+
+class MallInfo(ctypes.Structure):
+    """glibc's ``struct mallinfo2`` (malloc.h)."""
+
+    _fields_ = [(n, ctypes.c_size_t) for n in ("arena", "ordblks", "smblks", "hblks", "hblkhd",
+                                               "usmblks", "fsmblks", "uordblks", "fordblks",
+                                               "keepcost")]
+
+
+def heap_info() -> dict:
+    """The C heap of this process in MB (glibc's ``mallinfo2``; empty elsewhere):
+    ``heap_arenas_mb`` (bytes the arenas took from the system), ``heap_mapped_mb`` (blocks
+    mapped of their own), ``heap_used_mb`` (allocated in the arenas), ``heap_free_mb`` (free in
+    the arenas, kept: what fragmentation costs)."""
+    try:
+        info = ctypes.CDLL("libc.so.6").mallinfo2
+    except (OSError, AttributeError):
+        return {}
+    info.restype = MallInfo
+    m = info()
+    return {f"heap_{name}_mb": getattr(m, field) / 2**20 for name, field in
+            (("arenas", "arena"), ("mapped", "hblkhd"), ("used", "uordblks"), ("free", "fordblks"))}
 
 
 def gl_object_counts(state: AppState, names: int = 4096) -> dict:
@@ -1022,11 +1074,17 @@ def idle_quick(out: Path) -> Idle:
     return Idle(out, seconds=3.0)
 
 
-def soak_quick(out: Path) -> Soak:
-    """:class:`Soak` for 10 rounds."""
-    return Soak(out, rounds=10)
+def soak_memory(out: Path) -> Soak:
+    """:class:`Soak` for 150 s and at least three times its warm-up rounds (the test of the
+    window's memory over a session)."""
+    return Soak(out, rounds=None, seconds=150.0, min_rounds=24)
 
 
 def soak_10min(out: Path) -> Soak:
     """:class:`Soak` for 600 s."""
     return Soak(out, rounds=None, seconds=600.0)
+
+
+def soak_30min(out: Path) -> Soak:
+    """:class:`Soak` for 1800 s (issue #29, item 3's session)."""
+    return Soak(out, rounds=None, seconds=1800.0)

@@ -60,6 +60,7 @@ def test_a_shared_job_runs_on_for_the_reference_when_the_panel_moves_on(gate):
         assert other.cancelled.is_set() and not mine.cancelled.is_set()
         gate.release.set()
         mine.thread.join(30)
+        other.thread.join(30)  # its render may not have begun yet: counted once it has ended
         assert refs.request(scene, cam, "gate", {"level": 2}, tiled=False) is mine
         assert np.all(mine.image == np.float32(0.2)) and sorted(gate.renders) == [1, 2]
     finally:
@@ -79,3 +80,48 @@ def test_a_job_only_one_board_holds_is_cancelled_when_it_moves_on(gate):
     finally:
         gate.release.set()
         panels.join_all(30)
+
+
+def test_a_panel_takes_the_reference_job_that_started_first(gate):
+    """Issue #29: the reference could take a panel's job, but a panel asking for the request
+    the reference was already rendering started it again (two renders of one image)."""
+    scene = load_scene(resolve("whitted"))
+    cam = scene.camera.with_resolution(8, 6)
+    refs = JobBoard(cached=True)
+    woken = []
+    panels = JobBoard(notify=lambda: woken.append(1), share=lambda: [refs])
+    refs.share = panels
+    try:
+        theirs = refs.request(scene, cam, "gate", {"level": 2}, tiled=False)
+        mine = panels.request(scene, cam, "gate", {"level": 2}, tiled=False)
+        assert mine is theirs and panels.count == 0 and refs.count == 1  # taken, not started
+        assert panels.busy() and panels.current["gate"] is theirs
+        # the reference moving on (the camera moved for it only) leaves the panel's job running
+        moved = refs.request(scene, cam, "gate", {"level": 1}, tiled=False)
+        assert moved is not mine and not mine.cancelled.is_set()
+        gate.release.set()
+        mine.thread.join(30)
+        moved.thread.join(30)
+        assert np.all(mine.image == np.float32(0.2)) and woken  # the panel's window was woken
+        assert panels.request(scene, cam, "gate", {"level": 2}, tiled=False) is mine
+        assert sorted(gate.renders) == [1, 2]  # level 2 rendered once, for both boards
+    finally:
+        gate.release.set()
+        panels.join_all(30)
+        refs.join_all(30)
+
+
+def test_a_panel_does_not_take_a_cancelled_reference_job(gate):
+    scene = load_scene(resolve("whitted"))
+    cam = scene.camera.with_resolution(8, 6)
+    refs = JobBoard(cached=True)
+    panels = JobBoard(share=lambda: [refs])
+    try:
+        theirs = refs.request(scene, cam, "gate", {"level": 2}, tiled=False)
+        theirs.cancelled.set()  # the plot's key changed: it is ending
+        mine = panels.request(scene, cam, "gate", {"level": 2}, tiled=False)
+        assert mine is not theirs and panels.count == 1
+    finally:
+        gate.release.set()
+        panels.join_all(30)
+        refs.join_all(30)

@@ -97,6 +97,12 @@ class PanelImages(MutableMapping):
     def __len__(self) -> int:
         return len(self._values) + len(self._pending)
 
+    def nbytes(self, key: str | None = None) -> int:
+        """Bytes of ``key``'s image held on the CPU (every entry's with no key; a pending entry
+        holds none: its image is on the GPU)."""
+        keys = self._values if key is None else [key] if key in self._values else []
+        return sum(self._values[k].nbytes for k in keys)
+
     def version(self, key: str) -> int:
         """Number of changes of ``key`` so far (0 if never set)."""
         return self._versions.get(key, 0)

@@ -33,8 +33,9 @@ round's image is shown as it lands.
 The error plot's boards render references (``JobBoard(cached=True, share=...)``): a reference
 is first looked up in the CLI's disk cache (:mod:`workbench.compare.reference_cache`, keyed by
 the scene as data, the method, its options, the size and the code), stored there once
-rendered, and a panel's job of the very same request (the path tracer's panel at its finest
-knob is the emitter scenes' reference) is shared rather than rendered twice.
+rendered, and a job of the very same request on another board (the path tracer's panel at its
+finest knob is the emitter scenes' reference) is shared rather than rendered twice, whichever
+board started it: the reference takes the panel's job, and a panel the reference's (issue #29).
 """
 from __future__ import annotations
 
@@ -174,6 +175,13 @@ class Job:
             self.notify()
 
     def _run(self, scene, method, opts, cached):
+        from ...renderers import gl
+        try:
+            self._render(scene, method, opts, cached)
+        finally:  # a GL context the render made in this thread would outlive it (leaked)
+            gl.end_thread()
+
+    def _render(self, scene, method, opts, cached):
         import numba
 
         from ...renderers.base import render
@@ -269,6 +277,12 @@ class Job:
     def done(self) -> bool:
         return self.image is not None or self.error is not None
 
+    def nbytes(self) -> int:
+        """Bytes of the images the job holds (the partial one and the finished one)."""
+        with self.lock:
+            image = 0 if self.image is None or self.image is self.partial else self.image.nbytes
+            return self.partial.nbytes + image
+
 
 class JobBoard:
     """The current job of each CPU method plus the threads started and not yet ended (joined
@@ -280,9 +294,11 @@ class JobBoard:
     ``notify``: called with no argument from a job's thread when it has new tiles, its image
     or an error (the window wakes its loop with it), or None; ``count``: jobs started so far;
     ``cached``: its jobs go through the reference cache (:meth:`Job._cached`; the error plot's
-    reference boards); ``share``: another board (the panels') whose current job of the same
-    request is taken instead of starting one; a job two boards hold is not cancelled when one
-    of them moves on to another request (the other still wants its image)."""
+    reference boards); ``share``: the other boards whose current job of the same request is
+    taken instead of starting one: a board, or a function of no argument giving a list of them
+    (the panels' board asks the error plot for its reference boards, which are made later); a
+    job two boards hold is not cancelled when one of them moves on to another request (the
+    other still wants its image)."""
 
     def __init__(self, settle: float = 0.0, notify=None, cached: bool = False, share=None):
         self.settle = settle
@@ -323,10 +339,12 @@ class JobBoard:
             if job.thread.is_alive() or now - seen[1] < self.settle:
                 return job
         del self.waiting[method]
-        theirs = None if self.share is None else self.share.current.get(method)
-        if theirs is not None and theirs.key == key and not theirs.cancelled.is_set():
-            self.current[method] = theirs  # the panel renders this very request: shared
+        theirs = self._shared(method, key)
+        if theirs is not None:  # another board renders this very request: shared
+            self.current[method] = theirs
             theirs.holders.add(id(self))
+            if theirs.notify is None:  # its new tiles wake this board's window too
+                theirs.notify = self.notify
             return theirs
         job = Job(scene, camera, method, options, tiled, self.notify, self.cached)
         job.holders.add(id(self))
@@ -337,6 +355,16 @@ class JobBoard:
         self.count += 1
         return job
 
+    def _shared(self, method: str, key: tuple):
+        """The running (not cancelled) job of request ``key`` that a board of ``share`` holds
+        for ``method``, or None."""
+        boards = self.share() if callable(self.share) else [] if self.share is None else [self.share]
+        for board in boards:
+            theirs = board.current.get(method) if board is not self else None
+            if theirs is not None and theirs.key == key and not theirs.cancelled.is_set():
+                return theirs
+        return None
+
     def keep_only(self, methods) -> None:
         """Cancel and forget the jobs of methods no longer shown (a removed panel's render
         must not run on to its end)."""
@@ -346,6 +374,14 @@ class JobBoard:
             if not job.holders:  # else another board (the error plot's reference) still wants it
                 job.cancelled.set()
             self.waiting.pop(m, None)
+
+    def nbytes(self) -> int:
+        """Bytes of the images its current jobs hold (:meth:`Job.nbytes`)."""
+        return sum(j.nbytes() for j in self.current.values())
+
+    def alive(self) -> bool:
+        """A thread it started has not ended."""
+        return any(j.thread.is_alive() for j in self.started)
 
     def busy(self) -> bool:
         """A job is running or its result is stale (a restart is pending)."""

@@ -270,10 +270,12 @@ def over_stale(state: AppState, method: str, job, image: np.ndarray) -> np.ndarr
 
 def update_images(state: AppState) -> None:
     """Bring every selected panel up to date (called once per frame, before the widgets)."""
+    from .panel_memory import keep_hidden
     from .pyrender_proc import refresh_pyrender
     if state.gpu is not None:
         take_gpu_stats(state, "difference")
     state.jobs.keep_only(state.methods)
+    keep_hidden(state)  # the resources of panels hidden long ago are freed
     if state.gpu is not None:  # a removed panel's approximation keeps nothing awake
         state.gpu.modes.approximate &= set(state.methods)
     for m in state.methods:

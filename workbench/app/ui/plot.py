@@ -193,9 +193,12 @@ def _matched(state: AppState, plot: ErrorPlot, method: str):
     if ref_m == plot.reference and opts == plot.ref_options:  # the full reference itself
         plot.matched[method] = plot.ref_image
         return plot.ref_image, ""
-    board = plot.matched_boards.get((ref_m, tuple(sorted(opts.items()))))
+    held = (ref_m, tuple(sorted(opts.items())))
+    plot.matched_in_use.add(held)
+    board = plot.matched_boards.get(held)
     if board is None:
-        board = plot.matched_boards[(ref_m, tuple(sorted(opts.items())))] = JobBoard(cached=True, share=state.jobs)
+        board = JobBoard(cached=True, share=state.jobs)
+        plot.matched_boards.put(held, board)
     job = board.request(state.scene, state.camera, ref_m, opts, tiled=tiled(ref_m))
     what = f"{ref_m} ({options_text(opts)})"
     if job.cancelled.is_set():  # the previous key's job, still ending
@@ -251,7 +254,9 @@ def track(state: AppState) -> None:
         plot.points, plot.pending, plot.failed = {}, {}, {}
         plot.matched, plot.matched_points, plot.matched_pending = {}, {}, {}
         plot.matched_options = {}
+        plot.matched_in_use.clear()  # the same set object: the boards' cache reads it
         plot.matched_message = ""
+    plot.matched_boards.trim()  # a board's images came since it was put
     _collect(plot, plot.pending, plot.points, "error")
     _collect(plot, plot.matched_pending, plot.matched_points, "matched error")
     if plot.shown < state.frame - 1:  # the plot's window is hidden: no reference render

@@ -17,6 +17,7 @@ import numpy as np
 from ...renderers.base import USER_PREFIX, available, check_methods, get_renderer
 from ...scene.model import Camera, Scene
 from .drag_resolution import DragResolution
+from .bounded import LruCache
 from .images import PanelImages
 from ...scene.features import scene_needs
 from .jobs import RESTART_SETTLE_SECONDS, JobBoard
@@ -38,6 +39,9 @@ DISPLAY_MODES = ("direct24", "direct16-555", "direct16-565", "direct16-565-fs",
 """Display modes offered per panel (the colour chapter's 24/16-bit direct and indexed CLUTs);
 ``workbench.core.display`` accepts more from the CLI."""
 HARMONIES = ("complementary", "triad", "square", "hexagon")
+MATCHED_BOARDS_KEPT = 4
+"""The error plot's boards of matched references kept (one per reference method and options:
+each holds its last images); the least recently used beyond them is dropped."""
 
 
 @dataclass
@@ -67,8 +71,11 @@ class ErrorPlot:
     ``matched[method]`` is that reference's image once rendered, or False (the method has
     none), for the panel's options ``matched_options[method]`` (Gouraud's and Phong's
     matched reference follows their stand-ins); ``matched_boards`` render them, one :class:`~.jobs.JobBoard` per (reference method,
-    options) (a board runs one job per method); ``matched_message`` says which are still
-    rendering.
+    options) (a board runs one job per method), the :data:`MATCHED_BOARDS_KEPT` used last
+    within the window's cache budget (:class:`~.bounded.LruCache`: an evicted board's jobs are
+    cancelled, and it is joined at exit from ``retired``), never one the current key uses
+    (``matched_in_use``: evicted, it would be asked for again at once); ``matched_message``
+    says which are still rendering.
     """
 
     key: tuple | None = None
@@ -85,7 +92,9 @@ class ErrorPlot:
     matched_options: dict = field(default_factory=dict)
     matched_points: dict = field(default_factory=dict)
     matched_pending: dict = field(default_factory=dict)
-    matched_boards: dict = field(default_factory=dict)
+    matched_boards: LruCache = None
+    retired: list = field(default_factory=list)
+    matched_in_use: set = field(default_factory=set)
     matched_message: str = ""
     metric: str = "rmse"
     hover: str = ""
@@ -97,6 +106,17 @@ class ErrorPlot:
     gave_up: bool = False
     board: object = None
     pool: ProcessPoolExecutor | None = None
+
+    def __post_init__(self):
+        if self.matched_boards is None:
+            self.matched_boards = LruCache(MATCHED_BOARDS_KEPT, size_of=lambda board: board.nbytes(),
+                                           on_evict=self._retire, pinned=self.matched_in_use.__contains__)
+
+    def _retire(self, _key, board) -> None:
+        """An evicted matched board: its jobs cancelled (unless a panel shares one), kept in
+        ``retired`` until its threads have ended."""
+        board.keep_only(())
+        self.retired = [b for b in self.retired if b.alive()] + [board]
 
     def busy(self, frame: int) -> bool:
         """Something will arrive without any input: evaluations in the worker, or, while the
@@ -114,8 +134,9 @@ class ErrorPlot:
     def shutdown(self, timeout: float | None = None) -> None:
         """Cancel the reference renders (their threads joined, within ``timeout`` seconds
         each when given) and end the worker process (joined)."""
-        for board in self.boards():
+        for board in [*self.boards(), *self.retired]:
             board.join_all(timeout)
+        self.retired = []
         if self.pool is not None:
             self.pool.shutdown(wait=True, cancel_futures=True)
             self.pool = None
@@ -196,6 +217,9 @@ class AppState:
     wrapped: set = field(default_factory=set)
     """Section titles too long for their window in the last frame, wrapped instead of cut
     (:func:`.section.section`)."""
+    hidden_panels: object = None
+    """The panels hidden lately that still hold their images, sessions and textures, with the
+    bytes each holds (a :class:`~.bounded.LruCache`: :func:`.panel_memory.keep_hidden`)."""
     quit: bool = False
     """Close the window at the end of this frame (scripts; SIGTERM and SIGINT)."""
     quit_signal: int = 0
@@ -277,12 +301,15 @@ def new_state(scene_name: str, methods: list[str] | None = None,
                              f"{USER_PREFIX}FILE (got {', '.join(methods)})")
     check_methods(user)  # a user's shading model file that cannot be used: one line
     examples = Path.cwd() / "examples" / "shading"
+    errors = ErrorPlot()
+    # a panel takes the error plot's reference job of its very request (issue #29)
+    jobs = JobBoard(RESTART_SETTLE_SECONDS, share=errors.boards)
     return AppState(scene=scene, scene_path=path, base_scene=scene,
                     camera=panel_camera(scene.camera, panel_size), methods=methods,
                     options={m: default_options(m) for m in [*allowed, *user]},
                     material=next(iter(scene.materials)), panel_size=panel_size,
-                    diff_pair=(methods[0], methods[min(1, len(methods) - 1)]), jobs=JobBoard(RESTART_SETTLE_SECONDS),
-                    browser=Browser(path.parent), errors=ErrorPlot(), user_methods=user,
+                    diff_pair=(methods[0], methods[min(1, len(methods) - 1)]), jobs=jobs,
+                    browser=Browser(path.parent), errors=errors, user_methods=user,
                     shading_browser=Browser(examples if examples.is_dir() else Path.cwd(),
                                             pattern="*.glsl"))
 
