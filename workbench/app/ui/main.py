@@ -160,7 +160,7 @@ def _loop(state: AppState, max_frames: int | None, script, window: tuple[int, in
     from .panel_gpu import release_gl
     from .panel_refresh import in_progress, update_images
     from .panel_show import draw_shown_images
-    from .layout import docking_params
+    from .layout import docking_params, refit
     from .panels import status_bar
     from .plot import track
     clock = {"t": None, "title": window_title(state)}
@@ -181,6 +181,7 @@ def _loop(state: AppState, max_frames: int | None, script, window: tuple[int, in
         if clock["t"] is not None:
             state.frame_seconds = now - clock["t"]
         clock["t"] = now
+        refit(state)
         update_images(state)
         track(state)
         if window_title(state) != clock["title"]:  # the scene changed: so does the title
