@@ -147,8 +147,9 @@ def refresh_cpu(state: AppState, method: str) -> None:
                                 else f"done: {job.meter.text()}" if job.shoots and job.meter.first
                                 else "done")
     elif job.meter is not None and job.meter.first is not None:
-        # samples per pixel, rows or shooting rounds done, and the time left
-        state.status[method] = ("refining: " if job.progressive or job.shoots
+        # samples per pixel, rows or shooting rounds done, and the time left (a phased job:
+        # its phase, and the time elapsed where the phase reports no amount done)
+        state.status[method] = ("" if job.phased else "refining: " if job.progressive or job.shoots
                                 else "rendering: ") + job.meter.text()
     else:
         state.status[method] = "rendering..."
