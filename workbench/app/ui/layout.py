@@ -111,7 +111,7 @@ def refit(state: AppState) -> None:
     root = None if root_id is None else internal.dock_builder_get_node(root_id)
     if root is None or root.size.y <= 0:
         return
-    key = (root.size.x, root.size.y, state.camera.height)
+    key = (root.size.y, state.camera.height)
     if key == state.layout_fit:
         return
     row_id = docking.dock_space_id_from_name("ControlSpace")

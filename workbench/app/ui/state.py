@@ -193,7 +193,7 @@ class AppState:
     window_size: tuple[int, int] = (0, 0)
     """The window's size when it closed (GLFW), kept for the next run (:mod:`.window_size`)."""
     layout_fit: tuple | None = None
-    """(dock space width, height, panels' height) the control row was last sized for
+    """(dock space height, panels' height) the control row was last sized for
     (:func:`.layout.refit`)."""
     wrapped: set = field(default_factory=set)
     """Section titles too long for their window in the last frame, wrapped instead of cut
