@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import workbench
+from child_processes import children
 from statistics_budget import band
 from workbench.core.errors import WorkbenchError
 from workbench.renderers import mitsuba_method as mm
@@ -161,3 +162,31 @@ def test_cli_and_reports_summarise_the_noise_image_instead_of_dumping_it(tmp_pat
     assert json.loads((tmp_path / "a.json").read_text())["stats"]["stderr"].startswith("array (20, 24, 3)")
     shown = stats_for_display({"stderr": np.full((2, 2, 3), 3.0, np.float32), "spp": 4})
     assert shown == {"stderr": "array (2, 2, 3) float32, RMS 3", "spp": 4}
+
+
+class Stop(Exception):
+    """Raised by a progress callback: the render must end with it, and the child with it."""
+
+
+@pytest.mark.parametrize("variant", ["scalar_rgb", "auto"])
+def test_progress_counts_the_childs_samples_and_a_stop_ends_the_child(variant):
+    """The window's progress bar of the mitsuba method (issue #29): the child's start-up
+    reports no amount done, then the samples per pixel done (the scalar variant block by
+    block, the LLVM one pass by pass); a cancelled job's next report raises, which must end
+    the child process (before: it ran on unseen)."""
+    scene = _spot_scene(16, 12)
+    steps = []
+    res = workbench.render(scene, "mitsuba", spp=8, variant=variant, on_progress=lambda *a: steps.append(a))
+    assert steps[0] == ("Mitsuba choosing its variant", 0, None, "")
+    assert all(total is None and done == 0 for phase, done, total, unit in steps if phase != "Mitsuba")
+    counted = [done for phase, done, total, unit in steps if phase == "Mitsuba"]
+    assert counted == sorted(counted) and steps[-1] == ("Mitsuba", 8, 8, "spp")
+    assert np.array_equal(res.image, workbench.render(scene, "mitsuba", spp=8, variant=variant).image)
+    before = children()
+
+    def stop(phase, *_):  # the first report read from the running child
+        if phase in ("Mitsuba loading the scene", "Mitsuba"):
+            raise Stop
+    with pytest.raises(Stop):
+        workbench.render(scene, "mitsuba", spp=8, variant=variant, on_progress=stop)
+    assert children() <= before

@@ -16,9 +16,12 @@ import shutil
 import numpy as np
 import pytest
 
+from child_processes import children
+
 import workbench
 from workbench.core.errors import WorkbenchError
 from workbench.renderers import povray_sdl
+from workbench.renderers.povray import progress_report
 from workbench.scene.io import scene_from_dict
 
 pytestmark = pytest.mark.skipif(shutil.which("povray") is None, reason="POV-Ray not installed (Debian package povray)")
@@ -145,3 +148,38 @@ def test_estimate_covers_the_images_read_back():
     small, big = r.estimate_bytes(scene, 10, 10), r.estimate_bytes(scene, 1000, 1000)
     assert big - small == (1000 * 1000 - 100) * 3 * (2 + 8 + 4 + 16)  # + POV-Ray's float buffer
     assert small > 81920 * 50  # the mesh's SDL text (at least 50 bytes a triangle)
+
+
+def test_progress_report_reads_povrays_verbose_output():
+    lines = ["==== [Parsing...] ====", "Parser Statistics", "==== [Rendering...] ====",
+             "Rendered 1024 of 4096 pixels (25%)", "Rendered 2048 of 4096 pixels (50%)"]
+    start = ("POV-Ray starting", 0, None, "")
+    assert progress_report([], start) == start
+    assert progress_report(lines[:2], start) == ("POV-Ray parsing", 0, None, "")
+    assert progress_report(lines[:3], start) == ("POV-Ray rendering", 0, None, "")
+    assert progress_report(lines, start) == ("POV-Ray rendering", 2048, 4096, "pixels")
+
+
+class Stop(Exception):
+    """Raised by a progress callback: the render must end with it, and POV-Ray with it."""
+
+
+def test_progress_is_povrays_own_report_and_a_stop_ends_povray():
+    """The window's progress bar of the povray method (issue #29); a cancelled job's next
+    report raises, which must end the POV-Ray process (before: it ran on unseen)."""
+    scene = workbench.load_scene("whitted")
+    steps = []
+    res = workbench.render(scene, "povray", width=160, height=120, on_progress=lambda *a: steps.append(a))
+    assert steps[0] == ("POV-Ray starting", 0, None, "")
+    assert steps[-1] == ("POV-Ray rendering", 160 * 120, 160 * 120, "pixels")
+    counted = [s[1] for s in steps if s[3] == "pixels"]
+    assert counted == sorted(counted)
+    assert np.array_equal(res.image, workbench.render(scene, "povray", width=160, height=120).image)
+    before = children()
+
+    def stop(phase, *_):
+        if phase != "POV-Ray starting":
+            raise Stop
+    with pytest.raises(Stop):
+        workbench.render(scene, "povray", width=640, height=480, on_progress=stop)
+    assert children() <= before

@@ -5,6 +5,13 @@ a list of ``[spp, seed]``), renders each pass with ``mi.render`` and writes ``pa
 ((P, H, W, 3) float32, one image per pass) and ``result.json`` (timings).  Mitsuba is only
 ever imported here: ``mi.set_variant`` is process-wide state, and an LLVM back end that
 aborts takes only this process down.
+
+While it runs it keeps ``FOLDER/progress.txt`` (replaced whole, never half written) saying
+how far it is (:func:`report`): ``load`` while Mitsuba loads the scene, then ``render N``
+with N the samples per pixel done over all passes.  Within a pass only the scalar variants
+report (Mitsuba's progress reporter, block by block, heard at log level Info through
+:class:`ProgressAppender`); a JIT variant (``llvm_*``) renders a pass as one kernel and
+reports nothing until it ends.
 """
 from __future__ import annotations
 
@@ -37,6 +44,37 @@ def peak_rss_bytes() -> int | None:
     return None
 
 
+REPORT_SECONDS = 0.1
+"""Least time between two progress reports within a pass."""
+
+
+def report(folder: str, text: str) -> None:
+    """``FOLDER/progress.txt`` now says ``text`` (written beside it, then renamed over it)."""
+    path = os.path.join(folder, "progress.txt")
+    with open(path + ".new", "w", encoding="ascii") as f:
+        f.write(text)
+    os.replace(path + ".new", path)
+
+
+def progress_appender(mi, folder: str, done: list):
+    """A Mitsuba log appender that reports the render's progress (``render N``, ``done[0]``
+    the samples per pixel of the passes before, ``done[1]`` this pass's) and passes warnings
+    and errors on to standard error."""
+    class ProgressAppender(mi.Appender):
+        last = 0.0
+
+        def append(self, level, text):
+            if level >= mi.LogLevel.Warn:
+                print(text, file=sys.stderr, flush=True)
+
+        def log_progress(self, progress, name, formatted, eta, ptr=None):
+            now = time.perf_counter()
+            if now - self.last >= REPORT_SECONDS or progress >= 1.0:
+                self.last = now
+                report(folder, f"render {done[0] + float(progress) * done[1]:.6g}")
+    return ProgressAppender()
+
+
 def main(folder: str) -> None:
     with open(os.path.join(folder, "plan.json"), encoding="utf-8") as f:
         plan = json.load(f)
@@ -44,15 +82,25 @@ def main(folder: str) -> None:
     import mitsuba as mi
     mi.set_variant(plan["variant"])
     t_import = time.perf_counter() - t0
+    report(folder, "load")
     t0 = time.perf_counter()
     scene = mi.load_dict(to_mitsuba(plan["scene"], mi))
     t_load = time.perf_counter() - t0
+    done = [0, 0]  # spp of the passes before, of this pass
+    logger = mi.logger()
+    logger.clear_appenders()
+    logger.add_appender(progress_appender(mi, folder, done))
+    logger.set_log_level(mi.LogLevel.Info)  # the progress reporter's level
     images, times = [], []
     cpu0 = time.process_time()
+    report(folder, "render 0")
     for spp, seed in plan["passes"]:
         t0 = time.perf_counter()
+        done[1] = int(spp)
         images.append(np.asarray(mi.render(scene, spp=int(spp), seed=int(seed)), dtype=np.float32))
         times.append(time.perf_counter() - t0)
+        done[0] += int(spp)
+        report(folder, f"render {done[0]}")
     cpu = time.process_time() - cpu0
     np.save(os.path.join(folder, "passes.npy"), np.stack(images))
     peak = peak_rss_bytes()

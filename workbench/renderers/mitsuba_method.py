@@ -18,6 +18,15 @@ Variant
 scene in a throw-away child process; if that fails (abort, missing library) it uses
 ``scalar_rgb``.  ``RenderResult.stats["variant"]`` says which variant ran and why.
 
+Progress
+--------
+With ``on_progress(phase, done, total, unit)`` (the window's progress bar) the child's
+progress file is read while it runs (:func:`child_progress`, :mod:`.watch`): its start-up and
+the scene's loading report no amount done, then the samples per pixel done.  Only the scalar
+variant reports within a pass (block by block); the LLVM variant renders a pass as one kernel,
+so its count moves once per pass (half the samples each).  An exception from ``on_progress``
+(a cancelled job) ends the child.
+
 Noise
 -----
 The ``spp`` samples are taken as two independent passes of ``spp/2`` samples (different seeds);
@@ -45,8 +54,9 @@ from ..core.errors import WorkbenchError
 from ..core.tol import tol
 from ..scene.model import Scene
 from ..scene.tessellate import MAX_LEVEL
-from .base import Knob, Option, RenderResult
+from .base import Knob, Option, RenderResult, callback
 from .estimates import triangle_bound
+from .watch import relay, run_watched
 from . import support as sp
 from .mitsuba_export import MODEL_NOTES, RR_DEPTH, export_scene
 from ..scene import features as F
@@ -126,22 +136,45 @@ def combine_passes(passes: np.ndarray, spp: list[int]) -> tuple[np.ndarray, np.n
     return image.astype(np.float32), stderr.astype(np.float32)
 
 
-def run_child(plan: dict, folder: str, timeout: float) -> tuple[np.ndarray, dict]:
-    """Write ``plan.json`` into ``folder``, render in the child, return (passes, child timings)."""
+def child_progress(folder: str, spp: int) -> tuple:
+    """What the child's progress file (:func:`.mitsuba_child.report`) tells, as
+    ``on_progress``'s (phase, done, total, unit): starting (no file yet: Python and Mitsuba
+    loading) and loading the scene report no amount done; then samples per pixel done of
+    ``spp``."""
+    try:
+        with open(os.path.join(folder, "progress.txt"), encoding="ascii") as f:
+            words = f.read().split()
+    except OSError:
+        words = []
+    if words[:1] == ["load"]:
+        return ("Mitsuba loading the scene", 0, None, "")
+    if words[:1] == ["render"] and len(words) == 2:
+        return ("Mitsuba", int(float(words[1])), spp, "spp")
+    return ("Mitsuba starting", 0, None, "")
+
+
+def run_child(plan: dict, folder: str, timeout: float, on_progress=None) -> tuple[np.ndarray, dict]:
+    """Write ``plan.json`` into ``folder``, render in the child, return (passes, child
+    timings); ``on_progress(phase, done, total, unit)`` hears :func:`child_progress` while it
+    runs (an exception from it ends the child)."""
     with open(os.path.join(folder, "plan.json"), "w", encoding="utf-8") as f:
         json.dump(plan, f)
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join([workbench_root()] + [p for p in [env.get("PYTHONPATH")] if p])
+    spp = sum(n for n, _ in plan["passes"])
+    if os.path.exists(os.path.join(folder, "progress.txt")):  # a failed child's, before a retry
+        os.remove(os.path.join(folder, "progress.txt"))
+    poll = relay(lambda last: child_progress(folder, spp), on_progress, child_progress(folder, spp))
     try:
-        out = subprocess.run([sys.executable, "-m", "workbench.renderers.mitsuba_child", folder],
-                             capture_output=True, env=env, timeout=timeout)
+        code, _, err = run_watched([sys.executable, "-m", "workbench.renderers.mitsuba_child", folder],
+                                   folder, env, timeout, poll)
     except subprocess.TimeoutExpired:
         raise WorkbenchError(f"method 'mitsuba': the render took longer than timeout = {timeout:g} s") from None
     res_path = os.path.join(folder, "result.json")
-    if out.returncode != 0 or not os.path.isfile(res_path):
-        tail = out.stderr.decode(errors="replace").strip().splitlines()[-3:]
+    if code != 0 or not os.path.isfile(res_path):
+        tail = err.strip().splitlines()[-3:]
         raise WorkbenchError(f"method 'mitsuba': the Mitsuba child process failed (exit status "
-                             f"{out.returncode}): {' | '.join(tail)[-600:]}")
+                             f"{code}): {' | '.join(tail)[-600:]}")
     with open(res_path, encoding="utf-8") as f:
         info = json.load(f)
     return np.load(os.path.join(folder, "passes.npy")), info
@@ -172,6 +205,9 @@ class MitsubaRenderer:
         "background_light": Option(bool, True, "a non-black background becomes a constant environment "
                                                "emitter that lights the scene (false: black)"),
         "timeout": Option(float, 3600.0, "seconds before the child render is stopped"),
+        "on_progress": Option(callback, None, "callback on_progress(phase, done, total, unit) while "
+                              "the child runs: samples per pixel done (within a pass only the "
+                              "scalar variant reports; total None: no amount reported)"),
     }
 
     def __init__(self):
@@ -206,7 +242,7 @@ class MitsubaRenderer:
 
     def render(self, scene: Scene, width: int, height: int, *, spp: int = 64, seed: int = 0,
                variant: str = "auto", tessellation: int = 16, background_light: bool = True,
-               timeout: float = 3600.0) -> RenderResult:
+               timeout: float = 3600.0, on_progress=None) -> RenderResult:
         if not mitsuba_installed():
             raise WorkbenchError(f"method 'mitsuba': {INSTALL_HINT}")
         if not 2 <= spp <= MAX_SPP:
@@ -219,6 +255,8 @@ class MitsubaRenderer:
         if not timeout > 0:
             raise WorkbenchError(f"method 'mitsuba': timeout must be > 0 seconds, got {timeout}")
         t0 = time.perf_counter()
+        if on_progress is not None:
+            on_progress("Mitsuba choosing its variant", 0, None, "")
         run_variant, why = self.choose_variant(variant)
         t_probe = time.perf_counter() - t0
         n1 = spp // 2
@@ -230,14 +268,14 @@ class MitsubaRenderer:
             plan = {"variant": run_variant, "scene": ex.scene_dict, "passes": passes_spec}
             t0 = time.perf_counter()
             try:
-                passes, info = run_child(plan, folder, timeout)
+                passes, info = run_child(plan, folder, timeout, on_progress)
             except WorkbenchError:
                 if run_variant == FALLBACK_VARIANT or variant != "auto":
                     raise
                 # the LLVM variant passed the probe but died on this scene: scalar instead
                 plan["variant"], why = FALLBACK_VARIANT, f"{run_variant} failed on this scene: fell back to {FALLBACK_VARIANT}"
                 run_variant = FALLBACK_VARIANT
-                passes, info = run_child(plan, folder, timeout)
+                passes, info = run_child(plan, folder, timeout, on_progress)
             t_child = time.perf_counter() - t0
         image, stderr = combine_passes(passes, [n1, spp - n1])
         t_render = float(sum(info["passes"]))

@@ -11,8 +11,10 @@ output; the workbench's own methods do not).  No depth image.
 Options: ``max_trace_level`` (the knob: POV-Ray's, primary rays = level 1, like the ray
 tracer's ``max_depth``), ``adc_bailout`` (POV-Ray's adaptive depth control, like the ray
 tracer's ``threshold``; default the same 1e-3), ``antialias`` (POV-Ray's ``+A`` threshold, 0 =
-one ray through each pixel centre, as the ray tracer with ``spp = 1``), ``blinn`` and
-``threads``.  Timings: ``export`` (writing the SDL), ``parse`` and ``trace`` (POV-Ray's own
+one ray through each pixel centre, as the ray tracer with ``spp = 1``), ``blinn``,
+``threads`` and ``on_progress(phase, done, total, unit)``: with it POV-Ray runs verbose
+(``+V``) and its own report is passed on while it runs (:func:`progress_report`: parsing,
+which says no amount done, then "Rendered N of M pixels" as each block is done).  Timings: ``export`` (writing the SDL), ``parse`` and ``trace`` (POV-Ray's own
 statistics), ``read``; stats: POV-Ray's ray counts.
 """
 from __future__ import annotations
@@ -32,7 +34,8 @@ from ..scene import features as ft
 from ..scene.model import Mesh, Scene
 from . import povray_sdl
 from . import support as sp
-from .base import Knob, Option, RenderResult
+from .base import Knob, Option, RenderResult, callback
+from .watch import Tail, relay, run_watched
 
 PROGRAM = "povray"
 TIMEOUT_S = 3600
@@ -52,6 +55,26 @@ def read_ppm16(data: bytes) -> np.ndarray:
     n = w * h * 3
     pix = np.frombuffer(data, dtype=dtype, count=n, offset=head.end())
     return pix.reshape(h, w, 3).astype(np.float64) / maxval
+
+
+RENDERED = re.compile(r"Rendered (\d+) of (\d+) pixels")
+
+
+def progress_report(lines: list[str], last: tuple | None) -> tuple | None:
+    """The latest (phase, done, total, unit) that POV-Ray's verbose output ``lines`` (``+V``,
+    standard error) tells, after ``last``: ``("POV-Ray parsing", 0, None, "")`` from its
+    "[Parsing...]" banner (parsing reports no amount done), ``("POV-Ray rendering", 0, None,
+    "")`` from its "[Rendering...]" banner, ``("POV-Ray rendering", N, M, "pixels")`` from its
+    "Rendered N of M pixels" lines; ``last`` when they tell nothing new."""
+    for line in lines:
+        hit = RENDERED.search(line)
+        if hit:
+            last = ("POV-Ray rendering", int(hit.group(1)), int(hit.group(2)), "pixels")
+        elif "[Parsing" in line:
+            last = ("POV-Ray parsing", 0, None, "")
+        elif "[Rendering" in line:
+            last = ("POV-Ray rendering", 0, None, "")
+    return last
 
 
 def _stat(log: str, pattern: str) -> float:
@@ -91,6 +114,8 @@ class PovrayRenderer:
         "antialias": Option(float, 0.0, "POV-Ray's +A threshold (0 = off: one ray through each pixel centre)"),
         "blinn": Option(bool, False, "specular as POV-Ray's specular/roughness 1/n (Blinn) instead of phong/phong_size n"),
         "threads": Option(int, 0, "POV-Ray's Work_Threads (0 = POV-Ray's default: one per core)"),
+        "on_progress": Option(callback, None, "callback on_progress(phase, done, total, unit) with "
+                              "POV-Ray's own report while it runs (total None: no amount reported)"),
     }
 
     memory_options = ("max_trace_level",)
@@ -106,7 +131,7 @@ class PovrayRenderer:
 
     def render(self, scene: Scene, width: int, height: int, *, max_trace_level: int = 5,
                adc_bailout: float = 1e-3, antialias: float = 0.0, blinn: bool = False,
-               threads: int = 0) -> RenderResult:
+               threads: int = 0, on_progress=None) -> RenderResult:
         if not 1 <= max_trace_level <= 256:
             raise WorkbenchError(f"method 'povray': option 'max_trace_level' must be within 1..256, got {max_trace_level}")
         if adc_bailout < 0 or antialias < 0 or threads < 0:
@@ -125,22 +150,25 @@ class PovrayRenderer:
             for name, src in ex.files.items():  # POV-Ray reads files in its working folder
                 shutil.copyfile(src, d / name)
             cmd = [exe, "+Iscene.pov", "+Oimage.ppm", f"+W{width}", f"+H{height}", "+FP16",
-                   "File_Gamma=1.0", "-D", "-P", "-V", "+GS", "+MV3.7"]
+                   "File_Gamma=1.0", "-D", "-P", "+V" if on_progress else "-V", "+GS", "+MV3.7"]
             cmd.append(f"+A{antialias:.6g}" if antialias > 0 else "-A")
             if threads > 0:
                 cmd.append(f"Work_Threads={threads}")
             env = dict(os.environ, HOME=tmp)  # no user configuration file, and no warning about it
+            said = Tail(d / "stderr.log")
+            poll = relay(lambda last: progress_report(said.lines(), last), on_progress,
+                         ("POV-Ray starting", 0, None, ""))
             t1 = time.perf_counter()
             try:
-                p = subprocess.run(cmd, cwd=d, capture_output=True, text=True, env=env, timeout=TIMEOUT_S)
+                code, out_text, err_text = run_watched(cmd, d, env, TIMEOUT_S, poll)
             except subprocess.TimeoutExpired:
                 raise WorkbenchError(f"method 'povray': POV-Ray did not finish within {TIMEOUT_S} s") from None
             timings["povray_process"] = time.perf_counter() - t1
-            log = p.stdout + p.stderr
+            log = out_text + err_text
             out = d / "image.ppm"
-            if p.returncode != 0 or not out.is_file():
-                tail = " | ".join(line.strip() for line in log.strip().splitlines()[-6:])
-                raise WorkbenchError(f"method 'povray': POV-Ray failed (exit {p.returncode}): {tail}")
+            if code != 0 or not out.is_file():
+                tail = " | ".join(line.strip() for line in re.split(r"[\r\n]+", log.strip())[-6:])
+                raise WorkbenchError(f"method 'povray': POV-Ray failed (exit {code}): {tail}")
             t2 = time.perf_counter()
             image = read_ppm16(out.read_bytes()).astype(np.float32)
             timings["read"] = time.perf_counter() - t2

@@ -73,3 +73,40 @@ class Progress:
 
 def progress(out: Path) -> Progress:
     return Progress(out)
+
+
+class Phases:
+    """Records, per frame and per panel whose method reports phases (``on_progress``: the
+    hybrid method, POV-Ray, Mitsuba), the job's meter (phase, done, target, measured), the
+    bar's value the panel draws (:meth:`~workbench.app.ui.meter.Meter.bar`), whether it draws
+    one and its status line; ends once no job runs (or :data:`WAIT_SECONDS` passed), with each
+    panel's job outcome."""
+
+    def __init__(self, out: Path):
+        self.out, self.t0 = out, time.perf_counter()
+        self.log = {"frames": {}, "finished": False}
+
+    def __call__(self, state: AppState) -> None:
+        now = time.perf_counter()
+        for m in state.methods:
+            job = state.jobs.current.get(m)
+            if job is None or not job.phased:
+                continue
+            meter = job.meter
+            running = running_meter(job)
+            self.log["frames"].setdefault(m, []).append({
+                "frame": state.frame, "phase": meter.phase, "done": meter.done,
+                "target": meter.target, "unit": meter.unit, "measured": meter.measured,
+                "fraction": meter.fraction, "bar": running is not None,
+                "bar_value": None if running is None else running.bar(now - self.t0),
+                "status": state.status.get(m, ""), "job_done": job.done})
+        if state.frame > 2 and (not state.jobs.busy() or now - self.t0 > WAIT_SECONDS):
+            self.log["finished"] = not state.jobs.busy()
+            self.log["jobs"] = {m: {"error": j.error, "done": j.image is not None,
+                                    "status": state.status.get(m, "")}
+                                for m, j in state.jobs.current.items()}
+            state.quit = True
+
+
+def phases(out: Path) -> Phases:
+    return Phases(out)

@@ -677,6 +677,103 @@ class Screens:
         state.quit = True
 
 
+class SceneScreens:
+    """Every bundled scene in turn (issue #29's acceptance test, ``test_ui_screens.py``): each
+    scene is switched to as the Scene window's combo does (the first is the one the window
+    opened with); once nothing is in progress (its jobs, the error plot's reference and
+    points, the GL panels' programs; at most :data:`CPU_WAIT_SECONDS`) and ``frames`` frames
+    later, the window as the X server shows it is saved as ``screen_{scene}.png``
+    (``xwd``, :mod:`.screenshot`), each panel's display texture as ``shown_{scene}_{m}.npy``,
+    and logged under ``scenes``: the widgets cut at a window's right edge over those frames,
+    the section titles wrapped, the window report, the blit rectangles, the panels' and the
+    scene camera's sizes, each panel's status and its linear image's range.  Then, with
+    ``resize``, the window is resized (as a user's drag of its corner) and, once the X server
+    has applied it and ``frames`` frames later, ``resized`` logs the window report and the
+    blit rectangles again."""
+
+    def __init__(self, out: Path, frames: int = 3, resize: tuple[int, int] | None = None):
+        from workbench.scene.library import bundled
+        self.out, self.frames, self.resize = out, frames, resize
+        self.scenes = [p.stem for p in bundled()]
+        self.log = {"scenes": {}, "order": self.scenes}
+        self.k, self.t0, self.rested, self.cut = 0, time.perf_counter(), None, set()
+        self.asked = None
+
+    def __call__(self, state: AppState) -> None:
+        from workbench.app.ui.panel_refresh import in_progress
+        from workbench.app.ui.state import set_scene
+        if self.asked is not None:
+            return self._after_resize(state)
+        busy = in_progress(state) and time.perf_counter() - self.t0 < CPU_WAIT_SECONDS
+        if state.frame < 2 or busy:
+            self.rested, self.cut = None, set()
+            return
+        if self.rested is None:
+            self.rested = state.frame
+        if state.frame > self.rested:  # widgets drawn in a rested frame
+            self.cut |= state.cut
+        if state.frame < self.rested + self.frames:
+            return
+        self._dump(state, self.scenes[self.k])
+        self.k += 1
+        if self.k < len(self.scenes):
+            set_scene(state, self.scenes[self.k])
+            self.t0, self.rested = time.perf_counter(), None
+        elif self.resize is not None:
+            from workbench.app.ui.glfw_title import glfw_library
+            glfw = glfw_library()
+            glfw.glfwSetWindowSize.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_int]
+            glfw.glfwSetWindowSize(glfw.glfwGetCurrentContext(), *self.resize)
+            self.asked, self.rested = time.perf_counter(), None
+        else:
+            state.quit = True
+
+    def _dump(self, state: AppState, scene: str) -> None:
+        from workbench.app.ui import screenshot
+        from workbench.app.ui.glfw_title import window_title
+        assert state.scene_path.stem == scene, (state.scene_path, scene)
+        for m in [*state.methods, "difference"]:
+            if m in state.images:
+                tex = shown_texture(state, m)
+                tw, th = tex.size
+                np.save(self.out / f"shown_{scene}_{m}.npy", np.frombuffer(
+                    tex.read(), np.uint8).reshape(th, tw, -1)[..., :3])
+        shot = screenshot.save(window_title(state), self.out / f"screen_{scene}.png")
+        images = {}
+        for m in state.methods:
+            if m in state.images:
+                a = np.asarray(state.images[m], np.float64)
+                images[m] = {"min": float(a.min()), "max": float(a.max()), "std": float(a.std())}
+        cam0 = state.scene.camera
+        self.log["scenes"][scene] = {
+            "screen": list(shot.shape), "cut": sorted(self.cut), "wrapped": sorted(state.wrapped),
+            "windows": window_report(), "blits": [[m, list(r)] for m, r in state.gpu.blits.last],
+            "camera": [state.camera.width, state.camera.height],
+            "scene_camera": [cam0.width, cam0.height], "methods": list(state.methods),
+            "status": {m: state.status.get(m, "") for m in state.methods}, "images": images,
+            "timed_out": not time.perf_counter() - self.t0 < CPU_WAIT_SECONDS,
+            "seconds": time.perf_counter() - self.t0, "frame": state.frame}
+
+    def _after_resize(self, state: AppState) -> None:
+        from workbench.app.ui.glfw_title import window_size
+        applied = tuple(window_size()) == tuple(self.resize)
+        if not applied and time.perf_counter() - self.asked < RESIZE_WAIT_SECONDS:
+            return
+        if self.rested is None:
+            self.rested = state.frame
+        if state.frame < self.rested + 3 * self.frames:  # the dock space, its refit, the windows
+            return
+        self.log["resized"] = {"window": list(window_size()), "windows": window_report(),
+                               "blits": [[m, list(r)] for m, r in state.gpu.blits.last],
+                               "camera": [state.camera.width, state.camera.height]}
+        state.quit = True
+
+
+def scene_screens_shrunk(out: Path) -> SceneScreens:
+    """:class:`SceneScreens`, then the window shrunk to 1024 x 600 at run time."""
+    return SceneScreens(out, resize=(1024, 600))
+
+
 def _compiles(state: AppState) -> int:
     """GL programs compiled so far by the GL panels' sessions, released ones included."""
     if state.gpu is None:

@@ -28,5 +28,26 @@ def test_a_meter_without_target_takes_the_jobs_fraction():
     assert m.fraction == 1.0
 
 
+def test_a_phase_not_measured_shows_the_time_elapsed_and_an_indeterminate_bar():
+    m = Meter("", None, phase="radiosity solve (direct: no progress reported)", started=10.0)
+    m.update(0, now=10.5)
+    assert not m.measured and m.bar(3.0) == -3.0  # imgui's moving indeterminate bar
+    assert m.seconds_left() is None
+    assert m.text(now=75.0) == "radiosity solve (direct: no progress reported): 1:05 elapsed"
+    shots = Meter("shots", None, phase="radiosity shooting", started=0.0)
+    shots.update(48, now=4.0)
+    assert not shots.measured and shots.text(now=4.0) == "radiosity shooting: 48 shots, 0:04 elapsed"
+
+
+def test_a_measured_phase_shows_the_time_elapsed_until_its_rate_is_known():
+    m = Meter("rows", 64, phase="ray trace", started=0.0)
+    m.update(0, now=1.0)
+    assert m.measured and m.text(now=2.0) == "ray trace: 0/64 rows, 0:02 elapsed"
+    m.update(32, now=3.0)  # half the rows in 2 s: 2 s left
+    assert m.bar(9.0) == 0.5 and m.text() == "ray trace: 32/64 rows, 0:02 left"
+    m.update(64, now=5.0)
+    assert m.text(now=6.0) == "ray trace: 64/64 rows"
+
+
 def test_clock_text():
     assert clock_text(0.6) == "0:01" and clock_text(0.4) == "0:00" and clock_text(75) == "1:15" and clock_text(3725) == "1:02:05"

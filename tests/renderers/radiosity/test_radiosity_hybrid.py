@@ -47,3 +47,35 @@ def test_hybrid_spheres_reflect_the_room(pair):
 def test_hybrid_without_emitters_is_not_applicable():
     with pytest.raises(NotApplicable, match="no emitters"):
         workbench.render(workbench.load_scene("whitted"), "hybrid", width=8, height=8)
+
+
+class Stop(Exception):
+    """Raised by a progress callback: the render must end with it."""
+
+
+def test_hybrid_reports_each_step_and_the_bands_of_its_image(gl_ctx):
+    """The window's progress bar of the hybrid method (issue #29): the form factors' rows, the
+    solve (no amount reported), the ray-trace pass's rows; its bands are the final image."""
+    scene = workbench.load_scene("cornell_spheres")
+    kw = dict(width=24, height=20, patch_size=0.2, hemicube_resolution=32)
+    steps, image = [], np.zeros((20, 24, 3), np.float32)
+
+    def band(y0, y1, x0, x1, tile):
+        image[y0:y1, x0:x1] = tile
+    res = workbench.render(scene, "hybrid", **kw, on_progress=lambda *a: steps.append(a), on_tile=band)
+    assert np.array_equal(res.image, workbench.render(scene, "hybrid", **kw).image)
+    assert np.array_equal(image, res.image)
+    P = res.stats["patches"]
+    rows = [s for s in steps if s[0] == "radiosity form factors"]
+    assert rows[0] == ("radiosity form factors", 0, P, "patches") and rows[-1][1] == P
+    assert all(b[1] > a[1] for a, b in zip(rows, rows[1:]))
+    traced = [s for s in steps if s[0] == "ray trace"]
+    assert traced[0] == ("ray trace", 0, 20, "rows") and traced[-1] == ("ray trace", 20, 20, "rows")
+    solve = ("radiosity solve (direct: no progress reported)", 0, None, "")
+    assert steps == [*rows, solve, *traced]  # one step after the other
+
+    def stop(phase, *_):
+        if phase.startswith("radiosity solve"):
+            raise Stop
+    with pytest.raises(Stop):
+        workbench.render(scene, "hybrid", **kw, on_progress=stop)

@@ -28,7 +28,11 @@ job's samples per pixel of its target, a tiled job's rows, a shooting radiosity'
 the unshot share of the emitted power), which the panel shows as a progress bar with the time
 left.  A method whose options include ``on_pass`` and that is not progressive (radiosity's
 progressive refinement) is rendered with ``on_pass(shots, image, unshot, progress)``: each
-round's image is shown as it lands.
+round's image is shown as it lands.  A method whose options include ``on_progress`` (the
+hybrid method's passes, the outside programs POV-Ray and Mitsuba) is rendered with
+``on_progress(phase, done, total, unit)``: each phase gets a meter of its own (``total`` None:
+not measured, an indeterminate bar with the time elapsed), and a cancelled job's next report
+raises :class:`Cancelled` (an outside program is then ended).
 
 The error plot's boards render references (``JobBoard(cached=True, share=...)``): a reference
 is first looked up in the CLI's disk cache (:mod:`workbench.compare.reference_cache`, keyed by
@@ -87,6 +91,8 @@ class Job:
     with ``on_pass``), else None.
     shoots : the method is not progressive but reports rounds through ``on_pass``
     (radiosity's progressive refinement): each round's image is shown whole.
+    phased : the method reports its phases through ``on_progress`` (its meter is the
+    current phase's; tiles, if it has them, only bring the image).
     cached : ``stats["cache"]`` of a job rendered through the reference cache (``"hit"``:
     loaded, not rendered; ``"miss"``...), else None.
     """
@@ -114,9 +120,11 @@ class Job:
         self.shots, self.unshot = 0, 1.0  # a shooting job's rounds so far (radiosity)
         # a non-progressive method with on_pass (radiosity's shooting) shows each round
         self.shoots = not self.progressive and "on_pass" in r.options
+        self.phased = "on_progress" in r.options
         target = options.get(r.knob.name, r.knob.default)  # checked in the thread
         self.meter = (Meter("spp", int(target)) if self.progressive
                       else Meter("shots") if self.shoots
+                      else Meter("") if self.phased
                       else Meter("rows", camera.height) if tiled else None)
         self.cached = None
         self.options = dict(options)
@@ -130,6 +138,8 @@ class Job:
             opts["on_tile"] = self._on_tile
         if self.shoots:
             opts["on_pass"] = self._on_round
+        if self.phased:
+            opts["on_progress"] = self._on_progress
         self.thread = threading.Thread(
             target=self._run, args=(replace(scene, camera=camera), method, opts, cached),
             name=f"ui-job-{method}", daemon=False)
@@ -141,7 +151,8 @@ class Job:
         with self.lock:
             self.partial[y0:y1, x0:x1] = tile
             self.rows_done = max(self.rows_done, y1)
-            self.meter.update(self.rows_done)
+            if not self.phased:
+                self.meter.update(self.rows_done)
             self.version += 1
         self._notify()
 
@@ -157,6 +168,19 @@ class Job:
             self.meter.update(shots, progress, f"unshot {100 * unshot:.2g} %")
             self.shots, self.unshot = shots, unshot
             self.version += 1
+        self._notify()
+
+    def _on_progress(self, phase: str, done: int, total: int | None, unit: str = ""):
+        """A phased method's report (``on_progress``): ``done`` of ``total`` ``unit`` in
+        ``phase`` (``total`` None: not measured); a new phase starts a new meter (its own
+        rate and time left)."""
+        if self.cancelled.is_set():
+            raise Cancelled
+        with self.lock:
+            m = self.meter
+            if m.first is None or (m.phase, m.unit, m.target) != (phase, unit, total or None):
+                self.meter = Meter(unit, total or None, phase=phase)
+            self.meter.update(done)
         self._notify()
 
     def _on_spp(self, spp, image, std_error):

@@ -160,7 +160,7 @@ def _loop(state: AppState, max_frames: int | None, script, window: tuple[int, in
     from .panel_gpu import release_gl
     from .panel_refresh import in_progress, update_images
     from .panel_show import draw_shown_images
-    from .layout import docking_params
+    from .layout import docking_params, refit
     from .panels import status_bar
     from .plot import track
     clock = {"t": None, "title": window_title(state)}
@@ -182,6 +182,7 @@ def _loop(state: AppState, max_frames: int | None, script, window: tuple[int, in
             state.frame_seconds = now - clock["t"]
         clock["t"] = now
         state.drag.frame(state.camera, now, state.frame_seconds)  # the GL panels' scale
+        refit(state)
         update_images(state)
         track(state)
         if window_title(state) != clock["title"]:  # the scene changed: so does the title

@@ -152,8 +152,9 @@ def refresh_cpu(state: AppState, method: str) -> None:
                                 else f"done: {job.meter.text()}" if job.shoots and job.meter.first
                                 else "done")
     elif job.meter is not None and job.meter.first is not None:
-        # samples per pixel, rows or shooting rounds done, and the time left
-        state.status[method] = ("refining: " if job.progressive or job.shoots
+        # samples per pixel, rows or shooting rounds done, and the time left (a phased job:
+        # its phase, and the time elapsed where the phase reports no amount done)
+        state.status[method] = ("" if job.phased else "refining: " if job.progressive or job.shoots
                                 else "rendering: ") + job.meter.text()
     else:
         state.status[method] = waiting_text(method, job)
@@ -229,15 +230,13 @@ def shown_progress(state: AppState, method: str, job, held: dict) -> dict:
 
 
 def waiting_text(method: str, job) -> str:
-    """The status of a job that has reported no progress yet: its elapsed time, and whether
-    progress will come (bands of rows, passes; the hybrid's rows come after its radiosity
-    solve) or the method reports none (it renders in one piece: POV-Ray and Mitsuba in a
-    child process)."""
+    """The status of a job that has reported no progress yet: its elapsed time, and, for a
+    method with no way to report any (no rows, passes, rounds or phases), that it will not."""
     from .meter import clock_text
     elapsed = clock_text(time.perf_counter() - job.begun)
     if job.meter is None:
-        return f"rendering, {elapsed} elapsed ({method} reports no progress: one piece)"
-    return f"rendering, {elapsed} elapsed, no {job.meter.unit} yet"
+        return f"rendering, {elapsed} elapsed ({method} reports no progress)"
+    return f"rendering, {elapsed} elapsed"
 
 
 def running_meter(job):

@@ -241,6 +241,17 @@ def text_in_width(text: str, width: float, disabled: bool = False) -> None:
         imgui.set_tooltip(text)
 
 
+def progress_line(meter, text: str, width: float) -> None:
+    """A job's progress bar ``width`` pixels wide (indeterminate while its phase is not
+    measured, :meth:`.meter.Meter.bar`) with ``text`` over it, cut to the bar (the whole text
+    as a tooltip when cut)."""
+    pad = 2 * imgui.get_style().frame_padding.x
+    shown = fit_text(text, max(1.0, width - pad))
+    imgui.progress_bar(meter.bar(imgui.get_time()), imgui.ImVec2(width, 0), shown)
+    if shown != text and imgui.is_item_hovered():
+        imgui.set_tooltip(text)
+
+
 def image_panels(state: AppState) -> None:
     """One image per selected method at the scene camera's aspect, as large as the window
     allows, in as many rows as fit best (:func:`~.placement.panel_grid`); each image is shown
@@ -274,8 +285,9 @@ def image_panels(state: AppState) -> None:
             imgui.dummy(imgui.ImVec2(w, h))
         from .panel_refresh import running_meter
         job = state.jobs.current.get(m)
-        if job is not None and running_meter(job) is not None:  # done/target, time left
-            imgui.progress_bar(job.meter.fraction, imgui.ImVec2(w, 0), state.status.get(m, ""))
+        meter = None if job is None else running_meter(job)
+        if meter is not None:  # done/target and time left, or a phase's time elapsed
+            progress_line(meter, state.status.get(m, ""), w)
         else:
             text_in_width(state.status.get(m, ""), w, disabled=True)
         mode = state.display.get(m, "direct24")

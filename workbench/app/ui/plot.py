@@ -308,7 +308,8 @@ def error_plot(state: AppState) -> None:
     imgui.push_text_wrap_pos(0.0)
     meter = reference_meter(plot)
     if meter is not None:  # the reference's done/target and time left, as the panels' bars
-        imgui.progress_bar(meter.fraction, imgui.ImVec2(-1, 0), plot.message)
+        from .panels import progress_line
+        progress_line(meter, plot.message, imgui.get_content_region_avail().x)
     else:
         imgui.text_disabled(plot.message)
     if plot.matched_message:

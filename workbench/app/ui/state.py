@@ -214,6 +214,9 @@ class AppState:
     """Widgets that ran past their window's right edge in the last frame (``panels.check_fits``)."""
     window_size: tuple[int, int] = (0, 0)
     """The window's size when it closed (GLFW), kept for the next run (:mod:`.window_size`)."""
+    layout_fit: tuple | None = None
+    """(dock space height, panels' height) the control row was last sized for
+    (:func:`.layout.refit`)."""
     wrapped: set = field(default_factory=set)
     """Section titles too long for their window in the last frame, wrapped instead of cut
     (:func:`.section.section`)."""

@@ -168,7 +168,7 @@ def analytic_pairs(geom: Geometry, I, J, order: int = 8) -> np.ndarray:
 # --------------------------------------------------------------------------- dispatcher
 def compute(geom: Geometry, method: str = "hemicube", resolution: int = 128, *,
             rotate: bool = False, rays: int = 4096, order: int = 8, seed: int = 0,
-            normalize: bool = True) -> FormFactors:
+            normalize: bool = True, on_rows=None) -> FormFactors:
     """Form-factor matrix of ``geom`` by ``method`` (see the module docstring).
 
     Parameters
@@ -178,6 +178,8 @@ def compute(geom: Geometry, method: str = "hemicube", resolution: int = 128, *,
     normalize : hemicube: scale the delta form factors to sum to exactly 1 (errata 6).
     rays : raycast: rays per patch.
     order : analytic: Gauss-Legendre order per triangle edge.
+    on_rows : hemicube: ``on_rows(done, total)`` after each batch of rows (the other methods
+        compute the matrix in one call and report nothing).
     """
     if method not in METHODS:
         raise WorkbenchError(f"form factor method must be one of {', '.join(METHODS)}, got {method!r}")
@@ -187,7 +189,7 @@ def compute(geom: Geometry, method: str = "hemicube", resolution: int = 128, *,
         from .hemicube import Hemicube
         hc = Hemicube(geom, resolution, rotate=rotate, seed=seed, normalize=normalize)
         try:
-            F = hc.matrix()
+            F = hc.matrix(on_rows)
             info = hc.info()
         finally:  # GL objects are not garbage-collected: free them on every path
             hc.release()

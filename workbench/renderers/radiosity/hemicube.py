@@ -297,19 +297,22 @@ class Hemicube:
             out[s:s + len(ids)] = ids
         return out
 
-    def rows(self, patches) -> np.ndarray:
+    def rows(self, patches, on_rows=None) -> np.ndarray:
         """Rows F[i, :] (len(patches), P) of the patches listed: each item buffer's delta
-        form factors summed per patch (numba, :func:`.kernels.accumulate_items`)."""
+        form factors summed per patch (numba, :func:`.kernels.accumulate_items`);
+        ``on_rows(done, total)`` after each batch, if given."""
         from .kernels import accumulate_items
         patches = np.asarray(patches, dtype=np.int64).ravel()
         out = np.zeros((len(patches), self.P))
         for s, ids in self._each_batch(patches):
             accumulate_items(ids, self.weights, out[s:s + len(ids)])
+            if on_rows is not None:
+                on_rows(s + len(ids), len(patches))
         return out
 
-    def matrix(self) -> np.ndarray:
-        """The full matrix F (P, P)."""
-        return self.rows(np.arange(self.P))
+    def matrix(self, on_rows=None) -> np.ndarray:
+        """The full matrix F (P, P) (``on_rows`` as :meth:`rows`)."""
+        return self.rows(np.arange(self.P), on_rows)
 
     def info(self) -> dict:
         return {"hemicube_resolution": self.res, "weight_sum": float(self.weights.sum()),

@@ -11,6 +11,11 @@ solution already holds both; ks is kept for highlights), keeps specular objects 
 and renders it with the registered ``raytrace`` method: a primary ray that hits a diffuse
 surface returns its radiosity, one that hits a mirror or glass follows the ray tracer's
 recursion until it lands on a diffuse surface (or the light, or the background).
+
+Progress (the window's, :mod:`workbench.app.ui.jobs`): ``on_progress(phase, done, total,
+unit)`` hears the radiosity pass's phases (:func:`.method.solve_scene`: the form factors'
+rows, then the solve, which reports no amount done) and the ray-trace pass's rows
+(``"ray trace"``); ``on_tile`` gets the ray-trace pass's bands of the final image.
 """
 from __future__ import annotations
 
@@ -85,10 +90,13 @@ class HybridRenderer:
                "max_depth": Option(int, 5, "ray tracer: maximum ray generations per path"),
                "threshold": Option(float, 1e-3, "ray tracer: weight below which a child ray is not traced", low=0.0),
                "spp": Option(int, 1, "ray tracer: samples per pixel"),
-               "on_tile": Option(callback, None, "callback on_tile(y0, y1, x0, x1, tile) after each band of "
-                                 "rows of the ray-tracing pass (the window's progress)"),
                "fresnel": Option(str, "none", "ray tracer: reflection/transmission split",
-                                 ("none", "schlick", "exact"))}
+                                 ("none", "schlick", "exact")),
+               "on_tile": Option(callback, None, "ray-trace pass: callback on_tile(y0, y1, x0, x1, "
+                                 "tile) with each band of the final image as it is traced"),
+               "on_progress": Option(callback, None, "callback on_progress(phase, done, total, unit) "
+                                     "at each step of both passes (total None: the step reports "
+                                     "no amount done)")}
     memory_options = ("patch_size", "hemicube_resolution", "solver", "row_cache_mb",
                       "max_depth", "threshold", "spp")
 
@@ -102,10 +110,21 @@ class HybridRenderer:
         return solve + estimate_trace_bytes(scene, width, height, opts, True, extra_triangles=2 * P)
 
     def render(self, scene: m.Scene, width: int, height: int, **opts) -> RenderResult:
-        sol = solve_scene(scene, opts, self.name)
+        on_progress, on_tile = opts["on_progress"], opts["on_tile"]
+        sol = solve_scene(scene, opts, self.name, on_progress=on_progress)
         derived, replaced = derived_scene(scene, sol.patches, sol.radiance)
+        traced = {"rows": 0}
+
+        def band(y0, y1, x0, x1, tile):
+            if on_tile is not None:
+                on_tile(y0, y1, x0, x1, tile)
+            traced["rows"] = max(traced["rows"], y1)
+            on_progress("ray trace", traced["rows"], height, "rows")
+        if on_progress is not None:
+            on_progress("ray trace", 0, height, "rows")
         rt = render_method(derived, "raytrace", width=width, height=height,
-                           on_tile=opts["on_tile"], **{k: opts[k] for k in RAYTRACE_OPTIONS})
+                           on_tile=band if on_progress is not None else on_tile,
+                           **{k: opts[k] for k in RAYTRACE_OPTIONS})
         timings = dict(sol.timings)
         timings["compile"] += rt.timings.get("compile", 0.0)
         timings["raytrace"] = rt.timings["total"]

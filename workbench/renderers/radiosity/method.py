@@ -209,12 +209,20 @@ def check_camera_outside(scene: Scene, method: str) -> None:
                                 "(move the camera out, or use pathtrace)")
 
 
-def solve_scene(scene: Scene, opts: dict, method: str, on_round=None) -> Solution:
+def solve_scene(scene: Scene, opts: dict, method: str, on_round=None,
+                on_progress=None) -> Solution:
     """Patches, form factors and solution of ``scene`` with the ``common_options``
     (:func:`check_camera_outside` first).  ``on_round(patches, shots, radiance, unshot,
     progress)`` is called after each round of shots of matrix-free progressive refinement
     (``solver="progressive"`` with hemicube form factors; :func:`_rounds`), never by the other
-    solvers."""
+    solvers.  ``on_progress(phase, done, total, unit)`` (the hybrid method's, see
+    :mod:`workbench.app.ui.jobs`) hears the phases: the hemicube matrix's rows (``"radiosity
+    form factors"``, patches done of all), then the solve, which reports no amount done
+    (``total`` None), as do ray-cast form factors and shooting (its shots counted)."""
+    def phase(name, done=0, total=None, unit=""):
+        if on_progress is not None:
+            on_progress(name, done, total, unit)
+
     check_camera_outside(scene, method)
     if opts["max_iterations"] < 0:
         raise WorkbenchError(f"{method}: max_iterations must be >= 0 (0: automatic), got {opts['max_iterations']}")
@@ -236,14 +244,27 @@ def solve_scene(scene: Scene, opts: dict, method: str, on_round=None) -> Solutio
     cap = opts["max_iterations"] or None
     if opts["solver"] == "progressive" and opts["form_factors"] == "hemicube":
         shoot = _shoot_raycast if opts["shot_rows"] == "raycast" else _shoot_hemicube
+
+        def shot(shots, radiance, unshot, progress):
+            phase("radiosity shooting", shots, None, "shots")
+            if on_round is not None:
+                on_round(patches, shots, radiance, unshot, progress)
+        phase("radiosity shooting", 0, None, "shots")
         res = shoot(geom, E, R, opts, stats, timings, tol, cap,
-                    None if on_round is None else (lambda *a: on_round(patches, *a)))
+                    None if on_round is None and on_progress is None else shot)
         timings["form_factors"] = res.seconds   # rows and shots interleave
         timings["solve"] = 0.0
     else:
+        hemicube = opts["form_factors"] == "hemicube"
+        phase("radiosity form factors" if hemicube else
+              f"radiosity form factors ({opts['form_factors']}: no progress reported)",
+              0, len(patches) if hemicube else None, "patches" if hemicube else "")
         ff: FormFactors = compute(geom, opts["form_factors"], opts["hemicube_resolution"],
                                   rotate=opts["hemicube_rotate"], rays=opts["rays"],
-                                  normalize=opts["hemicube_normalize"])
+                                  normalize=opts["hemicube_normalize"],
+                                  on_rows=lambda done, total: phase("radiosity form factors",
+                                                                    done, total, "patches"))
+        phase(f"radiosity solve ({opts['solver']}: no progress reported)")
         timings["form_factors"] = ff.seconds
         rep = ff.report()
         stats.update({"row_sum_min": rep["row_sum_min"], "row_sum_max": rep["row_sum_max"],
