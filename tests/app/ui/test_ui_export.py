@@ -129,3 +129,19 @@ def test_an_export_while_the_path_tracer_refines_records_what_it_had(xvfb, tmp_p
     ui, cli = np.load(folder / "pathtrace.npy"), np.load(tmp_path / "pt.npy")
     assert np.isfinite(ui).all() and ui.shape == cli.shape == (h, w, 3)
     assert np.abs(ui - cli).max() <= 1e-5
+
+
+def test_a_gl_panel_exported_at_a_drags_lower_resolution_says_so():
+    """An export taken while a GL panel shows a drag's smaller image (issue #29, items 1 and 5)
+    records it as ``reduced`` with both sizes, and its note says so; at full size it is done."""
+    from types import SimpleNamespace
+
+    from workbench.app.ui.export import panel_record, progress_note
+
+    state = SimpleNamespace(kinds={"flat": "gl"}, images={"flat": np.zeros((6, 8, 3), np.float32)},
+                            camera=SimpleNamespace(width=16, height=12))
+    record = panel_record(state, "flat")
+    assert record == {"state": "reduced", "size": [8, 6], "full_size": [16, 12]}
+    assert progress_note("flat", record) == "flat at 8x6 of 16x12 (drawn during a camera drag)"
+    state.images["flat"] = np.zeros((12, 16, 3), np.float32)
+    assert panel_record(state, "flat") == {"state": "done"} and progress_note("flat", {"state": "done"}) == ""

@@ -132,7 +132,8 @@ def skipped_panels(state: AppState) -> dict[str, str]:
 
 def panel_record(state: AppState, method: str) -> dict:
     """The state ``method``'s exported image was in: ``{"state": "done"}`` for a GL panel (drawn
-    in the frame) and a child's image of the current request; a CPU or progressive panel's
+    in the frame; ``"reduced"`` with its ``size`` and ``full_size`` when drawn at a drag's
+    lower resolution, :mod:`.drag_resolution`) and a child's image of the current request; a CPU or progressive panel's
     :func:`.panel_refresh.shown_progress` (``refining`` with ``spp``, ``target_spp``,
     ``passes``, ``noise``, ``converged``; ``rendering`` with ``rows_done``; ``stale``); a
     child's image of an earlier request ``stale``."""
@@ -143,6 +144,9 @@ def panel_record(state: AppState, method: str) -> dict:
         proc = state.pyrender
         current = (state.scene_version, state.camera, tuple(sorted(state.options[method].items())))
         return {"state": "done" if proc is not None and proc.image_key == current else "stale"}
+    h, w = np.shape(state.images[method])[:2] if method in state.images else (0, 0)
+    if (h, w) != (state.camera.height, state.camera.width):  # drawn during a drag, at its scale
+        return {"state": "reduced", "size": [w, h], "full_size": [state.camera.width, state.camera.height]}
     return {"state": "done"}
 
 
@@ -164,6 +168,9 @@ def progress_note(method: str, record: dict) -> str:
         return f"{method} after {record['shots']} shots ({100 * record['unshot']:.2g} % of the power unshot)"
     if record["state"] == "rendering":
         return f"{method} partial ({record['rows_done']}/{record['rows']} rows)"
+    if record["state"] == "reduced":
+        (w, h), (fw, fh) = record["size"], record["full_size"]
+        return f"{method} at {w}x{h} of {fw}x{fh} (drawn during a camera drag)"
     if record["state"] != "done":
         return f"{method} {record['state']} (an earlier request's image)"
     return ""
