@@ -397,7 +397,7 @@ def csg_hit(geo, start, length, ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps, l
     boundary in ``(tmin, tmax)``."""
     kinds, prog, ptype, xf, par, aux = geo.kinds, geo.prog, geo.ptype, geo.xf, geo.par, geo.aux
     st, sp_, sf, sn = levels
-    top = 0
+    top = np.int64(0)  # int64, not a literal: one compile of combine (see walks.LANE)
     for q in range(start, start + length):
         c = prog[q]
         if c >= 0:

@@ -175,7 +175,7 @@ def blob_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out, cap):
 @nb.njit(cache=True, error_model="numpy")
 def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
     """Nearest hit ``tmin < t < tmax``: ``(t, 0)``, ``(inf, 0)`` on a miss."""
-    if blob_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, 1) == 1:
+    if blob_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, np.int64(1)) == 1:  # int64, not a literal: one compile (see kernels.walks.LANE)
         return out_t[0], 0
     return np.inf, 0
 

@@ -81,7 +81,7 @@ def iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f,
 @nb.njit(cache=True, error_model="numpy")
 def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
     """Nearest hit ``tmin < t < tmax``: ``(t, face)``, ``(inf, 0)`` on a miss."""
-    if iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, 1, stack) == 1:
+    if iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, np.int64(1), stack) == 1:  # int64: see kernels.walks.LANE
         return out_t[0], out_f[0]
     return np.inf, 0
 

@@ -161,6 +161,9 @@ _NEW = 64           # the roots of the current level
 _HITS_T = 72        # a segment's hits: t
 _HITS_S = 84        # and s
 _MAX_HITS = 12
+C0 = np.int64(0)    # slot 0: a polynomial's constant term
+DEG3, DEG6 = np.int64(3), np.int64(6)  # the degrees solved: a profile's cubic, a swept cubic's sextic
+# (int64, not literals: numba compiles a callee once per literal argument, kernels.walks.LANE)
 
 
 @nb.njit(cache=True, error_model="numpy", forceinline=True)
@@ -291,8 +294,8 @@ def _spline_segment_hits(aux, j, ox, oy, oz, dx, dy, dz, st):
             for k in range(4):
                 uk = aux[j + 4 + k] - (oy if k == 0 else 0.0)
                 _put(st, i + k, _get(st, i + k) + a * ui * uk - dy * dy * aux[j + i] * aux[j + k])
-        _put(st, 0, _get(st, 0) + dy * dy * q)
-        nr = _roots_in(st, 6, -SIGMA, 1.0 + SIGMA)
+        _put(st, C0, _get(st, C0) + dy * dy * q)
+        nr = _roots_in(st, DEG6, -SIGMA, 1.0 + SIGMA)
         for r in range(nr):
             s = _get(st, _CRIT + r)
             s, t = _polish(aux, j, ox, oy, oz, dx, dy, dz, s, (_cubic(aux, j + 4, s) - oy) / dy)
@@ -304,8 +307,8 @@ def _spline_segment_hits(aux, j, ox, oy, oz, dx, dy, dz, st):
     tc = -m / a
     for i in range(4):
         _put(st, i, aux[j + 4 + i])
-    _put(st, 0, aux[j + 4] - (oy + dy * tc))
-    nr = _roots_in(st, 3, -SEED_MARGIN, 1.0 + SEED_MARGIN)
+    _put(st, C0, aux[j + 4] - (oy + dy * tc))
+    nr = _roots_in(st, DEG3, -SEED_MARGIN, 1.0 + SEED_MARGIN)
     for r in range(nr):
         s0 = _get(st, _CRIT + r)
         R = _cubic(aux, j, s0)
@@ -369,8 +372,8 @@ def _spline_inside(par, k, aux, x, y, z, st):
             continue
         for c in range(4):
             _put(st, c, aux[j + 4 + c])
-        _put(st, 0, aux[j + 4] - y)
-        nr = _roots_in(st, 3, 0.0, 1.0)
+        _put(st, C0, aux[j + 4] - y)
+        nr = _roots_in(st, DEG3, 0.0, 1.0)
         for r in range(nr):
             if _cubic(aux, j, _get(st, _CRIT + r)) > rho:
                 res = not res
@@ -387,8 +390,8 @@ def _spline_param(aux, j, x, y, z, st):
         if which < 2:
             for c in range(4):
                 _put(st, c, aux[j + (4 if which == 0 else 0) + c])
-            _put(st, 0, _get(st, 0) - (y if which == 0 else rho))
-            nr = _roots_in(st, 3, -SEED_MARGIN, 1.0 + SEED_MARGIN)
+            _put(st, C0, _get(st, C0) - (y if which == 0 else rho))
+            nr = _roots_in(st, DEG3, -SEED_MARGIN, 1.0 + SEED_MARGIN)
         for r in range(nr):
             s = _get(st, _CRIT + r) if which < 2 else float(r)
             d = math.hypot(_cubic(aux, j, s) - rho, _cubic(aux, j + 4, s) - y)
