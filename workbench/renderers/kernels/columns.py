@@ -28,6 +28,7 @@ class Mat(Columns):
     BUMPED = 18          # 1: has a bump map
     OPACITY = 19         # 1: has an opacity map
     ENVIRONMENT = 20     # 1: reflects the environment map
+    MEDIUM = 21          # the primitive row of the heterogeneous medium inside (a hypertexture), -1: none
 
 
 class Light(Columns):

@@ -100,10 +100,11 @@ class SceneData:
         and the triangles' tree (if the scene has triangles).  The analytic primitives' tree
         walk is always compiled."""
         present = {int(p) for p in np.unique(self.ptype)}
-        package = [k for k in kernel_kinds() if k.TYPE in PACKAGE_KINDS]
+        package = [k for k in kernel_kinds() if k.TYPE in PACKAGE_KINDS and not getattr(k, "MEDIUM", False)]
         out = []
         if present & ({k.PTYPE for k in package} | {CSGNODE}):
             out += [k.TYPE for k in package] + ["csg"]
+        out += [k.TYPE for k in kernel_kinds() if getattr(k, "MEDIUM", False) and k.PTYPE in present]
         out += [marker_name(k) for k in kernel_kinds() if k.TYPE not in PACKAGE_KINDS and k.PTYPE in present]
         if len(self.tri_v):
             out.append("triangles")
@@ -118,12 +119,20 @@ class SceneData:
                         kinds_marker(self.features()))
 
 
-def _material_row(mat: m.Material, front_only: bool = False) -> np.ndarray:
-    """The material's row of the material table (columns :class:`..kernels.columns.Mat`)."""
+def _material_row(mat: m.Material, front_only: bool = False, medium: int = -1) -> np.ndarray:
+    """The material's row of the material table (columns :class:`..kernels.columns.Mat`);
+    ``medium``: the primitive row of the heterogeneous medium it bounds (-1: none)."""
     return pack(Mat, color=mat.color, ka=mat.ka, kd=mat.kd, ks=mat.ks, shininess=mat.shininess,
                 kr=mat.kr, kt=mat.kt, ior=mat.ior, absorption=mat.absorption, emission=mat.emission,
                 front_only=front_only, textured=mat.texture is not None, bumped=mat.bump is not None,
-                opacity=mat.opacity is not None, environment=mat.environment)
+                opacity=mat.opacity is not None, environment=mat.environment, medium=medium)
+
+
+def medium_boundary(name: str) -> m.Material:
+    """The material of a medium kind's boundary (``MEDIUM`` kinds: the hypertexture): it lights
+    nothing and refracts nothing (index 1, all transmitted), so a ray crossing it only enters
+    or leaves the medium."""
+    return m.Material(name=name, color=(1.0, 1.0, 1.0), ka=0.0, kd=0.0, ks=0.0, kr=0.0, kt=1.0, ior=1.0)
 
 
 def light_rows(lights) -> np.ndarray:
@@ -181,6 +190,7 @@ class _Builder:
         self.materials = list(scene.materials.values())
         self.mat_index = {mt.name: i for i, mt in enumerate(self.materials)}
         self.front_only: set[int] = set()
+        self.medium_of: dict[int, int] = {}  # material index -> its medium's primitive row
         self.aux: list[np.ndarray] = []
         self.n_aux = 0
 
@@ -198,7 +208,12 @@ class _Builder:
         ofw = np.linalg.inv(world_from_object)
         row_par = np.zeros(NPAR)
         row_par[:len(par)] = par
-        row = dict(ptype=ptype, top=top, obj=obj_index, mat=self.mat_index[obj.material],
+        mat = self.mat_index[obj.material]
+        if getattr(kind_of(obj), "MEDIUM", False):  # a boundary material of its own
+            self.materials.append(medium_boundary(f"{obj.material}#medium{len(self.rows)}"))
+            mat = len(self.materials) - 1
+            self.medium_of[mat] = len(self.rows)
+        row = dict(ptype=ptype, top=top, obj=obj_index, mat=mat,
                    xf=ofw[:3, :4].reshape(-1), nm=ofw[:3, :3].T.reshape(-1), par=row_par, solid=solid,
                    shadow=shadow, wfo=np.asarray(world_from_object, dtype=np.float64), has_uv=False)
         self.rows.append(row)
@@ -313,7 +328,8 @@ def flatten(scene: m.Scene, accel: str = "bvh", prepared: PreparedScene | None =
     scale = max(float(np.abs(finite).max()), prepared.extent, float(np.abs(scene.camera.position).max()))
     prims = _prim_tree(rows, owners, _owner_boxes(prepared), accel, scale)
     bvh_time = time.perf_counter() - t0
-    mat_tab = np.stack([_material_row(mt, i in b.front_only) for i, mt in enumerate(b.materials)])
+    mat_tab = np.stack([_material_row(mt, i in b.front_only, b.medium_of.get(i, -1))
+                        for i, mt in enumerate(b.materials)])
     return SceneData(
         ptype=col("ptype", np.int64), top=col("top", np.bool_), obj=col("obj", np.int64),
         mat=col("mat", np.int64), xf=col("xf", np.float64).reshape(-1, 12),

@@ -1,0 +1,176 @@
+"""Numba kernels of the ``hypertexture`` kind (:mod:`.hypertexture`, whose module docstring gives
+the field): the bounding sphere's entry points for the ray tracer's dispatch (signatures:
+:mod:`.crossing_events`) and the medium's optics at a point (:func:`optics`), which the
+renderers' marches and trackers call.  Apart from the kind so that reading a scene does not
+import numba."""
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from .hypertexture import AUX_ALBEDO, AUX_EMISSION, AUX_STOPS, Par
+
+JIT = dict(cache=True, error_model="numpy")
+_M32 = np.uint64(0xFFFFFFFF)
+
+
+@nb.njit(**JIT)
+def _hash3(ix, iy, iz):
+    """:func:`workbench.core.noise._hash3` of one lattice point (int64 coordinates), in [0, 1)."""
+    m = _M32
+    h = (((np.uint64(ix & 0xFFFFFFFF) * np.uint64(73856093)) & m)
+         ^ ((np.uint64(iy & 0xFFFFFFFF) * np.uint64(19349663)) & m)
+         ^ ((np.uint64(iz & 0xFFFFFFFF) * np.uint64(83492791)) & m))
+    h ^= h >> np.uint64(16)
+    h = (h * np.uint64(0x7FEB352D)) & m
+    h ^= h >> np.uint64(15)
+    h = (h * np.uint64(0x846CA68B)) & m
+    h ^= h >> np.uint64(16)
+    return float(h >> np.uint64(8)) / 16777216.0
+
+
+@nb.njit(**JIT)
+def value_noise(x, y, z):
+    """:func:`workbench.core.noise.value_noise` at one point."""
+    fx, fy, fz = math.floor(x), math.floor(y), math.floor(z)
+    ix, iy, iz = np.int64(fx), np.int64(fy), np.int64(fz)
+    tx, ty, tz = x - fx, y - fy, z - fz
+    wx = tx * tx * tx * (tx * (tx * 6.0 - 15.0) + 10.0)
+    wy = ty * ty * ty * (ty * (ty * 6.0 - 15.0) + 10.0)
+    wz = tz * tz * tz * (tz * (tz * 6.0 - 15.0) + 10.0)
+    out = 0.0
+    for dx in range(2):
+        for dy in range(2):
+            for dz in range(2):
+                w = (wx if dx else 1.0 - wx) * (wy if dy else 1.0 - wy) * (wz if dz else 1.0 - wz)
+                out += w * _hash3(ix + dx, iy + dy, iz + dz)
+    return out
+
+
+@nb.njit(**JIT)
+def _signed_distance(par, k, x, y, z):
+    base = int(par[k, Par.BASE])
+    a, b, c = par[k, Par.SIZE], par[k, Par.SIZE + 1], par[k, Par.SIZE + 2]
+    if base == 0:
+        return math.sqrt(x * x + y * y + z * z) - a
+    if base == 1:
+        qx, qy, qz = abs(x) - a, abs(y) - b, abs(z) - c
+        ox, oy, oz = max(qx, 0.0), max(qy, 0.0), max(qz, 0.0)
+        return math.sqrt(ox * ox + oy * oy + oz * oz) + min(max(qx, qy, qz), 0.0)
+    ring = math.sqrt(x * x + z * z) - a
+    return math.sqrt(ring * ring + y * y) - b
+
+
+@nb.njit(**JIT)
+def _noise(par, k, x, y, z):
+    kind = int(par[k, Par.NOISE])
+    if kind == 0:
+        return 0.0
+    f = par[k, Par.FREQUENCY]
+    qx, qy, qz = x * f + par[k, Par.PHASE], y * f + par[k, Par.PHASE + 1], z * f + par[k, Par.PHASE + 2]
+    out = 0.0
+    s = 1.0
+    for _ in range(int(par[k, Par.OCTAVES])):
+        v = value_noise(qx * s, qy * s, qz * s)
+        if kind == 1:
+            out += abs(2.0 * v - 1.0) / (2.0 * s)
+        else:
+            out += (v - 0.5) / s
+        s *= 2.0
+    return out - 0.5 if kind == 1 else out
+
+
+@nb.njit(**JIT)
+def density(par, k, x, y, z):
+    """``D`` in [0, 1] at an object-space point (the kind's module docstring)."""
+    soft = par[k, Par.SOFT]
+    s = _signed_distance(par, k, x, y, z) - par[k, Par.AMPLITUDE] * soft * _noise(par, k, x, y, z)
+    d = min(1.0, max(0.0, 0.5 - s / soft))
+    if d <= 0.0:
+        return 0.0
+    d = d ** par[k, Par.BIAS]
+    e = par[k, Par.GAIN]
+    if d < 0.5:
+        return 0.5 * (2.0 * d) ** e
+    return 1.0 - 0.5 * max(2.0 - 2.0 * d, 0.0) ** e
+
+
+@nb.njit(**JIT)
+def optics(par, k, aux, x, y, z):
+    """At an object-space point: ``(sigma_t, albedo r, g, b, emission r, g, b)``, extinction per
+    object-space unit, single-scattering albedo and emitted radiance (the ramp applied)."""
+    d = density(par, k, x, y, z)
+    if d <= 0.0:
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    off = int(par[k, Par.OFFSET])
+    n = int(par[k, Par.STOPS])
+    s0 = off + AUX_STOPS
+    cr, cg, cb = aux[s0 + 1], aux[s0 + 2], aux[s0 + 3]
+    if d >= aux[s0 + 4 * (n - 1)]:
+        j = s0 + 4 * (n - 1)
+        cr, cg, cb = aux[j + 1], aux[j + 2], aux[j + 3]
+    elif d > aux[s0]:
+        for i in range(n - 1):
+            j = s0 + 4 * i
+            d0, d1 = aux[j], aux[j + 4]
+            if d0 <= d <= d1:
+                u = (d - d0) / (d1 - d0) if d1 > d0 else 1.0
+                cr = aux[j + 1] + u * (aux[j + 5] - aux[j + 1])
+                cg = aux[j + 2] + u * (aux[j + 6] - aux[j + 2])
+                cb = aux[j + 3] + u * (aux[j + 7] - aux[j + 3])
+                break
+    a, e = off + AUX_ALBEDO, off + AUX_EMISSION
+    return (par[k, Par.DENSITY] * d, aux[a] * cr, aux[a + 1] * cg, aux[a + 2] * cb,
+            aux[e] * cr, aux[e + 1] * cg, aux[e + 2] * cb)
+
+
+# ----------------------------------------------------------------------------- the bounding sphere
+@nb.njit(**JIT)
+def _crossings(par, k, ox, oy, oz, dx, dy, dz):
+    """Both t of the object-space line with the bounding sphere (t0 <= t1), or (inf, inf)."""
+    r = par[k, Par.BOUND]
+    s = math.sqrt(dx * dx + dy * dy + dz * dz)
+    ux, uy, uz = dx / s, dy / s, dz / s
+    b = ox * ux + oy * uy + oz * uz
+    px, py, pz = ox - b * ux, oy - b * uy, oz - b * uz
+    disc = r * r - (px * px + py * py + pz * pz)
+    if not disc > 0.0:
+        return np.inf, np.inf
+    sq = math.sqrt(disc)
+    q = -b - sq if b >= 0.0 else -b + sq
+    c = (math.sqrt(ox * ox + oy * oy + oz * oz) - r) * (math.sqrt(ox * ox + oy * oy + oz * oz) + r)
+    t0 = c / q if q != 0.0 else -sq
+    t0, t1 = min(t0, q), max(t0, q)
+    return t0 / s, t1 / s
+
+
+@nb.njit(**JIT)
+def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
+    t0, t1 = _crossings(par, k, ox, oy, oz, dx, dy, dz)
+    if tmin < t0 < tmax:
+        return t0, 0
+    if tmin < t1 < tmax:
+        return t1, 0
+    return np.inf, 0
+
+
+@nb.njit(**JIT)
+def events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
+    t0, t1 = _crossings(par, k, ox, oy, oz, dx, dy, dz)
+    if t0 == np.inf or cap < 2:
+        return 0
+    out_t[0], out_f[0], out_t[1], out_f[1] = t0, 0, t1, 0
+    return 2
+
+
+@nb.njit(**JIT)
+def normal(par, k, aux, face, x, y, z, stack):
+    return x, y, z
+
+
+@nb.njit(**JIT)
+def inside(par, k, aux, x, y, z, stack):
+    r = par[k, Par.BOUND]
+    return x * x + y * y + z * z < r * r
