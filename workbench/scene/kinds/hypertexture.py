@@ -33,6 +33,12 @@ segment.  ``step`` (object-space length) is the ray march's step for the methods
 The ``material`` of the object is required, as for every object, and used by nothing but the
 raster methods' label; the medium's optics are the keys above.
 
+``grid = N`` (N >= 2) replaces the field by its samples at the centres of ``N^3`` cells tiling
+the cube ``[-R, R]^3`` (R = :func:`bound_radius`), interpolated trilinearly with the edge cells
+repeated beyond the centres (:func:`density_grid`, :func:`sample_grid`): the convention of
+OpenGL 3D textures and of Mitsuba's ``gridvolume``, so that every method, Mitsuba included,
+renders the same medium (the ground-truth check's twin).
+
 Aux layout (:func:`params`): albedo (3), emission (3), then ``(d, r, g, b)`` per ramp stop.
 """
 from __future__ import annotations
@@ -63,7 +69,7 @@ MEDIUM = True
 (:func:`workbench.renderers.raytrace.flatten.medium_boundary`) and its own feature group in
 the kernels' marker (compiled only for scenes that have one)."""
 KEYS = frozenset({"base", "size", "soft", "noise", "frequency", "amplitude", "octaves", "phase", "bias",
-                  "gain", "density", "albedo", "emission", "ramp", "step"})
+                  "gain", "density", "albedo", "emission", "ramp", "step", "grid"})
 REQUIRED = frozenset({"base", "size", "density"})
 BASES = {"sphere": 0, "box": 1, "torus": 2}
 """Base shapes and their codes in the parameter row."""
@@ -71,6 +77,8 @@ NOISES = {"none": 0, "turbulence": 1, "fbm": 2}
 """Noise kinds and their codes."""
 MAX_OCTAVES = 8
 MAX_STOPS = 16
+MAX_GRID = 256
+"""Largest ``grid`` resolution (256^3 float64 numbers in the ray tracer's aux: 128 MiB)."""
 MIN_STEPS, MAX_STEPS = 2, 1 << 16
 """The march's steps across the bounding sphere's diameter: ``step`` must give at least the
 first and at most the second (a step that tiny makes a render of hours)."""
@@ -95,6 +103,7 @@ class Hypertexture(m.SceneObject):
     emission: tuple = (0.0, 0.0, 0.0)
     ramp: np.ndarray = field(default_factory=lambda: np.array([[0.0, 1.0, 1.0, 1.0], [1.0, 1.0, 1.0, 1.0]]))
     step: float = 0.02
+    grid: int = 0
     kind = "hypertexture"
 
 
@@ -152,7 +161,10 @@ def read(t: dict, where: str, common: dict) -> Hypertexture:
         gain=val.number(t, where, "gain", 0.5, lo=0.001, hi=0.999),
         density=val.number(t, where, "density", lo=0.0, lo_open=True),
         albedo=albedo, emission=emission, ramp=ramp,
-        step=val.number(t, where, "step", 0.02, lo=0.0, lo_open=True), **common)
+        step=val.number(t, where, "step", 0.02, lo=0.0, lo_open=True),
+        grid=val.number(t, where, "grid", 0, lo=0, hi=MAX_GRID, integer=True), **common)
+    if h.grid == 1:
+        val.fail(f"{where}.grid", "expected 0 (the analytic field) or a resolution >= 2, got 1")
     steps = 2.0 * bound_radius(h) / h.step
     if not MIN_STEPS <= steps <= MAX_STEPS:
         val.fail(f"{where}.step", f"gives {steps:.3g} steps across the medium's bounding sphere "
@@ -218,7 +230,14 @@ def gain(t, g: float):
 
 
 def density(h: Hypertexture, p: np.ndarray) -> np.ndarray:
-    """``D(x)`` in [0, 1] (N,) at object-space points ``p`` (N, 3)."""
+    """``D(x)`` in [0, 1] (N,) at object-space points ``p`` (N, 3) (the grid's, when ``grid``)."""
+    if h.grid:
+        return sample_grid(density_grid(h, h.grid), bound_radius(h), p)
+    return field_density(h, p)
+
+
+def field_density(h: Hypertexture, p: np.ndarray) -> np.ndarray:
+    """The analytic field ``D(x)`` (N,) (module docstring), whatever ``grid`` says."""
     s = signed_distance(h, p) - h.amplitude * h.soft * noise_at(h, p)
     d0 = np.clip(0.5 - s / h.soft, 0.0, 1.0)
     return gain(bias(d0, h.bias), h.gain)
@@ -254,7 +273,24 @@ def density_grid(h: Hypertexture, res: int, limit: int = GRID_BYTES) -> np.ndarr
     Y, X = np.meshgrid(c, c, indexing="ij")
     for iz, z in enumerate(c):
         pts = np.stack([X.ravel(), Y.ravel(), np.full(X.size, z)], -1)
-        out[iz] = density(h, pts).reshape(res, res)
+        out[iz] = field_density(h, pts).reshape(res, res)
+    return out
+
+
+def sample_grid(grid: np.ndarray, R: float, p: np.ndarray) -> np.ndarray:
+    """Trilinear interpolation (N,) of ``grid`` (res, res, res) ``[z, y, x]`` (cell centres
+    tiling ``[-R, R]^3``, edges clamped) at object-space points ``p`` (N, 3)."""
+    res = grid.shape[0]
+    u = np.clip((np.asarray(p, dtype=np.float64) + R) / (2.0 * R) * res - 0.5, 0.0, res - 1.0)
+    i0 = np.minimum(np.floor(u).astype(np.int64), res - 2)
+    f = u - i0
+    out = np.zeros(len(u))
+    for dz in (0, 1):
+        for dy in (0, 1):
+            for dx in (0, 1):
+                w = ((f[:, 0] if dx else 1 - f[:, 0]) * (f[:, 1] if dy else 1 - f[:, 1])
+                     * (f[:, 2] if dz else 1 - f[:, 2]))
+                out += w * grid[i0[:, 2] + dz, i0[:, 1] + dy, i0[:, 0] + dx]
     return out
 
 
@@ -306,20 +342,24 @@ class Par(Columns):
     STEP = 16
     BOUND = 17
     STOPS = 18
+    GRID = 19        # 0: the analytic field; else the grid's resolution (its samples follow the stops)
 
 
 AUX_ALBEDO, AUX_EMISSION, AUX_STOPS = 0, 3, 6
-"""Offsets within the object's aux numbers."""
+"""Offsets within the object's aux numbers (the grid, when ``grid``, after the ramp's stops)."""
 
 
 def params(h: Hypertexture, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
-    """Parameter row head (:class:`Par`) and aux (albedo, emission, ramp stops)."""
+    """Parameter row head (:class:`Par`) and aux (albedo, emission, ramp stops, grid)."""
     size = tuple(h.size) + (0.0,) * (3 - len(h.size))
     head = pack(Par, offset=aux_offset, base=BASES[h.base], size=size, soft=h.soft, noise=NOISES[h.noise],
                 frequency=h.frequency, amplitude=h.amplitude, octaves=h.octaves, phase=h.phase,
                 bias=math.log(h.bias) / math.log(0.5), gain=math.log(1.0 - h.gain) / math.log(0.5),
-                density=h.density, step=h.step, bound=bound_radius(h), stops=len(h.ramp))
-    aux = np.concatenate([np.asarray(h.albedo, float), np.asarray(h.emission, float), h.ramp.reshape(-1)])
+                density=h.density, step=h.step, bound=bound_radius(h), stops=len(h.ramp), grid=h.grid)
+    parts = [np.asarray(h.albedo, float), np.asarray(h.emission, float), h.ramp.reshape(-1)]
+    if h.grid:
+        parts.append(density_grid(h, h.grid).astype(np.float64).reshape(-1))
+    aux = np.concatenate(parts)
     return head, aux
 
 

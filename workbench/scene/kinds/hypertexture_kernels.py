@@ -83,8 +83,32 @@ def _noise(par, k, x, y, z):
 
 
 @nb.njit(**JIT)
-def density(par, k, x, y, z):
-    """``D`` in [0, 1] at an object-space point (the kind's module docstring)."""
+def _grid(par, k, aux, x, y, z):
+    """Trilinear sample of the object's grid (:func:`.hypertexture.sample_grid`)."""
+    res = int(par[k, Par.GRID])
+    R = par[k, Par.BOUND]
+    g0 = int(par[k, Par.OFFSET]) + AUX_STOPS + 4 * int(par[k, Par.STOPS])
+    sc = res / (2.0 * R)
+    u = min(max((x + R) * sc - 0.5, 0.0), res - 1.0)
+    v = min(max((y + R) * sc - 0.5, 0.0), res - 1.0)
+    w = min(max((z + R) * sc - 0.5, 0.0), res - 1.0)
+    i, j, l = min(int(u), res - 2), min(int(v), res - 2), min(int(w), res - 2)
+    fu, fv, fw = u - i, v - j, w - l
+    out = 0.0
+    for dz in range(2):
+        for dy in range(2):
+            for dx in range(2):
+                wt = (fu if dx else 1.0 - fu) * (fv if dy else 1.0 - fv) * (fw if dz else 1.0 - fw)
+                out += wt * aux[g0 + ((l + dz) * res + j + dy) * res + i + dx]
+    return out
+
+
+@nb.njit(**JIT)
+def density(par, k, aux, x, y, z):
+    """``D`` in [0, 1] at an object-space point (the kind's module docstring; the grid's, when
+    the object has one)."""
+    if par[k, Par.GRID] > 0.0:
+        return _grid(par, k, aux, x, y, z)
     soft = par[k, Par.SOFT]
     s = _signed_distance(par, k, x, y, z) - par[k, Par.AMPLITUDE] * soft * _noise(par, k, x, y, z)
     d = min(1.0, max(0.0, 0.5 - s / soft))
@@ -101,7 +125,7 @@ def density(par, k, x, y, z):
 def optics(par, k, aux, x, y, z):
     """At an object-space point: ``(sigma_t, albedo r, g, b, emission r, g, b)``, extinction per
     object-space unit, single-scattering albedo and emitted radiance (the ramp applied)."""
-    d = density(par, k, x, y, z)
+    d = density(par, k, aux, x, y, z)
     if d <= 0.0:
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     off = int(par[k, Par.OFFSET])
