@@ -827,9 +827,8 @@ class RasterSession:
             depth = fbo.depth_attachment
             if not isinstance(color, moderngl.Texture) or not isinstance(depth, moderngl.Texture):
                 raise WorkbenchError("drawing hypertextures needs a framebuffer with colour and depth textures")
+        if depth.depth:  # moderngl's depth textures compare by default: read as window depths
             depth.compare_func = ""
-        else:
-            depth.compare_func = ""  # read as window depths (texelFetch)
         target = self._volume_targets.get(id(color))
         if target is None or target[0] is not color:
             target = (color, self.ctx.framebuffer(color_attachments=[color]))
