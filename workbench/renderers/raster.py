@@ -15,6 +15,10 @@ Gouraud and Phong also draw stand-ins for the global effects the scene needs (en
 maps, blending, shadow maps: :mod:`.raster_standins`, option ``standins``, on by default in
 :func:`render`; a :class:`RasterSession` builds them when given ``standins``).
 
+Hypertextures (participating media) are ray-marched in a fragment shader through a 3D
+texture of their density (:mod:`.raster_volume`, options ``volume_resolution`` and
+``step_scale``), composited over the opaque pass with the blended surfaces, back to front.
+
 Interactive use (the UI calls this every frame)::
 
     session = RasterSession(scene, "phong", tessellation=6)   # tessellate + upload once
