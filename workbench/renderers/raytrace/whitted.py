@@ -375,7 +375,7 @@ class _Tracer:
         self.ray_cap = wavefront_cap(scene, scene.camera.width, scene.camera.height, opts["spp"], self.G,
                                      opts.get("threshold", 0.0), recursive)
         names = [mt.name for mt in sd.materials]
-        self.media = [names.index(mt.name) for mt in media][-4:]
+        self.media = ([names.index(mt.name) for mt in media] + sd.media_holding(scene, scene.camera.position))[-4:]
         self.kopts = kernel_options(self.G, threshold=opts.get("threshold", 0.0), fresnel=fres,
                                     transmissive_shadows=opts["transmissive_shadows"], blinn=opts["blinn"],
                                     shadows=self.do_shadow, reflection=refl, refraction=refr,
