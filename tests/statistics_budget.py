@@ -42,6 +42,9 @@ ALPHA = {
     "test_pathtrace_modes::radiosity_cornell (slow)": 2e-6,
     # test_mitsuba_method.py: the mean of Mitsuba's cornell against radiosity's
     "test_mitsuba_method::cornell_mean": 2e-6,
+    # test_mitsuba_media.py: Mitsuba's transmittance through a soft sphere against a quadrature
+    # (exact Bernoulli variance; block chi-square and mean, normal approximation)
+    "test_mitsuba_media::transmittance": 1e-6,
     # tests/project/test_statistics_seeds.py: two or more failures of one comparison over 20 seeds
     # (binomial: at most C(20, 2) alpha^2 per comparison, summed over the comparisons)
     "test_statistics_seeds::twenty_seeds (slow)": 1e-7,
@@ -63,6 +66,7 @@ SEEDED = {
     "test_pathtrace_modes::kernel_reference": "test_pathtrace_modes:check_kernel_reference",
     "test_pathtrace_modes::back_face": "test_pathtrace_modes:check_back_face",
     "test_mitsuba_method::cornell_mean": "test_mitsuba_method:check_cornell_mean",
+    "test_mitsuba_media::transmittance": "test_mitsuba_media:check_transmittance",
 }
 """Test -> ``module:function`` taking ``(seed, tmp_path)`` that raises AssertionError when the
 comparison fails: the test itself calls it with a fixed seed.  The slow ground-truth variants
