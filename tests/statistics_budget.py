@@ -24,7 +24,7 @@ ALPHA = {
     "test_ground_truth::cornell@64 (slow)": 1e-5,
     "test_ground_truth::cornell_spheres@64 (slow)": 1e-5,
     # test_ground_truth_media.py: the same four checks on the hypertexture twin
-    "test_ground_truth_media::hypertexture_twin": 5e-6,
+    "test_ground_truth_media::hypertexture_twin (slow)": 5e-6,
     # test_radiosity_formfactors.py: the ray-cast form factor of two parallel squares (one
     # binomial estimate, normal approximation)
     "test_radiosity_formfactors::raycast": 1e-5,
@@ -56,7 +56,7 @@ ALPHA = {
 SEEDED = {
     "test_ground_truth::cornell": "test_ground_truth:check_cornell",
     "test_ground_truth::cornell_spheres": "test_ground_truth:check_cornell_spheres",
-    "test_ground_truth_media::hypertexture_twin": "test_ground_truth_media:check_twin",
+    "test_ground_truth_media::hypertexture_twin (slow)": "test_ground_truth_media:check_twin",
     "test_radiosity_formfactors::raycast": "test_radiosity_formfactors:check_raycast",
     "test_pathtrace::furnace": "test_pathtrace:check_furnace",
     "test_pathtrace::white_furnace": "test_pathtrace:check_white_furnace",

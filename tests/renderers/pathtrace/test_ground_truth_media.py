@@ -30,7 +30,10 @@ pytestmark = pytest.mark.skipif(not mitsuba_installed(), reason="Mitsuba 3 not i
 TWIN = Path(__file__).resolve().parents[2] / "scenes" / "hypertexture_twin.toml"
 #: What each side may leave out on the twin, and nothing else (prefixes).
 ALLOWED_LEFT_OUT = {"pathtrace": ("ambient: off",), "mitsuba": ()}
-SIZE, SPP = 32, 1024
+SIZE, SPP = 32, 2048
+"""At 1024 spp the mean's band was 2.2 % (the power check asks 2 %); at 2048 about 1.6 %.
+Measured before the path tracer rendered media, at 1024 spp on this 2-core machine: Mitsuba
+(scalar_rgb, volpath) 12.8 s, pathtrace 30.6 s: slow."""
 
 
 def compare_twin(seed: int, size: int = SIZE, spp: int = SPP) -> dict:
@@ -44,7 +47,7 @@ def compare_twin(seed: int, size: int = SIZE, spp: int = SPP) -> dict:
     for method, res in (("pathtrace", pt), ("mitsuba", mi)):
         extra = [str(x) for x in res.left_out if not str(x).startswith(ALLOWED_LEFT_OUT[method])]
         assert not extra, f"{method} leaves out part of the twin: {extra}"
-    z = band("test_ground_truth_media::hypertexture_twin", CHECKS)
+    z = band("test_ground_truth_media::hypertexture_twin (slow)", CHECKS)
     st = ag.noise_agreement(pt.image, pt.std_error, spp - 1, mi.image, mi.stats["stderr"], 1,
                             block=4, exclude=ag.light_pixels(scene, size, size), band_sd=z)
     st["z"] = z
@@ -58,5 +61,6 @@ def check_twin(seed: int, tmp_path=None) -> None:
     assert st["z"] * st["mean_off"]["rel_diff_se"] <= POWER_TOL, st["mean_off"]  # sees a 2 % bias
 
 
+@pytest.mark.slow
 def test_pathtrace_agrees_with_mitsuba_on_a_grid_volume_twin():
     check_twin(0)
