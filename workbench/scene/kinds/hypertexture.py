@@ -455,5 +455,11 @@ def mitsuba(h: Hypertexture, x) -> list[dict] | None:
 
 
 def povray(h: Hypertexture, w, in_csg: bool):
-    w.leave(FEATURE, "the hypertexture's noise field has no POV-Ray twin (its density pattern differs)")
+    """Not exported: POV-Ray's noise differs from ours, and its ``density_file df3`` with
+    ``interpolate 1`` (3.7's ``density_pattern``) puts sample ``j`` at ``j / S``, wraps the
+    upper neighbour periodically and is 0 outside the unit cube, unlike the grid's cell
+    centres and clamped edges (a padded df3 would match for a one-colour ramp: see
+    docs/hypertextures.md)."""
+    w.leave(FEATURE, "not exported: POV-Ray's noise differs from ours, and its df3 density file interpolates "
+            "samples at j/S with periodic wrap (our grid: cell centres, clamped edges)")
     return None
