@@ -131,21 +131,6 @@ def _march(geo, k, ox, oy, oz, dx, dy, dz, t0, t1, amb_r, amb_g, amb_b, scale, e
                      "1.0, 0.0, 0.0, 0.0", "march")
 
 
-def chord_of(geo, k, ox, oy, oz, dx, dy, dz):
-    """World ``(t0, t1)`` of the ray's overlap with medium row ``k``'s bounding region;
-    ``(inf, inf)`` when it misses (or for a scene without a medium)."""
-    raise TypeError("chord_of is callable from numba-compiled code only")
-
-
-@overload(chord_of, jit_options=GATE)
-def _chord_of(geo, k, ox, oy, oz, dx, dy, dz):
-    body = """
-qx, qy, qz, ux, uy, uz = to_object(geo, k, ox, oy, oz, dx, dy, dz)
-return chord(geo.par, k, qx, qy, qz, ux, uy, uz)
-"""
-    return _dispatch(geo.types[-1], body, "ox, oy, oz, dx, dy, dz", "np.inf, np.inf", "chord_of")
-
-
 _CHORD = """
 qx, qy, qz, ux, uy, uz = to_object(geo, k, ox, oy, oz, dx, dy, dz)
 c0, c1 = chord(geo.par, k, qx, qy, qz, ux, uy, uz)

@@ -33,7 +33,7 @@ from numba import prange
 from ..kernels.columns import RAY_COUNTS, Light, Mat, RayCount, WhittedOpt
 from ..kernels.flags import INLINE, NO_REFCOUNT, TASK
 from ..kernels.intersect import closest, scratch, surface
-from ..kernels.media import chord_of, march
+from ..kernels.media import march
 from ..kernels.optics import (_facing, _feeler, _ior, _light_dir, _pow, camera_ray, checker_color,
                               fresnel_reflectance)
 from ..kernels.shapes import _normalize
