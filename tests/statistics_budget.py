@@ -47,6 +47,9 @@ ALPHA = {
     # test_mitsuba_media.py: Mitsuba's transmittance through a soft sphere against a quadrature
     # (exact Bernoulli variance; block chi-square and mean, normal approximation)
     "test_mitsuba_media::transmittance": 1e-6,
+    # test_kernel_media.py: the path tracer's delta tracking against the march (image mean,
+    # normal approximation; RMS against the noise estimate)
+    "test_kernel_media::delta_tracking": 1e-6,
     # tests/project/test_statistics_seeds.py: two or more failures of one comparison over 20 seeds
     # (binomial: at most C(20, 2) alpha^2 per comparison, summed over the comparisons)
     "test_statistics_seeds::twenty_seeds (slow)": 1e-7,
@@ -70,6 +73,7 @@ SEEDED = {
     "test_pathtrace_modes::back_face": "test_pathtrace_modes:check_back_face",
     "test_mitsuba_method::cornell_mean": "test_mitsuba_method:check_cornell_mean",
     "test_mitsuba_media::transmittance": "test_mitsuba_media:check_transmittance",
+    "test_kernel_media::delta_tracking": "test_kernel_media:check_delta_tracking",
 }
 """Test -> ``module:function`` taking ``(seed, tmp_path)`` that raises AssertionError when the
 comparison fails: the test itself calls it with a fixed seed.  The slow ground-truth variants
