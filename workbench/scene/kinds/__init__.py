@@ -114,9 +114,9 @@ import numpy as np
 
 from ...core.errors import WorkbenchError
 from .. import model as m
-from . import blob, box, csg, hypertexture, isosurface, lathe, mesh, plane, polygon, prism, quadric, sphere
+from . import blob, box, csg, fur, hypertexture, isosurface, lathe, mesh, plane, polygon, prism, quadric, sphere
 
-_REGISTRY = {k.TYPE: k for k in (sphere, plane, box, quadric, polygon, mesh, csg, blob, isosurface, lathe, prism, hypertexture)}
+_REGISTRY = {k.TYPE: k for k in (sphere, plane, box, quadric, polygon, mesh, csg, blob, isosurface, lathe, prism, hypertexture, fur)}
 KINDS = MappingProxyType(_REGISTRY)
 """The registry: scene-file ``type`` name -> kind module (the package's, then those added by
 :func:`register`)."""
