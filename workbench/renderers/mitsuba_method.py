@@ -199,7 +199,8 @@ class MitsubaRenderer:
                                        "volume_grid), trilinear; emission left out (Mitsuba 3 has no "
                                        "emissive media)"},
         left_out={**MODEL_NOTES, F.SOLID_TEXTURES: MODEL_NOTES[F.TEXTURES],
-                  F.IMAGE_TEXTURES: MODEL_NOTES[F.TEXTURES]})
+                  F.IMAGE_TEXTURES: MODEL_NOTES[F.TEXTURES],
+                  F.TEXELS: "Mitsuba 3 has no texel model: the fur's base is exported without its fur"})
     knob = Knob("spp", (4, 16, 64, 256, 1024, 4096), 64, "samples per pixel (two independent halves)")
     options = {
         "spp": Option(int, 64, "samples per pixel, >= 2 (two independent passes of spp/2: noise estimate)"),

@@ -36,7 +36,9 @@ class PathTraceRenderer:
     name = "pathtrace"
     ui_kind = "progressive"
     support = sp.declare(
-        approximated={F.TEXTURES: "plain colours and planar or solid checkers only (others: plain colour)"},
+        approximated={F.TEXTURES: "plain colours and planar or solid checkers only (others: plain colour)",
+                      F.TEXELS: "the strands as a medium of albedo kd C with the isotropic phase function "
+                                "(no Kajiya-Kay highlight)"},
         left_out={f: "not evaluated by the path tracer's kernel (plain colour, unbumped, opaque, "
                   "background colour)" for f in (F.IMAGE_TEXTURES, F.BUMP, F.OPACITY, F.ENVIRONMENT)})
     knob = Knob("spp", (2, 4, 16, 64, 256), 16, "samples per pixel")

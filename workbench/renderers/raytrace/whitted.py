@@ -654,6 +654,8 @@ _APPROXIMATED = {
     F.EMITTERS: "emission seen directly; emitting surfaces light others only through area-light stand-ins",
     F.HYPERTEXTURES: "emission-absorption march (step: the object's step times step_scale) with the ambient "
                      "light as the only in-scattered light; the medium shadows surfaces",
+    F.TEXELS: "the texel shell marched with the Kajiya-Kay lobes and feelers against the surfaces "
+              "(the fur does not shadow itself)",
 }
 """What both Whitted methods stand in for (their ``support`` tables, :mod:`..support`)."""
 
