@@ -81,7 +81,8 @@ def test_kernels_under_an_inlined_helper_stay_functions_of_their_own(blob_probe)
 
 def test_features_of_the_bundled_scenes():
     """The marker names the extended group iff the scene has one of its kinds, the triangles
-    iff it has triangles; every scene's marker is one of four."""
+    iff it has triangles, each medium kind (hypertexture, fur: groups of their own) iff the
+    scene has it; every scene's marker is one of four, or names a medium."""
     markers = set()
     for path in sorted((ROOT / "scenes").glob("*.toml")):
         scene = workbench.load_scene(str(path))
@@ -91,8 +92,29 @@ def test_features_of_the_bundled_scenes():
         extended = bool(kinds & {"blob", "isosurface", "lathe", "prism", "csg"})
         assert all(n in names for n in EXTENDED) == extended, (path.stem, names)
         assert ("triangles" in names) == (len(sd.tri_v) > 0), (path.stem, names)
-        markers.add(names)
+        for medium in ("hypertexture", "fur"):
+            assert (medium in names) == (medium in kinds), (path.stem, names)
+        if not {"hypertexture", "fur"} & set(names):
+            markers.add(names)
     assert len(markers) <= 4
+
+
+MEDIA_PROBE = r'''
+import json
+import workbench
+from workbench.scene.kinds import fur_kernels, hypertexture_kernels
+workbench.render(workbench.load_scene("whitted"), "raytrace", width=16, height=12)
+print(json.dumps([len(f.signatures) for f in (hypertexture_kernels.optics, hypertexture_kernels.density,
+                                               fur_kernels.texel, fur_kernels.optics)]))
+'''
+
+
+def test_a_scene_without_media_compiles_no_medium_code():
+    """A Whitted render of the spheres (in a new process) loads no signature of the media's
+    kernels: the march and the trackers are gates that compile to constants without a medium."""
+    out = subprocess.run([sys.executable, "-c", MEDIA_PROBE], capture_output=True, text=True, cwd=ROOT, timeout=600)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert json.loads(out.stdout.strip().splitlines()[-1]) == [0, 0, 0, 0]
 
 
 def test_unknown_feature_is_refused():
