@@ -230,3 +230,17 @@ def test_the_fur_is_lit_by_its_lobe_and_shadowed_by_its_base(tmp_path):
         assert lit[centre].mean() > 0.1, (m, lit[centre].mean())
         assert dark[centre].max() < 1e-6, (m, dark[centre].max())
         assert dark.max() > 0.1  # the rim
+
+
+@pytest.mark.parametrize("method", ["raycast", "pathtrace"])
+def test_a_grid_over_the_memory_limit_is_refused_before_it_is_built(method, tmp_path):
+    """A hypertexture with a 256^3 grid (128 MiB of float64 numbers, counted three times while
+    flattening) under a 300 MB limit: one line naming the estimate, exit 2, no image (the
+    estimate counts the grid without building it: ``hypertexture.aux_count``)."""
+    p = tmp_path / "big.toml"
+    p.write_text(SCENE.format(noise="turbulence", density=1.0) + "grid = 256\n")
+    out = tmp_path / "x.png"
+    r = subprocess.run([sys.executable, "-m", "workbench", "render", str(p), "-m", method, "--size", "8x6",
+                        "--max-memory", "300M", "--out", str(out)], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 2 and "memory" in r.stderr and "Traceback" not in r.stderr, r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1 and not out.exists()

@@ -189,8 +189,14 @@ def flatten_bytes(scene: m.Scene) -> int:
         kind = kind_of(o)
         if getattr(kind, "COMPOSITE", False):
             return BYTES_PER_ROW + sum(node_bytes(c) for c in kind.children(o))
-        aux = len(kind.params(o, 0)[1]) if hasattr(kind, "params") else 0
-        return BYTES_PER_ROW + AUX_COPIES * 8 * aux
+        if hasattr(kind, "aux_count"):  # counted without building it (a hypertexture's grid)
+            aux = kind.aux_count(o)
+        else:
+            aux = len(kind.params(o, 0)[1]) if hasattr(kind, "params") else 0
+        # a grid is sampled in float32 slabs before it joins the float64 aux numbers
+        grid = 4 * kind.grid_cells(o) if hasattr(kind, "grid_cells") else 0
+        rows = 2 if getattr(kind, "MEDIUM", False) else 1  # a medium's own row beside a base's
+        return rows * BYTES_PER_ROW + AUX_COPIES * 8 * aux + grid
     lights = sum(isinstance(lt, m.AreaLight) for lt in scene.lights)
     return sum(node_bytes(o) for o in scene.objects) + lights * BYTES_PER_ROW
 

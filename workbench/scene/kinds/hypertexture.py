@@ -349,6 +349,17 @@ AUX_ALBEDO, AUX_EMISSION, AUX_STOPS = 0, 3, 6
 """Offsets within the object's aux numbers (the grid, when ``grid``, after the ramp's stops)."""
 
 
+def grid_cells(h: Hypertexture) -> int:
+    """Cells of its grid (0 without one)."""
+    return h.grid ** 3
+
+
+def aux_count(h: Hypertexture) -> int:
+    """How many numbers :func:`params` puts in aux, counted without building the grid (the ray
+    tracer's memory estimate)."""
+    return 6 + h.ramp.size + grid_cells(h)
+
+
 def params(h: Hypertexture, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:
     """Parameter row head (:class:`Par`) and aux (albedo, emission, ramp stops, grid)."""
     size = tuple(h.size) + (0.0,) * (3 - len(h.size))
