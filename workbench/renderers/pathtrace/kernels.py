@@ -66,7 +66,7 @@ import numpy as np
 
 from ..kernels.columns import PATH_COUNTS, Light, Mat, PathCount, PathOpt
 from ..kernels.rng import path_key, rand
-from .media import medium_vertex, shadow_transmittance
+from .media import shadow_gate, vertex_gate
 from .sampling import mis_weight, pick_emitter
 from ..kernels.tasks import run_tasks
 from ..kernels.flags import INLINE, NO_REFCOUNT, TASK
@@ -298,7 +298,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                         return Lr, Lg, Lb
                     br, bg_, bb = br / q_rr, bg_ / q_rr, bb / q_rr
                     ox, oy, oz = ox + tc * dx, oy + tc * dy, oz + tc * dz
-                    sr, sg, sb, dx, dy, dz, mdim = medium_vertex(geo, shading, emitters, opts, key, dim, mdim,
+                    sr, sg, sb, dx, dy, dz, mdim = vertex_gate(geo, shading, emitters, opts, key, dim, mdim,
                                                                  ox, oy, oz, br, bg_, bb, counts, scr)
                     Lr, Lg, Lb = Lr + sr, Lg + sg, Lb + sb
                     delta_before, pdf_prev, eye, tmin, t_acc = False, 0.25 / math.pi, False, 0.0, 0.0
@@ -467,7 +467,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                             vis = 0.0
                             counts[PathCount.SHADOW_RAYS] += 1
                             if wd > 2.0 * off and has_media:
-                                vis, mdim = shadow_transmittance(geo, mat_of, mat_tab, sx_, sy_, sz_, wx / wd, wy / wd,
+                                vis, mdim = shadow_gate(geo, mat_of, mat_tab, sx_, sy_, sz_, wx / wd, wy / wd,
                                                                  wz / wd, tmin_here, wd - 2.0 * off, zero, off, key,
                                                                  mdim, scr)
                             elif wd > 2.0 * off:
@@ -488,7 +488,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                 sx_, sy_, sz_, tmx = _feeler(px, py, pz, gx, gy, gz, lx, ly, lz, dist, off)
                 counts[PathCount.SHADOW_RAYS] += 1
                 if has_media:
-                    vis, mdim = shadow_transmittance(geo, mat_of, mat_tab, sx_, sy_, sz_, lx, ly, lz, tmin_here, tmx,
+                    vis, mdim = shadow_gate(geo, mat_of, mat_tab, sx_, sy_, sz_, lx, ly, lz, tmin_here, tmx,
                                                      zero, off, key, mdim, scr)
                 else:
                     _, kb, _, _, _, _ = cast(geo, bvh, tri_prim, only_tris, sx_, sy_, sz_, lx, ly, lz, tmin_here, tmx, np.bool_(True), zero, off, scr)

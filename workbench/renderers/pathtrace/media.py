@@ -2,7 +2,8 @@
 (ratio tracking through each medium it crosses, :func:`..kernels.media.ratio`) and the
 vertex of a real collision inside a medium (next-event estimation with the isotropic phase
 function ``1 / 4 pi`` and a new direction drawn from it).  :func:`.kernels.trace_path` calls
-them only for scenes with a medium (``PathOpt.MEDIA``); the delta tracking itself is
+them through :func:`shadow_gate` and :func:`vertex_gate`, which compile to constants for a
+scene without a medium (as the gates of :mod:`..kernels.media`); the delta tracking itself is
 :func:`..kernels.media.track`.  The free-flight and collision estimators: Novák et al., "Monte
 Carlo methods for volumetric light transport simulation", CGF 2018."""
 from __future__ import annotations
@@ -12,10 +13,12 @@ import math
 import numba as nb
 import numpy as np
 
+from numba.extending import overload
+
 from ..kernels.columns import Light, Mat, PathCount, PathOpt
-from ..kernels.flags import NO_REFCOUNT
+from ..kernels.flags import GATE, NO_REFCOUNT
 from ..kernels.intersect import closest
-from ..kernels.media import ratio
+from ..kernels.media import medium_kinds, ratio
 from ..kernels.optics import _light_dir
 from ..kernels.rng import rand
 from .sampling import mis_weight, pick_emitter
@@ -112,3 +115,37 @@ def medium_vertex(geo, shading, emitters, opts, key, dim, mdim, px, py, pz, br, 
     r = math.sqrt(max(0.0, 1.0 - z * z))
     phi = 2.0 * math.pi * rand(key, dim + 4)
     return lr, lg, lb, r * math.cos(phi), r * math.sin(phi), z, mdim
+
+
+def shadow_gate(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps, key, mdim, scr):
+    """:func:`shadow_transmittance` for a scene with a medium; ``(1, mdim)`` otherwise (never
+    reached: the caller asks ``PathOpt.HAS_MEDIA`` first)."""
+    raise TypeError("shadow_gate is callable from numba-compiled code only")
+
+
+@overload(shadow_gate, jit_options=GATE)
+def _shadow_gate(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps, key, mdim, scr):
+    on = bool(medium_kinds(geo.types[-1]))
+
+    def impl(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps, key, mdim, scr):
+        if on:
+            return shadow_transmittance(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps, key,
+                                        mdim, scr)
+        return 1.0, mdim
+    return impl
+
+
+def vertex_gate(geo, shading, emitters, opts, key, dim, mdim, px, py, pz, br, bg_, bb, counts, scr):
+    """:func:`medium_vertex` for a scene with a medium; nothing otherwise (never reached)."""
+    raise TypeError("vertex_gate is callable from numba-compiled code only")
+
+
+@overload(vertex_gate, jit_options=GATE)
+def _vertex_gate(geo, shading, emitters, opts, key, dim, mdim, px, py, pz, br, bg_, bb, counts, scr):
+    on = bool(medium_kinds(geo.types[-1]))
+
+    def impl(geo, shading, emitters, opts, key, dim, mdim, px, py, pz, br, bg_, bb, counts, scr):
+        if on:
+            return medium_vertex(geo, shading, emitters, opts, key, dim, mdim, px, py, pz, br, bg_, bb, counts, scr)
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, mdim
+    return impl
