@@ -76,6 +76,7 @@ class WhittedOpt(Columns):
     BACKGROUND = 12      # 1: a missed ray takes the background colour (no environment map)
     N_MEDIA = 13         # media around the camera
     MEDIA = 14, 4        # their material rows, innermost last
+    STEP_SCALE = 18      # multiplies every heterogeneous medium's march step; 0: the scene has none
 
 
 class PathOpt(Columns):

@@ -91,6 +91,11 @@ class SceneData:
     """Variable-length data of the kinds that have it (blob components, an isosurface's
     program, lathe profiles, prism polygons), flat float64; each row holds its offset."""
 
+    @property
+    def has_media(self) -> bool:
+        """Whether a heterogeneous medium bounds any material (``Mat.MEDIUM``)."""
+        return bool((self.mat_tab[:, Mat.MEDIUM] >= 0).any())
+
     def features(self) -> tuple[str, ...]:
         """What the kernels compile for this scene (:func:`..kernels.layout.features`), in
         groups, so that all scenes of the package's kinds together need at most four compiled

@@ -33,6 +33,7 @@ from numba import prange
 from ..kernels.columns import RAY_COUNTS, Light, Mat, RayCount, WhittedOpt
 from ..kernels.flags import INLINE, NO_REFCOUNT, TASK
 from ..kernels.intersect import closest, scratch, surface
+from ..kernels.media import chord_of, march
 from ..kernels.optics import (_facing, _feeler, _ior, _light_dir, _pow, camera_ray, checker_color,
                               fresnel_reflectance)
 from ..kernels.shapes import _normalize
@@ -90,20 +91,31 @@ def trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_on
 
 @nb.njit(**INLINE)
 def _transmittance(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmin, tmax, transmissive, zero,
-                   eps, stack, st, sp_, sf, sn):
+                   eps, media, stack, st, sp_, sf, sn):
     """Shadow feeler: 1 if nothing blocks the segment, 0 if blocked (any hit ends the search);
     with ``transmissive``, the product of the ``kt`` of every surface crossed (at most
-    ``SHADOW_CROSSINGS``)."""
+    ``SHADOW_CROSSINGS``).  ``media`` (``WhittedOpt.STEP_SCALE``, 0: none in the scene): the
+    boundaries of heterogeneous media block nothing, and the feeler takes the transmittance of
+    each medium's chord within the segment (:func:`..kernels.media.march`; at most four media
+    a feeler)."""
     v = 1.0
     t0 = tmin
+    m0, m1, m2, m3 = -1, -1, -1, -1  # media already marched
     for _ in range(SHADOW_CROSSINGS):
-        t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, t0, tmax, np.bool_(True), np.bool_(not transmissive),
-                                       zero, eps, stack, st, sp_, sf, sn)
+        t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, t0, tmax, np.bool_(True),
+                                       np.bool_(not transmissive and media == 0.0), zero, eps, stack, st, sp_, sf, sn)
         if k < 0:
             return v
-        if not transmissive:
+        med = int(mat_tab[mat_of[k], Mat.MEDIUM])
+        if med >= 0:
+            if med != m0 and med != m1 and med != m2 and med != m3:
+                m0, m1, m2, m3 = med, m0, m1, m2
+                tr, _, _, _ = march(geo, med, ox, oy, oz, dx, dy, dz, tmin, tmax, 0.0, 0.0, 0.0, media, False)
+                v *= tr
+        elif not transmissive:
             return 0.0
-        v *= mat_tab[mat_of[k], Mat.KT]
+        else:
+            v *= mat_tab[mat_of[k], Mat.KT]
         if v <= 0.0:
             return 0.0
         t0 = t + eps
@@ -148,6 +160,37 @@ def feeler_batch(lights, O, D, t, prim, ng, nsh, opts, fo, fd, ftmin, ftmax, wan
 
 
 @nb.njit(**INLINE)
+def _cross(mi, front, px, py, pz, fx, fy, fz, dx, dy, dz, w0, w1, w2, gen, stk, nstk, i, off, t_min, extent,
+           out, s):
+    """A ray crossing the boundary of medium material ``mi``: its continuation in slot ``s`` of
+    ``out`` (as a refracted child, without counting it), same direction and generation, the
+    medium pushed on its stack when entering (if the stack has room), removed when leaving."""
+    out_o, out_d, out_w, out_stk, out_nstk, out_kind, out_tmin, out_gen = out
+    out_o[s, 0], out_o[s, 1], out_o[s, 2] = px - off * fx, py - off * fy, pz - off * fz
+    out_d[s, 0], out_d[s, 1], out_d[s, 2] = dx, dy, dz
+    out_w[s, 0], out_w[s, 1], out_w[s, 2] = w0, w1, w2
+    n = nstk[i]
+    for q in range(4):
+        out_stk[s, q] = stk[i, q]
+    out_nstk[s] = n
+    if front:
+        if n < 4:
+            out_stk[s, n] = mi
+            out_nstk[s] = n + 1
+    else:
+        j = n - 1
+        while j >= 0 and stk[i, j] != mi:
+            j -= 1
+        if j >= 0:
+            for q in range(j, n - 1):
+                out_stk[s, q] = stk[i, q + 1]
+            out_nstk[s] = n - 1
+    out_kind[s] = 2
+    out_tmin[s] = t_min * max(max(abs(out_o[s, 0]), abs(out_o[s, 1]), abs(out_o[s, 2])), extent)
+    out_gen[s] = gen
+
+
+@nb.njit(**INLINE)
 def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, hits, contrib,
               out, s0, counts, scr):
     """Local model with shadow feelers at the hit of ray ``i``, then its reflected and refracted
@@ -181,6 +224,7 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
     ray_off, t_min = opts[WhittedOpt.RAY_OFFSET], opts[WhittedOpt.T_MIN]
     zero, extent = opts[WhittedOpt.ZERO], opts[WhittedOpt.EXTENT]
     add_bg = opts[WhittedOpt.BACKGROUND] > 0.5
+    media = opts[WhittedOpt.STEP_SCALE]
     nl = lights.shape[0]
     solid = geo.solid
     out_kind[s0], out_kind[s0 + 1] = 0, 0
@@ -195,19 +239,34 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
     mi = mat_of[k]
     dx, dy, dz = D[i, 0], D[i, 1], D[i, 2]
     px, py, pz = O[i, 0] + t[i] * dx, O[i, 1] + t[i] * dy, O[i, 2] + t[i] * dz
-    # Beer-Lambert absorption by the medium the ray travelled through
+    # the medium the ray travelled through: Beer-Lambert absorption, or a heterogeneous
+    # medium's emission-absorption march (..kernels.media)
     w0, w1, w2 = w[i, 0], w[i, 1], w[i, 2]
+    mr, mg, mb = 0.0, 0.0, 0.0
     if nstk[i] > 0:
         ma = stk[i, nstk[i] - 1]
-        w0 *= math.exp(-mat_tab[ma, Mat.ABSORPTION] * t[i])
-        w1 *= math.exp(-mat_tab[ma, Mat.ABSORPTION + 1] * t[i])
-        w2 *= math.exp(-mat_tab[ma, Mat.ABSORPTION + 2] * t[i])
+        med = int(mat_tab[ma, Mat.MEDIUM])
+        if med >= 0:
+            tr, mr, mg, mb = march(geo, med, O[i, 0], O[i, 1], O[i, 2], dx, dy, dz, 0.0, t[i],
+                                   ambient[0], ambient[1], ambient[2], media, True)
+            mr, mg, mb = w0 * mr, w1 * mg, w2 * mb
+            w0, w1, w2 = w0 * tr, w1 * tr, w2 * tr
+        else:
+            w0 *= math.exp(-mat_tab[ma, Mat.ABSORPTION] * t[i])
+            w1 *= math.exp(-mat_tab[ma, Mat.ABSORPTION + 1] * t[i])
+            w2 *= math.exp(-mat_tab[ma, Mat.ABSORPTION + 2] * t[i])
     sx, sy, sz = -dx, -dy, -dz
     gx, gy, gz = ng[i, 0], ng[i, 1], ng[i, 2]
     nx, ny, nz = _facing(nsh, i, dx, dy, dz)
     front = gx * sx + gy * sy + gz * sz > 0.0
     # side of the surface the ray came from
     fx, fy, fz = (gx, gy, gz) if front else (-gx, -gy, -gz)
+    if mat_tab[mi, Mat.MEDIUM] >= 0.0:  # a medium's boundary: straight on, same generation
+        contrib[i, 0], contrib[i, 1], contrib[i, 2] = mr, mg, mb
+        if max(w0, w1, w2) > threshold:
+            _cross(mi, front, px, py, pz, fx, fy, fz, dx, dy, dz, w0, w1, w2, depth[i], stk, nstk, i,
+                   ray_off * max(max(abs(px), abs(py), abs(pz)), extent), t_min, extent, out, s0 + 1)
+        return
     if mat_tab[mi, Mat.TEXTURED] > 0.5:  # textured: the caller's colour
         cr, cg, cb = col[i, 0], col[i, 1], col[i, 2]
     else:
@@ -241,7 +300,7 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
                 qx, qy, qz, tmx = _feeler(px, py, pz, gx, gy, gz, lx, ly, lz, dist, off)
                 vis = _transmittance(geo, mat_of, mat_tab, qx, qy, qz, lx, ly, lz,
                                      t_min * max(pm, extent), tmx, transmissive, zero, eps,
-                                     stack, st, sp_, sf, sn)
+                                     media, stack, st, sp_, sf, sn)
             if vis <= 0.0:
                 continue
         spec = 0.0
@@ -258,7 +317,7 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
         lr += lights[li, Light.POWER] * f * (kd * cr * ndl + spec)
         lg += lights[li, Light.POWER + 1] * f * (kd * cg * ndl + spec)
         lb += lights[li, Light.POWER + 2] * f * (kd * cb * ndl + spec)
-    contrib[i, 0], contrib[i, 1], contrib[i, 2] = w0 * lr, w1 * lg, w2 * lb
+    contrib[i, 0], contrib[i, 1], contrib[i, 2] = w0 * lr + mr, w1 * lg + mg, w2 * lb + mb
     counts[i, RayCount.SHADOW_RAYS] = nshadow
     # ---- reflection / transmission weights (Whitted 1980; Fresnel optional)
     kr, kt = mat_tab[mi, Mat.KR], mat_tab[mi, Mat.KT]

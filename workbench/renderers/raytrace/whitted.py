@@ -299,16 +299,16 @@ def ensure_compiled(sd: SceneData, fused: bool = False) -> float:
 def kernel_options(generations: int, *, threshold: float = 0.0, fresnel: int = 0,
                    transmissive_shadows: bool = False, blinn: bool = False, shadows: bool = False,
                    reflection: bool = False, refraction: bool = False, extent: float = 1.0,
-                   background: bool = True, media=()) -> np.ndarray:
+                   background: bool = True, media=(), step_scale: float = 0.0) -> np.ndarray:
     """The Whitted kernels' options (columns :class:`..kernels.columns.WhittedOpt`): the
     tolerances from ``tol``, the media around the camera (material rows, innermost last, at
-    most four)."""
+    most four), the factor of the heterogeneous media's march steps (0: the scene has none)."""
     media = list(media)[-4:]
     return pack(WhittedOpt, generations=generations, threshold=threshold, fresnel=fresnel,
                 transmissive_shadows=transmissive_shadows, blinn=blinn, shadows=shadows,
                 reflection=reflection, refraction=refraction, ray_offset=tol.ray_offset, t_min=tol.t_min,
                 zero=tol.zero, extent=extent, background=background, n_media=len(media),
-                media=media + [0] * (4 - len(media)))
+                media=media + [0] * (4 - len(media)), step_scale=step_scale)
 
 
 def fusable(scene: Scene, materials) -> bool:
@@ -379,7 +379,8 @@ class _Tracer:
         self.kopts = kernel_options(self.G, threshold=opts.get("threshold", 0.0), fresnel=fres,
                                     transmissive_shadows=opts["transmissive_shadows"], blinn=opts["blinn"],
                                     shadows=self.do_shadow, reflection=refl, refraction=refr,
-                                    extent=sd.extent, background=not self.env, media=self.media)
+                                    extent=sd.extent, background=not self.env, media=self.media,
+                                    step_scale=opts["step_scale"] if sd.has_media else 0.0)
         self.ambient = np.asarray(scene.ambient, dtype=np.float64)
         self.geo = sd.kernel_args()
         self.stats = dict(primary_rays=0, shadow_rays=0, reflected_rays=0, refracted_rays=0,
@@ -543,6 +544,8 @@ class _WhittedBase:
     def render(self, scene: Scene, width: int, height: int, **o) -> RenderResult:
         if not 1 <= o["spp"] <= 4096:
             raise WorkbenchError(f"method {self.name!r}: option 'spp' must be within 1..4096, got {o['spp']}")
+        if not 1.0 / 64 <= o["step_scale"] <= 64.0:
+            raise WorkbenchError(f"method {self.name!r}: option 'step_scale' must be within 1/64..64, got {o['step_scale']}")
         timings = {}
         t0 = time.perf_counter()
         prepared = prepare(scene)
@@ -655,6 +658,8 @@ _COMMON = {
     "accel": Option(str, "bvh", "acceleration structure over the triangles and the bounded analytic "
                     "primitives: bvh (4-wide binned SAH), octree (the course's arbre octal) or none (every "
                     "triangle and primitive tested); same images", ACCELS),
+    "step_scale": Option(float, 1.0, "multiplies every hypertexture's march step (its 'step' key): the "
+                         "knob of the emission-absorption march, 1/64..64", low=1.0 / 64),
     "traversal_stats": Option(bool, False, "count nodes visited and primitives tested per pixel-centre "
                               "camera ray (stats accel_*; a pass of its own, timed apart)"),
 }

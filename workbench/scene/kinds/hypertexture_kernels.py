@@ -150,9 +150,21 @@ def optics(par, k, aux, x, y, z):
             aux[e] * cr, aux[e + 1] * cg, aux[e + 2] * cb)
 
 
+@nb.njit(**JIT)
+def step(par, k):
+    """The march's step (object-space length)."""
+    return par[k, Par.STEP]
+
+
+@nb.njit(**JIT)
+def majorant(par, k):
+    """An upper bound of ``sigma_t`` over the medium (D <= 1)."""
+    return par[k, Par.DENSITY]
+
+
 # ----------------------------------------------------------------------------- the bounding sphere
 @nb.njit(**JIT)
-def _crossings(par, k, ox, oy, oz, dx, dy, dz):
+def chord(par, k, ox, oy, oz, dx, dy, dz):
     """Both t of the object-space line with the bounding sphere (t0 <= t1), or (inf, inf)."""
     r = par[k, Par.BOUND]
     s = math.sqrt(dx * dx + dy * dy + dz * dz)
@@ -172,7 +184,7 @@ def _crossings(par, k, ox, oy, oz, dx, dy, dz):
 
 @nb.njit(**JIT)
 def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
-    t0, t1 = _crossings(par, k, ox, oy, oz, dx, dy, dz)
+    t0, t1 = chord(par, k, ox, oy, oz, dx, dy, dz)
     if tmin < t0 < tmax:
         return t0, 0
     if tmin < t1 < tmax:
@@ -182,7 +194,7 @@ def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
 
 @nb.njit(**JIT)
 def events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
-    t0, t1 = _crossings(par, k, ox, oy, oz, dx, dy, dz)
+    t0, t1 = chord(par, k, ox, oy, oz, dx, dy, dz)
     if t0 == np.inf or cap < 2:
         return 0
     out_t[0], out_f[0], out_t[1], out_f[1] = t0, 0, t1, 0
