@@ -18,6 +18,12 @@ length (``L`` the object-space length, ``step`` the row's times ``step_scale``),
 its midpoint: ``tau_j = sigma_t(x_j) h |D'|``, ``L += T (1 - exp(-tau_j)) J_j``,
 ``T *= exp(-tau_j)`` with the source ``J = (1 - a) Le + a ambient`` (albedo ``a``: the ambient
 light is the only light scattered in by this model).
+
+Tracking (the path tracer; Woodcock et al. 1965, Novák et al., "Monte Carlo methods for
+volumetric light transport simulation", CGF 2018): tentative collisions at exponential
+distances of the majorant ``sigma_bar`` (the row's ``majorant``); delta tracking (:func:`track`)
+accepts one as real with probability ``sigma_t / sigma_bar``, ratio tracking (:func:`ratio`)
+multiplies the transmittance estimate by ``1 - sigma_t / sigma_bar`` at each: both unbiased.
 """
 from __future__ import annotations
 
@@ -30,10 +36,14 @@ from numba.extending import overload
 from ...scene.kinds import KINDS, kernel_module
 from .flags import GATE, INLINE
 from .layout import marker_features, marker_name
+from .rng import rand
 
 MAX_MARCH_STEPS = 1 << 20
 """Most steps of one march (the kinds bound ``step`` against their size; this bounds
 ``step_scale`` too)."""
+MAX_COLLISIONS = 1 << 24
+"""Most tentative collisions of one tracking (a majorant of 1e6 per unit over a unit chord
+takes 1e6; beyond the cap the tracking stops as if absorbed, a bias the stress cases show)."""
 T_CUT = 1e-12
 """A march stops once its transmittance falls below this (what is behind adds < 1e-12 of its
 radiance)."""
@@ -64,14 +74,17 @@ def _dispatch(kinds, body: str, args: str, miss: str, name: str):
     ``chord``, ``step``) for the medium kind whose ``PTYPE`` is ``geo.ptype[k]``; ``miss``
     for a scene without one."""
     present = medium_kinds(kinds)
-    env = {"np": np, "math": math, "to_object": to_object, "MAX_STEPS": MAX_MARCH_STEPS, "T_CUT": T_CUT}
+    env = {"np": np, "math": math, "to_object": to_object, "MAX_STEPS": MAX_MARCH_STEPS, "T_CUT": T_CUT,
+           "rand": rand, "MAX_COLLISIONS": MAX_COLLISIONS}
     lines = [f"def impl(geo, k, {args}):"]
     for i, kind in enumerate(present):
         mod = kernel_module(kind)
         env[f"optics{i}"], env[f"chord{i}"], env[f"step{i}"] = mod.optics, mod.chord, mod.step
+        env[f"majorant{i}"] = mod.majorant
         lines.append(f"    if geo.ptype[k] == {int(kind.PTYPE)}:")
         lines += ["        " + ln.replace("optics(", f"optics{i}(").replace("chord(", f"chord{i}(")
-                  .replace("step(", f"step{i}(") for ln in body.strip("\n").split("\n")]
+                  .replace("step(", f"step{i}(").replace("majorant(", f"majorant{i}(")
+                  for ln in body.strip("\n").split("\n")]
     lines.append(f"    return {miss}")
     exec(compile("\n".join(lines), f"<{name} over {', '.join(k.TYPE for k in present) or 'no medium'}>", "exec"), env)
     return env["impl"]
@@ -131,3 +144,70 @@ qx, qy, qz, ux, uy, uz = to_object(geo, k, ox, oy, oz, dx, dy, dz)
 return chord(geo.par, k, qx, qy, qz, ux, uy, uz)
 """
     return _dispatch(geo.types[-1], body, "ox, oy, oz, dx, dy, dz", "np.inf, np.inf", "chord_of")
+
+
+_CHORD = """
+qx, qy, qz, ux, uy, uz = to_object(geo, k, ox, oy, oz, dx, dy, dz)
+c0, c1 = chord(geo.par, k, qx, qy, qz, ux, uy, uz)
+t0, t1 = max(t0, c0), min(t1, c1)
+speed = math.sqrt(ux * ux + uy * uy + uz * uz)
+mj = majorant(geo.par, k) * speed
+"""
+
+_TRACK = _CHORD + """
+if not t1 > t0 or not mj > 0.0:
+    return np.inf, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, dim
+t = t0
+for _ in range(MAX_COLLISIONS):
+    t -= math.log(1.0 - rand(key, dim)) / mj
+    if t >= t1:
+        return np.inf, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, dim + 1
+    st, a0, a1, a2, e0, e1, e2 = optics(geo.par, k, geo.aux, qx + t * ux, qy + t * uy, qz + t * uz)
+    if rand(key, dim + 1) * mj < st * speed:
+        return t, a0, a1, a2, e0, e1, e2, dim + 2
+    dim += 2
+return t, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, dim
+"""
+
+
+def track(geo, k, ox, oy, oz, dx, dy, dz, t0, t1, key, dim):
+    """Delta tracking of medium row ``k`` along the world ray over ``[t0, t1]`` (clipped to its
+    chord), random numbers ``rand(key, dim), rand(key, dim + 1), ...``.  Returns ``(t, albedo
+    r, g, b, emission r, g, b, next dim)``: ``t`` of the first real collision (``inf``: none
+    before ``t1``) and the medium's optics there."""
+    raise TypeError("track is callable from numba-compiled code only")
+
+
+@overload(track, jit_options=GATE)
+def _track(geo, k, ox, oy, oz, dx, dy, dz, t0, t1, key, dim):
+    return _dispatch(geo.types[-1], _TRACK, "ox, oy, oz, dx, dy, dz, t0, t1, key, dim",
+                     "np.inf, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, dim", "track")
+
+
+_RATIO = _CHORD + """
+if not t1 > t0 or not mj > 0.0:
+    return 1.0, dim
+t = t0
+tr = 1.0
+for _ in range(MAX_COLLISIONS):
+    t -= math.log(1.0 - rand(key, dim)) / mj
+    dim += 1
+    if t >= t1:
+        return tr, dim
+    st, _a0, _a1, _a2, _e0, _e1, _e2 = optics(geo.par, k, geo.aux, qx + t * ux, qy + t * uy, qz + t * uz)
+    tr *= 1.0 - st * speed / mj
+    if tr < T_CUT:
+        return 0.0, dim
+return 0.0, dim
+"""
+
+
+def ratio(geo, k, ox, oy, oz, dx, dy, dz, t0, t1, key, dim):
+    """Ratio tracking: an unbiased estimate of medium row ``k``'s transmittance along the world
+    ray over ``[t0, t1]`` (clipped to its chord).  Returns ``(T, next dim)``."""
+    raise TypeError("ratio is callable from numba-compiled code only")
+
+
+@overload(ratio, jit_options=GATE)
+def _ratio(geo, k, ox, oy, oz, dx, dy, dz, t0, t1, key, dim):
+    return _dispatch(geo.types[-1], _RATIO, "ox, oy, oz, dx, dy, dz, t0, t1, key, dim", "1.0, dim", "ratio")

@@ -65,9 +65,13 @@ import numba as nb
 import numpy as np
 
 from ..kernels.columns import PATH_COUNTS, Light, Mat, PathCount, PathOpt
+from ..kernels.rng import path_key, rand
+from .media import medium_vertex, shadow_transmittance
+from .sampling import mis_weight, pick_emitter
 from ..kernels.tasks import run_tasks
 from ..kernels.flags import INLINE, NO_REFCOUNT, TASK
 from ..kernels.intersect import closest, scratch, surface
+from ..kernels.media import track
 from ..kernels.optics import _feeler, _light_dir, checker_color, fresnel_reflectance
 from ..kernels.shapes import _normalize
 from ..kernels.walks import bvh_hit
@@ -77,34 +81,8 @@ BLOCK = 32
 """Pixels per work item of :func:`render_samples`."""
 INV_PI = 1.0 / math.pi
 INV_2PI = 0.5 / math.pi
-_G = np.uint64(0x9E3779B97F4A7C15)
 JITTER_U, JITTER_V = np.int64(0), np.int64(1)
 """The random dimensions of the pixel jitter, as int64 (not literals: see ``kernels.walks.LANE``)."""
-_M1 = np.uint64(0xBF58476D1CE4E5B9)
-_M2 = np.uint64(0x94D049BB133111EB)
-_S30, _S27, _S31, _S11 = np.uint64(30), np.uint64(27), np.uint64(31), np.uint64(11)
-
-
-@nb.njit(**INLINE)
-def _mix(z):
-    """SplitMix64's finaliser (Steele, Lea & Flood, OOPSLA 2014): a bijective 64-bit hash."""
-    z = (z ^ (z >> _S30)) * _M1
-    z = (z ^ (z >> _S27)) * _M2
-    return z ^ (z >> _S31)
-
-
-@nb.njit(**INLINE)
-def path_key(seed, pixel, sample):
-    """The random stream of one path: a hash of (seed, pixel, sample index)."""
-    return _mix(_mix(_mix(np.uint64(seed) + _G) + np.uint64(pixel)) + np.uint64(sample))
-
-
-@nb.njit(**INLINE)
-def rand(key, dim):
-    """Uniform in [0, 1): dimension ``dim`` of the stream ``key`` (53 bits)."""
-    return float(_mix(key + np.uint64(dim) * _G) >> _S11) * (1.0 / 9007199254740992.0)
-
-
 @nb.njit(**INLINE)
 def _frame(nx, ny, nz):
     """Two unit tangents completing ``n`` (Duff et al., "Building an orthonormal basis,
@@ -136,16 +114,6 @@ def camera_ray_at(cam, i, j, u, v):
 
 
 @nb.njit(**INLINE)
-def mis_weight(pa, pb, beta):
-    """Power heuristic ``pa^beta / (pa^beta + pb^beta)`` (``beta = 1``: balance heuristic)."""
-    if beta == 2.0:
-        a, b = pa * pa, pb * pb
-    else:
-        a, b = pa, pb
-    return a / (a + b) if a > 0.0 else 0.0
-
-
-@nb.njit(**INLINE)
 def phong_lobe(ks, shin, rx, ry, rz, wx, wy, wz):
     """``(ks cos^n alpha (n + 2) / (2 pi), cos^n alpha (n + 1) / (2 pi))``: the normalised Phong
     lobe's value and its sampling density, ``alpha`` the angle between ``w`` and the mirror
@@ -155,19 +123,6 @@ def phong_lobe(ks, shin, rx, ry, rz, wx, wy, wz):
         return 0.0, 0.0
     c = ca ** shin if shin > 0.0 else 1.0
     return ks * (shin + 2.0) * INV_2PI * c, (shin + 1.0) * INV_2PI * c
-
-
-@nb.njit(**NO_REFCOUNT)
-def pick_emitter(cdf, u):
-    """Index of the first ``cdf`` entry above ``u`` (binary search)."""
-    lo, hi = 0, cdf.shape[0] - 1
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if cdf[mid] > u:
-            hi = mid
-        else:
-            lo = mid + 1
-    return lo
 
 
 @nb.njit(cache=True, error_model="numpy")
@@ -266,6 +221,25 @@ def cast(geo, bvh, tri_prim, only_tris, ox, oy, oz, dx, dy, dz, tmin, tmax, any_
     return cast_all(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr)
 
 
+@nb.njit(**INLINE)
+def _enter_or_leave(stk, nstk, mi, front):
+    """The media stack after crossing the boundary of medium material ``mi``: pushed when
+    entering (if there is room), its topmost entry removed when leaving.  Returns its size."""
+    if front:
+        if nstk < 4:
+            stk[nstk] = mi
+            return nstk + 1
+        return nstk
+    j = nstk - 1
+    while j >= 0 and stk[j] != mi:
+        j -= 1
+    if j < 0:
+        return nstk
+    for q in range(j, nstk - 1):
+        stk[q] = stk[q + 1]
+    return nstk - 1
+
+
 @nb.njit(**NO_REFCOUNT)
 def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts, scr, rows):
     """Radiance (RGB) carried along one path from ``o`` in direction ``d`` (unit): see the
@@ -285,6 +259,9 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
     use_tex, beta_mis = opts[PathOpt.TEXTURED] > 0.5, opts[PathOpt.MIS_BETA]
     nstk = int(opts[PathOpt.N_MEDIA])
     transport = int(opts[PathOpt.TRANSPORT])
+    has_media = opts[PathOpt.HAS_MEDIA] > 0.5
+    mdim = np.int64(1 << 40)               # the media's random dimensions (..kernels.media)
+    t_acc = 0.0                            # distance since the last vertex, across media boundaries
     for q in range(4):
         stk[q] = int(opts[PathOpt.MEDIA + q])
     n_em = em_cdf.shape[0]
@@ -307,11 +284,30 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                 Lg += bg_ * opts[PathOpt.BACKGROUND + 1]
                 Lb += bb * opts[PathOpt.BACKGROUND + 2]
             return Lr, Lg, Lb
-        if nstk > 0:  # Beer-Lambert absorption of the medium the segment crossed
+        if nstk > 0:  # the medium the segment crossed: Beer-Lambert, or delta tracking
             ma = stk[nstk - 1]
-            br *= math.exp(-mat_tab[ma, Mat.ABSORPTION] * t)
-            bg_ *= math.exp(-mat_tab[ma, Mat.ABSORPTION + 1] * t)
-            bb *= math.exp(-mat_tab[ma, Mat.ABSORPTION + 2] * t)
+            med = int(mat_tab[ma, Mat.MEDIUM])
+            if med >= 0:
+                tc, a0, a1, a2, e0, e1, e2, mdim = track(geo, med, ox, oy, oz, dx, dy, dz, 0.0, t, key, mdim)
+                if tc < np.inf:  # a real collision: the absorbed share emits, the rest scatters
+                    Lr, Lg, Lb = Lr + br * (1.0 - a0) * e0, Lg + bg_ * (1.0 - a1) * e1, Lb + bb * (1.0 - a2) * e2
+                    br, bg_, bb = br * a0, bg_ * a1, bb * a2
+                    q_rr = min(0.95, max(br, bg_, bb))
+                    if q_rr <= 0.0 or rand(key, dim + 5) >= q_rr:
+                        counts[PathCount.ENDED_BY_ROULETTE] += 1
+                        return Lr, Lg, Lb
+                    br, bg_, bb = br / q_rr, bg_ / q_rr, bb / q_rr
+                    ox, oy, oz = ox + tc * dx, oy + tc * dy, oz + tc * dz
+                    sr, sg, sb, dx, dy, dz, mdim = medium_vertex(geo, shading, emitters, opts, key, dim, mdim,
+                                                                 ox, oy, oz, br, bg_, bb, counts, scr)
+                    Lr, Lg, Lb = Lr + sr, Lg + sg, Lb + sb
+                    delta_before, pdf_prev, eye, tmin, t_acc = False, 0.25 / math.pi, False, 0.0, 0.0
+                    counts[PathCount.EXTENSION_RAYS] += 1
+                    continue
+            else:
+                br *= math.exp(-mat_tab[ma, Mat.ABSORPTION] * t)
+                bg_ *= math.exp(-mat_tab[ma, Mat.ABSORPTION + 1] * t)
+                bb *= math.exp(-mat_tab[ma, Mat.ABSORPTION + 2] * t)
         px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
         surface(geo, k, f, tri, b1, b2, px, py, pz, ncancel, h_ng, h_ns, h_uv, h_po, h_ev, 0, scr[0])
         mi = mat_of[k]
@@ -319,6 +315,12 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
         cos_g = -(gx * dx + gy * dy + gz * dz)
         front = cos_g > 0.0
         fx, fy, fz = (gx, gy, gz) if front else (-gx, -gy, -gz)   # geometric normal, incident side
+        if mat_tab[mi, Mat.MEDIUM] >= 0.0:  # a medium's boundary: on through it, not a vertex
+            nstk = _enter_or_leave(stk, nstk, mi, front)
+            off = ray_off * max(max(abs(px), abs(py), abs(pz)), extent)
+            ox, oy, oz = px - off * fx, py - off * fy, pz - off * fz
+            tmin, t_acc = t_min * max(max(abs(ox), abs(oy), abs(oz)), extent), t_acc + t
+            continue
         nx, ny, nz = h_ns[0, 0], h_ns[0, 1], h_ns[0, 2]
         if nx * dx + ny * dy + nz * dz > 0.0:
             nx, ny, nz = -nx, -ny, -nz                              # shading normal, incident side
@@ -350,7 +352,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
             if not delta_before:
                 dens = lpdf_tri[tri] if tri >= 0 else lpdf_prim[k]
                 if dens > 0.0 and cos_g != 0.0:
-                    w = mis_weight(pdf_prev, dens * t * t / abs(cos_g), beta_mis)
+                    w = mis_weight(pdf_prev, dens * (t_acc + t) ** 2 / abs(cos_g), beta_mis)
             Lr += br * er * w
             Lg += bg_ * eg * w
             Lb += bb * eb * w
@@ -462,14 +464,19 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                             sx_, sy_, sz_, _ = _feeler(px, py, pz, gx, gy, gz, lx, ly, lz, dist, off)
                             wx, wy, wz = qx - sx_, qy - sy_, qz - sz_
                             wd = math.sqrt(wx * wx + wy * wy + wz * wz)
-                            kb = -1
+                            vis = 0.0
                             counts[PathCount.SHADOW_RAYS] += 1
-                            if wd > 2.0 * off:
+                            if wd > 2.0 * off and has_media:
+                                vis, mdim = shadow_transmittance(geo, mat_of, mat_tab, sx_, sy_, sz_, wx / wd, wy / wd,
+                                                                 wz / wd, tmin_here, wd - 2.0 * off, zero, off, key,
+                                                                 mdim, scr)
+                            elif wd > 2.0 * off:
                                 _, kb, _, _, _, _ = cast(geo, bvh, tri_prim, only_tris, sx_, sy_, sz_, wx / wd,
                                                          wy / wd, wz / wd, tmin_here, wd - 2.0 * off,
                                                          np.bool_(True), zero, off, scr)
-                            if kb < 0:
-                                wl = mis_weight(p_l, p_b, beta_mis) * cos_s / p_l
+                                vis = 1.0 if kb < 0 else 0.0
+                            if vis > 0.0:
+                                wl = vis * mis_weight(p_l, p_b, beta_mis) * cos_s / p_l
                                 Lr += br * (adr * INV_PI + fs) * ler * wl
                                 Lg += bg_ * (adg * INV_PI + fs) * leg * wl
                                 Lb += bb * (adb * INV_PI + fs) * leb * wl
@@ -480,11 +487,16 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                     continue
                 sx_, sy_, sz_, tmx = _feeler(px, py, pz, gx, gy, gz, lx, ly, lz, dist, off)
                 counts[PathCount.SHADOW_RAYS] += 1
-                _, kb, _, _, _, _ = cast(geo, bvh, tri_prim, only_tris, sx_, sy_, sz_, lx, ly, lz, tmin_here, tmx, np.bool_(True), zero, off, scr)
-                if kb >= 0:
+                if has_media:
+                    vis, mdim = shadow_transmittance(geo, mat_of, mat_tab, sx_, sy_, sz_, lx, ly, lz, tmin_here, tmx,
+                                                     zero, off, key, mdim, scr)
+                else:
+                    _, kb, _, _, _, _ = cast(geo, bvh, tri_prim, only_tris, sx_, sy_, sz_, lx, ly, lz, tmin_here, tmx, np.bool_(True), zero, off, scr)
+                    vis = 1.0 if kb < 0 else 0.0
+                if vis <= 0.0:
                     continue
                 fs, _ = phong_lobe(a_s, shin, rx, ry, rz, lx, ly, lz)
-                e_ = math.pi * sc * cos_s  # irradiance per unit light value
+                e_ = math.pi * sc * cos_s * vis  # irradiance per unit light value
                 Lr += br * (adr * INV_PI + fs) * lights[li, Light.POWER] * e_
                 Lg += bg_ * (adg * INV_PI + fs) * lights[li, Light.POWER + 1] * e_
                 Lb += bb * (adb * INV_PI + fs) * lights[li, Light.POWER + 2] * e_
@@ -541,7 +553,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                     for q in range(jj, nstk - 1):
                         stk[q] = stk[q + 1]
                     nstk -= 1
-        tmin = tmin_here
+        tmin, t_acc = tmin_here, 0.0
         counts[PathCount.EXTENSION_RAYS] += 1
     counts[PathCount.ENDED_BY_BOUNCE_CAP] += 1
     return Lr, Lg, Lb

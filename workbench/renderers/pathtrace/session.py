@@ -20,6 +20,7 @@ from ...core.columns import pack
 from ...core.errors import NotApplicable, WorkbenchError
 from ...core.tol import tol
 from ...scene import model as m
+from ...scene.kinds import kind_of
 from ...scene.prepared import prepare
 from ..raytrace.flatten import flatten, light_rows
 from ..kernels.columns import LIGHT_COLS, PATH_COUNTS, TEX_COLS, Mat, PathCount, PathOpt
@@ -113,7 +114,9 @@ class PathTraceSession:
         point = [lt for lt in scene.lights if not isinstance(lt, m.AreaLight)] if full else []
         lights = np.ascontiguousarray(light_rows(point).reshape(-1, LIGHT_COLS))
         surfaces_emit = bool((sd.mat_tab[sd.mat, Mat.EMISSION:Mat.EMISSION + 3] > 0).any())
-        emissive = surfaces_emit or bool((sd.tri_e > 0).any())
+        media_emit = any(max(getattr(o, "emission", (0.0,))) > 0 for o in scene.objects
+                         if getattr(kind_of(o), "MEDIUM", False))
+        emissive = surfaces_emit or media_emit or bool((sd.tri_e > 0).any())
         background = np.asarray(scene.background, dtype=np.float64)
         if full and not (emissive or len(point) or (background > 0).any()):
             raise NotApplicable("pathtrace: nothing emits light (no emissive surface, no light and a "
@@ -134,7 +137,7 @@ class PathTraceSession:
                          max_bounces=max_bounces, textured=self.textured, mis_beta=MIS[mis],
                          background=background, n_media=len(media), media=media + [0] * (4 - len(media)),
                          transport=TRANSPORT[transport], pixel_filter=PIXEL_FILTER[pixel_filter],
-                         only_triangles=len(sd.tri_v) > 0 and not sd.top.any())
+                         only_triangles=len(sd.tri_v) > 0 and not sd.top.any(), has_media=sd.has_media)
         self.shading = (sd.mat, sd.mat_tab, np.ascontiguousarray(tex), lights)
         self.geo = sd.kernel_args()
         self.cam = camera_frame(self.scene.camera, self.width, self.height)

@@ -643,6 +643,8 @@ class _WhittedBase:
 _APPROXIMATED = {
     F.AREA_LIGHTS: "stand-in point lights (the scene's area-light samples), hard shadows per sample",
     F.EMITTERS: "emission seen directly; emitting surfaces light others only through area-light stand-ins",
+    F.HYPERTEXTURES: "emission-absorption march (step: the object's step times step_scale) with the ambient "
+                     "light as the only in-scattered light; the medium shadows surfaces",
 }
 """What both Whitted methods stand in for (their ``support`` tables, :mod:`..support`)."""
 
