@@ -1,6 +1,7 @@
 """``workbench study`` on a scene with hypertextures: a method that declares ``step_scale`` (the
 ray marchers) or ``volume_resolution`` (the raster's 3D texture) is swept along it instead of
-its knob, and its references take the finest value; a method without either keeps its knob.
+its knob (the texture's resolution first when it has both), and its references take the finest
+values; a method without either keeps its knob.
 The renderers here are stubs declaring those options, so the test holds whether or not the
 real methods have them yet."""
 from __future__ import annotations
@@ -17,8 +18,8 @@ from workbench.renderers.support import declare
 
 
 class Stub:
-    """A method with a knob and, optionally, one medium option; renders a grey image whose
-    level is the medium option's value (so that each point differs)."""
+    """A method with a knob and, optionally, medium options; renders a grey image whose level is
+    the step multiplier (or else the texture resolution), so that each point differs."""
 
     support = declare()
     memory_options = ()
@@ -38,7 +39,8 @@ class Stub:
 
 def _install(monkeypatch):
     stubs = [Stub("marcher", Knob("spp", (1, 2, 4), 1), {"step_scale": Option(float, 1.0, "march step x")}),
-             Stub("texturer", Knob("tessellation", (1, 2, 4), 2), {"volume_resolution": Option(int, 64, "3D texture")}),
+             Stub("texturer", Knob("tessellation", (1, 2, 4), 2), {"volume_resolution": Option(int, 64, "3D texture"),
+                                                                  "step_scale": Option(float, 1.0, "march step x")}),
              Stub("plain", Knob("spp", (2, 4, 16), 4), {})]
     compare_fakes.install(monkeypatch, {s.name: "compare_fakes:Facets" for s in stubs})
     for s in stubs:
@@ -78,7 +80,7 @@ def test_references_take_the_finest_medium_setting(monkeypatch):
     _install(monkeypatch)
     fire, ball = workbench.load_scene("fire"), compare_fakes.sphere_scene()
     assert finest_options("marcher", fire) == {"spp": 4, "step_scale": 0.25}
-    assert finest_options("texturer", fire) == {"tessellation": 4, "volume_resolution": 128}
+    assert finest_options("texturer", fire) == {"tessellation": 4, "volume_resolution": 128, "step_scale": 0.25}
     assert finest_options("marcher", ball) == finest_options("marcher") == {"spp": 4}
 
 

@@ -134,12 +134,13 @@ def candidates(scene: Scene) -> list[tuple[str, str]]:
     return [(m, why) for m, why in out if m in available()]
 
 
-MEDIUM_KNOBS = (("step_scale", (4.0, 2.0, 1.0, 0.5, 0.25)), ("volume_resolution", (16, 32, 64, 128)))
+MEDIUM_KNOBS = (("volume_resolution", (16, 32, 64, 128)), ("step_scale", (4.0, 2.0, 1.0, 0.5, 0.25)))
 """Options on which a participating medium's discretisation error depends, with the values a
-study sweeps (cheapest first): the ray marchers' step multiplier (``step_scale``, times every
-hypertexture's ``step``) and the raster's 3D texture resolution (``volume_resolution``).  On a
-scene with hypertextures a method that declares one is swept along it and its references take
-its last (finest) value; a method with neither (the path tracer) keeps its knob."""
+study sweeps (cheapest first): the raster's 3D texture resolution (``volume_resolution``) and
+the ray marchers' step multiplier (``step_scale``, times every hypertexture's ``step``).  On a
+scene with hypertextures a method is swept along the first of them it declares (the raster,
+which has both, along its texture's resolution) and its references take the last (finest)
+value of each it declares; a method with neither (the path tracer) keeps its knob."""
 
 
 def medium_finest(method: str, scene: Scene | None) -> dict:
