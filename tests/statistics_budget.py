@@ -23,6 +23,8 @@ ALPHA = {
     "test_ground_truth::cornell_spheres": 1e-5,
     "test_ground_truth::cornell@64 (slow)": 1e-5,
     "test_ground_truth::cornell_spheres@64 (slow)": 1e-5,
+    # test_ground_truth_media.py: the same four checks on the hypertexture twin
+    "test_ground_truth_media::hypertexture_twin (slow)": 5e-6,
     # test_radiosity_formfactors.py: the ray-cast form factor of two parallel squares (one
     # binomial estimate, normal approximation)
     "test_radiosity_formfactors::raycast": 1e-5,
@@ -42,6 +44,12 @@ ALPHA = {
     "test_pathtrace_modes::radiosity_cornell (slow)": 2e-6,
     # test_mitsuba_method.py: the mean of Mitsuba's cornell against radiosity's
     "test_mitsuba_method::cornell_mean": 2e-6,
+    # test_mitsuba_media.py: Mitsuba's transmittance through a soft sphere against a quadrature
+    # (exact Bernoulli variance; block chi-square and mean, normal approximation)
+    "test_mitsuba_media::transmittance": 1e-6,
+    # test_kernel_media.py: the path tracer's delta tracking against the march (image mean,
+    # normal approximation; RMS against the noise estimate)
+    "test_kernel_media::delta_tracking": 1e-6,
     # tests/project/test_statistics_seeds.py: two or more failures of one comparison over 20 seeds
     # (binomial: at most C(20, 2) alpha^2 per comparison, summed over the comparisons)
     "test_statistics_seeds::twenty_seeds (slow)": 1e-7,
@@ -51,6 +59,7 @@ ALPHA = {
 SEEDED = {
     "test_ground_truth::cornell": "test_ground_truth:check_cornell",
     "test_ground_truth::cornell_spheres": "test_ground_truth:check_cornell_spheres",
+    "test_ground_truth_media::hypertexture_twin (slow)": "test_ground_truth_media:check_twin",
     "test_radiosity_formfactors::raycast": "test_radiosity_formfactors:check_raycast",
     "test_pathtrace::furnace": "test_pathtrace:check_furnace",
     "test_pathtrace::white_furnace": "test_pathtrace:check_white_furnace",
@@ -63,6 +72,8 @@ SEEDED = {
     "test_pathtrace_modes::kernel_reference": "test_pathtrace_modes:check_kernel_reference",
     "test_pathtrace_modes::back_face": "test_pathtrace_modes:check_back_face",
     "test_mitsuba_method::cornell_mean": "test_mitsuba_method:check_cornell_mean",
+    "test_mitsuba_media::transmittance": "test_mitsuba_media:check_transmittance",
+    "test_kernel_media::delta_tracking": "test_kernel_media:check_delta_tracking",
 }
 """Test -> ``module:function`` taking ``(seed, tmp_path)`` that raises AssertionError when the
 comparison fails: the test itself calls it with a fixed seed.  The slow ground-truth variants

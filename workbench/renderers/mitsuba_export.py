@@ -28,6 +28,12 @@ mesh                triangle mesh, its own normals or flat
 blob, isosurface,   no such primitives in Mitsuba 3: their raster tessellation (marching
 lathe, prism        cubes, revolved profile at the ``tessellation`` level; the prism's exact
                     triangles, flat), noted in ``left_out``; an open lathe is an open surface
+hypertexture        a ``heterogeneous`` medium inside its bounding sphere (a ``sphere`` with a
+                    ``null`` BSDF, ``interior`` = the medium): ``sigma_t`` a ``gridvolume`` of
+                    the density (a Mitsuba ``.vol`` file, :func:`write_vol`), ``scale`` the
+                    ``density`` per world length, ``albedo`` a constant or an RGB
+                    ``gridvolume``, isotropic phase; the camera inside it gets it as its
+                    ``medium``.  No emission (Mitsuba 3 has no emissive media): noted
 (each kind)         written by its module's ``mitsuba(obj, x)`` (:mod:`workbench.scene.kinds`)
                     through :class:`ShapeWriter`
 kd x color          ``diffuse`` reflectance, inside ``twosided`` (workbench surfaces are
@@ -52,7 +58,8 @@ directional light   ``directional``, irradiance ``pi I color``
 background          ``constant`` emitter of that radiance when not black (it then also lights
                     the scene, unlike the ray tracer's background: noted in left_out); option
                     ``background_light = false``: not exported (black)
-integrator          ``path``, ``max_depth = -1`` (unbounded, Russian roulette from depth 5)
+integrator          ``path``, ``max_depth = -1`` (unbounded, Russian roulette from depth 5);
+                    ``volpath`` (the same settings) when a participating medium is exported
 =================== ==========================================================================
 
 Left out (with the reason, per scene): textures, bump maps, opacity maps other than constant,
@@ -72,7 +79,7 @@ from ..scene import features as F
 from ..scene import model as m
 from ..scene.kinds import is_solid, kind_of
 from ..scene.tessellate import tessellate_object
-from .support import Note
+from .support import Note, Status
 
 #: Alpha below which an opacity cuts a surface out (the workbench's rule, ``model.Opacity``).
 OPACITY_CUT = 0.5
@@ -138,6 +145,34 @@ def write_ply(path: str, positions: np.ndarray, faces: np.ndarray, normals: np.n
         f.write("\n".join(head).encode("ascii"))
         f.write(vert.tobytes())
         f.write(face.tobytes())
+
+
+VOL_VERSION = 3
+"""Mitsuba's grid volume file format version (``gridvolume`` plugin documentation)."""
+VOL_FLOAT32 = 1
+"""Its encoding code for float32 data (the only one it reads)."""
+
+
+def write_vol(path: str, data: np.ndarray, lo, hi) -> None:
+    """Mitsuba's binary grid volume (``.vol``, the ``gridvolume`` plugin's format, little
+    endian): ``VOL``, version 3, encoding 1 (float32), the x, y and z resolutions and the
+    channel count (int32), the bounding box (xmin, ymin, zmin, xmax, ymax, zmax as float32),
+    then the values x fastest: ``data[((z yres + y) xres + x) channels + c]``.
+
+    data : (zres, yres, xres) or (zres, yres, xres, channels) numbers (1, 3 or 6 channels).
+    lo, hi : (3,) the box written in the header (Mitsuba ignores it unless ``use_grid_bbox``).
+    """
+    a = np.asarray(data, dtype="<f4")
+    if a.ndim == 3:
+        a = a[..., None]
+    if a.ndim != 4 or a.shape[3] not in (1, 3, 6):
+        raise ValueError(f"a grid volume is (z, y, x) or (z, y, x, 1|3|6), got shape {a.shape}")
+    zres, yres, xres, ch = a.shape
+    head = np.array([VOL_FLOAT32, xres, yres, zres, ch], dtype="<i4").tobytes()
+    box = np.array([*lo, *hi], dtype="<f4").tobytes()
+    with open(path, "wb") as f:
+        f.write(b"VOL" + bytes([VOL_VERSION]) + head + box)
+        f.write(np.ascontiguousarray(a).tobytes())
 
 
 def camera_to_world(cam: m.Camera) -> np.ndarray:
@@ -243,16 +278,48 @@ class ShapeWriter:
     it (``mitsuba(obj, x)``, see :mod:`workbench.scene.kinds`): :meth:`tessellated` (the
     object's raster tessellation as PLY meshes), :meth:`analytic` (a Mitsuba shape dict of
     its own, e.g. ``sphere``), :meth:`similarity_scale` and :meth:`leave`; ``level`` is the
-    export's tessellation level.  Shapes are named ``shape_00000``... in the order added."""
+    export's tessellation level; participating media go through :meth:`write_volume` (a
+    grid as a ``.vol`` file; ``volume_grid`` is the export's resolution for fields that have
+    none of their own) and :meth:`medium`.  Shapes are named ``shape_00000``... in the order
+    added."""
 
-    def __init__(self, scene: m.Scene, folder: str, d: dict, level: int, left: list[Note]):
+    def __init__(self, scene: m.Scene, folder: str, d: dict, level: int, left: list[Note],
+                 volume_grid: int = 64):
         self.scene, self.folder, self.d, self.level, self.left = scene, folder, d, level, left
+        self.volume_grid = volume_grid
         self.pts: list[np.ndarray] = []
-        self.shapes = self.triangles = 0
+        self.shapes = self.triangles = self.volumes = 0
+        self.camera_media: list[dict] = []
+        self.media_boxes: list[tuple[np.ndarray, np.ndarray]] = []
+        self.media = 0
 
-    def leave(self, feature: str, reason: str) -> None:
-        """A note for ``left_out``."""
-        self.left.append(Note(feature, reason))
+    def leave(self, feature: str, reason: str, approximated: bool = False) -> None:
+        """A note for ``left_out`` (``approximated``: the feature is exported, not exactly)."""
+        self.left.append(Note(feature, reason, Status.APPROXIMATED if approximated else Status.LEFT_OUT))
+
+    def write_volume(self, data: np.ndarray, lo, hi) -> str:
+        """Write a grid (``(z, y, x)`` or ``(z, y, x, channels)``, :func:`write_vol`) into the
+        export's folder; returns its path (for a ``gridvolume``'s ``filename``)."""
+        path = os.path.join(self.folder, f"volume_{self.volumes:05d}.vol")
+        write_vol(path, data, lo, hi)
+        self.volumes += 1
+        return path
+
+    def medium(self, shape: dict, medium: dict, lo: np.ndarray, hi: np.ndarray,
+               around_camera: bool = False) -> dict:
+        """Add a shape dict (``type``, ``to_world``, ...) that bounds the participating
+        ``medium`` dict: a ``null`` BSDF (no surface), the medium as its ``interior``; ``lo, hi``
+        (3,) its world bounds.  ``around_camera``: the camera is inside it (the sensor gets the
+        medium).  The export then uses the ``volpath`` integrator."""
+        shape = {**shape, "bsdf": {"type": "null"}, "interior": medium}
+        self.d[f"shape_{self.shapes:05d}"] = shape
+        self.pts.append(np.array([lo, hi], dtype=np.float64))
+        self.shapes += 1
+        self.media += 1
+        self.media_boxes.append((np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)))
+        if around_camera:
+            self.camera_media.append(medium)
+        return shape
 
     def similarity_scale(self, M: np.ndarray) -> float | None:
         """The uniform scale of the linear part of ``M`` (4, 4), or None."""
@@ -311,7 +378,7 @@ def has_light(scene: m.Scene, background_light: bool = True) -> bool:
 
 
 def export_scene(scene: m.Scene, folder: str, tessellation: int, spp: int = 16,
-                 background_light: bool = True) -> Export:
+                 background_light: bool = True, volume_grid: int = 64) -> Export:
     """Mitsuba scene dictionary of ``scene`` (its camera and resolution), meshes written to ``folder``.
 
     Parameters
@@ -323,6 +390,8 @@ def export_scene(scene: m.Scene, folder: str, tessellation: int, spp: int = 16,
     spp : the sensor's sample count (the renderer passes its own to ``mi.render``).
     background_light : export a non-black background as a ``constant`` emitter (it then lights
         the scene); False: black, as far as light is concerned.
+    volume_grid : resolution of the grid that samples a participating medium's field when the
+        object has no grid of its own (a hypertexture without ``grid``).
 
     Raises
     ------
@@ -336,7 +405,7 @@ def export_scene(scene: m.Scene, folder: str, tessellation: int, spp: int = 16,
     left: list[Note] = []
     d: dict = {"type": "scene",
                "integrator": {"type": "path", "max_depth": -1, "rr_depth": RR_DEPTH, "hide_emitters": False}}
-    sw = ShapeWriter(scene, folder, d, tessellation, left)
+    sw = ShapeWriter(scene, folder, d, tessellation, left, volume_grid)
     open_mats = {o.material for o in scene.objects if not is_solid(o)}
     for name, mat in scene.materials.items():
         if any(o.material == name for o in scene.objects):
@@ -350,6 +419,12 @@ def export_scene(scene: m.Scene, folder: str, tessellation: int, spp: int = 16,
         write = getattr(kind_of(obj), "mitsuba", None)  # optional for a plugin kind
         if write is None or write(obj, sw) is None:
             left.append(Note(kind_of(obj).FEATURE, f"{obj.kind} object kind not exported to Mitsuba 3"))
+    if sw.media:  # participating media: the volumetric path tracer, with the same settings
+        d["integrator"] = {**d["integrator"], "type": "volpath"}
+        boxes = sw.media_boxes
+        if any(np.all(a[0] < b[1]) and np.all(b[0] < a[1]) for i, a in enumerate(boxes) for b in boxes[i + 1:]):
+            left.append(Note("media", "media whose bounds overlap: Mitsuba's volpath follows one medium at a "
+                             "time (the last boundary crossed), not their sum"))
     # lights
     black = {"type": "diffuse", "reflectance": rgb((0.0, 0.0, 0.0))}
     for light in scene.lights:
@@ -396,5 +471,10 @@ def export_scene(scene: m.Scene, folder: str, tessellation: int, spp: int = 16,
                    "film": {"type": "hdrfilm", "width": int(cam.width), "height": int(cam.height),
                             "rfilter": {"type": "box"}, "pixel_format": "rgb",
                             "component_format": "float32", "sample_border": False}}
+    if sw.camera_media:
+        d["sensor"]["medium"] = sw.camera_media[0]
+        if len(sw.camera_media) > 1:
+            left.append(Note("media", f"the camera is inside {len(sw.camera_media)} media: Mitsuba's sensor "
+                             "starts in one (the first); the others are missed until a ray crosses their boundary"))
     return Export(d, sorted(set(left)), sw.triangles, sw.shapes)
 

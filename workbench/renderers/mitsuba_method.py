@@ -1,7 +1,8 @@
 """Mitsuba 3 as an outside reference renderer (method ``mitsuba``), as pyrender is for raster.
 
 The scene is exported by :mod:`.mitsuba_export` (mapping table there) and rendered by Mitsuba's
-``path`` integrator (unbounded depth, Russian roulette) with a box pixel filter: each pixel is
+``path`` integrator (``volpath`` when the scene has a participating medium; unbounded depth,
+Russian roulette) with a box pixel filter: each pixel is
 the box-filtered average of the radiance over its square, linear float32 RGB, not clipped.
 
 Child process
@@ -61,6 +62,8 @@ from . import support as sp
 from .mitsuba_export import MODEL_NOTES, RR_DEPTH, export_scene
 from ..scene import features as F
 from ..scene.features import scene_needs
+from ..scene.kinds import kind_of
+from ..scene.kinds.hypertexture import MAX_GRID
 
 FALLBACK_VARIANT = "scalar_rgb"
 FAST_VARIANT = "llvm_ad_rgb"
@@ -191,7 +194,10 @@ class MitsubaRenderer:
                       F.OPACITY: "constant opacity cuts an object out or keeps it opaque; maps not exported",
                       F.REFRACTION: "exact Fresnel split only (Mitsuba's dielectric)",
                       F.POINT_LIGHTS: "isotropic, inverse-square (falloff 'none' matched at the scene's centre)",
-                      F.EMITTERS: "emissive surfaces emit from their front side only"},
+                      F.EMITTERS: "emissive surfaces emit from their front side only",
+                      F.HYPERTEXTURES: "a heterogeneous medium on a grid (the object's grid, else option "
+                                       "volume_grid), trilinear; emission left out (Mitsuba 3 has no "
+                                       "emissive media)"},
         left_out={**MODEL_NOTES, F.SOLID_TEXTURES: MODEL_NOTES[F.TEXTURES],
                   F.IMAGE_TEXTURES: MODEL_NOTES[F.TEXTURES]})
     knob = Knob("spp", (4, 16, 64, 256, 1024, 4096), 64, "samples per pixel (two independent halves)")
@@ -202,6 +208,8 @@ class MitsubaRenderer:
                           VARIANTS),
         "tessellation": Option(int, 16, f"tessellation level of quadrics and CSG, 1..{MAX_LEVEL} "
                                         "(spheres are analytic)"),
+        "volume_grid": Option(int, 64, f"grid resolution of a hypertexture without its own grid, "
+                                       f"2..{MAX_GRID} (the density sampled at the cells' centres)"),
         "background_light": Option(bool, True, "a non-black background becomes a constant environment "
                                                "emitter that lights the scene (false: black)"),
         "timeout": Option(float, 3600.0, "seconds before the child render is stopped"),
@@ -227,7 +235,7 @@ class MitsubaRenderer:
             return FAST_VARIANT, f"{FAST_VARIANT} probe rendered"
         return FALLBACK_VARIANT, f"{FAST_VARIANT} unusable here ({why}): fell back to {FALLBACK_VARIANT}"
 
-    memory_options = ("tessellation",)
+    memory_options = ("tessellation", "volume_grid")
 
     def estimate_bytes(self, scene: Scene, width: int, height: int, **options) -> int:
         """Peak memory of a render (child process and the parent's images), bytes: a fixed child
@@ -235,14 +243,16 @@ class MitsubaRenderer:
         :func:`.estimates.triangle_bound` at the export's level (the exporter writes every
         object's raster tessellation, or less: analytic spheres, flat kinds at level 1; the
         marching-cubes kinds grow with the level as their surface does, from their level-1
-        count)."""
+        count), plus each kind's own data (``mitsuba_bytes``: a medium's grids)."""
         level = int(options.get("tessellation", self.options["tessellation"].default))
+        grid = int(options.get("volume_grid", self.options["volume_grid"].default))
+        extra = sum(getattr(kind_of(o), "mitsuba_bytes", lambda o, g: 0)(o, grid) for o in scene.objects)
         return int(CHILD_BASE_BYTES + BYTES_PER_PIXEL * width * height
-                   + BYTES_PER_TRIANGLE * triangle_bound(scene, level))
+                   + BYTES_PER_TRIANGLE * triangle_bound(scene, level) + extra)
 
     def render(self, scene: Scene, width: int, height: int, *, spp: int = 64, seed: int = 0,
-               variant: str = "auto", tessellation: int = 16, background_light: bool = True,
-               timeout: float = 3600.0, on_progress=None) -> RenderResult:
+               variant: str = "auto", tessellation: int = 16, volume_grid: int = 64,
+               background_light: bool = True, timeout: float = 3600.0, on_progress=None) -> RenderResult:
         if not mitsuba_installed():
             raise WorkbenchError(f"method 'mitsuba': {INSTALL_HINT}")
         if not 2 <= spp <= MAX_SPP:
@@ -252,6 +262,8 @@ class MitsubaRenderer:
             raise WorkbenchError(f"method 'mitsuba': seed must be >= 0, got {seed}")
         if not 1 <= tessellation <= MAX_LEVEL:
             raise WorkbenchError(f"method 'mitsuba': tessellation must be within 1..{MAX_LEVEL}, got {tessellation}")
+        if not 2 <= volume_grid <= MAX_GRID:
+            raise WorkbenchError(f"method 'mitsuba': volume_grid must be within 2..{MAX_GRID}, got {volume_grid}")
         if not timeout > 0:
             raise WorkbenchError(f"method 'mitsuba': timeout must be > 0 seconds, got {timeout}")
         t0 = time.perf_counter()
@@ -263,7 +275,7 @@ class MitsubaRenderer:
         passes_spec = [[n1, 2 * seed], [spp - n1, 2 * seed + 1]]
         with tempfile.TemporaryDirectory(prefix="workbench-mitsuba-") as folder:
             t0 = time.perf_counter()
-            ex = export_scene(scene, folder, tessellation, spp, background_light)
+            ex = export_scene(scene, folder, tessellation, spp, background_light, volume_grid)
             t_export = time.perf_counter() - t0
             plan = {"variant": run_variant, "scene": ex.scene_dict, "passes": passes_spec}
             t0 = time.perf_counter()
@@ -283,7 +295,8 @@ class MitsubaRenderer:
                    "process": t_child - t_render - info["load"], "compile": 0.0}
         stats = {"variant": run_variant, "variant_reason": why, "mitsuba_version": info["mitsuba_version"],
                  "spp": spp, "seed": seed, "passes": passes_spec, "triangles": ex.triangles, "shapes": ex.shapes,
-                 "integrator": f"path (max_depth -1, Russian roulette from depth {RR_DEPTH})",
+                 "integrator": f"{ex.scene_dict['integrator']['type']} (max_depth -1, Russian roulette "
+                               f"from depth {RR_DEPTH})",
                  "pixel_filter": "box (pixel's box-filtered average), not clipped",
                  "samples_per_second": spp * width * height / max(t_render, tol.zero),
                  "render_cpu_seconds": info["cpu"], "child_peak_rss_bytes": info["peak_rss_bytes"],

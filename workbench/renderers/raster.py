@@ -15,6 +15,10 @@ Gouraud and Phong also draw stand-ins for the global effects the scene needs (en
 maps, blending, shadow maps: :mod:`.raster_standins`, option ``standins``, on by default in
 :func:`render`; a :class:`RasterSession` builds them when given ``standins``).
 
+Hypertextures (participating media) are ray-marched in a fragment shader through a 3D
+texture of their density (:mod:`.raster_volume`, options ``volume_resolution`` and
+``step_scale``), composited over the opaque pass with the blended surfaces, back to front.
+
 Interactive use (the UI calls this every frame)::
 
     session = RasterSession(scene, "phong", tessellation=6)   # tessellate + upload once
@@ -74,6 +78,7 @@ from .base import Knob, Option, RenderResult, check_memory, convert_options
 from .raster_shaders import (LIVE_MATERIAL_FIELDS, ProgramCache, base_defines, light_kind,
                              light_uniforms, light_values, material_defines, material_uniforms)
 from . import raster_standins as sti
+from . import raster_volume as rv
 
 DEPTH_CHOICES = (16, 24, 32)
 #: Varying interpolation: GL's perspective-correct one, or the course's screen-space scanline.
@@ -98,7 +103,8 @@ _STANDINS = {
 _COMMON_APPROX = {**{f: _TESSELLATED for f in (ft.SPHERES, ft.QUADRICS, ft.CSG, ft.BLOBS, ft.ISOSURFACES,
                                                ft.LATHES)},
                   ft.AREA_LIGHTS: "stand-in point lights (the scene's area-light samples)",
-                  ft.EMITTERS: "emission drawn on the surface; it lights others only through area-light stand-ins"}
+                  ft.EMITTERS: "emission drawn on the surface; it lights others only through area-light stand-ins",
+                  ft.HYPERTEXTURES: rv.REASON}
 #: The raster modes' support tables (:mod:`.support`): flat draws no stand-ins, and only Phong
 #: has a per-fragment normal for bump mapping.
 SUPPORT = {
@@ -274,12 +280,15 @@ class RasterSession:
     standins : the stand-ins for global effects asked for (:class:`.raster_standins.
         StandinOptions`; None: none, the bare local model); those the scene needs and the
         mode draws are built (:func:`.raster_standins.plan`).
+    volume_resolution, step_scale : texels per side of the hypertextures' 3D textures (their
+        own ``grid`` when set) and the factor of their march step (:mod:`.raster_volume`).
     """
 
     def __init__(self, scene: Scene, mode: str, *, tessellation: int = DEFAULT_LEVEL,
                  blinn: bool = False, depth_bits: int = 24, ctx=None, backface_culling: bool = True,
                  shading=None, interpolation: str = "perspective", normals: str = "smooth",
-                 standins: sti.StandinOptions | None = None):
+                 standins: sti.StandinOptions | None = None,
+                 volume_resolution: int = rv.DEFAULT_RESOLUTION, step_scale: float = 1.0):
         if mode not in ("flat", "gouraud", "phong"):
             raise WorkbenchError(f"unknown raster mode {mode!r}")
         if shading is not None and mode != "phong":
@@ -289,6 +298,7 @@ class RasterSession:
             raise WorkbenchError(f"depth_bits must be one of {DEPTH_CHOICES}, got {depth_bits}")
         if interpolation not in INTERPOLATIONS:
             raise WorkbenchError(f"interpolation must be one of {', '.join(INTERPOLATIONS)}, got {interpolation!r}")
+        rv.volume_bytes(scene, volume_resolution, step_scale)  # refuses before anything is built
         self.scene, self.mode, self.depth_bits, self.blinn = scene, mode, depth_bits, blinn
         self.interpolation = interpolation
         #: materials (names) and whether the lights are drawn by live programs
@@ -302,6 +312,7 @@ class RasterSession:
         self.timings: dict[str, float] = {}
         t0 = time.perf_counter()
         parts, empty = _parts(scene, tessellation)
+        empty = [o for o in empty if not any(o is v for v in rv.media(scene))]  # marched, not tessellated
         #: objects whose surface tessellates to nothing (a blob's threshold above its field's
         #: maximum): not drawn, as the ray methods find no surface there; said in left_out
         self.empty_objects = [o.name or o.kind for o in empty]
@@ -323,16 +334,23 @@ class RasterSession:
         self._gl_images: dict[tuple, object] = {}
         self._gl_objects: list = []  # vertex arrays and buffers, freed by release()
         self._fbos: OrderedDict = OrderedDict()
+        self._depth_of: dict[int, tuple] = {}  # id of an own FBO -> (colour, depth) textures
         self._uniforms_of: dict[int, _Draw] = {}  # program -> draw whose uniforms it holds
         self._camera_of: dict[int, bytes] = {}    # program -> clip matrix it holds
         t0 = time.perf_counter()
         self._build_standins(pairs, standins)
         self.draws = [self._upload(p, m, name) for p, m, name in pairs]
         self.cull_boxes = self._cull_groups() if backface_culling else np.zeros((0, 8, 3))
+        self.volume_resolution, self.step_scale = int(volume_resolution), float(step_scale)
+        #: the hypertextures' ray marches (:mod:`.raster_volume`), drawn in the camera's pass
+        self.volumes, self.timings["volume_bake"] = rv.build(self.ctx, self.programs, scene,
+                                                             self.volume_resolution, self.step_scale)
+        self._volume_targets: OrderedDict = OrderedDict()  # colour texture id -> colour-only FBO
         self.background = None
         if scene.environment is not None:
             self.background = self._background(scene.environment)
-        self.timings["upload"] = time.perf_counter() - t0 - self.programs.compile_seconds
+        self.timings["upload"] = (time.perf_counter() - t0 - self.programs.compile_seconds
+                                  - self.timings["volume_bake"])
         # llvmpipe compiles a program's machine code at its first draw: do it now, counted as
         # compile time (a 1 x 1 frame)
         t0 = time.perf_counter()
@@ -745,9 +763,15 @@ class RasterSession:
         self.env_maps, self.shadow_atlas = {}, None
         for obj in vaos + self._gl_objects + list(self._gl_images.values()) + list(self.programs.programs.values()):
             obj.release()
+        for v in self.volumes:
+            v.vao.release()
+            v.texture.release()
+        for _, target in self._volume_targets.values():
+            gl.release_framebuffer(target)
         for _, free in self._fbos.values():
             free()
         self._gl_objects, self._gl_images, self._fbos = [], {}, OrderedDict()
+        self.volumes, self._volume_targets, self._depth_of = [], OrderedDict(), {}
         self.programs.programs.clear()
         self._uniforms_of, self._camera_of = {}, {}
         self.draws, self.background = [], None
@@ -755,7 +779,8 @@ class RasterSession:
     def gl_bytes(self) -> int:
         """Bytes of GL memory the session holds (:func:`.gl.object_bytes`): geometry buffers,
         images, the stand-ins' maps and its framebuffers."""
-        objs = [*self._gl_objects, *self._gl_images.values(), *(f for f, _ in self._fbos.values())]
+        objs = [*self._gl_objects, *self._gl_images.values(), *(f for f, _ in self._fbos.values()),
+                *(v.texture for v in self.volumes)]
         for m in [*self.env_maps.values(), self.shadow_atlas]:
             if m is not None:
                 objs += [getattr(m, "color", None), m.depth]
@@ -776,6 +801,7 @@ class RasterSession:
                 from .raster_depth import FloatDepthFramebuffer
                 holder = FloatDepthFramebuffer(self.ctx, color)
                 self._fbos[key] = (holder.fbo, holder.release)
+                self._depth_of[id(holder.fbo)] = (color, holder.depth_texture(self.ctx))
             else:
                 depth = self.ctx.depth_texture((width, height))
                 fbo = self.ctx.framebuffer([color], depth)
@@ -785,9 +811,39 @@ class RasterSession:
                     color.release()
                     depth.release()
                 self._fbos[key] = (fbo, free)
+                self._depth_of[id(fbo)] = (color, depth)
             if len(self._fbos) > 4:
-                self._fbos.popitem(last=False)[1][1]()
+                old, free = self._fbos.popitem(last=False)[1]
+                self._release_volume_target(self._depth_of.pop(id(old), (None,))[0])
+                free()
         return self._fbos[key][0]
+
+    # ------------------------------------------------------------------ the media's pass
+    def _volume_target(self, fbo):
+        """(colour-only FBO on ``fbo``'s colour texture, ``fbo``'s depth texture): the volume
+        pass draws into the first while sampling the second (no feedback loop: the depth
+        texture is not attached to the FBO drawn into)."""
+        import moderngl
+        color, depth = self._depth_of.get(id(fbo), (None, None))
+        if color is None:  # the caller's FBO (the UI's): its attachments, if textures
+            attached = fbo.color_attachments
+            color = attached[0] if attached else None
+            depth = fbo.depth_attachment
+            if not isinstance(color, moderngl.Texture) or not isinstance(depth, moderngl.Texture):
+                raise WorkbenchError("drawing hypertextures needs a framebuffer with colour and depth textures")
+        if depth.depth:  # moderngl's depth textures compare by default: read as window depths
+            depth.compare_func = ""
+        target = self._volume_targets.get(id(color))
+        if target is None or target[0] is not color:
+            target = (color, self.ctx.framebuffer(color_attachments=[color]))
+            self._volume_targets[id(color)] = target
+            if len(self._volume_targets) > 4:
+                gl.release_framebuffer(self._volume_targets.popitem(last=False)[1][1])
+        return target[1], depth
+
+    def _release_volume_target(self, color) -> None:
+        if color is not None and id(color) in self._volume_targets:
+            gl.release_framebuffer(self._volume_targets.pop(id(color))[1])
 
     def draw_to(self, fbo, camera: Camera, near: float | None = None, far: float | None = None):
         """Draw the scene seen by ``camera`` into ``fbo`` (colour attachment 0 + depth), after
@@ -907,10 +963,28 @@ class RasterSession:
                 tex.use(UNITS[name])
             bg_draw.vao.render(moderngl.TRIANGLES, vertices=3)
             ctx.depth_func = "<"
+        # the media (camera pass only) interleaved with the blended surfaces, back to front
+        volumes = self.volumes if skip is None else []
+        if volumes:
+            far_first = lambda item: -float(np.linalg.norm(item.centre - cam_pos))
+            blended = sorted(blended + volumes, key=far_first)
         if blended:
             ctx.enable(moderngl.BLEND)
             fbo.depth_mask = False
+            target = None
             for d in blended:
+                if isinstance(d, rv.VolumeDraw):
+                    if target is None:
+                        target = self._volume_target(fbo)
+                    ctx.disable(moderngl.DEPTH_TEST)
+                    target[0].use()
+                    ctx.viewport = viewport
+                    ctx.blend_func = moderngl.ONE, moderngl.SRC_ALPHA  # L + T behind
+                    rv.draw(ctx, d, target[1], camera, near, far, viewport)
+                    fbo.use()
+                    ctx.viewport = viewport
+                    ctx.enable(moderngl.DEPTH_TEST)
+                    continue
                 # closed solids seen from outside their box: only their front faces (the back
                 # ones would blend in twice); from inside, the inner (back) faces are the surface
                 if _closed(d.part.kind) and _beyond_near(camera, [_box_corners(d.part.positions)], near)[0]:
@@ -990,21 +1064,23 @@ _MAX_SESSIONS = 6
 
 def session_for(scene: Scene, mode: str, tessellation: int, blinn: bool, depth_bits: int,
                 shading=None, interpolation: str = "perspective", normals: str = "smooth",
-                standins: sti.StandinOptions | None = None) -> tuple[RasterSession, bool]:
+                standins: sti.StandinOptions | None = None, volume_resolution: int = rv.DEFAULT_RESOLUTION,
+                step_scale: float = 1.0) -> tuple[RasterSession, bool]:
     """A cached :class:`RasterSession` for the scene's content (camera excluded), shading
     model (``shading``: a user's, by its source text and parameter values), interpolation,
-    normal rule and stand-ins; returns ``(session, created)``."""
+    normal rule, stand-ins and the media's texture resolution and step; returns
+    ``(session, created)``."""
     ctx = gl.context()
     key = (id(ctx), id(scene.objects), id(scene.materials), id(scene.lights), id(scene.environment),
            scene.ambient, mode, tessellation, blinn, depth_bits, None if shading is None else shading.key,
-           interpolation, normals, standins)
+           interpolation, normals, standins, int(volume_resolution), float(step_scale))
     hit = _SESSIONS.get(key)
     if hit is not None and hit[1] is scene.objects:
         _SESSIONS.move_to_end(key)
         return hit[0], False
     session = RasterSession(scene, mode, tessellation=tessellation, blinn=blinn, depth_bits=depth_bits, ctx=ctx,
                             shading=shading, interpolation=interpolation, normals=normals,
-                            standins=standins)
+                            standins=standins, volume_resolution=volume_resolution, step_scale=step_scale)
     _SESSIONS[key] = (session, scene.objects)
     if len(_SESSIONS) > _MAX_SESSIONS:
         _SESSIONS.popitem(last=False)[1][0].release()
@@ -1054,9 +1130,13 @@ class _RasterRenderer:
         "envmap_iterations": Option(int, sti.DEFAULT_ENV_ITERATIONS,
                                     "parallax-correction steps of environment-map lookups (0: seen from the "
                                     "object's centre)"),
+        "volume_resolution": Option(int, rv.DEFAULT_RESOLUTION,
+                                    "texels per side of a hypertexture's 3D density texture (its own grid "
+                                    "when set)", low=2),
+        "step_scale": Option(float, 1.0, "factor of the hypertextures' ray-march step (their 'step')"),
     }
 
-    memory_options = ("tessellation", "envmap_resolution", "shadow_resolution")
+    memory_options = ("tessellation", "envmap_resolution", "shadow_resolution", "volume_resolution")
 
     #: Whether the method draws the stand-ins (:mod:`.raster_standins`): Gouraud and Phong; flat
     #: shading and users' shading models draw the bare local model.
@@ -1084,22 +1164,33 @@ class _RasterRenderer:
                                   opts["shadow_bias"], opts["envmap_iterations"])
         return RasterSession(scene, self.mode or self.name, tessellation=opts["tessellation"], blinn=opts["blinn"],
                              depth_bits=opts["depth_bits"], ctx=ctx, shading=shading,
-                             interpolation=opts["interpolation"], normals=opts["normals"], standins=standins)
+                             interpolation=opts["interpolation"], normals=opts["normals"], standins=standins,
+                             volume_resolution=opts["volume_resolution"], step_scale=opts["step_scale"])
 
     def estimate_bytes(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
                        standins: str = "on", envmap_resolution: int = sti.DEFAULT_ENV_RESOLUTION,
                        shadow_resolution: int = sti.DEFAULT_SHADOW_RESOLUTION,
                        shadow_bias: float = sti.DEFAULT_SHADOW_BIAS,
-                       envmap_iterations: int = sti.DEFAULT_ENV_ITERATIONS, shading=None, **_) -> int:
-        """Triangles (:func:`.estimates.triangle_bound` at ``tessellation``), pixels and the
-        stand-ins' maps (:func:`.raster_standins.standin_bytes`)."""
+                       envmap_iterations: int = sti.DEFAULT_ENV_ITERATIONS, shading=None,
+                       volume_resolution: int = rv.DEFAULT_RESOLUTION, step_scale: float = 1.0, **_) -> int:
+        """Triangles (:func:`.estimates.triangle_bound` at ``tessellation``), pixels, the
+        stand-ins' maps (:func:`.raster_standins.standin_bytes`) and the media's 3D textures
+        (twice: the baked grid and its GL copy; refused above their own limit,
+        :func:`.raster_volume.volume_bytes`)."""
         if not 1 <= tessellation <= MAX_LEVEL:
             raise WorkbenchError(f"method {self.name!r}: tessellation must be within 1..{MAX_LEVEL}, "
                                  f"got {tessellation}")
         opts = self._standins(standins, envmap_resolution, shadow_resolution, shadow_bias, envmap_iterations)
+        volumes = self._volume_bytes(scene, volume_resolution, step_scale)
         return raster_bytes(scene, width, height, tessellation, _BYTES_PER_TRIANGLE, _BYTES_PER_PIXEL,
                             _FIXED_BYTES) + sti.standin_bytes(scene, opts, self.mode or self.name,
-                                                              user_model=shading is not None)
+                                                              user_model=shading is not None) + 2 * volumes
+
+    def _volume_bytes(self, scene: Scene, volume_resolution: int, step_scale: float) -> int:
+        try:
+            return rv.volume_bytes(scene, volume_resolution, step_scale)
+        except WorkbenchError as e:
+            raise WorkbenchError(f"method {self.name!r}: {e}") from None
 
     def _standins(self, standins, envmap_resolution, shadow_resolution, shadow_bias,
                   envmap_iterations) -> sti.StandinOptions:
@@ -1116,15 +1207,17 @@ class _RasterRenderer:
                envmap_resolution: int = sti.DEFAULT_ENV_RESOLUTION,
                shadow_resolution: int = sti.DEFAULT_SHADOW_RESOLUTION,
                shadow_bias: float = sti.DEFAULT_SHADOW_BIAS,
-               envmap_iterations: int = sti.DEFAULT_ENV_ITERATIONS) -> RenderResult:
+               envmap_iterations: int = sti.DEFAULT_ENV_ITERATIONS,
+               volume_resolution: int = rv.DEFAULT_RESOLUTION, step_scale: float = 1.0) -> RenderResult:
         if not 1 <= tessellation <= MAX_LEVEL:
             raise WorkbenchError(f"method {self.name!r}: tessellation must be within 1..{MAX_LEVEL}, "
                                  f"got {tessellation}")
         if near < 0 or far < 0 or (near and far and far <= near):
             raise WorkbenchError(f"method {self.name!r}: need 0 < near < far, got near={near}, far={far}")
         opts = self._standins(standins, envmap_resolution, shadow_resolution, shadow_bias, envmap_iterations)
+        self._volume_bytes(scene, volume_resolution, step_scale)
         session, created = session_for(scene, self.mode or self.name, tessellation, blinn, depth_bits, shading,
-                                       interpolation, normals, opts)
+                                       interpolation, normals, opts, volume_resolution, step_scale)
         t0 = time.perf_counter()
         image, depth, (n, f) = session.draw(scene.camera.with_resolution(width, height),
                                             near=near or None, far=far or None, with_depth=True)
@@ -1139,6 +1232,8 @@ class _RasterRenderer:
                  "near": n, "far": f, "depth_bits": depth_bits, "programs": len(session.programs.programs),
                  "draw_calls": len(session.draws), "session_reused": not created,
                  "interpolation": interpolation, "normals": normals, "standins": session.standins_used}
+        if session.volumes:
+            stats["volume_resolutions"] = [v.resolution for v in session.volumes]
         return RenderResult(self.name, image, timings, stats, list(session.features_used),
                             list(session.left_out), depth=depth)
 

@@ -76,6 +76,11 @@ class FloatDepthFramebuffer:
             raise WorkbenchError(f"float depth framebuffer incomplete (status {status:#x})")
         self.fbo = ctx.detect_framebuffer(fbo.value)
 
+    def depth_texture(self, ctx):
+        """The depth texture as a moderngl texture (sampled by the volume pass; the wrapper
+        does not own it: :meth:`release` deletes it)."""
+        return ctx.external_texture(self._tex.value, tuple(self.color.size), 1, 0, "f4")
+
     def release(self) -> None:
         g = _gl()
         g["DeleteFramebuffers"](1, ctypes.byref(self._fbo))

@@ -18,6 +18,9 @@ Pipeline, one step per course slide:
 5. Shade the pixels each polygon won (``couleurObjet(O, x, y)``): ``E + C diffuse +
    specular`` (+ ``kr`` times the environment in the reflected direction for environment-
    mapped materials), the background (or the environment) where nothing was drawn.
+6. March the hypertextures over that image, back to front, each ray's segment ending at the
+   depth buffer's surface (:mod:`.zbuffer_volume`, the GL volume pass's twin:
+   :mod:`.raster_volume`).
 
 Step 5 runs once per pixel after the scan, on the attributes the winning polygon wrote:
 the same image as shading each fragment when it passes the test, for opaque surfaces.
@@ -45,8 +48,10 @@ from ..scene.parts import Part
 from ..scene.prepared import prepare
 from ..scene.tessellate import (DEFAULT_LEVEL, MAX_LEVEL, NORMAL_RULES, area_light_parts, tessellate_scene,
                                 with_normal_rule)
+from . import raster_volume as rv
 from . import support as sp
 from . import texturing as tx
+from . import zbuffer_volume as zv
 from .base import Knob, Option, RenderResult
 from .estimates import raster_bytes
 from .local_model import shade
@@ -64,7 +69,8 @@ SUPPORT = sp.declare(
     approximated={**{f: "drawn as its tessellation (the tessellation knob)"
                      for f in (ft.SPHERES, ft.QUADRICS, ft.CSG, ft.BLOBS, ft.ISOSURFACES, ft.LATHES)},
                   ft.AREA_LIGHTS: "stand-in point lights (the scene's area-light samples)",
-                  ft.EMITTERS: "emission drawn on the surface; it lights others only through area-light stand-ins"},
+                  ft.EMITTERS: "emission drawn on the surface; it lights others only through area-light stand-ins",
+                  ft.HYPERTEXTURES: rv.REASON},
     left_out={
         ft.BUMP: "the Z-buffer twin interpolates the course's normals only (no perturbation)",
         ft.OPACITY: "the Z-buffer keeps the nearest surface only (drawn opaque, no cut-outs)",
@@ -299,8 +305,12 @@ class ZBufferRenderer:
         "view": Option(str, "color", "color image or depth view (white near, black far)", ("color", "depth")),
         "near": Option(float, 0.0, "near clip plane (0: the camera's, or from the scene bounds)"),
         "far": Option(float, 0.0, "far clip plane (0: the camera's, or from the scene bounds)"),
+        "volume_resolution": Option(int, rv.DEFAULT_RESOLUTION,
+                                    "cells per side of a hypertexture's density grid (its own grid when set)",
+                                    low=2),
+        "step_scale": Option(float, 1.0, "factor of the hypertextures' ray-march step (their 'step')"),
     }
-    memory_options = ("tessellation",)
+    memory_options = ("tessellation", "volume_resolution")
 
     def _check(self, tessellation: int, depth_bits: int, near: float = 0.0, far: float = 0.0) -> None:
         if not 1 <= tessellation <= MAX_LEVEL:
@@ -313,16 +323,30 @@ class ZBufferRenderer:
             raise WorkbenchError(f"method {self.name!r}: need 0 < near < far, got near={near}, far={far}")
 
     def estimate_bytes(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
-                       depth_bits: int = 24, near: float = 0.0, far: float = 0.0, **_) -> int:
-        """Triangles (:func:`.estimates.triangle_bound` at ``tessellation``) and pixels."""
+                       depth_bits: int = 24, near: float = 0.0, far: float = 0.0,
+                       volume_resolution: int = rv.DEFAULT_RESOLUTION, step_scale: float = 1.0, **_) -> int:
+        """Triangles (:func:`.estimates.triangle_bound` at ``tessellation``), pixels and the
+        media's march: the float32 grid and its float64 trilinear temporaries (about 3x), and
+        :data:`.zbuffer_volume.BYTES_PER_PIXEL` (refused above the grids' own limit,
+        :func:`.raster_volume.volume_bytes`)."""
         self._check(tessellation, depth_bits, near, far)
+        grids = self._volume_bytes(scene, volume_resolution, step_scale)
+        march = zv.BYTES_PER_PIXEL * width * height if grids else 0
         return raster_bytes(scene, width, height, tessellation, _BYTES_PER_TRIANGLE, _BYTES_PER_PIXEL,
-                            _FIXED_BYTES)
+                            _FIXED_BYTES) + 4 * grids + march
+
+    def _volume_bytes(self, scene: Scene, volume_resolution: int, step_scale: float) -> int:
+        try:
+            return rv.volume_bytes(scene, volume_resolution, step_scale)
+        except WorkbenchError as e:
+            raise WorkbenchError(f"method {self.name!r}: {e}") from None
 
     def render(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
                shading: str = "gouraud", depth_bits: int = 24, blinn: bool = False, normals: str = "smooth",
-               view: str = "color", near: float = 0.0, far: float = 0.0) -> RenderResult:
+               view: str = "color", near: float = 0.0, far: float = 0.0,
+               volume_resolution: int = rv.DEFAULT_RESOLUTION, step_scale: float = 1.0) -> RenderResult:
         self._check(tessellation, depth_bits, near, far)
+        self._volume_bytes(scene, volume_resolution, step_scale)
         timings: dict[str, float] = {}
         camera = scene.camera.with_resolution(width, height)
         needs = ft.scene_needs(scene)
@@ -334,6 +358,10 @@ class ZBufferRenderer:
         image = self._shade(frame, pairs, shading, scene, camera, eye, blinn, needs)
         timings["shade"] = time.perf_counter() - t0
         depth = self._depth(frame, depth_bits, near, far)
+        if view != "depth" and rv.media(scene):
+            t0 = time.perf_counter()
+            image, timings["volume_bake"] = zv.composite(image, scene, camera, depth, volume_resolution, step_scale)
+            timings["volume_march"] = time.perf_counter() - t0 - timings["volume_bake"]
         if view == "depth":
             g = np.where(np.isfinite(depth), 1.0 - (depth - near) / (far - near), 0.0)
             image = np.repeat(np.clip(g, 0.0, 1.0)[..., None], 3, -1)

@@ -34,7 +34,10 @@ import numpy as np
 from numba.extending import overload
 
 from ...scene.kinds import KINDS, kernel_module
+from .columns import Light, Mat
 from .flags import GATE, INLINE
+from .intersect import closest
+from .optics import _light_dir
 from .layout import marker_features, marker_name
 from .rng import rand
 
@@ -69,25 +72,46 @@ def to_object(geo, k, ox, oy, oz, dx, dy, dz):
             a[k, 8] * dx + a[k, 9] * dy + a[k, 10] * dz)
 
 
-def _dispatch(kinds, body: str, args: str, miss: str, name: str):
+def _dispatch(kinds, body, args: str, miss: str, name: str):
     """An implementation ``impl(geo, k, <args>)`` running ``body`` (source using ``optics``,
-    ``chord``, ``step``) for the medium kind whose ``PTYPE`` is ``geo.ptype[k]``; ``miss``
-    for a scene without one."""
+    ``chord``, ``step``, ``majorant``, and for texel kinds ``texel`` and ``kajiya_kay``; or a
+    function of the kind's kernel module returning the source) for the medium kind whose
+    ``PTYPE`` is ``geo.ptype[k]``; ``miss`` for a scene without one."""
     present = medium_kinds(kinds)
     env = {"np": np, "math": math, "to_object": to_object, "MAX_STEPS": MAX_MARCH_STEPS, "T_CUT": T_CUT,
-           "rand": rand, "MAX_COLLISIONS": MAX_COLLISIONS}
+           "rand": rand, "MAX_COLLISIONS": MAX_COLLISIONS, "light_dir": _light_dir, "visibility": visibility,
+           "POWER": int(Light.POWER)}
     lines = [f"def impl(geo, k, {args}):"]
+    names = ("optics", "chord", "step", "majorant", "texel", "kajiya_kay")
     for i, kind in enumerate(present):
         mod = kernel_module(kind)
-        env[f"optics{i}"], env[f"chord{i}"], env[f"step{i}"] = mod.optics, mod.chord, mod.step
-        env[f"majorant{i}"] = mod.majorant
+        text = body(mod) if callable(body) else body
+        for n in names:
+            if hasattr(mod, n):
+                env[f"{n}{i}"] = getattr(mod, n)
+                text = text.replace(f"{n}(", f"{n}{i}(")
         lines.append(f"    if geo.ptype[k] == {int(kind.PTYPE)}:")
-        lines += ["        " + ln.replace("optics(", f"optics{i}(").replace("chord(", f"chord{i}(")
-                  .replace("step(", f"step{i}(").replace("majorant(", f"majorant{i}(")
-                  for ln in body.strip("\n").split("\n")]
+        lines += ["        " + ln for ln in text.strip("\n").split("\n")]
     lines.append(f"    return {miss}")
     exec(compile("\n".join(lines), f"<{name} over {', '.join(k.TYPE for k in present) or 'no medium'}>", "exec"), env)
     return env["impl"]
+
+
+@nb.njit(**GATE)
+def visibility(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmax, eps, scr):
+    """1 if no surface but media boundaries lies on ``o + t d``, ``eps < t < tmax``, else 0
+    (a texel's feeler: the fur does not shadow itself in this model)."""
+    stack, st, sp_, sf, sn = scr
+    t0 = eps
+    for _ in range(16):
+        t, kk, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, t0, tmax, np.bool_(True), np.bool_(False),
+                                        0.0, eps, stack, st, sp_, sf, sn)
+        if kk < 0:
+            return 1.0
+        if mat_tab[mat_of[kk], Mat.MEDIUM] < 0.0:
+            return 0.0
+        t0 = t + eps
+    return 0.0
 
 
 _MARCH = """
@@ -117,33 +141,72 @@ return tr, lr, lg, lb
 """
 
 
-def march(geo, k, ox, oy, oz, dx, dy, dz, t0, t1, amb_r, amb_g, amb_b, scale, emit):
+_MARCH_TEXEL = """
+lights, mat_of, mat_tab = light
+qx, qy, qz, ux, uy, uz = to_object(geo, k, ox, oy, oz, dx, dy, dz)
+c0, c1 = chord(geo.par, k, qx, qy, qz, ux, uy, uz)
+t0, t1 = max(t0, c0), min(t1, c1)
+speed = math.sqrt(ux * ux + uy * uy + uz * uz)
+if not t1 > t0:
+    return 1.0, 0.0, 0.0, 0.0
+n = min(MAX_STEPS, max(1, int(math.ceil((t1 - t0) * speed / (step(geo.par, k) * scale)))))
+h = (t1 - t0) / n
+tr, lr, lg, lb = 1.0, 0.0, 0.0, 0.0
+nm = geo.nm
+for j in range(n):
+    t = t0 + (j + 0.5) * h
+    d, tx, ty, tz = texel(geo.par, k, qx + t * ux, qy + t * uy, qz + t * uz)
+    if d > 0.0:
+        st, a0, a1, a2, _e0, _e1, _e2 = optics(geo.par, k, geo.aux, qx + t * ux, qy + t * uy, qz + t * uz)
+        att = math.exp(-st * h * speed)
+        f = tr * (1.0 - att)
+        if emit:
+            wx = nm[k, 0] * tx + nm[k, 1] * ty + nm[k, 2] * tz
+            wy = nm[k, 3] * tx + nm[k, 4] * ty + nm[k, 5] * tz
+            wz = nm[k, 6] * tx + nm[k, 7] * ty + nm[k, 8] * tz
+            wn = math.sqrt(wx * wx + wy * wy + wz * wz)
+            if wn > 0.0:
+                wx, wy, wz = wx / wn, wy / wn, wz / wn
+            px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
+            sr, sg, sb = a0 * amb_r, a1 * amb_g, a2 * amb_b
+            eps = 1e-9 * max(max(abs(px), abs(py), abs(pz)), 1.0)
+            for li in range(lights.shape[0]):
+                lx, ly, lz, dist, sc = light_dir(lights, li, px, py, pz)
+                if sc == 0.0:
+                    continue
+                vis = visibility(geo, mat_of, mat_tab, px, py, pz, lx, ly, lz, dist, eps, scr)
+                if vis > 0.0:
+                    sin_tl, spec = kajiya_kay(geo.par, k, wx, wy, wz, lx, ly, lz, dx, dy, dz)
+                    w = sc * vis
+                    sr += lights[li, POWER] * w * (a0 * sin_tl + spec)
+                    sg += lights[li, POWER + 1] * w * (a1 * sin_tl + spec)
+                    sb += lights[li, POWER + 2] * w * (a2 * sin_tl + spec)
+            lr += f * sr
+            lg += f * sg
+            lb += f * sb
+        tr *= att
+        if tr < T_CUT:
+            return 0.0, lr, lg, lb
+return tr, lr, lg, lb
+"""
+
+
+def march(geo, k, ox, oy, oz, dx, dy, dz, t0, t1, amb_r, amb_g, amb_b, scale, emit, light, scr):
     """Emission-absorption march (module docstring) of medium row ``k`` along the world ray over
     ``[t0, t1]`` (clipped to the medium's chord); ``scale`` multiplies the row's step; without
-    ``emit`` only the transmittance.  Returns ``(T, L r, g, b)``; ``(1, 0, 0, 0)`` for a
-    scene without a medium."""
+    ``emit`` only the transmittance.  A texel kind (a kernel module with ``texel`` and
+    ``kajiya_kay``: the fur) lights its strands instead: ambient and, through feelers against
+    the surfaces (:func:`visibility`), each light of ``light = (lights, mat_of, mat_tab)`` by
+    its Kajiya-Kay lobes.  ``scr``: the intersector's scratch.  Returns ``(T, L r, g, b)``;
+    ``(1, 0, 0, 0)`` for a scene without a medium."""
     raise TypeError("march is callable from numba-compiled code only")
 
 
 @overload(march, jit_options=GATE)
-def _march(geo, k, ox, oy, oz, dx, dy, dz, t0, t1, amb_r, amb_g, amb_b, scale, emit):
-    return _dispatch(geo.types[-1], _MARCH, "ox, oy, oz, dx, dy, dz, t0, t1, amb_r, amb_g, amb_b, scale, emit",
+def _march(geo, k, ox, oy, oz, dx, dy, dz, t0, t1, amb_r, amb_g, amb_b, scale, emit, light, scr):
+    return _dispatch(geo.types[-1], lambda mod: _MARCH_TEXEL if hasattr(mod, "kajiya_kay") else _MARCH,
+                     "ox, oy, oz, dx, dy, dz, t0, t1, amb_r, amb_g, amb_b, scale, emit, light, scr",
                      "1.0, 0.0, 0.0, 0.0", "march")
-
-
-def chord_of(geo, k, ox, oy, oz, dx, dy, dz):
-    """World ``(t0, t1)`` of the ray's overlap with medium row ``k``'s bounding region;
-    ``(inf, inf)`` when it misses (or for a scene without a medium)."""
-    raise TypeError("chord_of is callable from numba-compiled code only")
-
-
-@overload(chord_of, jit_options=GATE)
-def _chord_of(geo, k, ox, oy, oz, dx, dy, dz):
-    body = """
-qx, qy, qz, ux, uy, uz = to_object(geo, k, ox, oy, oz, dx, dy, dz)
-return chord(geo.par, k, qx, qy, qz, ux, uy, uz)
-"""
-    return _dispatch(geo.types[-1], body, "ox, oy, oz, dx, dy, dz", "np.inf, np.inf", "chord_of")
 
 
 _CHORD = """

@@ -129,7 +129,8 @@ class PathTraceSession:
         if tex is None:
             tex = np.zeros((len(sd.mat_tab), TEX_COLS))
         names = [mt.name for mt in sd.materials]
-        media = [names.index(mt.name) for mt in prepared.camera_media][-4:]
+        media = ([names.index(mt.name) for mt in prepared.camera_media]
+                 + sd.media_holding(traced, traced.camera.position))[-4:]
         if transport == "diffuse":  # every surface opaque: no medium
             media = []
         self.opts = pack(PathOpt, fresnel=FRESNEL[fresnel], ray_offset=tol.ray_offset, t_min=tol.t_min,

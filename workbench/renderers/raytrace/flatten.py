@@ -96,6 +96,19 @@ class SceneData:
         """Whether a heterogeneous medium bounds any material (``Mat.MEDIUM``)."""
         return bool((self.mat_tab[:, Mat.MEDIUM] >= 0).any())
 
+    def media_holding(self, scene: m.Scene, point) -> list[int]:
+        """Material rows of the heterogeneous media whose bounds hold the world ``point`` (the
+        camera inside a hypertexture starts in its medium), in row order."""
+        out = []
+        for r in np.flatnonzero(self.mat_tab[self.mat, Mat.MEDIUM] >= 0):
+            if self.obj[r] >= len(scene.objects):
+                continue
+            o = scene.objects[self.obj[r]]
+            q = self.xf[r].reshape(3, 4) @ np.append(np.asarray(point, dtype=np.float64), 1.0)
+            if kind_of(o).inside(o, q):
+                out.append(int(self.mat[r]))
+        return out
+
     def features(self) -> tuple[str, ...]:
         """What the kernels compile for this scene (:func:`..kernels.layout.features`), in
         groups, so that all scenes of the package's kinds together need at most four compiled

@@ -33,7 +33,7 @@ from numba import prange
 from ..kernels.columns import RAY_COUNTS, Light, Mat, RayCount, WhittedOpt
 from ..kernels.flags import INLINE, NO_REFCOUNT, TASK
 from ..kernels.intersect import closest, scratch, surface
-from ..kernels.media import chord_of, march
+from ..kernels.media import march
 from ..kernels.optics import (_facing, _feeler, _ior, _light_dir, _pow, camera_ray, checker_color,
                               fresnel_reflectance)
 from ..kernels.shapes import _normalize
@@ -110,7 +110,8 @@ def _transmittance(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmin, tmax, tra
         if med >= 0:
             if med != m0 and med != m1 and med != m2 and med != m3:
                 m0, m1, m2, m3 = med, m0, m1, m2
-                tr, _, _, _ = march(geo, med, ox, oy, oz, dx, dy, dz, tmin, tmax, 0.0, 0.0, 0.0, media, False)
+                tr, _, _, _ = march(geo, med, ox, oy, oz, dx, dy, dz, tmin, tmax, 0.0, 0.0, 0.0, media, False,
+                                    (mat_tab[:0], mat_of, mat_tab), (stack, st, sp_, sf, sn))
                 v *= tr
         elif not transmissive:
             return 0.0
@@ -248,7 +249,7 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
         med = int(mat_tab[ma, Mat.MEDIUM])
         if med >= 0:
             tr, mr, mg, mb = march(geo, med, O[i, 0], O[i, 1], O[i, 2], dx, dy, dz, 0.0, t[i],
-                                   ambient[0], ambient[1], ambient[2], media, True)
+                                   ambient[0], ambient[1], ambient[2], media, True, (lights, mat_of, mat_tab), scr)
             mr, mg, mb = w0 * mr, w1 * mg, w2 * mb
             w0, w1, w2 = w0 * tr, w1 * tr, w2 * tr
         else:

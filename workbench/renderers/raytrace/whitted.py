@@ -375,7 +375,7 @@ class _Tracer:
         self.ray_cap = wavefront_cap(scene, scene.camera.width, scene.camera.height, opts["spp"], self.G,
                                      opts.get("threshold", 0.0), recursive)
         names = [mt.name for mt in sd.materials]
-        self.media = [names.index(mt.name) for mt in media][-4:]
+        self.media = ([names.index(mt.name) for mt in media] + sd.media_holding(scene, scene.camera.position))[-4:]
         self.kopts = kernel_options(self.G, threshold=opts.get("threshold", 0.0), fresnel=fres,
                                     transmissive_shadows=opts["transmissive_shadows"], blinn=opts["blinn"],
                                     shadows=self.do_shadow, reflection=refl, refraction=refr,
@@ -604,6 +604,15 @@ class _WhittedBase:
             st.update(primary_ray_counts(sd, *camera_rays(cam, width, height, 1, 0)[:2]))
             timings["traversal_stats"] = time.perf_counter() - t2
         st["scene_extent"] = sd.extent
+        if o["march_error"] and sd.has_media and o["step_scale"] / 2 >= 1.0 / 64:
+            # the march's step error, estimated by the same render at half the step
+            t3 = time.perf_counter()
+            half = self.render(scene, width, height, **{**o, "step_scale": o["step_scale"] / 2, "march_error": False,
+                                                        "on_tile": None, "progress": False})
+            diff = image.reshape(height, width, 3) - half.image
+            st["march_error_rmse"] = float(np.sqrt(np.mean(diff.astype(np.float64) ** 2)))
+            st["march_error_max"] = float(np.abs(diff).max())
+            timings["march_error"] = time.perf_counter() - t3
         used, left = self._features(scene, tr)
         return RenderResult(self.name, image.reshape(height, width, 3), timings, st, used, left,
                             depth=depth.reshape(height, width))
@@ -662,6 +671,8 @@ _COMMON = {
                     "triangle and primitive tested); same images", ACCELS),
     "step_scale": Option(float, 1.0, "multiplies every hypertexture's march step (its 'step' key): the "
                          "knob of the emission-absorption march, 1/64..64", low=1.0 / 64),
+    "march_error": Option(bool, False, "estimate the hypertextures' march error: render again at half the "
+                          "step and report the difference (stats march_error_rmse, march_error_max; timed apart)"),
     "traversal_stats": Option(bool, False, "count nodes visited and primitives tested per pixel-centre "
                               "camera ray (stats accel_*; a pass of its own, timed apart)"),
 }

@@ -86,9 +86,14 @@ Functions (``W`` and ``M`` are (4, 4) ``world_from_object`` including any CSG pa
     shape writer ``x`` (:class:`workbench.renderers.mitsuba_export.ShapeWriter`):
     ``x.tessellated(obj, level, flat=, open_surface=)`` (its raster tessellation as PLY
     meshes), ``x.analytic(shape_dict, material, lo, hi)`` (a Mitsuba primitive of its own),
-    ``x.similarity_scale(W)``, ``x.leave(feature, reason)`` (an approximation, in ``left_out``) and
-    ``x.level`` (the export's tessellation level).  Returns the shape dicts added; None: not
-    exported (noted).
+    ``x.similarity_scale(W)``, ``x.leave(feature, reason, approximated=False)`` (in
+    ``left_out``), ``x.level`` (the export's tessellation level) and, for a participating
+    medium, ``x.write_volume(grid, lo, hi)`` (a Mitsuba ``.vol`` file, its path),
+    ``x.medium(shape_dict, medium_dict, lo, hi, around_camera)`` (a boundary with a ``null``
+    BSDF and the medium inside; the export then uses ``volpath``) and ``x.volume_grid`` (the
+    export's grid resolution).  Returns the shape dicts added; None: not exported (noted).
+``mitsuba_bytes(obj, volume_grid) -> int``  optional: bytes its Mitsuba export adds beyond
+    its triangles (a medium's grids), for the ``mitsuba`` method's memory estimate.
 
 The numba functions (intersection and normal by ``par`` row) live in
 :mod:`workbench.renderers.kernels.shapes`, which imports the ``PTYPE`` constants from here.
@@ -109,9 +114,9 @@ import numpy as np
 
 from ...core.errors import WorkbenchError
 from .. import model as m
-from . import blob, box, csg, hypertexture, isosurface, lathe, mesh, plane, polygon, prism, quadric, sphere
+from . import blob, box, csg, fur, hypertexture, isosurface, lathe, mesh, plane, polygon, prism, quadric, sphere
 
-_REGISTRY = {k.TYPE: k for k in (sphere, plane, box, quadric, polygon, mesh, csg, blob, isosurface, lathe, prism, hypertexture)}
+_REGISTRY = {k.TYPE: k for k in (sphere, plane, box, quadric, polygon, mesh, csg, blob, isosurface, lathe, prism, hypertexture, fur)}
 KINDS = MappingProxyType(_REGISTRY)
 """The registry: scene-file ``type`` name -> kind module (the package's, then those added by
 :func:`register`)."""

@@ -57,6 +57,8 @@ def parse(ctx: rd.Ctx, t: dict, w: str, common: dict, child, kind_of) -> m.CSG:
     left = child(t["left"], f"{w}.left", common["material"])
     right = child(t["right"], f"{w}.right", common["material"])
     for side, c in (("left", left), ("right", right)):
+        if getattr(kind_of(c), "MEDIUM", False):
+            ctx.fail(f"{w}.{side}.type", f"CSG needs solid surfaces; a {c.kind} is a participating medium")
         if not is_solid(c, kind_of):
             ctx.fail(f"{w}.{side}.type", f"CSG needs solids; a {c.kind} has no inside"
                      + (" (an open lathe profile: end it where it starts, or on the axis)" if c.kind == "lathe" else ""))

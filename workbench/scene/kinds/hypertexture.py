@@ -369,6 +369,97 @@ def flatten(b, obj: Hypertexture, index: int, W: np.ndarray, top: bool) -> int:
 
 
 # --------------------------------------------------------------------------- exporters
+def ramp_is_affine(h: Hypertexture) -> bool:
+    """Whether ``ramp`` is one straight line over ``[0, 1]`` (then the trilinear interpolation
+    of ``ramp(D)`` between grid samples equals ``ramp`` of the interpolated ``D``)."""
+    d = np.unique(np.concatenate([[0.0, 1.0], h.ramp[:, 0]]))
+    c = ramp(h, d)
+    line = c[0] + d[:, None] * (c[-1] - c[0])
+    return bool(np.abs(c - line).max() <= 1e-12 * max(1.0, float(np.abs(c).max())))
+
+
+MITSUBA_BYTES_PER_CELL = 64
+"""Bytes per grid cell of the Mitsuba export: the density (float32 in the exporter, twice in
+Mitsuba: the file's grid and its texture: 12) and the RGB albedo grid (36), rounded up."""
+
+
+def mitsuba_bytes(h: Hypertexture, volume_grid: int) -> int:
+    """Bytes the Mitsuba export of ``h`` adds (:func:`mitsuba`): its grids (the object's
+    ``grid``, else ``volume_grid`` cells along each side)."""
+    return MITSUBA_BYTES_PER_CELL * grid_bytes(h.grid or volume_grid, 1, 1)
+
+
+def mitsuba(h: Hypertexture, x) -> list[dict] | None:
+    """A Mitsuba 3 ``heterogeneous`` medium inside the bounding sphere, through the shape
+    writer ``x`` (:class:`workbench.renderers.mitsuba_export.ShapeWriter`):
+
+    - the boundary: ``sphere`` with ``to_world = world_from_object S(R)`` (``x.medium``: a
+      ``null`` BSDF, the medium as its interior);
+    - ``sigma_t``: a ``gridvolume`` of ``D`` at the centres of the cells tiling ``[-R, R]^3``
+      (:func:`density_grid`; ``grid``, else the export's ``x.volume_grid``, noted), trilinear
+      and clamped: Mitsuba's grid maps the unit cube through its ``to_world`` =
+      ``world_from_object T(-R) S(2R)`` and Dr.Jit's texture puts sample ``i`` at
+      ``(i + 1/2) / res`` (``pos res - 1/2``) and clamps the indices: the convention of
+      :func:`sample_grid`;
+    - ``scale``: ``density / s`` with ``s`` the transform's uniform scale (Mitsuba's extinction
+      is per world length, ours per object length); a transform that is not a similarity has no
+      such scalar (its length ratio depends on the direction): not exported;
+    - ``albedo``: ``albedo ramp`` as a constant when the ramp is one colour, else an RGB
+      ``gridvolume`` of ``albedo ramp(D)`` at the same cells (interpolated as colours: exact
+      where the ramp is linear, :func:`ramp_is_affine`, noted otherwise);
+    - isotropic phase function.  Emission is not exported (Mitsuba 3 has no emissive media)."""
+    from ...core import transform as tf
+    W = np.asarray(h.world_from_object, dtype=np.float64)
+    s = x.similarity_scale(W)
+    if s is None:
+        x.leave(FEATURE, "a hypertexture under a transform that is not a similarity is not exported: Mitsuba's "
+                "extinction is per world length, the same in every direction")
+        return []
+    R = bound_radius(h)
+    res = h.grid or x.volume_grid
+    D = density_grid(h, res)
+    if not h.grid:
+        x.leave(FEATURE, f"the analytic density sampled at {res}^3 cell centres, trilinear (option volume_grid; "
+                "the object's grid = N is exact)", approximated=True)
+    lo, hi = (-R, -R, -R), (R, R, R)
+    V = (W @ tf.translate(lo) @ tf.scale(2.0 * R)).tolist()
+
+    def grid(data):
+        return {"type": "gridvolume", "filename": x.write_volume(data, lo, hi), "to_world": V,
+                "filter_type": "trilinear", "wrap_mode": "clamp"}
+
+    albedo = np.asarray(h.albedo, dtype=np.float64)
+    colours = h.ramp[:, 1:]
+    if albedo.max() == 0.0 or np.all(colours == colours[0]):
+        alb = {"type": "rgb", "value": [float(c) for c in albedo * colours[0]]}
+    else:
+        if grid_bytes(res, 3) > GRID_BYTES:
+            raise WorkbenchError(f"hypertexture albedo grid of {res}^3 RGB cells: {grid_bytes(res, 3) / 2**20:.1f} "
+                                 f"MiB exceeds the limit of {GRID_BYTES / 2**20:.0f} MiB")
+        rgb = np.empty(D.shape + (3,), np.float32)
+        for iz in range(res):  # slice by slice: ramp's float64 temporaries stay small
+            rgb[iz] = (albedo * ramp(h, D[iz].ravel())).reshape(res, res, 3)
+        alb = grid(rgb)
+        if not ramp_is_affine(h):
+            x.leave(FEATURE, "the albedo ramp is interpolated between the grid's samples as colours "
+                    "(ramp of the interpolated density elsewhere; they differ where the ramp bends)", approximated=True)
+    medium = {"type": "heterogeneous", "sigma_t": grid(D), "scale": float(h.density / s), "albedo": alb,
+              "phase": {"type": "isotropic"}}
+    if max(h.emission) > 0.0:
+        x.leave(FEATURE, "the medium's emission is not exported: Mitsuba 3 has no emissive media "
+                "(absorption and scattering only)")
+    centre = W[:3, 3]
+    cam = np.linalg.solve(W, np.append(np.asarray(x.scene.camera.position, dtype=np.float64), 1.0))[:3]
+    sphere = {"type": "sphere", "to_world": (W @ tf.scale(R)).tolist()}
+    return [x.medium(sphere, medium, centre - s * R, centre + s * R, around_camera=bool(np.linalg.norm(cam) < R))]
+
+
 def povray(h: Hypertexture, w, in_csg: bool):
-    w.leave(FEATURE, "the hypertexture's noise field has no POV-Ray twin (its density pattern differs)")
+    """Not exported: POV-Ray's noise differs from ours, and its ``density_file df3`` with
+    ``interpolate 1`` (3.7's ``density_pattern``) puts sample ``j`` at ``j / S``, wraps the
+    upper neighbour periodically and is 0 outside the unit cube, unlike the grid's cell
+    centres and clamped edges (a padded df3 would match for a one-colour ramp: see
+    docs/hypertextures.md)."""
+    w.leave(FEATURE, "not exported: POV-Ray's noise differs from ours, and its df3 density file interpolates "
+            "samples at j/S with periodic wrap (our grid: cell centres, clamped edges)")
     return None

@@ -164,9 +164,9 @@ def majorant(par, k):
 
 # ----------------------------------------------------------------------------- the bounding sphere
 @nb.njit(**JIT)
-def chord(par, k, ox, oy, oz, dx, dy, dz):
-    """Both t of the object-space line with the bounding sphere (t0 <= t1), or (inf, inf)."""
-    r = par[k, Par.BOUND]
+def sphere_chord(r, ox, oy, oz, dx, dy, dz):
+    """Both t of the object-space line with the sphere of radius ``r`` about the origin
+    (t0 <= t1), or (inf, inf) (the stable form of :func:`.sphere.roots`)."""
     s = math.sqrt(dx * dx + dy * dy + dz * dz)
     ux, uy, uz = dx / s, dy / s, dz / s
     b = ox * ux + oy * uy + oz * uz
@@ -176,10 +176,17 @@ def chord(par, k, ox, oy, oz, dx, dy, dz):
         return np.inf, np.inf
     sq = math.sqrt(disc)
     q = -b - sq if b >= 0.0 else -b + sq
-    c = (math.sqrt(ox * ox + oy * oy + oz * oz) - r) * (math.sqrt(ox * ox + oy * oy + oz * oz) + r)
+    no = math.sqrt(ox * ox + oy * oy + oz * oz)
+    c = (no - r) * (no + r)
     t0 = c / q if q != 0.0 else -sq
     t0, t1 = min(t0, q), max(t0, q)
     return t0 / s, t1 / s
+
+
+@nb.njit(**JIT)
+def chord(par, k, ox, oy, oz, dx, dy, dz):
+    """Both t of the object-space line with the bounding sphere (t0 <= t1), or (inf, inf)."""
+    return sphere_chord(par[k, Par.BOUND], ox, oy, oz, dx, dy, dz)
 
 
 @nb.njit(**JIT)
