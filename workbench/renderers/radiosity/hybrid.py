@@ -53,8 +53,9 @@ def is_diffuse(mat: m.Material) -> bool:
 
 
 def derived_scene(scene: m.Scene, patches, radiance: np.ndarray) -> tuple[m.Scene, int]:
-    """The scene with every diffuse object replaced by its radiosity-emitting patch mesh, and
-    without its participating media (left out: :data:`SUPPORT`).
+    """The scene with every diffuse object replaced by its radiosity-emitting patch mesh (a fur
+    by its base's), and without the participating media that have no surface (hypertextures,
+    left out: :data:`SUPPORT`).
 
     Returns the scene and the number of objects replaced."""
     vrad = patches.vertex_values(radiance)
@@ -63,10 +64,10 @@ def derived_scene(scene: m.Scene, patches, radiance: np.ndarray) -> tuple[m.Scen
         by_object.setdefault(id(obj), []).append(s)
     objects, materials, replaced = [], dict(scene.materials), 0
     for obj in scene.objects:
-        if getattr(kind_of(obj), "MEDIUM", False):  # left out (SUPPORT): no patches, no volume transport
-            continue
         mat = scene.material_of(obj)
         surfaces = by_object.get(id(obj))
+        if getattr(kind_of(obj), "MEDIUM", False) and not surfaces:
+            continue  # a medium without a surface (hypertexture): left out (SUPPORT), no volume transport
         if not is_diffuse(mat) or not surfaces:
             objects.append(obj)
             continue
