@@ -17,6 +17,7 @@ import pytest
 import workbench
 from seen_pixels import coverage, iou, scene_dict
 from workbench.scene.io import scene_from_dict
+from workbench.scene.kinds import kind_of
 
 SCENES = sorted(p.stem for p in (Path(__file__).resolve().parents[2] / "scenes").glob("*.toml"))
 W, H = 64, 48
@@ -34,6 +35,9 @@ def test_bundled_scene_objects_seen_alike(name, gl_ctx):
     # geometry only: an opacity map's holes count as covered in the ray caster's depth (the
     # first surface hit) and not in the raster's (discarded fragments)
     sc = replace(sc, materials={k: replace(mt, opacity=None) for k, mt in sc.materials.items()})
+    # surfaces only: a participating medium (hypertexture) has no silhouette to agree on (the ray
+    # caster's depth marks where its march saw density, the raster's 3D texture where it blended)
+    sc = replace(sc, objects=tuple(o for o in sc.objects if not getattr(kind_of(o), "MEDIUM", False)))
     ray, ras = coverage(sc, "raycast", W, H), coverage(sc, "phong", W, H)
     assert iou(ray, ras) >= 0.97, (name, iou(ray, ras), int(ray.sum()), int(ras.sum()))
 

@@ -134,10 +134,29 @@ def candidates(scene: Scene) -> list[tuple[str, str]]:
     return [(m, why) for m, why in out if m in available()]
 
 
-def finest_options(method: str) -> dict:
-    """Options putting ``method``'s quality knob at its most accurate value."""
+MEDIUM_KNOBS = (("volume_resolution", (16, 32, 64, 128)), ("step_scale", (4.0, 2.0, 1.0, 0.5, 0.25)))
+"""Options on which a participating medium's discretisation error depends, with the values a
+study sweeps (cheapest first): the raster's 3D texture resolution (``volume_resolution``) and
+the ray marchers' step multiplier (``step_scale``, times every hypertexture's ``step``).  On a
+scene with hypertextures a method is swept along the first of them it declares (the raster,
+which has both, along its texture's resolution) and its references take the last (finest)
+value of each it declares; a method with neither (the path tracer) keeps its knob."""
+
+
+def medium_finest(method: str, scene: Scene | None) -> dict:
+    """The finest value of each :data:`MEDIUM_KNOBS` option ``method`` declares, on a scene with
+    hypertextures (else nothing)."""
+    if scene is None or F.HYPERTEXTURES not in F.scene_needs(scene):
+        return {}
+    accepted = get_renderer(method).options
+    return {name: values[-1] for name, values in MEDIUM_KNOBS if name in accepted}
+
+
+def finest_options(method: str, scene: Scene | None = None) -> dict:
+    """Options putting ``method``'s quality knob at its most accurate value, and on a scene with
+    hypertextures its march step or texture resolution too (:func:`medium_finest`)."""
     knob = get_renderer(method).knob
-    return {knob.name: knob.values[-1]} if knob.values else {}
+    return {**({knob.name: knob.values[-1]} if knob.values else {}), **medium_finest(method, scene)}
 
 
 def display_noise(std_error: np.ndarray | None, image: np.ndarray) -> float:
@@ -232,7 +251,7 @@ def render_reference(scene: Scene, width: int, height: int, method: str, options
 def _full_options(method: str, scene: Scene) -> dict:
     if method == "pathtrace":
         return {}
-    opts = finest_options(method)
+    opts = finest_options(method, scene)
     if method in ("raytrace", "raycast") and "spp" not in opts:
         opts["spp"] = CONVERGED_SPP
     return opts
@@ -255,7 +274,7 @@ def choose_reference(scene: Scene, width: int, height: int, method: str | None =
             tried.append(f"{m}: cannot be loaded ({e})")
             continue
         if method is not None and m != "pathtrace":
-            opts = finest_options(m)    # the user's method as it is, at its finest knob
+            opts = finest_options(m, scene)    # the user's method as it is, at its finest knob
         ref = render_reference(scene, width, height, m, opts, why, what=_what(m, scene))
         if ref.run.status == "ok":
             return ref
@@ -339,6 +358,7 @@ class References:
         if spec is None:
             return None
         m, opts, what = spec
+        opts = {**opts, **medium_finest(m, self.scene)}  # the medium's limit too (MEDIUM_KNOBS)
         key = (m, tuple(sorted(opts.items())))
         if key not in self._matched:
             if m == self.full.method and opts == _full_options(m, self.scene) and m == "pathtrace":
@@ -362,5 +382,5 @@ def physical_differences(result_left_out: list, reference_features: list[str]) -
 
 
 __all__ = ["CONVERGED_SPP", "IDEAL_IMAGE", "MATCHED", "Reference", "References", "SAMPLING_NOTE",
-           "candidates", "choose_reference", "display_noise", "finest_options", "matched_spec",
+           "MEDIUM_KNOBS", "candidates", "choose_reference", "display_noise", "finest_options", "matched_spec",
            "physical_differences", "render_reference"]

@@ -1,8 +1,9 @@
 """``workbench study``: error against run time along each method's quality knob.
 
 For every method and every value of its knob (``get_renderer(m).knob.values``, cheapest to most
-accurate, or another option given with ``--sweep``; ``--quick`` keeps at most 4 of them, evenly
-spread and including both ends), the
+accurate, or another option given with ``--sweep``, or on a scene with hypertextures the march's
+step or the 3D texture's resolution when the method has them: :data:`.reference.MEDIUM_KNOBS`; ``--quick``
+keeps at most 4 of them, evenly spread and including both ends), the
 point is rendered once cold (shader / JIT compile time reported apart) and ``repeat`` times warm;
 its run time is the median of the warm wall times.  Its error against the scene's reference
 (RMSE, PSNR, FLIP; :mod:`workbench.compare.metrics`) is measured on the last image.
@@ -38,9 +39,9 @@ from .executors import Executor, open_executor
 from .html import esc, img_tag, page, table
 from .metrics import metrics
 from .outputs import dumps, jsonable, machine_info, staged
-from .reference import SAMPLING_NOTE, References
+from .reference import MEDIUM_KNOBS, SAMPLING_NOTE, References
 from .runs import timed_run
-from ..scene.features import scene_needs
+from ..scene.features import HYPERTEXTURES, scene_needs
 
 CSV_FIELDS = ["method", "knob", "value", "status", "reason", "time_s", "cold_s", "compile_s", "rmse",
               "psnr", "flip", "rmse_matched", "flip_matched", "matched_reference", "nonfinite_pixels",
@@ -54,6 +55,37 @@ def sweep_values(values: tuple, quick: bool) -> list:
         return values
     idx = sorted(set(np.linspace(0, len(values) - 1, 4).round().astype(int).tolist()))
     return [values[i] for i in idx]
+
+
+def method_sweep(scene: Scene, method: str, sweeps: dict[str, tuple[str, list]]) -> tuple[str, tuple]:
+    """``(option, values)`` the study sweeps for ``method``: the ``sweeps`` entry if given, else
+    on a scene with hypertextures the first option of :data:`.reference.MEDIUM_KNOBS` that the method's
+    options table declares, else the method's knob.  Raises ImportError when the method's module
+    cannot be loaded."""
+    r = get_renderer(method)
+    if method in sweeps:
+        option, values = sweeps[method]
+        return option, tuple(values)
+    if HYPERTEXTURES in scene_needs(scene):
+        for option, values in MEDIUM_KNOBS:
+            if option in r.options:
+                return option, values
+    return r.knob.name, tuple(r.knob.values)
+
+
+def study_plan(scene: Scene, names: list[str], sweeps: dict[str, tuple[str, list]],
+               quick: bool) -> list[tuple[str, str | None, object, str]]:
+    """The study's grid: ``(method, option, value, why)`` per point, in the order they run;
+    ``why`` is empty, or says why the method cannot be loaded (one point, option and value None)."""
+    plan = []
+    for m in names:
+        try:
+            option, values = method_sweep(scene, m, sweeps)
+        except ImportError as e:
+            plan.append((m, None, None, f"cannot be loaded ({e})"))
+            continue
+        plan += [(m, option, v, "") for v in sweep_values(values, quick)]
+    return plan
 
 
 def pareto(times: list[float], errors: list[float]) -> list[bool]:
@@ -185,15 +217,7 @@ def study(scene: Scene, out_dir: str | Path, methods: list[str] | None = None,
 
 def _study(scene, out_dir, names, w, h, quick, repeat, reference, reference_image, sweeps, jobs, progress,
            command, fixed, load, ex: Executor) -> dict:
-    plan = []
-    for m in names:
-        try:
-            knob = get_renderer(m).knob
-        except ImportError as e:
-            plan.append((m, None, None, f"cannot be loaded ({e})"))
-            continue
-        option, values = sweeps.get(m, (knob.name, knob.values))
-        plan += [(m, option, v, "") for v in sweep_values(tuple(values), quick)]
+    plan = study_plan(scene, names, sweeps, quick)
     points, images = [], []
     from tqdm import tqdm
     bar = tqdm(total=len(plan) * (repeat + 1), desc=f"study {scene.name}", unit="render",

@@ -76,7 +76,9 @@ SUPPORT = sp.declare(
     left_out={ft.SHADOWS: "shadow maps not enabled (the local models have none)",
               ft.REFLECTION: "no mirror reflection in pyrender (kr mapped to metalness)",
               ft.REFRACTION: "no refraction in pyrender", ft.ABSORPTION: "no refraction in pyrender",
-              ft.BUMP: "bump maps not mapped", ft.ENVIRONMENT: "no environment map in pyrender"})
+              ft.BUMP: "bump maps not mapped", ft.ENVIRONMENT: "no environment map in pyrender",
+              ft.HYPERTEXTURES: "pyrender draws surface meshes only: a participating medium has none, "
+                                "so it is not drawn"})
 """pyrender's support table (:mod:`.support`)."""
 
 

@@ -25,6 +25,7 @@ import numpy as np
 
 from ...scene import features as ft
 from ...scene import model as m
+from ...scene.kinds import kind_of
 from ..base import Knob, Option, RenderResult, callback
 from ..base import render as render_method
 from .. import support as sp
@@ -37,8 +38,11 @@ SUPPORT = sp.declare(
                      if c.status is sp.Status.APPROXIMATED},
                   ft.REFLECTION: "ray-traced from the eye; caustics are not transported by the radiosity pass",
                   ft.REFRACTION: "ray-traced from the eye; caustics are not transported by the radiosity pass"},
-    left_out={f: c.reason for f, c in RADIOSITY_SUPPORT.items()
-              if c.status is sp.Status.LEFT_OUT and f not in _RAY_PASS})
+    left_out={**{f: c.reason for f, c in RADIOSITY_SUPPORT.items()
+                 if c.status is sp.Status.LEFT_OUT and f not in _RAY_PASS},
+              ft.HYPERTEXTURES: "the radiosity pass has no patches in a participating medium (no volume "
+                                "transport), so the eye-ray pass drops it too rather than draw a medium that "
+                                "neither lights nor shadows the surfaces around it"})
 """Radiosity's table, with the specular effects the eye-ray pass adds (:mod:`..support`)."""
 
 RAYTRACE_OPTIONS = ("max_depth", "threshold", "spp", "fresnel")
@@ -49,7 +53,9 @@ def is_diffuse(mat: m.Material) -> bool:
 
 
 def derived_scene(scene: m.Scene, patches, radiance: np.ndarray) -> tuple[m.Scene, int]:
-    """The scene with every diffuse object replaced by its radiosity-emitting patch mesh.
+    """The scene with every diffuse object replaced by its radiosity-emitting patch mesh (a fur
+    by its base's), and without the participating media that have no surface (hypertextures,
+    left out: :data:`SUPPORT`).
 
     Returns the scene and the number of objects replaced."""
     vrad = patches.vertex_values(radiance)
@@ -60,6 +66,8 @@ def derived_scene(scene: m.Scene, patches, radiance: np.ndarray) -> tuple[m.Scen
     for obj in scene.objects:
         mat = scene.material_of(obj)
         surfaces = by_object.get(id(obj))
+        if getattr(kind_of(obj), "MEDIUM", False) and not surfaces:
+            continue  # a medium without a surface (hypertexture): left out (SUPPORT), no volume transport
         if not is_diffuse(mat) or not surfaces:
             objects.append(obj)
             continue

@@ -38,6 +38,9 @@ SUPPORT = sp.declare(
         ft.BUMP: "patches are flat",
         ft.OPACITY: "patches are opaque",
         ft.ENVIRONMENT: "radiosity has no environment light",
+        ft.HYPERTEXTURES: "a participating medium has no surface to cut into patches: radiosity "
+                          "exchanges light between surfaces only (no absorption, emission or "
+                          "scattering in a volume); the medium is not drawn and lets all light through",
     })
 """What radiosity builds, approximates and leaves out, with why (:mod:`..support`)."""
 
