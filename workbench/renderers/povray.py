@@ -106,7 +106,10 @@ class PovrayRenderer:
                   ft.ENVIRONMENT: "environment mapping and the scene's environment not exported "
                                   "(escaping rays see the background colour)",
                   ft.ABSORPTION: "Beer-Lambert absorption not exported to POV-Ray",
-                  ft.TEXELS: "POV-Ray has no texel model: the fur's base is exported without its fur"})
+                  ft.TEXELS: "POV-Ray has no texel model: the fur's base is exported without its fur",
+                  ft.HYPERTEXTURES: "not exported: POV-Ray's noise differs from ours, and its df3 density "
+                                    "file interpolates samples at j/S with periodic wrap (our grid: cell "
+                                    "centres, clamped edges)"})
     knob = Knob("max_trace_level", (1, 2, 3, 4, 5, 6, 8, 12), 5,
                 "POV-Ray's max_trace_level (primary = 1, as the ray tracer's max_depth)")
     options = {

@@ -78,7 +78,8 @@ SUPPORT = sp.declare(
               ft.REFRACTION: "no refraction in pyrender", ft.ABSORPTION: "no refraction in pyrender",
               ft.BUMP: "bump maps not mapped", ft.ENVIRONMENT: "no environment map in pyrender",
               ft.HYPERTEXTURES: "pyrender draws surface meshes only: a participating medium has none, "
-                                "so it is not drawn"})
+                                "so it is not drawn",
+              ft.TEXELS: "pyrender draws the fur's base only (no texel model)"})
 """pyrender's support table (:mod:`.support`)."""
 
 

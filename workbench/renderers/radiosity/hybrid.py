@@ -42,7 +42,9 @@ SUPPORT = sp.declare(
                  if c.status is sp.Status.LEFT_OUT and f not in _RAY_PASS},
               ft.HYPERTEXTURES: "the radiosity pass has no patches in a participating medium (no volume "
                                 "transport), so the eye-ray pass drops it too rather than draw a medium that "
-                                "neither lights nor shadows the surfaces around it"})
+                                "neither lights nor shadows the surfaces around it",
+              ft.TEXELS: "the fur's base takes its radiosity patches; its strands, a medium without "
+                         "patches, are dropped from both passes"})
 """Radiosity's table, with the specular effects the eye-ray pass adds (:mod:`..support`)."""
 
 RAYTRACE_OPTIONS = ("max_depth", "threshold", "spp", "fresnel")

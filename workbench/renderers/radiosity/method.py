@@ -41,6 +41,8 @@ SUPPORT = sp.declare(
         ft.HYPERTEXTURES: "a participating medium has no surface to cut into patches: radiosity "
                           "exchanges light between surfaces only (no absorption, emission or "
                           "scattering in a volume); the medium is not drawn and lets all light through",
+        ft.TEXELS: "the fur's base is cut into patches; its strands are a medium, which radiosity does "
+                   "not transport (not drawn)",
     })
 """What radiosity builds, approximates and leaves out, with why (:mod:`..support`)."""
 
