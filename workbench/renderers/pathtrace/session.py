@@ -60,6 +60,12 @@ def _kernels():
     return kernels
 
 
+MAX_MAJORANT_DEPTH = 1e4
+"""Most expected tentative collisions of one crossing of a medium (its majorant times its
+bounding sphere's diameter, object space) the path tracer accepts: delta and ratio tracking
+cost that many density evaluations per crossing."""
+
+
 class PathTraceSession:
     """The path tracer's state for one scene at one image size.
 
@@ -114,6 +120,16 @@ class PathTraceSession:
         point = [lt for lt in scene.lights if not isinstance(lt, m.AreaLight)] if full else []
         lights = np.ascontiguousarray(light_rows(point).reshape(-1, LIGHT_COLS))
         surfaces_emit = bool((sd.mat_tab[sd.mat, Mat.EMISSION:Mat.EMISSION + 3] > 0).any())
+        for o in scene.objects:
+            kind = kind_of(o)
+            if getattr(kind, "MEDIUM", False):
+                depth = o.density * 2.0 * kind.bound_radius(o)
+                if depth > MAX_MAJORANT_DEPTH:
+                    raise WorkbenchError(
+                        f"pathtrace: {o.kind} {o.name or ''!s}{' ' if o.name else ''}has a majorant of {o.density:g} per "
+                        f"unit across {2 * kind.bound_radius(o):.4g} units: about {depth:.3g} tentative collisions per "
+                        f"crossing for delta tracking, above {MAX_MAJORANT_DEPTH:g} (minutes per image); lower its "
+                        f"density, or use raycast or raytrace (the march's cost is its step count)")
         media_emit = any(max(getattr(o, "emission", (0.0,))) > 0 for o in scene.objects
                          if getattr(kind_of(o), "MEDIUM", False))
         emissive = surfaces_emit or media_emit or bool((sd.tri_e > 0).any())
