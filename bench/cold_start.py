@@ -4,7 +4,8 @@ cache it left ("warm"): the kernel-layer issue's targets.
 Each case is the console script run as a new process (``workbench render SCENE -m METHOD``, a
 64 x 48 image) with ``NUMBA_CACHE_DIR`` pointing at a new empty folder, so the run compiles
 every kernel it needs; the warm run repeats it on that folder.  ``every kind`` renders the
-``kinds`` and ``csg`` scenes (every object kind, CSG) with ray casting, Whitted and path tracing
+``kinds``, ``csg``, ``fire`` and ``fur`` scenes (every object kind, CSG, the two media) with ray
+casting, Whitted and path tracing
 in one cache folder, one after the other: the compile time of every kernel of every kind, summed.
 
 Writes ``bench/results/cold_start.json`` and ``docs/benchmarks/cold_start.md`` and prints it.  Run:
@@ -30,7 +31,7 @@ ROOT = Path(__file__).resolve().parents[1]
 WORKBENCH = str(Path(sys.executable).with_name("workbench"))
 CASES = {"whitted raytrace": [("whitted", "raytrace")],
          "cornell pathtrace": [("cornell", "pathtrace")],
-         "every kind": [(s, m) for s in ("kinds", "csg") for m in ("raycast", "raytrace", "pathtrace")]}
+         "every kind": [(s, m) for s in ("kinds", "csg", "fire", "fur") for m in ("raycast", "raytrace", "pathtrace")]}
 TARGETS = {"whitted raytrace": 15.0, "cornell pathtrace": 15.0, "every kind": 60.0}
 SMOKE_CASES = {"smoke: whitted phong": [("whitted", "phong")]}
 
