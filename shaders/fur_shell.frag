@@ -2,7 +2,8 @@
 // One shell fragment of a fur (the model of workbench/renderers/raster_fur.py, twin of
 // zbuffer_fur.py): the texel D at the fragment's object-space point; where D = 1 the layer's
 // opacity a = 1 - exp(-DENSITY min(LAYER / |cos|, LENGTH)) (LAYER = LENGTH / N_SHELLS, cos
-// between the view ray and the shell's normal, object space) and the Kajiya-Kay source
+// between the view ray and the shell's normal, object space: radial on a
+// sphere, the face's on a box) and the Kajiya-Kay source
 // J = ALBEDO Ia + sum_l I_l (ALBEDO sin(T, L) + spec) with no shadowing; output (a J, a),
 // blended (ONE, ONE_MINUS_SRC_ALPHA) back to front.
 // Needs: fur_texel.glsl's, LAYER, DENSITY, ALBEDO, SCENE_AMBIENT, FOR_EACH_LIGHT, TOL_ZERO.
@@ -42,7 +43,12 @@ void main() {
     vec3 T_obj;
     if (fur_texel(v_obj, T_obj) == 0.0) discard;
     vec3 d = safe_normalize(v_world - u_eye);
-    float c = abs(dot(safe_normalize(u_object_from_world * d), safe_normalize(v_obj_normal)));
+#if BASE_BOX
+    vec3 n = v_obj_normal;  // the face's
+#else
+    vec3 n = v_obj;         // radial
+#endif
+    float c = abs(dot(safe_normalize(u_object_from_world * d), safe_normalize(n)));
     float a = 1.0 - exp(-DENSITY * min(LAYER / max(c, 1.0e-30), LENGTH));
     vec3 T = safe_normalize(u_normal_matrix * T_obj);
     vec3 J = ALBEDO * SCENE_AMBIENT;

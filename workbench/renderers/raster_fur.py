@@ -126,10 +126,14 @@ def build(ctx, programs, scene: Scene, level: int, shells: int, lights) -> list[
         vbo = ctx.buffer(np.ascontiguousarray(np.concatenate([P, N], 1), dtype="f4").tobytes())
         ibo = ctx.buffer(np.ascontiguousarray(F, dtype="i4").tobytes())
         prog = programs.get("fur_shell", defines(scene, f, shells, lights))
-        vao = ctx.vertex_array(prog, [(vbo, "3f 3f", "in_obj_position", "in_obj_normal")], ibo,
-                               index_element_size=4, skip_errors=True)
-        out.append(FurDraw(f, prog, vao, (vbo, ibo)))
+        out.append(FurDraw(f, prog, _vertex_array(ctx, prog, vbo, ibo), (vbo, ibo)))
     return out
+
+
+def _vertex_array(ctx, prog, vbo, ibo):
+    """The vertex array of a fur's mesh for ``prog`` (a sphere's program reads no normal)."""
+    layout = ("3f 3f", "in_obj_position", "in_obj_normal") if "in_obj_normal" in prog else ("3f 12x", "in_obj_position")
+    return ctx.vertex_array(prog, [(vbo, *layout)], ibo, index_element_size=4)
 
 
 def recompile(programs, scene: Scene, draws: list[FurDraw], shells: int, lights) -> None:
@@ -139,8 +143,7 @@ def recompile(programs, scene: Scene, draws: list[FurDraw], shells: int, lights)
         if prog is not v.prog:
             v.vao.release()
             v.prog = prog
-            v.vao = prog.ctx.vertex_array(prog, [(v.buffers[0], "3f 3f", "in_obj_position", "in_obj_normal")],
-                                          v.buffers[1], index_element_size=4, skip_errors=True)
+            v.vao = _vertex_array(prog.ctx, prog, *v.buffers)
 
 
 def draw(ctx, v: FurDraw, clip_bytes: bytes, eye, shells: int) -> None:
