@@ -42,7 +42,7 @@ perspective-correct one whatever the ``interpolation`` option.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -50,7 +50,6 @@ from ..core.errors import WorkbenchError
 from ..scene.kinds import fur as fur_kind
 from ..scene.kinds import kind_of
 from ..scene.model import Scene
-from ..scene.tessellate import _level
 from .estimates import triangle_bound
 from .raster_shaders import _float, _vec3, base_defines, light_list
 
@@ -76,16 +75,17 @@ def check_shells(shells) -> int:
     return int(shells)
 
 
+def fur_triangles(scene: Scene, level: int) -> int:
+    """Upper bound of the triangles of one shell of every fur (their bases' tessellations)."""
+    fs = furs(scene)
+    return triangle_bound(replace(scene, objects=type(scene.objects)(fs)), level) if fs else 0
+
+
 def shell_bytes(scene: Scene, level: int, shells: int) -> int:
     """Bytes the shells add to a GL raster session: the furs' base meshes once (the ``shells``
     instances share them); checks ``shells``."""
     check_shells(shells)
-    fs = furs(scene)
-    if not fs:
-        return 0
-    from dataclasses import replace
-    tris = triangle_bound(replace(scene, objects=type(scene.objects)(fs)), level)
-    return 3 * tris * _BYTES_PER_VERTEX
+    return 3 * fur_triangles(scene, level) * _BYTES_PER_VERTEX
 
 
 def defines(scene: Scene, f: fur_kind.Fur, shells: int, lights) -> dict[str, object]:
@@ -122,7 +122,7 @@ def build(ctx, programs, scene: Scene, level: int, shells: int, lights) -> list[
     check_shells(shells)
     out = []
     for f in furs(scene):
-        P, N, F = fur_kind.base_mesh(f, _level(f, level))
+        P, N, F = fur_kind.base_mesh(f, level)
         vbo = ctx.buffer(np.ascontiguousarray(np.concatenate([P, N], 1), dtype="f4").tobytes())
         ibo = ctx.buffer(np.ascontiguousarray(F, dtype="i4").tobytes())
         prog = programs.get("fur_shell", defines(scene, f, shells, lights))

@@ -18,7 +18,6 @@ import numpy as np
 
 from ..scene.kinds import fur as fur_kind
 from ..scene.model import Camera, Scene
-from ..scene.tessellate import _level
 from . import raster_fur as rf
 from .raster_shaders import light_kind, light_values
 from .zbuffer_scan import new_frame, scan_polygons
@@ -36,8 +35,7 @@ def shell_bytes(scene: Scene, level: int, shells: int, width: int, height: int) 
     rf.check_shells(shells)
     if not rf.furs(scene):
         return 0
-    tris = rf.shell_bytes(scene, level, shells) // (3 * rf._BYTES_PER_VERTEX)
-    return BYTES_PER_TRIANGLE * tris + BYTES_PER_PIXEL * width * height
+    return BYTES_PER_TRIANGLE * rf.fur_triangles(scene, level) + BYTES_PER_PIXEL * width * height
 
 
 def kajiya_kay(f: fur_kind.Fur, T: np.ndarray, L: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -84,7 +82,7 @@ def composite(image: np.ndarray, scene: Scene, camera: Camera, depth: np.ndarray
     for f in furs:
         W = np.asarray(f.world_from_object, dtype=np.float64)
         inv = np.linalg.inv(W)
-        P0, _, F = fur_kind.base_mesh(f, _level(f, level))
+        P0, _, F = fur_kind.base_mesh(f, level)
         scales = fur_kind.shell_scales(f, shells)
         order = [(i, False) for i in range(shells - 1, -1, -1)] + [(i, True) for i in range(shells)]
         for i, front in order:

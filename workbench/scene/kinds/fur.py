@@ -172,9 +172,10 @@ def shell_scales(f: Fur, shells: int) -> np.ndarray:
 
 
 def base_mesh(f: Fur, level: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The base's tessellation in object space: points (V, 3), unit normals (V, 3) and
-    counter-clockwise faces (F, 3) (what the raster scales into shells, :func:`shell_scales`)."""
-    parts = _base_kind(f).tessellate(base_object(f), level, np.eye(4))
+    """The base's tessellation in object space at ``level`` (the object's own ``tessellation``
+    wins): points (V, 3), unit normals (V, 3) and counter-clockwise faces (F, 3) (what the
+    raster scales into shells, :func:`shell_scales`)."""
+    parts = _base_kind(f).tessellate(base_object(f), int(f.tessellation or level), np.eye(4))
     offsets = np.cumsum([0] + [len(q.positions) for q in parts[:-1]])
     return (np.concatenate([q.positions for q in parts]), np.concatenate([q.normals for q in parts]),
             np.concatenate([q.faces + o for q, o in zip(parts, offsets)]))
