@@ -76,16 +76,7 @@ vec2 project_spherical(Mapping m, vec3 d) {
     : vec3(m.scale * PROJECT(PROJ, m, P, uv), 0.0))
 
 // ---------------------------------------------------------------- noise (lowbias32 value noise)
-float hash3(ivec3 i) {
-    uvec3 u = uvec3(i);
-    uint h = (u.x * 73856093u) ^ (u.y * 19349663u) ^ (u.z * 83492791u);
-    h ^= h >> 16u;
-    h *= 0x7FEB352Du;
-    h ^= h >> 15u;
-    h *= 0x846CA68Bu;
-    h ^= h >> 16u;
-    return float(h >> 8u) / 16777216.0;
-}
+#include "hash.glsl"
 
 vec3 quintic(vec3 t) {
     return t * t * t * (t * (t * 6.0 - 15.0) + 10.0);

@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from workbench.core import noise
+
 from workbench.renderers import texturing as tx
 from workbench.scene.model import Bump, Environment, Material, Opacity, Texture
 
@@ -63,7 +65,7 @@ def test_noise_deterministic_in_range_and_continuous():
     assert np.abs(tx.value_noise(p + 1e-6) - a).max() < 1e-4
     # lattice points take the hash value exactly
     ip = np.floor(p)
-    assert np.allclose(tx.value_noise(ip), tx._hash3(*ip.astype(np.int64).T))
+    assert np.allclose(tx.value_noise(ip), noise._hash3(*ip.astype(np.int64).T))
 
 
 def test_bricks_mortar_fraction():

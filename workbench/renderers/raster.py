@@ -18,6 +18,8 @@ maps, blending, shadow maps: :mod:`.raster_standins`, option ``standins``, on by
 Hypertextures (participating media) are ray-marched in a fragment shader through a 3D
 texture of their density (:mod:`.raster_volume`, options ``volume_resolution`` and
 ``step_scale``), composited over the opaque pass with the blended surfaces, back to front.
+Furs (Kajiya-Kay texels) are drawn over their base as layered shells (:mod:`.raster_fur`,
+option ``shells``), in the same back-to-front pass.
 
 Interactive use (the UI calls this every frame)::
 
@@ -78,6 +80,7 @@ from .base import Knob, Option, RenderResult, check_memory, convert_options
 from .raster_shaders import (LIVE_MATERIAL_FIELDS, ProgramCache, base_defines, light_kind,
                              light_uniforms, light_values, material_defines, material_uniforms)
 from . import raster_standins as sti
+from . import raster_fur as rf
 from . import raster_volume as rv
 
 DEPTH_CHOICES = (16, 24, 32)
@@ -104,7 +107,7 @@ _COMMON_APPROX = {**{f: _TESSELLATED for f in (ft.SPHERES, ft.QUADRICS, ft.CSG, 
                                                ft.LATHES)},
                   ft.AREA_LIGHTS: "stand-in point lights (the scene's area-light samples)",
                   ft.EMITTERS: "emission drawn on the surface; it lights others only through area-light stand-ins",
-                  ft.HYPERTEXTURES: rv.REASON}
+                  ft.HYPERTEXTURES: rv.REASON, ft.TEXELS: rf.REASON}
 #: The raster modes' support tables (:mod:`.support`): flat draws no stand-ins, and only Phong
 #: has a per-fragment normal for bump mapping.
 SUPPORT = {
@@ -282,13 +285,15 @@ class RasterSession:
         mode draws are built (:func:`.raster_standins.plan`).
     volume_resolution, step_scale : texels per side of the hypertextures' 3D textures (their
         own ``grid`` when set) and the factor of their march step (:mod:`.raster_volume`).
+    shells : layered shells per fur (:mod:`.raster_fur`).
     """
 
     def __init__(self, scene: Scene, mode: str, *, tessellation: int = DEFAULT_LEVEL,
                  blinn: bool = False, depth_bits: int = 24, ctx=None, backface_culling: bool = True,
                  shading=None, interpolation: str = "perspective", normals: str = "smooth",
                  standins: sti.StandinOptions | None = None,
-                 volume_resolution: int = rv.DEFAULT_RESOLUTION, step_scale: float = 1.0):
+                 volume_resolution: int = rv.DEFAULT_RESOLUTION, step_scale: float = 1.0,
+                 shells: int = rf.DEFAULT_SHELLS):
         if mode not in ("flat", "gouraud", "phong"):
             raise WorkbenchError(f"unknown raster mode {mode!r}")
         if shading is not None and mode != "phong":
@@ -299,6 +304,7 @@ class RasterSession:
         if interpolation not in INTERPOLATIONS:
             raise WorkbenchError(f"interpolation must be one of {', '.join(INTERPOLATIONS)}, got {interpolation!r}")
         rv.volume_bytes(scene, volume_resolution, step_scale)  # refuses before anything is built
+        self.shells = rf.check_shells(shells)
         self.scene, self.mode, self.depth_bits, self.blinn = scene, mode, depth_bits, blinn
         self.interpolation = interpolation
         #: materials (names) and whether the lights are drawn by live programs
@@ -346,6 +352,8 @@ class RasterSession:
         self.volumes, self.timings["volume_bake"] = rv.build(self.ctx, self.programs, scene,
                                                              self.volume_resolution, self.step_scale)
         self._volume_targets: OrderedDict = OrderedDict()  # colour texture id -> colour-only FBO
+        #: the furs' shells (:mod:`.raster_fur`), drawn in the camera's pass
+        self.furs = rf.build(self.ctx, self.programs, scene, tessellation, self.shells, self.lights)
         self.background = None
         if scene.environment is not None:
             self.background = self._background(scene.environment)
@@ -704,6 +712,7 @@ class RasterSession:
         self.scene, self.lights = scene, lights
         if lights_edited:
             self._light_values = light_uniforms(lights)
+            rf.recompile(self.programs, scene, self.furs, self.shells, lights)  # lights are literals there
         self.live_materials |= edited
         self.live_areas |= set(areas)
         self.live_lights = self.live_lights or lights_edited
@@ -744,7 +753,7 @@ class RasterSession:
         if was_live:
             self._env_drawn = False
         used = [d.prog for d in self.draws] + ([self.background.prog] if self.background else [])
-        used += [d.tint.prog for d in self.draws if d.tint is not None]
+        used += [d.tint.prog for d in self.draws if d.tint is not None] + [v.prog for v in self.furs]
         if self.shadow_atlas is not None:
             used.append(self.programs.get("shadow_depth", base_defines()))
         gone = {id(p) for p in self.programs.release_unused(used)}
@@ -766,12 +775,16 @@ class RasterSession:
         for v in self.volumes:
             v.vao.release()
             v.texture.release()
+        for v in self.furs:
+            v.vao.release()
+            for b in v.buffers:
+                b.release()
         for _, target in self._volume_targets.values():
             gl.release_framebuffer(target)
         for _, free in self._fbos.values():
             free()
         self._gl_objects, self._gl_images, self._fbos = [], {}, OrderedDict()
-        self.volumes, self._volume_targets, self._depth_of = [], OrderedDict(), {}
+        self.volumes, self._volume_targets, self._depth_of, self.furs = [], OrderedDict(), {}, []
         self.programs.programs.clear()
         self._uniforms_of, self._camera_of = {}, {}
         self.draws, self.background = [], None
@@ -780,7 +793,7 @@ class RasterSession:
         """Bytes of GL memory the session holds (:func:`.gl.object_bytes`): geometry buffers,
         images, the stand-ins' maps and its framebuffers."""
         objs = [*self._gl_objects, *self._gl_images.values(), *(f for f, _ in self._fbos.values()),
-                *(v.texture for v in self.volumes)]
+                *(v.texture for v in self.volumes), *(b for v in self.furs for b in v.buffers)]
         for m in [*self.env_maps.values(), self.shadow_atlas]:
             if m is not None:
                 objs += [getattr(m, "color", None), m.depth]
@@ -963,8 +976,9 @@ class RasterSession:
                 tex.use(UNITS[name])
             bg_draw.vao.render(moderngl.TRIANGLES, vertices=3)
             ctx.depth_func = "<"
-        # the media (camera pass only) interleaved with the blended surfaces, back to front
-        volumes = self.volumes if skip is None else []
+        # the media and the furs' shells (camera pass only) interleaved with the blended
+        # surfaces, back to front
+        volumes = self.volumes + self.furs if skip is None else []
         if volumes:
             far_first = lambda item: -float(np.linalg.norm(item.centre - cam_pos))
             blended = sorted(blended + volumes, key=far_first)
@@ -973,6 +987,9 @@ class RasterSession:
             fbo.depth_mask = False
             target = None
             for d in blended:
+                if isinstance(d, rf.FurDraw):
+                    rf.draw(ctx, d, clip_bytes, eye, self.shells)
+                    continue
                 if isinstance(d, rv.VolumeDraw):
                     if target is None:
                         target = self._volume_target(fbo)
@@ -1065,22 +1082,23 @@ _MAX_SESSIONS = 6
 def session_for(scene: Scene, mode: str, tessellation: int, blinn: bool, depth_bits: int,
                 shading=None, interpolation: str = "perspective", normals: str = "smooth",
                 standins: sti.StandinOptions | None = None, volume_resolution: int = rv.DEFAULT_RESOLUTION,
-                step_scale: float = 1.0) -> tuple[RasterSession, bool]:
+                step_scale: float = 1.0, shells: int = rf.DEFAULT_SHELLS) -> tuple[RasterSession, bool]:
     """A cached :class:`RasterSession` for the scene's content (camera excluded), shading
     model (``shading``: a user's, by its source text and parameter values), interpolation,
-    normal rule, stand-ins and the media's texture resolution and step; returns
+    normal rule, stand-ins, the media's texture resolution and step and the furs' shells; returns
     ``(session, created)``."""
     ctx = gl.context()
     key = (id(ctx), id(scene.objects), id(scene.materials), id(scene.lights), id(scene.environment),
            scene.ambient, mode, tessellation, blinn, depth_bits, None if shading is None else shading.key,
-           interpolation, normals, standins, int(volume_resolution), float(step_scale))
+           interpolation, normals, standins, int(volume_resolution), float(step_scale), int(shells))
     hit = _SESSIONS.get(key)
     if hit is not None and hit[1] is scene.objects:
         _SESSIONS.move_to_end(key)
         return hit[0], False
     session = RasterSession(scene, mode, tessellation=tessellation, blinn=blinn, depth_bits=depth_bits, ctx=ctx,
                             shading=shading, interpolation=interpolation, normals=normals,
-                            standins=standins, volume_resolution=volume_resolution, step_scale=step_scale)
+                            standins=standins, volume_resolution=volume_resolution, step_scale=step_scale,
+                            shells=shells)
     _SESSIONS[key] = (session, scene.objects)
     if len(_SESSIONS) > _MAX_SESSIONS:
         _SESSIONS.popitem(last=False)[1][0].release()
@@ -1134,9 +1152,11 @@ class _RasterRenderer:
                                     "texels per side of a hypertexture's 3D density texture (its own grid "
                                     "when set)", low=2),
         "step_scale": Option(float, 1.0, "factor of the hypertextures' ray-march step (their 'step')"),
+        "shells": Option(int, rf.DEFAULT_SHELLS, f"layered shells drawn for each fur (1..{rf.MAX_SHELLS})",
+                         low=1),
     }
 
-    memory_options = ("tessellation", "envmap_resolution", "shadow_resolution", "volume_resolution")
+    memory_options = ("tessellation", "envmap_resolution", "shadow_resolution", "volume_resolution", "shells")
 
     #: Whether the method draws the stand-ins (:mod:`.raster_standins`): Gouraud and Phong; flat
     #: shading and users' shading models draw the bare local model.
@@ -1165,30 +1185,39 @@ class _RasterRenderer:
         return RasterSession(scene, self.mode or self.name, tessellation=opts["tessellation"], blinn=opts["blinn"],
                              depth_bits=opts["depth_bits"], ctx=ctx, shading=shading,
                              interpolation=opts["interpolation"], normals=opts["normals"], standins=standins,
-                             volume_resolution=opts["volume_resolution"], step_scale=opts["step_scale"])
+                             volume_resolution=opts["volume_resolution"], step_scale=opts["step_scale"],
+                             shells=opts["shells"])
 
     def estimate_bytes(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
                        standins: str = "on", envmap_resolution: int = sti.DEFAULT_ENV_RESOLUTION,
                        shadow_resolution: int = sti.DEFAULT_SHADOW_RESOLUTION,
                        shadow_bias: float = sti.DEFAULT_SHADOW_BIAS,
                        envmap_iterations: int = sti.DEFAULT_ENV_ITERATIONS, shading=None,
-                       volume_resolution: int = rv.DEFAULT_RESOLUTION, step_scale: float = 1.0, **_) -> int:
+                       volume_resolution: int = rv.DEFAULT_RESOLUTION, step_scale: float = 1.0,
+                       shells: int = rf.DEFAULT_SHELLS, **_) -> int:
         """Triangles (:func:`.estimates.triangle_bound` at ``tessellation``), pixels, the
-        stand-ins' maps (:func:`.raster_standins.standin_bytes`) and the media's 3D textures
+        stand-ins' maps (:func:`.raster_standins.standin_bytes`), the media's 3D textures
         (twice: the baked grid and its GL copy; refused above their own limit,
-        :func:`.raster_volume.volume_bytes`)."""
+        :func:`.raster_volume.volume_bytes`) and the furs' meshes (:func:`.raster_fur.shell_bytes`)."""
         if not 1 <= tessellation <= MAX_LEVEL:
             raise WorkbenchError(f"method {self.name!r}: tessellation must be within 1..{MAX_LEVEL}, "
                                  f"got {tessellation}")
         opts = self._standins(standins, envmap_resolution, shadow_resolution, shadow_bias, envmap_iterations)
         volumes = self._volume_bytes(scene, volume_resolution, step_scale)
-        return raster_bytes(scene, width, height, tessellation, _BYTES_PER_TRIANGLE, _BYTES_PER_PIXEL,
+        fur = self._shell_bytes(scene, tessellation, shells)
+        return fur + raster_bytes(scene, width, height, tessellation, _BYTES_PER_TRIANGLE, _BYTES_PER_PIXEL,
                             _FIXED_BYTES) + sti.standin_bytes(scene, opts, self.mode or self.name,
                                                               user_model=shading is not None) + 2 * volumes
 
     def _volume_bytes(self, scene: Scene, volume_resolution: int, step_scale: float) -> int:
         try:
             return rv.volume_bytes(scene, volume_resolution, step_scale)
+        except WorkbenchError as e:
+            raise WorkbenchError(f"method {self.name!r}: {e}") from None
+
+    def _shell_bytes(self, scene: Scene, tessellation: int, shells: int) -> int:
+        try:
+            return rf.shell_bytes(scene, tessellation, shells)
         except WorkbenchError as e:
             raise WorkbenchError(f"method {self.name!r}: {e}") from None
 
@@ -1208,7 +1237,8 @@ class _RasterRenderer:
                shadow_resolution: int = sti.DEFAULT_SHADOW_RESOLUTION,
                shadow_bias: float = sti.DEFAULT_SHADOW_BIAS,
                envmap_iterations: int = sti.DEFAULT_ENV_ITERATIONS,
-               volume_resolution: int = rv.DEFAULT_RESOLUTION, step_scale: float = 1.0) -> RenderResult:
+               volume_resolution: int = rv.DEFAULT_RESOLUTION, step_scale: float = 1.0,
+               shells: int = rf.DEFAULT_SHELLS) -> RenderResult:
         if not 1 <= tessellation <= MAX_LEVEL:
             raise WorkbenchError(f"method {self.name!r}: tessellation must be within 1..{MAX_LEVEL}, "
                                  f"got {tessellation}")
@@ -1216,8 +1246,9 @@ class _RasterRenderer:
             raise WorkbenchError(f"method {self.name!r}: need 0 < near < far, got near={near}, far={far}")
         opts = self._standins(standins, envmap_resolution, shadow_resolution, shadow_bias, envmap_iterations)
         self._volume_bytes(scene, volume_resolution, step_scale)
+        self._shell_bytes(scene, tessellation, shells)
         session, created = session_for(scene, self.mode or self.name, tessellation, blinn, depth_bits, shading,
-                                       interpolation, normals, opts, volume_resolution, step_scale)
+                                       interpolation, normals, opts, volume_resolution, step_scale, shells)
         t0 = time.perf_counter()
         image, depth, (n, f) = session.draw(scene.camera.with_resolution(width, height),
                                             near=near or None, far=far or None, with_depth=True)
@@ -1234,6 +1265,8 @@ class _RasterRenderer:
                  "interpolation": interpolation, "normals": normals, "standins": session.standins_used}
         if session.volumes:
             stats["volume_resolutions"] = [v.resolution for v in session.volumes]
+        if session.furs:
+            stats["shells"] = session.shells
         return RenderResult(self.name, image, timings, stats, list(session.features_used),
                             list(session.left_out), depth=depth)
 

@@ -53,8 +53,9 @@ DEPTH_UNIT, DENSITY_UNIT = 7, 8
 
 
 def media(scene: Scene) -> list:
-    """The scene's participating-medium objects (kinds with ``MEDIUM``: the hypertexture)."""
-    return [o for o in scene.objects if getattr(kind_of(o), "MEDIUM", False)]
+    """The scene's hypertextures (participating-medium kinds but the fur, whose texels the
+    raster draws as shells: :mod:`.raster_fur`)."""
+    return [o for o in scene.objects if getattr(kind_of(o), "MEDIUM", False) and kind_of(o).FEATURE != "texels"]
 
 
 def resolution_of(h: ht.Hypertexture, volume_resolution: int) -> int:

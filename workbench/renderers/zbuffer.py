@@ -20,7 +20,8 @@ Pipeline, one step per course slide:
    mapped materials), the background (or the environment) where nothing was drawn.
 6. March the hypertextures over that image, back to front, each ray's segment ending at the
    depth buffer's surface (:mod:`.zbuffer_volume`, the GL volume pass's twin:
-   :mod:`.raster_volume`).
+   :mod:`.raster_volume`); then composite the furs' layered shells (:mod:`.zbuffer_fur`, twin of
+   :mod:`.raster_fur`; after all the media, where GL interleaves them by distance).
 
 Step 5 runs once per pixel after the scan, on the attributes the winning polygon wrote:
 the same image as shading each fragment when it passes the test, for opaque surfaces.
@@ -48,9 +49,11 @@ from ..scene.parts import Part
 from ..scene.prepared import prepare
 from ..scene.tessellate import (DEFAULT_LEVEL, MAX_LEVEL, NORMAL_RULES, area_light_parts, tessellate_scene,
                                 with_normal_rule)
+from . import raster_fur as rf
 from . import raster_volume as rv
 from . import support as sp
 from . import texturing as tx
+from . import zbuffer_fur as zf
 from . import zbuffer_volume as zv
 from .base import Knob, Option, RenderResult
 from .estimates import raster_bytes
@@ -70,7 +73,7 @@ SUPPORT = sp.declare(
                      for f in (ft.SPHERES, ft.QUADRICS, ft.CSG, ft.BLOBS, ft.ISOSURFACES, ft.LATHES)},
                   ft.AREA_LIGHTS: "stand-in point lights (the scene's area-light samples)",
                   ft.EMITTERS: "emission drawn on the surface; it lights others only through area-light stand-ins",
-                  ft.HYPERTEXTURES: rv.REASON},
+                  ft.HYPERTEXTURES: rv.REASON, ft.TEXELS: rf.REASON},
     left_out={
         ft.BUMP: "the Z-buffer twin interpolates the course's normals only (no perturbation)",
         ft.OPACITY: "the Z-buffer keeps the nearest surface only (drawn opaque, no cut-outs)",
@@ -176,17 +179,16 @@ def to_window(clip: np.ndarray, width: int, height: int) -> np.ndarray:
                      (ndc[:, 2] + 1.0) * 0.5], -1)
 
 
-def _polygons(parts, clip_from_world: np.ndarray, width: int, height: int, corner_attrs):
-    """Every triangle of ``parts`` as window-space polygons (:class:`~.zbuffer_scan.Polygons`),
-    the id of each polygon being its triangle's index over all parts.  Returns
-    ``(polys, clipped)``, ``clipped`` (T,) bool: the triangles the near plane cuts."""
-    P = np.concatenate([p.positions[p.faces] for p in parts])        # (T, 3, 3)
-    A = np.concatenate(corner_attrs)                                   # (T, 3, K)
+def _polygons(P: np.ndarray, A: np.ndarray, clip_from_world: np.ndarray, width: int, height: int):
+    """Triangles ``P`` (T, 3, 3) world corners with attributes ``A`` (T, 3, K) as window-space
+    polygons (:class:`~.zbuffer_scan.Polygons`), the id of each polygon being its triangle's
+    index.  Returns ``(polys, clipped)``, ``clipped`` (T,) bool: the triangles the near plane
+    cuts."""
     clip = np.concatenate([P, np.ones(P.shape[:2] + (1,))], -1) @ clip_from_world.T
     cp, ap, keep = clip_near(clip, A)
     tri = np.flatnonzero(keep)
     xyz = [to_window(clip[keep].reshape(-1, 4), width, height)] + [to_window(c, width, height) for c in cp]
-    attrs = [A[keep].reshape(-1, N_ATTRS)] + ap
+    attrs = [A[keep].reshape(-1, A.shape[-1])] + ap
     count = np.concatenate([np.full(len(tri), 3), [len(c) for c in cp]]).astype(np.int64)
     crossing = np.flatnonzero((clip[:, :, 2] + clip[:, :, 3] >= 0.0).any(1) & ~keep)
     ident = np.concatenate([tri, crossing]).astype(np.int32)
@@ -232,7 +234,8 @@ def rasterise(scene: Scene, camera: Camera, *, tessellation: int, normals: str, 
     polys, clipped = None, np.zeros(0, dtype=bool)
     if sum(p.n_triangles for p in parts):
         corner = [corner_attributes(p, m, shading, scene, eye, blinn) for p, m in pairs]
-        polys, clipped = _polygons(parts, clip_from_world, camera.width, camera.height, corner)
+        polys, clipped = _polygons(np.concatenate([p.positions[p.faces] for p in parts]), np.concatenate(corner),
+                                   clip_from_world, camera.width, camera.height)
     timings["vertices"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     compiled = bool(scan_polygons.signatures)
@@ -309,10 +312,13 @@ class ZBufferRenderer:
                                     "cells per side of a hypertexture's density grid (its own grid when set)",
                                     low=2),
         "step_scale": Option(float, 1.0, "factor of the hypertextures' ray-march step (their 'step')"),
+        "shells": Option(int, rf.DEFAULT_SHELLS, f"layered shells drawn for each fur (1..{rf.MAX_SHELLS})",
+                         low=1),
     }
-    memory_options = ("tessellation", "volume_resolution")
+    memory_options = ("tessellation", "volume_resolution", "shells")
 
-    def _check(self, tessellation: int, depth_bits: int, near: float = 0.0, far: float = 0.0) -> None:
+    def _check(self, tessellation: int, depth_bits: int, near: float = 0.0, far: float = 0.0,
+               shells: int = rf.DEFAULT_SHELLS) -> None:
         if not 1 <= tessellation <= MAX_LEVEL:
             raise WorkbenchError(f"method {self.name!r}: tessellation must be within 1..{MAX_LEVEL}, "
                                  f"got {tessellation}")
@@ -321,19 +327,26 @@ class ZBufferRenderer:
                                  f"got {depth_bits}")
         if near < 0 or far < 0 or (near and far and far <= near):
             raise WorkbenchError(f"method {self.name!r}: need 0 < near < far, got near={near}, far={far}")
+        try:
+            rf.check_shells(shells)
+        except WorkbenchError as e:
+            raise WorkbenchError(f"method {self.name!r}: {e}") from None
 
     def estimate_bytes(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
                        depth_bits: int = 24, near: float = 0.0, far: float = 0.0,
-                       volume_resolution: int = rv.DEFAULT_RESOLUTION, step_scale: float = 1.0, **_) -> int:
-        """Triangles (:func:`.estimates.triangle_bound` at ``tessellation``), pixels and the
+                       volume_resolution: int = rv.DEFAULT_RESOLUTION, step_scale: float = 1.0,
+                       shells: int = rf.DEFAULT_SHELLS, **_) -> int:
+        """Triangles (:func:`.estimates.triangle_bound` at ``tessellation``), pixels, the
         media's march: the float32 grid and its float64 trilinear temporaries (about 3x), and
         :data:`.zbuffer_volume.BYTES_PER_PIXEL` (refused above the grids' own limit,
-        :func:`.raster_volume.volume_bytes`)."""
-        self._check(tessellation, depth_bits, near, far)
+        :func:`.raster_volume.volume_bytes`), and the furs' shells, one at a time
+        (:func:`.zbuffer_fur.shell_bytes`)."""
+        self._check(tessellation, depth_bits, near, far, shells)
         grids = self._volume_bytes(scene, volume_resolution, step_scale)
         march = zv.BYTES_PER_PIXEL * width * height if grids else 0
         return raster_bytes(scene, width, height, tessellation, _BYTES_PER_TRIANGLE, _BYTES_PER_PIXEL,
-                            _FIXED_BYTES) + 4 * grids + march
+                            _FIXED_BYTES) + 4 * grids + march + zf.shell_bytes(scene, tessellation, shells,
+                                                                                width, height)
 
     def _volume_bytes(self, scene: Scene, volume_resolution: int, step_scale: float) -> int:
         try:
@@ -344,8 +357,9 @@ class ZBufferRenderer:
     def render(self, scene: Scene, width: int, height: int, *, tessellation: int = DEFAULT_LEVEL,
                shading: str = "gouraud", depth_bits: int = 24, blinn: bool = False, normals: str = "smooth",
                view: str = "color", near: float = 0.0, far: float = 0.0,
-               volume_resolution: int = rv.DEFAULT_RESOLUTION, step_scale: float = 1.0) -> RenderResult:
-        self._check(tessellation, depth_bits, near, far)
+               volume_resolution: int = rv.DEFAULT_RESOLUTION, step_scale: float = 1.0,
+               shells: int = rf.DEFAULT_SHELLS) -> RenderResult:
+        self._check(tessellation, depth_bits, near, far, shells)
         self._volume_bytes(scene, volume_resolution, step_scale)
         timings: dict[str, float] = {}
         camera = scene.camera.with_resolution(width, height)
@@ -362,6 +376,13 @@ class ZBufferRenderer:
             t0 = time.perf_counter()
             image, timings["volume_bake"] = zv.composite(image, scene, camera, depth, volume_resolution, step_scale)
             timings["volume_march"] = time.perf_counter() - t0 - timings["volume_bake"]
+        if view != "depth" and rf.furs(scene):
+            t0 = time.perf_counter()
+            clip_from_world = camera.clip_from_camera(near, far) @ camera.camera_from_world()
+            image = zf.composite(image, scene, camera, depth, tessellation, shells,
+                                 lambda P: _polygons(P, np.zeros(P.shape[:2] + (1,)), clip_from_world,
+                                                     width, height)[0])
+            timings["shells"] = time.perf_counter() - t0
         if view == "depth":
             g = np.where(np.isfinite(depth), 1.0 - (depth - near) / (far - near), 0.0)
             image = np.repeat(np.clip(g, 0.0, 1.0)[..., None], 3, -1)
@@ -373,6 +394,8 @@ class ZBufferRenderer:
                  "near_clipped_pixels": int(near_clipped_pixels(raster).sum()), "near": near, "far": far,
                  "depth_bits": depth_bits, "fragments": int(frame.counts[0]),
                  "depth_passes": int(frame.counts[1]), "shading": shading, "normals": normals}
+        if rf.furs(scene):
+            stats["shells"] = shells
         return RenderResult(self.name, image.astype(np.float32), timings, stats, used, left,
                             depth=depth.astype(np.float32))
 

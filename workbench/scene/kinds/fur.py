@@ -149,6 +149,38 @@ def density(f: Fur, p: np.ndarray) -> np.ndarray:
     return np.where(inside & (best < f.thickness * (1.0 - np.clip(s, 0, f.length) / f.length)), 1.0, 0.0)
 
 
+def texel(f: Fur, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(D (N,), T (N, 3))`` at object-space points ``p`` (N, 3): :func:`density` and the
+    strand's object-space tangent, the unit direction from the foot point (zero where D = 0 or
+    on the base), as the numba ``fur_kernels.texel``."""
+    p = np.asarray(p, dtype=np.float64)
+    d = density(f, p)
+    v = p - _project(f, p)[1]
+    n = np.linalg.norm(v, axis=1)
+    t = np.where(((d > 0.0) & (n > 0.0))[:, None], v / np.maximum(n, 1e-300)[:, None], 0.0)
+    return d, t
+
+
+def shell_scales(f: Fur, shells: int) -> np.ndarray:
+    """(shells, 3) per-axis factors taking the base to each shell of the raster's stand-in:
+    shell ``i`` at offset ``o_i = length (i + 1/2) / shells``, the sphere of radius ``r + o_i``
+    or the box of half-sizes ``b + o_i`` (each face's plane moved out by ``o_i``, its edges and
+    corners square)."""
+    size = np.broadcast_to(np.asarray(f.size, dtype=np.float64), (3,))
+    o = f.length * (np.arange(shells) + 0.5) / shells
+    return (size + o[:, None]) / size
+
+
+def base_mesh(f: Fur, level: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The base's tessellation in object space at ``level`` (the object's own ``tessellation``
+    wins): points (V, 3), unit normals (V, 3) and counter-clockwise faces (F, 3) (what the
+    raster scales into shells, :func:`shell_scales`)."""
+    parts = _base_kind(f).tessellate(base_object(f), int(f.tessellation or level), np.eye(4))
+    offsets = np.cumsum([0] + [len(q.positions) for q in parts[:-1]])
+    return (np.concatenate([q.positions for q in parts]), np.concatenate([q.normals for q in parts]),
+            np.concatenate([q.faces + o for q, o in zip(parts, offsets)]))
+
+
 # --------------------------------------------------------------------------- the base surface
 def base_object(f: Fur) -> m.SceneObject:
     """The opaque base as an object of its kind (same material, transform, name)."""
