@@ -114,7 +114,7 @@ def visibility(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmax, eps, scr):
     return 0.0
 
 
-_MARCH = """
+_STEPS = """
 qx, qy, qz, ux, uy, uz = to_object(geo, k, ox, oy, oz, dx, dy, dz)
 c0, c1 = chord(geo.par, k, qx, qy, qz, ux, uy, uz)
 t0, t1 = max(t0, c0), min(t1, c1)
@@ -124,6 +124,9 @@ if not t1 > t0:
 n = min(MAX_STEPS, max(1, int(math.ceil((t1 - t0) * speed / (step(geo.par, k) * scale)))))
 h = (t1 - t0) / n
 tr, lr, lg, lb = 1.0, 0.0, 0.0, 0.0
+"""
+
+_MARCH = _STEPS + """
 for j in range(n):
     t = t0 + (j + 0.5) * h
     st, a0, a1, a2, e0, e1, e2 = optics(geo.par, k, geo.aux, qx + t * ux, qy + t * uy, qz + t * uz)
@@ -141,17 +144,8 @@ return tr, lr, lg, lb
 """
 
 
-_MARCH_TEXEL = """
+_MARCH_TEXEL = _STEPS + """
 lights, mat_of, mat_tab = light
-qx, qy, qz, ux, uy, uz = to_object(geo, k, ox, oy, oz, dx, dy, dz)
-c0, c1 = chord(geo.par, k, qx, qy, qz, ux, uy, uz)
-t0, t1 = max(t0, c0), min(t1, c1)
-speed = math.sqrt(ux * ux + uy * uy + uz * uz)
-if not t1 > t0:
-    return 1.0, 0.0, 0.0, 0.0
-n = min(MAX_STEPS, max(1, int(math.ceil((t1 - t0) * speed / (step(geo.par, k) * scale)))))
-h = (t1 - t0) / n
-tr, lr, lg, lb = 1.0, 0.0, 0.0, 0.0
 nm = geo.nm
 for j in range(n):
     t = t0 + (j + 0.5) * h

@@ -67,7 +67,7 @@ import numpy as np
 from ..kernels.columns import PATH_COUNTS, Light, Mat, PathCount, PathOpt
 from ..kernels.rng import path_key, rand
 from .media import shadow_gate, vertex_gate
-from .sampling import mis_weight, pick_emitter
+from .sampling import mis_weight, sample_emitter
 from ..kernels.tasks import run_tasks
 from ..kernels.flags import INLINE, NO_REFCOUNT, TASK
 from ..kernels.intersect import closest, scratch, surface
@@ -245,7 +245,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
     """Radiance (RGB) carried along one path from ``o`` in direction ``d`` (unit): see the
     module docstring.  Random dimensions: 0, 1 pixel jitter; then 8 per bounce."""
     mat_of, mat_tab, tex_tab, lights = shading
-    em_tri, em_n, em_prim, em_mtri, em_cdf, lpdf_prim, lpdf_tri = emitters
+    em_cdf, lpdf_prim, lpdf_tri = emitters[4], emitters[5], emitters[6]
     solid = geo.solid
     tri_e = geo.tri_e
     tri_prim = geo.tri_prim
@@ -422,40 +422,14 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
         # ---- next-event estimation at a non-delta surface
         if m_nd > 0.0:
             if n_em > 0:
-                e = pick_emitter(em_cdf, rand(key, dim))
-                su = math.sqrt(rand(key, dim + 1))
-                u2 = rand(key, dim + 2)
-                c0, c1, c2 = 1.0 - su, su * (1.0 - u2), su * u2
-                qx = c0 * em_tri[e, 0] + c1 * em_tri[e, 3] + c2 * em_tri[e, 6]
-                qy = c0 * em_tri[e, 1] + c1 * em_tri[e, 4] + c2 * em_tri[e, 7]
-                qz = c0 * em_tri[e, 2] + c1 * em_tri[e, 5] + c2 * em_tri[e, 8]
-                vx, vy, vz = qx - px, qy - py, qz - pz
-                dist = math.sqrt(vx * vx + vy * vy + vz * vz)
+                qx, qy, qz, lx, ly, lz, dist, cos_l, ler, leg, leb, p_l = sample_emitter(
+                    emitters, mat_of, mat_tab, tri_e, key, dim, px, py, pz, transport)
                 if dist > 0.0:
-                    lx, ly, lz = vx / dist, vy / dist, vz / dist
-                    cos_l = -(lx * em_n[e, 0] + ly * em_n[e, 1] + lz * em_n[e, 2])
-                    emi = mat_of[em_prim[e]]
-                    ler, leg, leb = 0.0, 0.0, 0.0
-                    if cos_l > 0.0 or (transport == 0 and mat_tab[emi, Mat.FRONT_ONLY] < 0.5):
-                        ler = mat_tab[emi, Mat.EMISSION]
-                        leg = mat_tab[emi, Mat.EMISSION + 1]
-                        leb = mat_tab[emi, Mat.EMISSION + 2]
-                    mt = em_mtri[e]
-                    if mt >= 0 and transport == 0:
-                        for q in range(3):
-                            v = c0 * tri_e[mt, q] + c1 * tri_e[mt, 3 + q] + c2 * tri_e[mt, 6 + q]
-                            if q == 0:
-                                ler += v
-                            elif q == 1:
-                                leg += v
-                            else:
-                                leb += v
                     cos_s = nx * lx + ny * ly + nz * lz
                     if ((ler > 0.0 or leg > 0.0 or leb > 0.0) and cos_s > 0.0 and cos_l != 0.0
                             and fx * lx + fy * ly + fz * lz > 0.0):
                         fs, ps = phong_lobe(a_s, shin, rx, ry, rz, lx, ly, lz)
                         p_b = P_nd * (m_d * cos_s * INV_PI + a_s * ps) / m_nd
-                        p_l = (lpdf_tri[mt] if mt >= 0 else lpdf_prim[em_prim[e]]) * dist * dist / abs(cos_l)
                         if p_l > 0.0:
                             # the feeler aims from its pushed origin at q itself: along l it would
                             # meet the light's plane up to off / |cos_l| short of q, past its 2 off

@@ -21,7 +21,7 @@ from ..kernels.intersect import closest
 from ..kernels.media import medium_kinds, ratio
 from ..kernels.optics import _light_dir
 from ..kernels.rng import rand
-from .sampling import mis_weight, pick_emitter
+from .sampling import mis_weight, sample_emitter
 
 INV_4PI = 0.25 / math.pi
 SHADOW_CROSSINGS = 16
@@ -63,42 +63,21 @@ def medium_vertex(geo, shading, emitters, opts, key, dim, mdim, px, py, pz, br, 
     weight ``phase / pdf`` is 1).  Random dimensions ``dim .. dim + 4`` of the path's stream.
     Returns ``(L r, g, b, new direction, next mdim)``."""
     mat_of, mat_tab, tex_tab, lights = shading
-    em_tri, em_n, em_prim, em_mtri, em_cdf, lpdf_prim, lpdf_tri = emitters
+    em_cdf = emitters[4]
     beta_mis = opts[PathOpt.MIS_BETA]
     zero = opts[PathOpt.ZERO]
     off = opts[PathOpt.RAY_OFFSET] * max(max(abs(px), abs(py), abs(pz)), opts[PathOpt.EXTENT])
     tri_e = geo.tri_e
     lr, lg, lb = 0.0, 0.0, 0.0
     if em_cdf.shape[0] > 0:
-        e = pick_emitter(em_cdf, rand(key, dim))
-        su = math.sqrt(rand(key, dim + 1))
-        u2 = rand(key, dim + 2)
-        c0, c1, c2 = 1.0 - su, su * (1.0 - u2), su * u2
-        qx = c0 * em_tri[e, 0] + c1 * em_tri[e, 3] + c2 * em_tri[e, 6]
-        qy = c0 * em_tri[e, 1] + c1 * em_tri[e, 4] + c2 * em_tri[e, 7]
-        qz = c0 * em_tri[e, 2] + c1 * em_tri[e, 5] + c2 * em_tri[e, 8]
-        vx, vy, vz = qx - px, qy - py, qz - pz
-        dist = math.sqrt(vx * vx + vy * vy + vz * vz)
-        if dist > 2.0 * off:
-            lx, ly, lz = vx / dist, vy / dist, vz / dist
-            cos_l = -(lx * em_n[e, 0] + ly * em_n[e, 1] + lz * em_n[e, 2])
-            emi = mat_of[em_prim[e]]
-            ler, leg, leb = 0.0, 0.0, 0.0
-            if cos_l > 0.0 or mat_tab[emi, Mat.FRONT_ONLY] < 0.5:
-                ler, leg, leb = mat_tab[emi, Mat.EMISSION], mat_tab[emi, Mat.EMISSION + 1], mat_tab[emi, Mat.EMISSION + 2]
-            mt = em_mtri[e]
-            if mt >= 0:
-                ler += c0 * tri_e[mt, 0] + c1 * tri_e[mt, 3] + c2 * tri_e[mt, 6]
-                leg += c0 * tri_e[mt, 1] + c1 * tri_e[mt, 4] + c2 * tri_e[mt, 7]
-                leb += c0 * tri_e[mt, 2] + c1 * tri_e[mt, 5] + c2 * tri_e[mt, 8]
-            if (ler > 0.0 or leg > 0.0 or leb > 0.0) and cos_l != 0.0:
-                p_l = (lpdf_tri[mt] if mt >= 0 else lpdf_prim[em_prim[e]]) * dist * dist / abs(cos_l)
-                if p_l > 0.0:
-                    counts[PathCount.SHADOW_RAYS] += 1
-                    vis, mdim = shadow_transmittance(geo, mat_of, mat_tab, px, py, pz, lx, ly, lz, 0.0,
-                                                     dist - 2.0 * off, zero, off, key, mdim, scr)
-                    wl = vis * mis_weight(p_l, INV_4PI, beta_mis) * INV_4PI / p_l
-                    lr, lg, lb = lr + br * ler * wl, lg + bg_ * leg * wl, lb + bb * leb * wl
+        qx, qy, qz, lx, ly, lz, dist, cos_l, ler, leg, leb, p_l = sample_emitter(
+            emitters, mat_of, mat_tab, tri_e, key, dim, px, py, pz, 0)
+        if dist > 2.0 * off and (ler > 0.0 or leg > 0.0 or leb > 0.0) and p_l > 0.0:
+            counts[PathCount.SHADOW_RAYS] += 1
+            vis, mdim = shadow_transmittance(geo, mat_of, mat_tab, px, py, pz, lx, ly, lz, 0.0, dist - 2.0 * off,
+                                             zero, off, key, mdim, scr)
+            wl = vis * mis_weight(p_l, INV_4PI, beta_mis) * INV_4PI / p_l
+            lr, lg, lb = lr + br * ler * wl, lg + bg_ * leg * wl, lb + bb * leb * wl
     for li in range(lights.shape[0]):
         lx, ly, lz, dist, sc = _light_dir(lights, li, px, py, pz)
         if sc == 0.0:

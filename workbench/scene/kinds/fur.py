@@ -37,6 +37,7 @@ from ...core.columns import Columns, pack
 from ...core.noise import _hash3
 from .. import model as m
 from . import box as box_kind, sphere as sphere_kind, values as val
+from .medium_sphere import BOUND as BOUND_COLUMN
 
 TYPE = "fur"
 FEATURE = "texels"
@@ -228,17 +229,17 @@ class Par(Columns):
     """The shell row's columns of ``par``."""
 
     BASE = 0         # 0 sphere, 1 box
-    SIZE = 1, 3
-    LENGTH = 4
-    CELL = 5         # the lattice's side 1 / sqrt(strands)
-    THICKNESS = 6
-    DENSITY = 7
-    COLOR = 8, 3
-    KD = 11
-    KS = 12
-    SHININESS = 13
-    STEP = 14
-    BOUND = 15
+    BOUND = BOUND_COLUMN  # the bounding sphere's radius (.medium_sphere)
+    SIZE = 2, 3
+    LENGTH = 5
+    CELL = 6         # the lattice's side 1 / sqrt(strands)
+    THICKNESS = 7
+    DENSITY = 8
+    COLOR = 9, 3
+    KD = 12
+    KS = 13
+    SHININESS = 14
+    STEP = 15
 
 
 def flatten(b, f: Fur, index: int, W: np.ndarray, top: bool) -> int:

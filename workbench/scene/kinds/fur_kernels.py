@@ -10,7 +10,8 @@ import numba as nb
 import numpy as np
 
 from .fur import Par
-from .hypertexture_kernels import _hash3, sphere_chord
+from .hypertexture_kernels import _hash3
+from . import medium_sphere
 
 JIT = dict(cache=True, error_model="numpy")
 
@@ -96,37 +97,6 @@ def majorant(par, k):
     return par[k, Par.DENSITY]
 
 
-# ----------------------------------------------------------------------------- the bounding sphere
-@nb.njit(**JIT)
-def chord(par, k, ox, oy, oz, dx, dy, dz):
-    return sphere_chord(par[k, Par.BOUND], ox, oy, oz, dx, dy, dz)
-
-
-@nb.njit(**JIT)
-def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
-    t0, t1 = chord(par, k, ox, oy, oz, dx, dy, dz)
-    if tmin < t0 < tmax:
-        return t0, 0
-    if tmin < t1 < tmax:
-        return t1, 0
-    return np.inf, 0
-
-
-@nb.njit(**JIT)
-def events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
-    t0, t1 = chord(par, k, ox, oy, oz, dx, dy, dz)
-    if t0 == np.inf or cap < 2:
-        return 0
-    out_t[0], out_f[0], out_t[1], out_f[1] = t0, 0, t1, 0
-    return 2
-
-
-@nb.njit(**JIT)
-def normal(par, k, aux, face, x, y, z, stack):
-    return x, y, z
-
-
-@nb.njit(**JIT)
-def inside(par, k, aux, x, y, z, stack):
-    r = par[k, Par.BOUND]
-    return x * x + y * y + z * z < r * r
+# its row of the ray tracer's table: the bounding sphere (.medium_sphere)
+first, events, normal, inside, chord = (medium_sphere.first, medium_sphere.events, medium_sphere.normal,
+                                        medium_sphere.inside, medium_sphere.chord)

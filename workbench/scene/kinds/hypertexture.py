@@ -54,6 +54,7 @@ from ...core.noise import value_noise
 from .. import model as m
 from . import values as val
 from .aux_rows import AUX_OFFSET, flatten_aux
+from .medium_sphere import BOUND as BOUND_COLUMN
 
 TYPE = "hypertexture"
 FEATURE = "hypertextures"
@@ -328,19 +329,19 @@ class Par(Columns):
     """Its columns of the primitive table's ``par`` (aux: :func:`params`)."""
 
     OFFSET = AUX_OFFSET
-    BASE = 1
-    SIZE = 2, 3
-    SOFT = 5
-    NOISE = 6
-    FREQUENCY = 7
-    AMPLITUDE = 8
-    OCTAVES = 9
-    PHASE = 10, 3
-    BIAS = 13        # the exponent ln b / ln 1/2
-    GAIN = 14        # the exponent ln (1 - g) / ln 1/2
-    DENSITY = 15
-    STEP = 16
-    BOUND = 17
+    BOUND = BOUND_COLUMN  # the bounding sphere's radius (.medium_sphere)
+    BASE = 2
+    SIZE = 3, 3
+    SOFT = 6
+    NOISE = 7
+    FREQUENCY = 8
+    AMPLITUDE = 9
+    OCTAVES = 10
+    PHASE = 11, 3
+    BIAS = 14        # the exponent ln b / ln 1/2
+    GAIN = 15        # the exponent ln (1 - g) / ln 1/2
+    DENSITY = 16
+    STEP = 17
     STOPS = 18
     GRID = 19        # 0: the analytic field; else the grid's resolution (its samples follow the stops)
 

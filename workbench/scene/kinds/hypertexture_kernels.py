@@ -11,6 +11,7 @@ import numba as nb
 import numpy as np
 
 from .hypertexture import AUX_ALBEDO, AUX_EMISSION, AUX_STOPS, Par
+from . import medium_sphere
 
 JIT = dict(cache=True, error_model="numpy")
 _M32 = np.uint64(0xFFFFFFFF)
@@ -162,58 +163,6 @@ def majorant(par, k):
     return par[k, Par.DENSITY]
 
 
-# ----------------------------------------------------------------------------- the bounding sphere
-@nb.njit(**JIT)
-def sphere_chord(r, ox, oy, oz, dx, dy, dz):
-    """Both t of the object-space line with the sphere of radius ``r`` about the origin
-    (t0 <= t1), or (inf, inf) (the stable form of :func:`.sphere.roots`)."""
-    s = math.sqrt(dx * dx + dy * dy + dz * dz)
-    ux, uy, uz = dx / s, dy / s, dz / s
-    b = ox * ux + oy * uy + oz * uz
-    px, py, pz = ox - b * ux, oy - b * uy, oz - b * uz
-    disc = r * r - (px * px + py * py + pz * pz)
-    if not disc > 0.0:
-        return np.inf, np.inf
-    sq = math.sqrt(disc)
-    q = -b - sq if b >= 0.0 else -b + sq
-    no = math.sqrt(ox * ox + oy * oy + oz * oz)
-    c = (no - r) * (no + r)
-    t0 = c / q if q != 0.0 else -sq
-    t0, t1 = min(t0, q), max(t0, q)
-    return t0 / s, t1 / s
-
-
-@nb.njit(**JIT)
-def chord(par, k, ox, oy, oz, dx, dy, dz):
-    """Both t of the object-space line with the bounding sphere (t0 <= t1), or (inf, inf)."""
-    return sphere_chord(par[k, Par.BOUND], ox, oy, oz, dx, dy, dz)
-
-
-@nb.njit(**JIT)
-def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
-    t0, t1 = chord(par, k, ox, oy, oz, dx, dy, dz)
-    if tmin < t0 < tmax:
-        return t0, 0
-    if tmin < t1 < tmax:
-        return t1, 0
-    return np.inf, 0
-
-
-@nb.njit(**JIT)
-def events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
-    t0, t1 = chord(par, k, ox, oy, oz, dx, dy, dz)
-    if t0 == np.inf or cap < 2:
-        return 0
-    out_t[0], out_f[0], out_t[1], out_f[1] = t0, 0, t1, 0
-    return 2
-
-
-@nb.njit(**JIT)
-def normal(par, k, aux, face, x, y, z, stack):
-    return x, y, z
-
-
-@nb.njit(**JIT)
-def inside(par, k, aux, x, y, z, stack):
-    r = par[k, Par.BOUND]
-    return x * x + y * y + z * z < r * r
+# its row of the ray tracer's table: the bounding sphere (.medium_sphere)
+first, events, normal, inside, chord = (medium_sphere.first, medium_sphere.events, medium_sphere.normal,
+                                        medium_sphere.inside, medium_sphere.chord)
