@@ -194,7 +194,7 @@ def flatten_bytes(scene: m.Scene) -> int:
         else:
             aux = len(kind.params(o, 0)[1]) if hasattr(kind, "params") else 0
         # a grid is sampled in float32 slabs before it joins the float64 aux numbers
-        grid = 4 * kind.grid_cells(o) if hasattr(kind, "grid_cells") else 0
+        grid = 4 * kind.grid_samples(o) if hasattr(kind, "grid_samples") else 0
         rows = 2 if getattr(kind, "MEDIUM", False) else 1  # a medium's own row beside a base's
         return rows * BYTES_PER_ROW + AUX_COPIES * 8 * aux + grid
     lights = sum(isinstance(lt, m.AreaLight) for lt in scene.lights)

@@ -7,6 +7,9 @@ import numpy as np
 
 AUX_OFFSET = 0
 """The column of such a kind's ``par`` that holds the offset of its numbers in ``aux``."""
+MEDIUM_BOUND = 1
+"""The column of a medium kind's ``par`` (the hypertexture, the fur) holding the radius of its
+bounding sphere, which :mod:`.medium_sphere` intersects for all of them."""
 
 
 def flatten_aux(b, obj, index: int, W: np.ndarray, top: bool, ptype: int,

@@ -37,7 +37,7 @@ from ...core.columns import Columns, pack
 from ...core.noise import _hash3
 from .. import model as m
 from . import box as box_kind, sphere as sphere_kind, values as val
-from .medium_sphere import BOUND as BOUND_COLUMN
+from .aux_rows import MEDIUM_BOUND as BOUND_COLUMN
 
 TYPE = "fur"
 FEATURE = "texels"

@@ -53,8 +53,7 @@ from ...core.errors import WorkbenchError
 from ...core.noise import value_noise
 from .. import model as m
 from . import values as val
-from .aux_rows import AUX_OFFSET, flatten_aux
-from .medium_sphere import BOUND as BOUND_COLUMN
+from .aux_rows import AUX_OFFSET, MEDIUM_BOUND as BOUND_COLUMN, flatten_aux
 
 TYPE = "hypertexture"
 FEATURE = "hypertextures"
@@ -350,7 +349,7 @@ AUX_ALBEDO, AUX_EMISSION, AUX_STOPS = 0, 3, 6
 """Offsets within the object's aux numbers (the grid, when ``grid``, after the ramp's stops)."""
 
 
-def grid_cells(h: Hypertexture) -> int:
+def grid_samples(h: Hypertexture) -> int:
     """Cells of its grid (0 without one)."""
     return h.grid ** 3
 
@@ -358,7 +357,7 @@ def grid_cells(h: Hypertexture) -> int:
 def aux_count(h: Hypertexture) -> int:
     """How many numbers :func:`params` puts in aux, counted without building the grid (the ray
     tracer's memory estimate)."""
-    return 6 + h.ramp.size + grid_cells(h)
+    return 6 + h.ramp.size + grid_samples(h)
 
 
 def params(h: Hypertexture, aux_offset: int) -> tuple[np.ndarray, np.ndarray]:

@@ -1,6 +1,7 @@
 """The bounding sphere of a medium kind (``MEDIUM = True``: the hypertexture, the fur): the
 ray tracer's entry points of its row (signatures: :mod:`.crossing_events`) and its chord,
-shared by the medium kinds, whose ``Par`` keeps the sphere's radius in column :data:`BOUND`."""
+shared by the medium kinds, whose ``Par`` keeps the sphere's radius in column
+:data:`.aux_rows.MEDIUM_BOUND`."""
 from __future__ import annotations
 
 import math
@@ -8,9 +9,7 @@ import math
 import numba as nb
 import numpy as np
 
-BOUND = 1
-"""The column of a medium kind's ``par`` holding its bounding sphere's radius (object space,
-about the origin)."""
+from .aux_rows import MEDIUM_BOUND as BOUND
 JIT = dict(cache=True, error_model="numpy")
 
 
