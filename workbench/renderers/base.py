@@ -262,7 +262,8 @@ def check_memory(r: Renderer, scene: Scene, width: int, height: int, options: di
     if not isinstance(est, (int, np.integer)) or est <= 0:
         raise TypeError(f"{type(r).__name__}.estimate_bytes returned {est!r}, not a positive int")
     if est > limit:
-        knobs = "".join(f"{k}={options[k]!r}, " for k in r.memory_options) + ("or " if r.memory_options else "")
+        named = [k for k in r.memory_options if k in options]  # (an API call may leave some at their default)
+        knobs = "".join(f"{k}={options[k]!r}, " for k in named) + ("or " if named else "")
         raise OverMemory(
             f"method {r.name!r}: {width}x{height} needs about {gib(est)} of memory, above the limit "
             f"of {gib(limit)}: change {knobs}the image size, or raise the limit "
