@@ -114,15 +114,18 @@ class SceneData:
         groups, so that all scenes of the package's kinds together need at most four compiled
         variants of each kernel: the extended kinds (the package's kinds with kernel modules of
         their own, and CSG: all of them if the scene has any among its rows, CSG leaves
-        included), each plugin kind the scene has (:func:`workbench.scene.kinds.register`),
-        and the triangles' tree (if the scene has triangles).  The analytic primitives' tree
-        walk is always compiled."""
+        included), the media kinds (hypertexture, fur: all of them if the scene has one),
+        each plugin kind the scene has (:func:`workbench.scene.kinds.register`), and the
+        triangles' tree (if the scene has triangles).  The analytic primitives' tree walk is
+        always compiled."""
         present = {int(p) for p in np.unique(self.ptype)}
         package = [k for k in kernel_kinds() if k.TYPE in PACKAGE_KINDS and not getattr(k, "MEDIUM", False)]
         out = []
         if present & ({k.PTYPE for k in package} | {CSGNODE}):
             out += [k.TYPE for k in package] + ["csg"]
-        out += [k.TYPE for k in kernel_kinds() if getattr(k, "MEDIUM", False) and k.PTYPE in present]
+        media = [k for k in kernel_kinds() if getattr(k, "MEDIUM", False)]
+        if present & {k.PTYPE for k in media}:  # the media kinds, all or none (one compiled variant)
+            out += [k.TYPE for k in media]
         out += [marker_name(k) for k in kernel_kinds() if k.TYPE not in PACKAGE_KINDS and k.PTYPE in present]
         if len(self.tri_v):
             out.append("triangles")
