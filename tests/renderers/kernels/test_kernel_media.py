@@ -15,40 +15,17 @@ import workbench
 from workbench.scene.io import load_scene
 from workbench.scene.kinds import hypertexture as H
 
+from media_scenes import medium_toml
 from statistics_budget import band
 
-SCENE = """
-[scene]
-name = "medium"
-background = [0.0, 0.0, 0.0]
-ambient = [0.0, 0.0, 0.0]
-[camera]
-position = [0.0, 0.0, -4.0]
-look_at = [0.0, 0.0, 0.0]
-fov_y = 30.0
-resolution = [33, 25]
-[materials.m]
-color = [1.0, 1.0, 1.0]
-[[objects]]
-type = "hypertexture"
-material = "m"
-base = "sphere"
-size = 0.6
-soft = 0.5
-noise = "{noise}"
-frequency = 3.0
-amplitude = 1.0
-bias = 0.3
-gain = 0.7
-density = {density}
-emission = [2.0, 1.0, 0.5]
-step = 0.05
-"""
+def _scene_text(noise="none", density=3.0) -> str:
+    return medium_toml(distance=4.0, resolution=(33, 25), size=0.6, soft=0.5, noise=f'"{noise}"', frequency=3.0,
+                       amplitude=1.0, bias=0.3, gain=0.7, density=density, emission="[2.0, 1.0, 0.5]", step=0.05)
 
 
 def _scene(tmp_path: Path, noise="none", density=3.0):
     p = tmp_path / "medium.toml"
-    p.write_text(SCENE.format(noise=noise, density=density))
+    p.write_text(_scene_text(noise, density))
     return load_scene(p)
 
 
@@ -238,7 +215,7 @@ def test_a_grid_over_the_memory_limit_is_refused_before_it_is_built(method, tmp_
     flattening) under a 300 MB limit: one line naming the estimate, exit 2, no image (the
     estimate counts the grid without building it: ``hypertexture.aux_count``)."""
     p = tmp_path / "big.toml"
-    p.write_text(SCENE.format(noise="turbulence", density=1.0) + "grid = 256\n")
+    p.write_text(_scene_text("turbulence", 1.0) + "grid = 256\n")
     out = tmp_path / "x.png"
     r = subprocess.run([sys.executable, "-m", "workbench", "render", str(p), "-m", method, "--size", "8x6",
                         "--max-memory", "300M", "--out", str(out)], capture_output=True, text=True, timeout=300)

@@ -17,30 +17,11 @@ from workbench.renderers.base import get_renderer
 from workbench.renderers.support import Status
 from workbench.scene import features as ft
 
+from media_scenes import medium_toml
+
 R0, SOFT, DENSITY = 0.5, 0.4, 1.5
-ANALYTIC = f"""
-[scene]
-name = "hypertexture-analytic"
-background = [0.0, 0.0, 0.0]
-ambient = [0.0, 0.0, 0.0]
-[camera]
-position = [0.0, 0.0, -3.0]
-look_at = [0.0, 0.0, 0.0]
-fov_y = 30.0
-resolution = [9, 9]
-[materials.m]
-color = [1.0, 1.0, 1.0]
-[[objects]]
-type = "hypertexture"
-material = "m"
-base = "sphere"
-size = {R0}
-soft = {SOFT}
-noise = "none"
-density = {DENSITY}
-emission = [1.0, 1.0, 1.0]
-step = 0.23
-"""
+ANALYTIC = medium_toml(name="hypertexture-analytic", distance=3.0, resolution=(9, 9), size=R0, soft=SOFT,
+                       noise='"none"', density=DENSITY, emission="[1.0, 1.0, 1.0]", step=0.23)
 
 
 def _fire(grid: int = 0, camera=None):
