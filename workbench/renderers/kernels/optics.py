@@ -27,6 +27,26 @@ def _ior(mat_tab, stk, ns_):
 
 
 @nb.njit(**INLINE)
+def enter_or_leave(stk, nstk, mi, front):
+    """The media stack ``stk`` (its first ``nstk`` entries) after crossing the boundary of a
+    medium's material ``mi``: pushed when entering (if there is room), its topmost entry
+    removed when leaving.  Returns its size."""
+    if front:
+        if nstk < 4:
+            stk[nstk] = mi
+            return nstk + 1
+        return nstk
+    j = nstk - 1
+    while j >= 0 and stk[j] != mi:
+        j -= 1
+    if j < 0:
+        return nstk
+    for q in range(j, nstk - 1):
+        stk[q] = stk[q + 1]
+    return nstk - 1
+
+
+@nb.njit(**INLINE)
 def fresnel_reflectance(fres, n1, n2, cosi, cost):
     """Reflected share F of light crossing from index ``n1`` to ``n2`` (``cosi``, ``cost``: the
     cosines of incidence and refraction): Schlick's approximation for ``fres == 1`` (cosine on the

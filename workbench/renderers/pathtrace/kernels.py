@@ -72,7 +72,7 @@ from ..kernels.tasks import run_tasks
 from ..kernels.flags import INLINE, NO_REFCOUNT, TASK
 from ..kernels.intersect import closest, scratch, surface
 from ..kernels.media import track
-from ..kernels.optics import _feeler, _light_dir, checker_color, fresnel_reflectance
+from ..kernels.optics import _feeler, _light_dir, checker_color, enter_or_leave, fresnel_reflectance
 from ..kernels.shapes import _normalize
 from ..kernels.walks import bvh_hit
 from ..raytrace.kernels import MAX_TASKS
@@ -221,25 +221,6 @@ def cast(geo, bvh, tri_prim, only_tris, ox, oy, oz, dx, dy, dz, tmin, tmax, any_
     return cast_all(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr)
 
 
-@nb.njit(**INLINE)
-def _enter_or_leave(stk, nstk, mi, front):
-    """The media stack after crossing the boundary of medium material ``mi``: pushed when
-    entering (if there is room), its topmost entry removed when leaving.  Returns its size."""
-    if front:
-        if nstk < 4:
-            stk[nstk] = mi
-            return nstk + 1
-        return nstk
-    j = nstk - 1
-    while j >= 0 and stk[j] != mi:
-        j -= 1
-    if j < 0:
-        return nstk
-    for q in range(j, nstk - 1):
-        stk[q] = stk[q + 1]
-    return nstk - 1
-
-
 @nb.njit(**NO_REFCOUNT)
 def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts, scr, rows):
     """Radiance (RGB) carried along one path from ``o`` in direction ``d`` (unit): see the
@@ -316,7 +297,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
         front = cos_g > 0.0
         fx, fy, fz = (gx, gy, gz) if front else (-gx, -gy, -gz)   # geometric normal, incident side
         if mat_tab[mi, Mat.MEDIUM] >= 0.0:  # a medium's boundary: on through it, not a vertex
-            nstk = _enter_or_leave(stk, nstk, mi, front)
+            nstk = enter_or_leave(stk, nstk, mi, front)
             off = ray_off * max(max(abs(px), abs(py), abs(pz)), extent)
             ox, oy, oz = px - off * fx, py - off * fy, pz - off * fz
             tmin, t_acc = t_min * max(max(abs(ox), abs(oy), abs(oz)), extent), t_acc + t

@@ -33,12 +33,12 @@ from numba import prange
 from ..kernels.columns import RAY_COUNTS, Light, Mat, RayCount, WhittedOpt
 from ..kernels.flags import INLINE, NO_REFCOUNT, TASK
 from ..kernels.intersect import closest, scratch, surface
-from ..kernels.media import march
 from ..kernels.optics import (_facing, _feeler, _ior, _light_dir, _pow, camera_ray, checker_color,
-                              fresnel_reflectance)
+                              enter_or_leave, fresnel_reflectance)
 from ..kernels.shapes import _normalize
 from ..kernels.tasks import run_tasks
-from .flatten import SHADOW_CROSSINGS
+from ..kernels.media import march
+from .feelers import _transmittance
 
 CHUNK = 64
 """Rays of a wavefront chunk."""
@@ -89,75 +89,12 @@ def trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_on
                     oz + t * D[i, 2], ncancel, ng, ns, uv, po, ev, i, stack)
 
 
-@nb.njit(**INLINE)
-def _transmittance(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmin, tmax, transmissive, zero,
-                   eps, media, stack, st, sp_, sf, sn):
-    """Shadow feeler: 1 if nothing blocks the segment, 0 if blocked (any hit ends the search);
-    with ``transmissive``, the product of the ``kt`` of every surface crossed (at most
-    ``SHADOW_CROSSINGS``).  ``media`` (``WhittedOpt.STEP_SCALE``, 0: none in the scene): the
-    boundaries of heterogeneous media block nothing, and the feeler takes the transmittance of
-    each medium's chord within the segment (:func:`..kernels.media.march`; at most four media
-    a feeler)."""
-    v = 1.0
-    t0 = tmin
-    m0, m1, m2, m3 = -1, -1, -1, -1  # media already marched
-    for _ in range(SHADOW_CROSSINGS):
-        t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, t0, tmax, np.bool_(True),
-                                       np.bool_(not transmissive and media == 0.0), zero, eps, stack, st, sp_, sf, sn)
-        if k < 0:
-            return v
-        med = int(mat_tab[mat_of[k], Mat.MEDIUM])
-        if med >= 0:
-            if med != m0 and med != m1 and med != m2 and med != m3:
-                m0, m1, m2, m3 = med, m0, m1, m2
-                tr, _, _, _ = march(geo, med, ox, oy, oz, dx, dy, dz, tmin, tmax, 0.0, 0.0, 0.0, media, False,
-                                    (mat_tab[:0], mat_of, mat_tab), (stack, st, sp_, sf, sn))
-                v *= tr
-        elif not transmissive:
-            return 0.0
-        else:
-            v *= mat_tab[mat_of[k], Mat.KT]
-        if v <= 0.0:
-            return 0.0
-        t0 = t + eps
-    return v
-
-
 @nb.njit(cache=True, error_model="numpy")
 def accumulate(acc, pix, contrib):
     """``acc[pix[i]] += contrib[i]`` (serial: several rays may share a pixel)."""
     for i in range(pix.shape[0]):
         for c in range(3):
             acc[pix[i], c] += contrib[i, c]
-
-
-@nb.njit(cache=True, error_model="numpy")
-def feeler_batch(lights, O, D, t, prim, ng, nsh, opts, fo, fd, ftmin, ftmax, want):
-    """The shadow feelers :func:`shade_hit` traces at each hit, one row per (hit ``i``, light
-    ``li``): row ``i L + li`` of ``fo, fd, ftmin, ftmax``; ``want`` is False where it traces
-    none (a miss, the light behind the shading normal, a zero light factor).  For a caller that
-    traces them itself (opacity maps) and passes their visibility to :func:`shade_batch`."""
-    nl = lights.shape[0]
-    ray_off, t_min, extent = opts[WhittedOpt.RAY_OFFSET], opts[WhittedOpt.T_MIN], opts[WhittedOpt.EXTENT]
-    for i in range(O.shape[0]):
-        dx, dy, dz = D[i, 0], D[i, 1], D[i, 2]
-        px, py, pz = O[i, 0] + t[i] * dx, O[i, 1] + t[i] * dy, O[i, 2] + t[i] * dz
-        nx, ny, nz = _facing(nsh, i, dx, dy, dz)
-        pm = max(abs(px), abs(py), abs(pz))
-        off = ray_off * max(pm, extent)
-        for li in range(nl):
-            r = i * nl + li
-            want[r] = False
-            if prim[i] < 0:
-                continue
-            lx, ly, lz, dist, scale = _light_dir(lights, li, px, py, pz)
-            if nx * lx + ny * ly + nz * lz <= 0.0 or scale == 0.0:
-                continue
-            qx, qy, qz, tmx = _feeler(px, py, pz, ng[i, 0], ng[i, 1], ng[i, 2], lx, ly, lz, dist, off)
-            fo[r, 0], fo[r, 1], fo[r, 2] = qx, qy, qz
-            fd[r, 0], fd[r, 1], fd[r, 2] = lx, ly, lz
-            ftmin[r], ftmax[r] = t_min * max(pm, extent), tmx
-            want[r] = True
 
 
 @nb.njit(**INLINE)
@@ -170,22 +107,9 @@ def _cross(mi, front, px, py, pz, fx, fy, fz, dx, dy, dz, w0, w1, w2, gen, stk, 
     out_o[s, 0], out_o[s, 1], out_o[s, 2] = px - off * fx, py - off * fy, pz - off * fz
     out_d[s, 0], out_d[s, 1], out_d[s, 2] = dx, dy, dz
     out_w[s, 0], out_w[s, 1], out_w[s, 2] = w0, w1, w2
-    n = nstk[i]
     for q in range(4):
         out_stk[s, q] = stk[i, q]
-    out_nstk[s] = n
-    if front:
-        if n < 4:
-            out_stk[s, n] = mi
-            out_nstk[s] = n + 1
-    else:
-        j = n - 1
-        while j >= 0 and stk[i, j] != mi:
-            j -= 1
-        if j >= 0:
-            for q in range(j, n - 1):
-                out_stk[s, q] = stk[i, q + 1]
-            out_nstk[s] = n - 1
+    out_nstk[s] = enter_or_leave(out_stk[s], nstk[i], mi, front)
     out_kind[s] = 2
     out_tmin[s] = t_min * max(max(abs(out_o[s, 0]), abs(out_o[s, 1]), abs(out_o[s, 2])), extent)
     out_gen[s] = gen

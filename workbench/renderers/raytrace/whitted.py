@@ -257,6 +257,11 @@ def _kernels():
     return kernels
 
 
+def _feelers():
+    from . import feelers
+    return feelers
+
+
 def ensure_compiled(sd: SceneData, fused: bool = False) -> float:
     """Run the kernels a render needs once on one ray (first-call JIT, or a load from the numba
     disk cache): :func:`.kernels.render_pixels` for the fused path, the wavefront kernels
@@ -281,8 +286,8 @@ def ensure_compiled(sd: SceneData, fused: bool = False) -> float:
                   arr["po"], arr["ev"])
     ch = _alloc_children(1)
     nl = len(sd.lights)
-    k.feeler_batch(sd.lights, O, D, np.ones(1), np.zeros(1, np.int64), D.copy(), D.copy(), kopts,
-                   np.empty((nl, 3)), np.empty((nl, 3)), np.empty(nl), np.empty(nl), np.empty(nl, np.bool_))
+    _feelers().feeler_batch(sd.lights, O, D, np.ones(1), np.zeros(1, np.int64), D.copy(), D.copy(), kopts,
+                            np.empty((nl, 3)), np.empty((nl, 3)), np.empty(nl), np.empty(nl), np.empty(nl, np.bool_))
     k.shade_batch(geo, sd.mat, sd.mat_tab, sd.lights, np.zeros(3), np.zeros(3), O, D, np.ones(1),
                   np.zeros(1, np.int64), D.copy(), D.copy(), np.ones((1, 3)), np.zeros((1, 3)),
                   np.empty((0, nl)), np.ones((1, 3)), np.zeros(1, np.int64), np.zeros((1, 4), np.int64),
@@ -471,15 +476,16 @@ class _Tracer:
 
     def _visibility(self, O, D, h, ns):
         """(n, L) visibility of each light from each hit through its shadow feeler
-        (:func:`.kernels.feeler_batch`: the feelers :func:`.kernels.shade_hit` would trace),
+        (:func:`.feelers.feeler_batch`: the feelers :func:`.kernels.shade_hit` would trace),
         with opacity maps: a surface lets ``1 - alpha`` through (all of it where cut out, as
         for the rays it cuts), and with ``transmissive_shadows`` also ``alpha kt`` (as
         :func:`.reference.shadow_feeler`)."""
-        k, sd = _kernels(), self.sd
+        sd = self.sd
         n, nl = len(O), len(sd.lights)
         fo, fd = np.empty((n * nl, 3)), np.empty((n * nl, 3))
         tmin, tmax, want = np.empty(n * nl), np.empty(n * nl), np.empty(n * nl, np.bool_)
-        k.feeler_batch(sd.lights, O, D, h["t"], h["prim"], h["ng"], ns, self.kopts, fo, fd, tmin, tmax, want)
+        _feelers().feeler_batch(sd.lights, O, D, h["t"], h["prim"], h["ng"], ns, self.kopts, fo, fd, tmin, tmax,
+                                want)
         vis = np.ones(n * nl)
         kt = sd.mat_tab[sd.mat, Mat.KT] if self.kopts[WhittedOpt.TRANSMISSIVE_SHADOWS] > 0.5 else np.zeros(len(sd.mat))
         todo = np.flatnonzero(want)

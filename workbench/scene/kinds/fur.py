@@ -52,7 +52,6 @@ KERNELS = "workbench.scene.kinds.fur_kernels"
 KEYS = frozenset({"base", "size", "length", "strands", "thickness", "density", "color", "kd", "ks", "shininess",
                   "step"})
 REQUIRED = frozenset({"base", "size", "length"})
-MIN_STEPS, MAX_STEPS = 2, 1 << 16
 
 
 @dataclass(frozen=True, eq=False)
@@ -96,10 +95,7 @@ def read(t: dict, where: str, common: dict) -> Fur:
     if f.thickness >= 0.5 / math.sqrt(f.strands):
         val.fail(f"{where}.thickness", f"must be below half the strands' spacing 1/sqrt(strands) = "
                  f"{1 / math.sqrt(f.strands):.4g}, got {f.thickness}")
-    steps = 2.0 * bound_radius(f) / f.step
-    if not MIN_STEPS <= steps <= MAX_STEPS:
-        val.fail(f"{where}.step", f"gives {steps:.3g} steps across the shell's bounding sphere; expected "
-                 f"{MIN_STEPS} to {MAX_STEPS}")
+    val.march_step(where, f.step, bound_radius(f), "the shell")
     return f
 
 

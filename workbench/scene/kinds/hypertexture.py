@@ -79,9 +79,8 @@ MAX_OCTAVES = 8
 MAX_STOPS = 16
 MAX_GRID = 256
 """Largest ``grid`` resolution (256^3 float64 numbers in the ray tracer's aux: 128 MiB)."""
-MIN_STEPS, MAX_STEPS = 2, 1 << 16
-"""The march's steps across the bounding sphere's diameter: ``step`` must give at least the
-first and at most the second (a step that tiny makes a render of hours)."""
+MIN_STEPS, MAX_STEPS = val.MARCH_STEPS
+"""The march's steps across the bounding sphere's diameter (:func:`.values.march_step`)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -165,10 +164,7 @@ def read(t: dict, where: str, common: dict) -> Hypertexture:
         grid=val.number(t, where, "grid", 0, lo=0, hi=MAX_GRID, integer=True), **common)
     if h.grid == 1:
         val.fail(f"{where}.grid", "expected 0 (the analytic field) or a resolution >= 2, got 1")
-    steps = 2.0 * bound_radius(h) / h.step
-    if not MIN_STEPS <= steps <= MAX_STEPS:
-        val.fail(f"{where}.step", f"gives {steps:.3g} steps across the medium's bounding sphere "
-                 f"(diameter {2 * bound_radius(h):.4g}); expected {MIN_STEPS} to {MAX_STEPS}")
+    val.march_step(where, h.step, bound_radius(h), "the medium")
     return h
 
 

@@ -98,3 +98,19 @@ def box(t, where: str, key: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
     if any(a >= b for a, b in zip(lo, hi)):
         fail(f"{w}.max", f"must exceed min on every axis (min {list(lo)}, max {list(hi)})")
     return lo, hi
+
+
+MARCH_STEPS = (2, 1 << 16)
+"""The march's steps across a medium's bounding sphere that a medium kind's ``step`` must give
+(hypertexture, fur): at least the first, at most the second (a step that tiny makes a render of
+hours)."""
+
+
+def march_step(where: str, step: float, radius: float, what: str) -> None:
+    """``step`` gives :data:`MARCH_STEPS` steps across the diameter of ``what``'s bounding
+    sphere of ``radius``."""
+    steps = 2.0 * radius / step
+    lo, hi = MARCH_STEPS
+    if not lo <= steps <= hi:
+        fail(f"{where}.step", f"gives {steps:.3g} steps across {what}'s bounding sphere "
+             f"(diameter {2 * radius:.4g}); expected {lo} to {hi}")
