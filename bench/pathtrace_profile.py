@@ -93,7 +93,8 @@ def main(argv=None) -> None:
     import workbench
     from workbench.renderers.pathtrace import kernels as K
     from workbench.renderers.pathtrace.session import PathTraceSession
-    from workbench.renderers.kernels.columns import PathCount, PathOpt
+    from workbench.renderers.kernels.columns import PathCount
+    from workbench.renderers.kernels.layout import marker_features
     from workbench.renderers.kernels.flags import NO_REFCOUNT
     # the module, not its functions: numba's cache key hashes a kernel's closure variables, and a
     # dispatcher pickles differently in every process (the cache would never hit)
@@ -143,11 +144,11 @@ def main(argv=None) -> None:
     @nb.njit(**NO_REFCOUNT)
     def cast_bvh(geo, O, D, TM, AH, n, any_hit, scr):
         """The path tracer's ``cast`` (every primitive a triangle: the BVH alone)."""
-        bvh = (geo[14], geo[15], geo[16], geo[17], geo[18])
+        bvh = (geo.bvh_node, geo.bvh_child, geo.bvh_leaf, geo.bvh_first, geo.bvh_tv4)
         hits = 0
         for q in range(n):
             if AH[q] == any_hit:
-                t, k, f, tri, b1, b2 = K.cast(geo, bvh, geo[13], True, O[q, 0], O[q, 1], O[q, 2], D[q, 0],
+                t, k, f, tri, b1, b2 = K.cast(geo, bvh, geo.tri_prim, O[q, 0], O[q, 1], O[q, 2], D[q, 0],
                                               D[q, 1], D[q, 2], 1e-9, TM[q], np.bool_(any_hit == 1), 1e-12,
                                               1e-6, scr)
                 hits += k >= 0
@@ -209,7 +210,7 @@ def main(argv=None) -> None:
     cam_r, ext_r, sh_r = st["camera_rays"] / nsamp, st["extension_rays"] / nsamp, st["shadow_rays"] / nsamp
     out["sample"] = {"cpu_ns": per_sample * 1e9, "camera_rays": cam_r, "extension_rays": ext_r, "shadow_rays": sh_r,
                      "mean_path_length": st["mean_path_length"], "only_bvh_triangles":
-                         bool(ses.opts[PathOpt.ONLY_TRIANGLES] > 0.5)}
+                         marker_features(ses.geo.kinds) == ("triangles",)}
 
     scr, rows = work_arrays()
     cap = a.size * a.size * 4 * 7

@@ -1,12 +1,15 @@
-"""The path tracer against Mitsuba 3 (``scalar_rgb``) on the Cornell box, same run, same host.
+"""The path tracer against Mitsuba 3 on the Cornell box and on ``cornell_spheres``, same run,
+same host: Mitsuba's vectorised ``llvm_ad_rgb`` variant (the anchor: the variant a user would
+pick for speed on a CPU) and its ``scalar_rgb`` variant.
 
-* ``throughput``: ``cornell`` at 256x256, 64 spp, the methods alternating ``--repeat`` times
-  (numba on 2 threads; Mitsuba's own thread pool, one thread per core: 2 here); per render the
-  wall time of the sampling phase (pathtrace ``timings["trace"]``, Mitsuba ``timings["render"]``,
-  the ``mi.render`` calls), the CPU seconds of that phase, the whole call's wall time, and the
-  1-minute load average before and after.  Samples per second (best of the repeats) and their
-  ratio pathtrace / Mitsuba, per wall second and per CPU second.
-* ``equal_rmse``: both methods at 16, 64 and 256 spp, three seeds each, at ``--rmse-size``
+* ``throughput``: each scene at 256x256, 64 spp, the methods alternating ``--repeat`` times
+  (default 5; numba on 2 threads; Mitsuba's own thread pool, one thread per core: 2 here); per
+  render the wall time of the sampling phase (pathtrace ``timings["trace"]``, Mitsuba
+  ``timings["render"]``, the ``mi.render`` calls), the CPU seconds of that phase, the whole
+  call's wall time, and the 1-minute load average before and after.  Samples per second and
+  per CPU second (medians of the repeats) and their ratios pathtrace / Mitsuba (> 1: the path
+  tracer is faster), against each variant.
+* ``equal_rmse``: every method at 16, 64 and 256 spp, three seeds each, at ``--rmse-size``
   (default 64) against one shared Mitsuba reference of ``--ref-spp`` (default 4096) spp, kept in
   the reference cache (``workbench.compare.reference_cache``: a second run does not re-render
   it).  Per render the RMSE and the *excess* MSE ``RMSE^2 - noise_ref^2`` (the reference's own
@@ -16,12 +19,16 @@
   varies from seed to seed), and from ``c`` and the measured sampling time per spp the time
   each method needs to reach the excess RMSE ``c_pathtrace / 8`` (pathtrace at 64 spp), and
   their ratio; the same off the light's own pixels.
-* Each part runs ``pathtrace`` (default: Russian roulette from the 3rd bounce), ``mitsuba``
-  (``scalar_rgb``, Russian roulette from depth 5) and ``pathtrace_rr5`` (``rr_start = 5``).
+* Methods: ``pathtrace`` (default: Russian roulette from the 3rd bounce), ``mitsuba_llvm``
+  (``llvm_ad_rgb``) and ``mitsuba`` (``scalar_rgb``), both with Russian roulette from depth 5,
+  and ``pathtrace_rr5`` (``rr_start = 5``).  ``llvm_ad_rgb`` is probed first (a tiny render in
+  a child process, ``renderers.mitsuba_method.probe_variant``); where it cannot load (Drjit
+  finds no usable ``libLLVM``: set ``DRJIT_LIBLLVM_PATH`` to Debian's ``libLLVM.so.19.1``), the
+  page says why and compares with ``scalar_rgb`` alone.
 * ``reference``: the pathtrace image of ``cornell`` at 256x256 run to the noise level
   ``--target`` (RMS of the per-pixel standard error), timed (wall and CPU), load average.
 
-Usage: ``PYTHONPATH=. .venv/bin/python bench/pathtrace_vs_mitsuba.py [--repeat 2] [--quick]``
+Usage: ``PYTHONPATH=. .venv/bin/python bench/pathtrace_vs_mitsuba.py [--repeat 5] [--quick]``
 writes ``bench/results/pathtrace_vs_mitsuba.json`` and ``docs/benchmarks/pathtrace_vs_mitsuba.md`` and
 prints it (``--quick``: small sizes, printed only unless ``--out`` is given).  Without Mitsuba its
 rows, the shared reference and the equal-RMSE part are skipped.  ``--smoke``: 16 x 16 at 4 spp, one
@@ -44,10 +51,12 @@ sys.path.insert(0, str(ROOT / "bench"))
 THREADS = 2
 
 from _common import Page, first_paragraph, fmt, ratio, skip_note, table  # noqa: E402
+SCENES = ("cornell", "cornell_spheres")
 #: What is compared: label -> (method, options).  ``pathtrace_rr5`` starts Russian roulette at
 #: the 5th bounce, as Mitsuba's path integrator does (the method's default is the 3rd).
-VARIANTS = {"pathtrace": ("pathtrace", {}), "mitsuba": ("mitsuba", {"variant": "scalar_rgb"}),
-            "pathtrace_rr5": ("pathtrace", {"rr_start": 5})}
+VARIANTS = {"pathtrace": ("pathtrace", {}), "mitsuba_llvm": ("mitsuba", {"variant": "llvm_ad_rgb"}),
+            "mitsuba": ("mitsuba", {"variant": "scalar_rgb"}), "pathtrace_rr5": ("pathtrace", {"rr_start": 5})}
+ANCHOR_LABELS = ("mitsuba_llvm", "mitsuba")
 
 
 def load() -> float:
@@ -74,23 +83,34 @@ def render(scene, label: str, size: int, spp: int, seed: int):
                "load_before": l0, "load_after": load()}
 
 
-def throughput(scene, size: int, spp: int, repeat: int, have_mitsuba: bool = True) -> dict:
+def median_run(runs: list[dict]) -> dict:
+    """The run of median samples per second (the lower middle one of an even count), with the
+    medians of every figure over the runs."""
+    order = sorted(runs, key=lambda e: e["samples_per_s"])
+    mid = dict(order[(len(order) - 1) // 2])
+    for k in ("sample_wall_s", "sample_cpu_s", "call_wall_s", "samples_per_s", "samples_per_cpu_s"):
+        mid[k] = float(np.median([e[k] for e in runs]))
+    mid["runs"] = len(runs)
+    return mid
+
+
+def throughput(scene, size: int, spp: int, repeat: int, labels: list[str]) -> dict:
     runs = []
-    labels = [m for m in VARIANTS if have_mitsuba or m != "mitsuba"]
     for k in range(repeat):
         for m in labels:
             runs.append(render(scene, m, size, spp, seed=k)[1])
-    best = {m: max((e for e in runs if e["method"] == m), key=lambda e: e["samples_per_s"]) for m in labels}
-    if not have_mitsuba:
-        return {"scene": scene.name, "size": size, "spp": spp, "threads": THREADS, "runs": runs, "best": best,
-                "mitsuba": skip_note("mitsuba")}
-    return {"scene": scene.name, "size": size, "spp": spp, "threads": THREADS, "runs": runs, "best": best,
-            "ratio_samples_per_s": best["pathtrace"]["samples_per_s"] / best["mitsuba"]["samples_per_s"],
-            "ratio_samples_per_cpu_s": best["pathtrace"]["samples_per_cpu_s"] / best["mitsuba"]["samples_per_cpu_s"],
-            "ratio_samples_per_s_rr5": best["pathtrace_rr5"]["samples_per_s"] / best["mitsuba"]["samples_per_s"]}
+    med = {m: median_run([e for e in runs if e["method"] == m]) for m in labels}
+    ratios = {}
+    for a in (x for x in ANCHOR_LABELS if x in labels):
+        for m in ("pathtrace", "pathtrace_rr5"):
+            ratios[f"{m}_over_{a}"] = {
+                "samples_per_s": med[m]["samples_per_s"] / med[a]["samples_per_s"],
+                "samples_per_cpu_s": med[m]["samples_per_cpu_s"] / med[a]["samples_per_cpu_s"]}
+    return {"scene": scene.name, "size": size, "spp": spp, "threads": THREADS, "runs": runs, "median": med,
+            "ratios": ratios}
 
 
-def equal_rmse(scene, size: int, ref_spp: int, spps=(16, 64, 256), seeds=(7, 8, 9)) -> dict:
+def equal_rmse(scene, size: int, ref_spp: int, labels: list[str], spps=(16, 64, 256), seeds=(7, 8, 9)) -> dict:
     from workbench.compare.agreement import light_pixels
     from workbench.compare.reference_cache import cached_render
     l0 = load()
@@ -106,7 +126,7 @@ def equal_rmse(scene, size: int, ref_spp: int, spps=(16, 64, 256), seeds=(7, 8, 
     per: dict = {}
     for spp in spps:
         for seed in seeds:
-            for m in VARIANTS:
+            for m in labels:
                 r, e = render(scene, m, size, spp, seed=seed)
                 err2 = (r.image.astype(np.float64) - ref.image) ** 2
                 mse, mse_off = float(np.mean(err2)), float(np.mean(err2[off]))
@@ -129,14 +149,16 @@ def equal_rmse(scene, size: int, ref_spp: int, spps=(16, 64, 256), seeds=(7, 8, 
         f.update(spp_to_target=spp_needed, wall_s_to_target=spp_needed * f["wall_s_per_spp"],
                  cpu_s_to_target=spp_needed * f["cpu_s_per_spp"],
                  efficiency_per_cpu_s=1.0 / (f["c"] ** 2 * f["cpu_s_per_spp"]))
-    M = fit["mitsuba"]
     ratios = {}
-    for m in ("pathtrace", "pathtrace_rr5"):
-        P = fit[m]
-        ratios[m] = {"wall_time_to_equal_rmse_over_mitsuba": P["wall_s_to_target"] / M["wall_s_to_target"],
-                     "cpu_time_to_equal_rmse_over_mitsuba": P["cpu_s_to_target"] / M["cpu_s_to_target"],
-                     "cpu_time_to_equal_rmse_off_light_over_mitsuba":
-                         (P["c_off_light"] ** 2 * P["cpu_s_per_spp"]) / (M["c_off_light"] ** 2 * M["cpu_s_per_spp"])}
+    for a in (x for x in ANCHOR_LABELS if x in fit):
+        M = fit[a]
+        for m in ("pathtrace", "pathtrace_rr5"):
+            P = fit[m]
+            ratios[f"{m}_over_{a}"] = {
+                "wall_time_to_equal_rmse": P["wall_s_to_target"] / M["wall_s_to_target"],
+                "cpu_time_to_equal_rmse": P["cpu_s_to_target"] / M["cpu_s_to_target"],
+                "cpu_time_to_equal_rmse_off_light":
+                    (P["c_off_light"] ** 2 * P["cpu_s_per_spp"]) / (M["c_off_light"] ** 2 * M["cpu_s_per_spp"])}
     out.update(target_excess_rmse=target, fit=fit, ratios=ratios)
     return out
 
@@ -154,50 +176,73 @@ def reference(scene, size: int, target: float) -> dict:
 
 
 def tables(res: dict) -> str:
-    t, q, ref = res["throughput"], res.get("equal_rmse"), res["reference"]
-    b = t["best"]
-    m = b.get("mitsuba")
-    out = [f"{res['image_definition']}.", "",
-           f"## Throughput: `{t['scene']}` at {t['size']} x {t['size']}, {t['spp']} spp, {t['threads']} threads, "
-           "best of the alternating runs", "",
-           table(["method", "sampling wall (s)", "sampling CPU (s)", "samples/s", "samples/CPU-s",
-                  "samples/s over Mitsuba (anchor)", "samples/CPU-s over Mitsuba"],
-                 [[k, e["sample_wall_s"], e["sample_cpu_s"], e["samples_per_s"], e["samples_per_cpu_s"],
-                   ratio(e["samples_per_s"], m["samples_per_s"]) if m else "–",
-                   ratio(e["samples_per_cpu_s"], m["samples_per_cpu_s"]) if m else "–"] for k, e in b.items()])]
-    if "mitsuba" in t and isinstance(t["mitsuba"], str):
-        out.append(t["mitsuba"] + ".\n")
-    if q and "fit" in q:
+    out = [f"{res['image_definition']}.", ""]
+    llvm = res.get("llvm")
+    if llvm:
+        out += [f"Mitsuba `llvm_ad_rgb`: {llvm['status']}" + (f" ({llvm['reason']})" if llvm.get("reason") else "")
+                + f"; `DRJIT_LIBLLVM_PATH` = {llvm.get('drjit_libllvm_path') or 'unset'}.", ""]
+    for t in res["throughput"]:
+        med = t["median"]
+        anchors = [a for a in ANCHOR_LABELS if a in med]
+        head = ["method", "sampling wall (s)", "sampling CPU (s)", "samples/s", "samples/CPU-s"]
+        for a in anchors:
+            head += [f"samples/s over {a}", f"samples/CPU-s over {a}"]
+        rows = []
+        for k, e in med.items():
+            row = [k, e["sample_wall_s"], e["sample_cpu_s"], e["samples_per_s"], e["samples_per_cpu_s"]]
+            for a in anchors:
+                row += [ratio(e["samples_per_s"], med[a]["samples_per_s"]),
+                        ratio(e["samples_per_cpu_s"], med[a]["samples_per_cpu_s"])]
+            rows.append(row)
+        out += [f"## Throughput: `{t['scene']}` at {t['size']} x {t['size']}, {t['spp']} spp, {t['threads']} threads, "
+                f"medians of {next(iter(med.values()))['runs']} alternating runs", "",
+                "Ratios above 1: the row's method is faster than the anchor.", "", table(head, rows), ""]
+        if not anchors:
+            out.append(skip_note("mitsuba") + ".\n")
+    for q in res.get("equal_rmse", []):
+        if "fit" not in q:
+            out.append(f"Equal-RMSE part: {q.get('skipped')}.\n")
+            continue
         r = q["reference"]
-        out += [f"## Time to equal error: {q['size']} x {q['size']}, seeds {q['seeds']}, against Mitsuba at "
-                f"{r['spp']} spp (noise {fmt(r['noise_rms'])})", "",
-                f"Target excess RMSE {fmt(q['target_excess_rmse'])} (pathtrace's at 64 spp).", "",
-                table(["method", "c", "c off the light", "CPU s per spp", "spp to target", "CPU s to target",
-                       "CPU time to equal RMSE over Mitsuba", "same, off the light"],
-                      [[k, f["c"], f["c_off_light"], f["cpu_s_per_spp"], f["spp_to_target"], f["cpu_s_to_target"],
-                        fmt(get_ratio(q, k, "cpu_time_to_equal_rmse_over_mitsuba")),
-                        fmt(get_ratio(q, k, "cpu_time_to_equal_rmse_off_light_over_mitsuba"))]
-                       for k, f in q["fit"].items()])]
-    elif q:
-        out.append(f"Equal-RMSE part: {q.get('skipped')}.\n")
+        anchors = [a for a in ANCHOR_LABELS if a in q["fit"]]
+        head = ["method", "c", "c off the light", "CPU s per spp", "spp to target", "CPU s to target"]
+        for a in anchors:
+            head += [f"CPU time to equal RMSE over {a}", "same, off the light"]
+        rows = []
+        for k, f in q["fit"].items():
+            row = [k, f["c"], f["c_off_light"], f["cpu_s_per_spp"], f["spp_to_target"], f["cpu_s_to_target"]]
+            for a in anchors:
+                rr = q["ratios"].get(f"{k}_over_{a}")
+                row += ["1 (anchor)" if k == a else ("–" if rr is None else fmt(rr["cpu_time_to_equal_rmse"])),
+                        "–" if rr is None else fmt(rr["cpu_time_to_equal_rmse_off_light"])]
+            rows.append(row)
+        out += [f"## Time to equal error: `{q['scene']}` at {q['size']} x {q['size']}, seeds {q['seeds']}, against "
+                f"Mitsuba (`scalar_rgb`) at {r['spp']} spp (noise {fmt(r['noise_rms'])})", "",
+                f"Target excess RMSE {fmt(q['target_excess_rmse'])} (pathtrace's at 64 spp).  Ratios below 1: "
+                "the row's method reaches it in less CPU time than the anchor.", "", table(head, rows), ""]
+    ref = res["reference"]
     out += [f"## Path tracer to noise {ref['target_noise_rms']} at {ref['size']} x {ref['size']}", "",
             table(["spp", "noise reached", "wall (s)", "trace wall (s)", "trace CPU (s)"],
                   [[ref["spp"], ref["reached_noise_rms"], ref["wall_s"], ref["trace_wall_s"], ref["trace_cpu_s"]]])]
     return "\n".join(out)
 
 
-def get_ratio(q, method, key):
-    return q.get("ratios", {}).get(method, {}).get(key, 1.0 if method == "mitsuba" else None)
+def llvm_status() -> dict:
+    """Whether Mitsuba's ``llvm_ad_rgb`` loads here (a tiny render in a child process)."""
+    from workbench.renderers.mitsuba_method import probe_variant
+    ok, why = probe_variant("llvm_ad_rgb")
+    return {"status": "loaded" if ok else "could not load: compared with scalar_rgb only",
+            "reason": None if ok else why, "drjit_libllvm_path": os.environ.get("DRJIT_LIBLLVM_PATH")}
 
 
-PAGE = Page("pathtrace_vs_mitsuba", "The path tracer against Mitsuba 3 on the Cornell box", first_paragraph(__doc__),
+PAGE = Page("pathtrace_vs_mitsuba", "The path tracer against Mitsuba 3 (llvm_ad_rgb and scalar_rgb)", first_paragraph(__doc__),
             "python bench/pathtrace_vs_mitsuba.py", tables, anchors=("mitsuba",),
             smoke_note="16 x 16 at 4 spp; equal RMSE at 8 x 8 against a 16-spp reference")
 
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeat", type=int, default=2)
+    ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--size", type=int, default=256)
     ap.add_argument("--spp", type=int, default=64)
     ap.add_argument("--rmse-size", type=int, default=64)
@@ -217,15 +262,21 @@ def main(argv=None) -> None:
 
     import workbench
     numba.set_num_threads(THREADS)
-    scene = workbench.load_scene("cornell")
-    workbench.render(scene, "pathtrace", width=8, height=8, spp=2)  # JIT compile or cache load, apart
     res = {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "machine": f"{os.cpu_count()} CPUs, shared",
-           "image_definition": "box-filtered pixel average, linear RGB, not clipped (both methods)",
+           "image_definition": "box-filtered pixel average, linear RGB, not clipped (every method)",
            "load_before": load()}
-    res["throughput"] = throughput(scene, a.size, a.spp, a.repeat, have)
-    res["equal_rmse"] = (equal_rmse(scene, a.rmse_size, a.ref_spp, spps, seeds) if have else
-                         {"skipped": skip_note("mitsuba") + " (it makes the shared reference)"})
-    res["reference"] = reference(scene, a.size, a.target)
+    labels = ["pathtrace", "pathtrace_rr5"]
+    if have:
+        res["llvm"] = llvm_status()
+        labels[1:1] = (["mitsuba_llvm"] if res["llvm"]["reason"] is None else []) + ["mitsuba"]
+    res["throughput"], res["equal_rmse"] = [], []
+    for name in SCENES:
+        scene = workbench.load_scene(name)
+        workbench.render(scene, "pathtrace", width=8, height=8, spp=2)  # JIT compile or cache load, apart
+        res["throughput"].append(throughput(scene, a.size, a.spp, a.repeat, labels))
+        res["equal_rmse"].append(dict(equal_rmse(scene, a.rmse_size, a.ref_spp, labels, spps, seeds), scene=name)
+                                 if have else {"skipped": skip_note("mitsuba") + " (it makes the shared reference)"})
+    res["reference"] = reference(workbench.load_scene("cornell"), a.size, a.target)
     res["load_after"] = load()
     print(json.dumps(res, indent=1))
     if not a.quick or out_given or a.smoke:

@@ -40,7 +40,7 @@ def first_hit(geo, scr):
 
 geo = flatten(workbench.load_scene("whitted")).kernel_args()
 if sys.argv[1] == "blob":
-    geo = geo._replace(kinds=kinds_marker(["blob", "prim_tree"]))
+    geo = geo._replace(kinds=kinds_marker(["blob", "analytic"]))
 first_hit(geo, k.scratch())
 compiled = {name: len(f.signatures) for name, f in [
     ("blob", blob_kernels.first), ("isosurface", isosurface_kernels.first),

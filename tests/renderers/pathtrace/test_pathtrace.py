@@ -13,7 +13,7 @@ from pathtrace_scenes import PLANE, scene
 from scipy.stats import chi2
 from statistics_budget import ALPHA, band
 from workbench.core.errors import NotApplicable
-from workbench.renderers.kernels.columns import PathOpt
+from workbench.renderers.kernels.layout import marker_features
 from workbench.renderers.pathtrace import reference
 from workbench.renderers.pathtrace.session import PathTraceSession
 from workbench.scene.library import bundled
@@ -202,6 +202,11 @@ radius = 0.35
 
 
 KERNEL_SCENES = ["cornell_spheres", "glossy", "cornell"]
+
+
+def only_triangles(ses) -> bool:
+    """Whether the session's kernels were compiled for triangles alone (``kernels.cast``)."""
+    return marker_features(ses.geo.kinds) == ("triangles",)
 REFERENCE_SPP = 160
 
 
@@ -209,8 +214,8 @@ def check_kernel_reference(seed: int, tmp_path, names=tuple(KERNEL_SCENES)) -> N
     """At a few pixels the numba kernel and the readable twin (the ray tracer's readable
     intersection, numpy random numbers) agree within the t band of their combined standard
     errors (the twin's 159 degrees of freedom).  On ``cornell`` every primitive is a BVH
-    triangle once its polygons and area light are (``PathOpt.ONLY_TRIANGLES``: each ray goes to the BVH
-    alone), while the twin traces the polygons themselves."""
+    triangle once its polygons and area light are (its kind marker names no analytic row: each ray goes to the
+    BVH alone), while the twin traces the polygons themselves."""
     for name in names:
         _kernel_against_reference(seed, tmp_path, name)
 
@@ -228,7 +233,7 @@ def _kernel_against_reference(seed: int, tmp_path, name: str) -> None:
         sc, w, h, opts = workbench.load_scene(name), 8, 8, dict(fresnel="schlick")
         pixels = [(1, 4), (5, 2), (5, 5), (3, 0), (7, 4)]
     ses = PathTraceSession(sc, w, h, seed=2 * seed + 7, **opts)
-    assert (ses.opts[PathOpt.ONLY_TRIANGLES] == 1.0) == (name == "cornell")
+    assert only_triangles(ses) == (name == "cornell")
     ses.add_samples(2048)
     km = ses.image.reshape(-1, 3)[[i * w + j for i, j in pixels]]
     ks = ses.std_error.reshape(-1, 3)[[i * w + j for i, j in pixels]]
@@ -258,7 +263,7 @@ def test_area_light_traced_as_triangles_keeps_one_emitting_side(tmp_path):
     up = PathTraceSession(_light_over_plane(tmp_path, True), 16, 12, seed=1, pixel_filter="center")
     down = PathTraceSession(_light_over_plane(tmp_path, False), 16, 12, seed=1, pixel_filter="center")
     for ses in (up, down):
-        assert ses.opts[PathOpt.ONLY_TRIANGLES] == 1.0 and len(ses.emitters.cdf) == 2 and (ses.emitters.mesh_tri >= 0).all()
+        assert only_triangles(ses) and len(ses.emitters.cdf) == 2 and (ses.emitters.mesh_tri >= 0).all()
         ses.add_samples(4)
     light = np.float32([3.0, 2.0, 1.0])
     seen = (up.image == light).all(axis=2)        # the front, from above: exactly its radiance
@@ -276,7 +281,7 @@ def check_area_light_triangles(seed: int, tmp_path) -> None:
     sc = _light_over_plane(tmp_path, False)
     tri, poly = (PathTraceSession(sc, 16, 12, seed=s, triangulate=t)
                  for s, t in ((2 * seed, True), (2 * seed + 1, False)))
-    assert poly.opts[PathOpt.ONLY_TRIANGLES] == 0.0
+    assert not only_triangles(poly)
     for ses in (tri, poly):
         ses.add_samples(64)
     se = np.sqrt((tri.std_error.astype(np.float64) ** 2).sum(axis=(0, 1))

@@ -97,8 +97,7 @@ class PathOpt(Columns):
     MEDIA = 14, 4        # their material rows, innermost last
     TRANSPORT = 18       # 0 full, 1 diffuse (see pathtrace.kernels)
     PIXEL_FILTER = 19    # 0 box, 1 pixel centre
-    ONLY_TRIANGLES = 20  # 1: every surface is a triangle (no analytic rows)
-    HAS_MEDIA = 21       # 1: heterogeneous media (hypertextures): tracked, shadow rays see through them
+    HAS_MEDIA = 20       # 1: heterogeneous media (hypertextures): tracked, shadow rays see through them
 
 
 class RayCount(Columns):

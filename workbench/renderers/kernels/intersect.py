@@ -62,7 +62,7 @@ def prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, sh
 
 # ----------------------------------------------------------------------------- gates
 # The walks below compile only for a scene that needs them (see ..kernels.specialise): CSG
-# programs, the analytic primitives' tree, the triangles' tree.  A gate whose feature is absent
+# programs, the analytic primitive rows (their list and their tree), the triangles' tree.  A gate whose feature is absent
 # is never reached (its caller tests the same data first) and compiles to a miss.
 
 def csg_gate(geo, start, length, ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps, levels, stack):
@@ -81,23 +81,42 @@ def _csg_gate(geo, start, length, ox, oy, oz, dx, dy, dz, tmin, tmax, zero, eps,
     return impl
 
 
-def prim_tree_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only, any_hit, zero, eps,
-                   stack, st, sp_, sf, sn):
-    """:func:`prim_tree_hit` if the scene has bounded analytic primitives."""
-    raise TypeError("prim_tree_gate is callable from numba-compiled code only")
+def analytic_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
+                  st, sp_, sf, sn):
+    """Nearest hit over the top-level analytic primitive rows if the scene has any (else a
+    miss): the unbounded rows one by one, then the bounded ones' tree (:func:`prim_tree_hit`).
+    Returns ``(t, prim, face, row)``, ``row = -1`` on a miss; with ``any_hit``, the first hit."""
+    raise TypeError("analytic_gate is callable from numba-compiled code only")
 
 
-@overload(prim_tree_gate, jit_options=INLINE)
-def _prim_tree_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only, any_hit, zero, eps,
-                    stack, st, sp_, sf, sn):
-    on = has(geo.types[-1], "prim_tree")  # geo.kinds' type
+@overload(analytic_gate, jit_options=INLINE)
+def _analytic_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
+                   st, sp_, sf, sn):
+    on = has(geo.types[-1], "analytic")  # geo.kinds' type
 
-    def impl(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only, any_hit, zero, eps,
-             stack, st, sp_, sf, sn):
+    def impl(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
+             st, sp_, sf, sn):
         if on:
-            return prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only,
-                                 any_hit, zero, eps, stack, st, sp_, sf, sn)
-        return best, -1, 0, -1
+            return analytic_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, shadow_only, any_hit, zero, eps,
+                                stack, st, sp_, sf, sn)
+        return tmax, -1, 0, np.int64(-1)
+    return impl
+
+
+def analytic_normal_gate(geo, k, f, x, y, z, stack):
+    """:func:`.shapes.object_normal` of row ``k`` if the scene has analytic rows (a scene of
+    triangles only never asks)."""
+    raise TypeError("analytic_normal_gate is callable from numba-compiled code only")
+
+
+@overload(analytic_normal_gate, jit_options=INLINE)
+def _analytic_normal_gate(geo, k, f, x, y, z, stack):
+    on = has(geo.types[-1], "analytic")
+
+    def impl(geo, k, f, x, y, z, stack):
+        if on:
+            return object_normal(geo.kinds, k, f, geo.ptype, geo.par, geo.aux, x, y, z, stack)
+        return 0.0, 0.0, 1.0
     return impl
 
 
@@ -187,16 +206,13 @@ def reach(best, brow, w, tmax):
 
 
 @nb.njit(**INLINE)
-def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
-            st, sp_, sf, sn):
-    """Nearest hit of a world ray over all primitives: the list of analytic primitives tested
-    one by one, then the analytic primitives' structure, then the triangles' (see
-    :mod:`.accel`).  Returns ``(t, prim, face, tri, b1, b2)``; ``prim = -1`` on a miss,
-    negative ``face`` is never returned (a flipped CSG normal is ``face + 16``)."""
+def analytic_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
+                 st, sp_, sf, sn):
+    """:func:`analytic_gate`'s search: the unbounded rows one by one, then the analytic
+    primitives' tree, coincident surfaces resolved by :func:`nearer`."""
     pfree, shadow = geo.pfree, geo.shadow
-    best, bp, bf, btri, bb1, bb2 = tmax, -1, 0, -1, 0.0, 0.0
+    best, bp, bf = tmax, -1, 0
     brow = np.int64(-1)  # int64, not a literal (see walks.LANE)
-    inv_w = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
     w = eps * inv_w
     for q in range(pfree.shape[0]):
         k = pfree[q]
@@ -207,15 +223,29 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
         if nearer(t, k, best, brow, w, tmax):
             best, bp, bf, brow = t, p, f, k
         if any_hit and bp >= 0:
-            return best, bp, bf, btri, bb1, bb2
+            return best, bp, bf, brow
     if geo.pref.shape[0] > 0 and _bounds_hit(geo.pbounds, ox, oy, oz, dx, dy, dz, tmin, reach(best, brow, w, tmax)):
-        t, p, f, row = prim_tree_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, np.int64(brow),
-                                      np.bool_(shadow_only), np.bool_(any_hit), zero, eps, stack, st,
-                                      sp_, sf, sn)
+        t, p, f, row = prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only,
+                                     any_hit, zero, eps, stack, st, sp_, sf, sn)
         if row >= 0:
             best, bp, bf, brow = t, p, f, row
-            if any_hit:
-                return best, bp, bf, btri, bb1, bb2
+    return best, bp, bf, brow
+
+
+@nb.njit(**INLINE)
+def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
+            st, sp_, sf, sn):
+    """Nearest hit of a world ray over all primitives: the list of analytic primitives tested
+    one by one, then the analytic primitives' structure, then the triangles' (see
+    :mod:`.accel`).  Returns ``(t, prim, face, tri, b1, b2)``; ``prim = -1`` on a miss,
+    negative ``face`` is never returned (a flipped CSG normal is ``face + 16``)."""
+    btri, bb1, bb2 = -1, 0.0, 0.0
+    inv_w = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
+    w = eps * inv_w
+    best, bp, bf, brow = analytic_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, np.bool_(shadow_only),
+                                       np.bool_(any_hit), zero, eps, stack, st, sp_, sf, sn)
+    if any_hit and bp >= 0:
+        return best, bp, bf, btri, bb1, bb2
     lim = reach(best, brow, w, tmax)
     if geo.tri_v.shape[0] > 0 and _bounds_hit(geo.bvh_bounds, ox, oy, oz, dx, dy, dz, tmin, lim):
         t, tri, b1, b2 = triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, lim, np.bool_(any_hit), stack)
@@ -261,7 +291,7 @@ def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_
         return
     f = face - 16 if face >= 16 else face
     sgn = -1.0 if face >= 16 else 1.0
-    ux, uy, uz = object_normal(geo.kinds, k, f, geo.ptype, geo.par, geo.aux, x, y, z, stack)
+    ux, uy, uz = analytic_normal_gate(geo, k, f, x, y, z, stack)
     wx = sgn * (nm[k, 0] * ux + nm[k, 1] * uy + nm[k, 2] * uz)
     wy = sgn * (nm[k, 3] * ux + nm[k, 4] * uy + nm[k, 5] * uz)
     wz = sgn * (nm[k, 6] * ux + nm[k, 7] * uy + nm[k, 8] * uz)

@@ -25,9 +25,11 @@ It bounds the traversal stacks: radiosity's visibility test keeps one pending ch
 level, the 4-wide walks at most three per level (``walks.BVH_STACK``), so neither ever drops
 a node."""
 
-GROUPS = ("csg", "triangles", "prim_tree")
+GROUPS = ("csg", "triangles", "analytic")
 """What a kernel compiles only when the scene has it, besides the kinds with kernel modules of
-their own: CSG programs, the triangles' BVH walk and the analytic primitives' tree walk."""
+their own: CSG programs, the triangles' BVH walk, and the analytic primitive rows (their
+intersection, normals and tree walk: a scene made of triangles only, as the path tracer's
+Cornell box, compiles none of it)."""
 
 
 def marker_name(kind) -> str:

@@ -63,6 +63,7 @@ import math
 
 import numba as nb
 import numpy as np
+from numba.extending import overload
 
 from ..kernels.columns import PATH_COUNTS, Light, Mat, PathCount, PathOpt
 from ..kernels.rng import path_key, rand
@@ -74,6 +75,7 @@ from ..kernels.intersect import closest, scratch, surface
 from ..kernels.media import track
 from ..kernels.optics import _feeler, _light_dir, checker_color, enter_or_leave, fresnel_reflectance
 from ..kernels.shapes import _normalize
+from ..kernels.specialise import has
 from ..kernels.walks import bvh_hit
 from ..raytrace.kernels import MAX_TASKS
 
@@ -145,12 +147,13 @@ def render_samples(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sum
         point / directional lights (``flatten.light_rows``, area lights excluded).
     emitters : :meth:`.emitters.Emitters.arrays`.
     cam : (16,) ``raytrace.whitted.camera_frame``.
-    opts : (21,) float64: fresnel (0 none, 1 Schlick, 2 exact), tol.ray_offset, tol.t_min,
-        tol.zero, extent, tol.normal_cancel, rr_start, max_bounces, textures on, MIS exponent,
-        background RGB (3), media around the camera (count, then 4 material rows), transport
-        (0 full, 1 diffuse, 2 eye_specular: see the module docstring), pixel filter (0 box:
-        uniform jitter in the pixel, 1 centre: every sample through the pixel's centre), only
-        BVH triangles (1: no top-level analytic primitive, see :func:`cast`).
+    opts : (PATH_OPTS,) float64, the columns of :class:`..kernels.columns.PathOpt`: fresnel (0
+        none, 1 Schlick, 2 exact), tol.ray_offset, tol.t_min, tol.zero, extent,
+        tol.normal_cancel, rr_start, max_bounces, textures on, MIS exponent, background RGB
+        (3), media around the camera (count, then 4 material rows), transport (0 full, 1
+        diffuse, 2 eye_specular: see the module docstring), pixel filter (0 box: uniform
+        jitter in the pixel, 1 centre: every sample through the pixel's centre), heterogeneous
+        media present.
     seed, s0, nsamp : int.
     sums, sumsq : (H*W, 3) float64, updated: sum and sum of squares of the sample radiances.
     counts : (PATH_COUNTS,) int64, updated (see ``PATH_COUNTS``).
@@ -204,21 +207,30 @@ def cast_all(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr):
                    sp_, sf, sn)
 
 
-@nb.njit(**INLINE)
-def cast(geo, bvh, tri_prim, only_tris, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr):
+def cast(geo, bvh, tri_prim, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr):
     """The hit of every ray of a path (camera, extension and shadow rays), as
-    :func:`..kernels.intersect.closest` returns it.  ``only_tris`` (``opts[PathOpt.ONLY_TRIANGLES]``: every
-    primitive a BVH triangle, no top-level analytic primitive, as the Cornell box once its
-    polygons and area light are triangles, :mod:`.geometry`): straight to
-    :func:`..kernels.walks.bvh_hit`, which is all ``closest`` would do (its loop over analytic
-    primitives is empty and its box test the BVH root's); the call then passes the BVH's five
-    arrays instead of the geometry's 21 (measured: 30-40 % of a ray's time in this scene)."""
-    if only_tris:
-        t, tri, b1, b2 = bvh_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, scr[0])
-        if tri < 0:
-            return np.inf, -1, 0, -1, 0.0, 0.0
-        return t, tri_prim[tri], 0, tri, b1, b2
-    return cast_all(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr)
+    :func:`..kernels.intersect.closest` returns it.  For a scene of triangles only (no
+    top-level analytic row: the kind marker has ``triangles`` and not ``analytic``, as the
+    Cornell box once its polygons and area light are triangles, :mod:`.geometry`): straight to
+    :func:`..kernels.walks.bvh_hit`, which is all ``closest`` would do; the call then passes
+    the BVH's five arrays instead of the geometry record, and ``closest`` is never compiled."""
+    raise TypeError("cast is callable from numba-compiled code only")
+
+
+@overload(cast, jit_options=INLINE)
+def _cast(geo, bvh, tri_prim, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr):
+    kinds = geo.types[-1]  # geo.kinds' type
+    if has(kinds, "triangles") and not has(kinds, "analytic"):
+        def impl(geo, bvh, tri_prim, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr):
+            t, tri, b1, b2 = bvh_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, scr[0])
+            if tri < 0:
+                return np.inf, -1, 0, -1, 0.0, 0.0
+            return t, tri_prim[tri], 0, tri, b1, b2
+        return impl
+
+    def impl(geo, bvh, tri_prim, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr):
+        return cast_all(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr)
+    return impl
 
 
 @nb.njit(**NO_REFCOUNT)
@@ -231,7 +243,6 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
     tri_e = geo.tri_e
     tri_prim = geo.tri_prim
     bvh = (geo.bvh_node, geo.bvh_child, geo.bvh_leaf, geo.bvh_first, geo.bvh_tv4)
-    only_tris = opts[PathOpt.ONLY_TRIANGLES] > 0.5
     h_ng, h_ns, h_uv, h_po, h_ev, stk = rows
     fres = int(opts[PathOpt.FRESNEL])
     ray_off, t_min, zero = opts[PathOpt.RAY_OFFSET], opts[PathOpt.T_MIN], opts[PathOpt.ZERO]
@@ -257,7 +268,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
     for bounce in range(max_bounces):
         dim = 2 + 8 * bounce
         eps = ray_off * max(max(abs(ox), abs(oy), abs(oz)), extent)
-        t, k, f, tri, b1, b2 = cast(geo, bvh, tri_prim, only_tris, ox, oy, oz, dx, dy, dz, tmin, np.inf, np.bool_(False), zero, eps, scr)
+        t, k, f, tri, b1, b2 = cast(geo, bvh, tri_prim, ox, oy, oz, dx, dy, dz, tmin, np.inf, np.bool_(False), zero, eps, scr)
         if k < 0:
             counts[PathCount.ESCAPED_PATHS] += 1
             if transport == 0 or eye:  # diffuse transport: the background is seen, it lights nothing
@@ -426,7 +437,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                                                                  wz / wd, tmin_here, wd - 2.0 * off, zero, off, key,
                                                                  mdim, scr)
                             elif wd > 2.0 * off:
-                                _, kb, _, _, _, _ = cast(geo, bvh, tri_prim, only_tris, sx_, sy_, sz_, wx / wd,
+                                _, kb, _, _, _, _ = cast(geo, bvh, tri_prim, sx_, sy_, sz_, wx / wd,
                                                          wy / wd, wz / wd, tmin_here, wd - 2.0 * off,
                                                          np.bool_(True), zero, off, scr)
                                 vis = 1.0 if kb < 0 else 0.0
@@ -446,7 +457,7 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                     vis, mdim = shadow_gate(geo, mat_of, mat_tab, sx_, sy_, sz_, lx, ly, lz, tmin_here, tmx,
                                                      zero, off, key, mdim, scr)
                 else:
-                    _, kb, _, _, _, _ = cast(geo, bvh, tri_prim, only_tris, sx_, sy_, sz_, lx, ly, lz, tmin_here, tmx, np.bool_(True), zero, off, scr)
+                    _, kb, _, _, _, _ = cast(geo, bvh, tri_prim, sx_, sy_, sz_, lx, ly, lz, tmin_here, tmx, np.bool_(True), zero, off, scr)
                     vis = 1.0 if kb < 0 else 0.0
                 if vis <= 0.0:
                     continue

@@ -77,7 +77,8 @@ class PathTraceSession:
     max_bounces : hard stop of a path (>= 1).  mis : ``power`` (exponent 2) or ``balance``.
     triangulate : trace plain opaque polygons and rectangles, and convex area lights, as
     triangles through the BVH (:mod:`.geometry`; the same surfaces, faster: a scene of triangles
-    only casts every ray straight into the BVH, ``PathOpt.ONLY_TRIANGLES``), else as the ray tracer's polygons.
+    only casts every ray straight into the BVH and compiles no analytic primitive's code:
+    ``kernels.cast``), else as the ray tracer's polygons.
     transport : ``full`` | ``diffuse`` | ``eye_specular`` (:data:`TRANSPORT`; the latter two
     ignore point and directional lights, textures and vertex emission).
     pixel_filter : ``box`` | ``center`` (:data:`PIXEL_FILTER`).
@@ -154,7 +155,7 @@ class PathTraceSession:
                          max_bounces=max_bounces, textured=self.textured, mis_beta=MIS[mis],
                          background=background, n_media=len(media), media=media + [0] * (4 - len(media)),
                          transport=TRANSPORT[transport], pixel_filter=PIXEL_FILTER[pixel_filter],
-                         only_triangles=len(sd.tri_v) > 0 and not sd.top.any(), has_media=sd.has_media)
+                         has_media=sd.has_media)
         self.shading = (sd.mat, sd.mat_tab, np.ascontiguousarray(tex), lights)
         self.geo = sd.kernel_args()
         self.cam = camera_frame(self.scene.camera, self.width, self.height)

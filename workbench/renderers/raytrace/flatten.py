@@ -116,8 +116,8 @@ class SceneData:
         their own, and CSG: all of them if the scene has any among its rows, CSG leaves
         included), the media kinds (hypertexture, fur: all of them if the scene has one),
         each plugin kind the scene has (:func:`workbench.scene.kinds.register`), and the
-        triangles' tree (if the scene has triangles).  The analytic primitives' tree walk is
-        always compiled."""
+        triangles' tree (if the scene has triangles) and the analytic rows (if it has a top-level
+        row that is not a mesh: :attr:`top`)."""
         present = {int(p) for p in np.unique(self.ptype)}
         package = [k for k in kernel_kinds() if k.TYPE in PACKAGE_KINDS and not getattr(k, "MEDIUM", False)]
         out = []
@@ -129,7 +129,9 @@ class SceneData:
         out += [marker_name(k) for k in kernel_kinds() if k.TYPE not in PACKAGE_KINDS and k.PTYPE in present]
         if len(self.tri_v):
             out.append("triangles")
-        return tuple(out) + ("prim_tree",)
+        if self.top.any():
+            out.append("analytic")
+        return tuple(out)
 
     def kernel_args(self) -> Geometry:
         """The geometry record passed to every numba kernel, its kind marker naming
