@@ -113,8 +113,10 @@ def _build_nodes(tb, idx, s0, e0, depth0, bounds0, limit):
     ``idx`` (T,), reordered in place, from a node at depth ``depth0`` with box and centroid
     bounds ``bounds0`` (12,); at most ``limit`` nodes are made.  Returns the nodes' boxes
     (n, 6) and meta (n, 3) (numbered from 0 at this range's root; leaves' ``first`` index
-    ``tb``) and the nodes still pending (k, 5) ``(start, end, parent, is_right, depth)``
-    with their bounds (k, 12), right child first: none unless the limit was reached.
+    ``tb``; views of the arrays allocated for ``limit`` nodes, not copied: the caller's
+    concatenation or collapse copies them) and the nodes still pending (k, 5) ``(start, end,
+    parent, is_right, depth)`` with their bounds (k, 12), right child first: none unless the
+    limit was reached.
     The boxes are kept in the order of ``idx`` (swapped with it), so that every pass over a
     node's range reads memory in sequence; a box's centroid (its centre) is recomputed where
     needed rather than stored and swapped beside it (less memory traffic, the same values); a
@@ -253,7 +255,7 @@ def _build_nodes(tb, idx, s0, e0, depth0, bounds0, limit):
         stack[sp, 0], stack[sp, 1], stack[sp, 2], stack[sp, 3], stack[sp, 4] = s, mid, node, 0, depth + 1
         bounds[sp, :] = acc[:12]
         sp += 1
-    return box[:n_nodes].copy(), meta[:n_nodes].copy(), stack[:sp].copy(), bounds[:sp].copy()
+    return box[:n_nodes], meta[:n_nodes], stack[:sp].copy(), bounds[:sp].copy()
 
 
 PARALLEL_MIN = 4096
