@@ -13,22 +13,29 @@ the bundled ``mesh`` scene's 81,920 triangles and camera, in one run (issue #28,
    centres, :meth:`workbench.scene.model.Camera.rays`) against the mesh alone (the scene's
    floor is left out: Embree gets only triangles).  Ours: the ray caster's closest-hit kernel
    ``trace_batch`` (:mod:`workbench.renderers.raytrace.kernels`: the BVH walk of
-   :mod:`workbench.renderers.kernels.walks` and the hit's surface data: normals, uv), as the
-   public ``workbench.raytrace.intersect`` calls it, on numba's threads, warm.  Embree:
+   :mod:`workbench.renderers.kernels.walks` and the hit's geometric normal), as the
+   public ``workbench.raytrace.intersect`` calls it (its arrays allocated), on numba's
+   threads, warm.  Embree:
    ``EmbreeScene.run(origins, directions, output=1)`` (distance, barycentrics, geometric
    normal and triangle of each ray, one ``rtcIntersect1`` per ray on one thread), the same
    rays in float32.  Also ours without the surface data: ``kernels.intersect.closest`` alone
-   over the rays (:func:`closest_kernel`), the traversal nearer to what ``run`` does.  The hits are compared (hit or miss per ray; distance within a relative
+   over the rays (:func:`closest_kernel`), the traversal nearer to what ``run`` does, and
+   ``trace_batch`` with the whole surface data of the Whitted wavefront (shading normal, uv,
+   object-space point, vertex emission).  The hits are compared (hit or miss per ray; distance within a relative
    ``T_RTOL``; geometric normals parallel), so that both answer the same question.
 
 Each quantity is measured ``--runs`` times, Embree's and ours alternating (A B A B: the
-machine is shared and its load comes and goes), wall and CPU seconds (``time.process_time``:
+machine is shared and its load comes and goes; our three ray measurements take turns at running
+first after Embree's, whose run leaves the caches holding its own tree: the one run right
+after another of ours over the same rays and tree measured 3-8 % more rays per CPU-second,
+on a loaded machine), wall and CPU seconds (``time.process_time``:
 every thread of this process, so Embree's TBB threads and numba's alike); the tables give the
 medians and their ratios.  Rays per CPU-second is the fair figure on a loaded machine with
 threads on one side and one thread on the other; on an idle one the CPU seconds also count the
 time thread pools spend waiting actively for work (numba's OpenMP workers, Embree's TBB workers
-after a build), so that CPU can exceed wall times the threads at work.  Timing is never a
-pass/fail test.
+after a build), so that CPU can exceed wall times the threads at work; numba's OpenMP workers
+(GNU libgomp) spin after each parallel kernel unless ``OMP_WAIT_POLICY=passive`` is set in
+the environment before the run (recorded in the results).  Timing is never a pass/fail test.
 
 Writes ``bench/results/embree.json`` and ``docs/benchmarks/embree.md``.  Run:
 ``.venv/bin/python bench/embree.py [--size 640x480] [--runs 7]``.  Without ``embreex`` our side
@@ -37,6 +44,7 @@ is measured alone (its columns skipped).  ``--smoke``: 64 x 48 rays, 2 runs each
 from __future__ import annotations
 
 import argparse
+import os
 import time
 from dataclasses import replace
 
@@ -131,9 +139,12 @@ class OurSide:
         self._closest(self.geo, O, D, self.tol.zero, self.tol.ray_offset, self.sd.extent, t, tri)
         return t, tri
 
-    def trace(self, O, D):
+    def trace(self, O, D, surface=False):
+        """``trace_batch`` over the rays as ``intersect`` calls it (the geometric normal alone),
+        or with ``surface``, the wavefront's whole surface data (shading normal, uv, object
+        point, vertex emission)."""
         n = len(O)
-        h = self.alloc(n)
+        h = self.alloc(n, surface)
         self.kernels.trace_batch(self.geo, O, D, np.zeros(n), np.full(n, np.inf), self.tol.zero,
                                  self.tol.ray_offset, self.sd.extent, self.tol.normal_cancel, False, h["t"],
                                  h["prim"], h["ng"], h["ns"], h["uv"], h["po"], h["ev"])
@@ -218,6 +229,7 @@ def main(argv=None) -> dict:
             print(f"embree: {skip_note('embreex')} ({e})", flush=True)
     res = dict(scene="mesh", triangles=int(len(tri)), vertices_embree=int(len(V32)), size=f"{w}x{h}",
                rays=int(len(O)), runs=args.runs, numba_threads=int(numba.get_num_threads()),
+               omp_wait_policy=os.environ.get("OMP_WAIT_POLICY", "(unset)"),
                embree_version=emb.embree_version if emb else None)
 
     # ---- 1. build, alternating
@@ -236,28 +248,31 @@ def main(argv=None) -> dict:
     # ---- 2. primary rays, alternating (both warm: one untimed pass first)
     ours = OurSide(mesh_scene)
     h_ours = ours.trace(O, D)
+    res["numba_threading_layer"] = numba.threading_layer()  # the one loaded (after a parallel kernel ran)
     t_c, _ = ours.closest(O, D)
     res["closest_only_same_t"] = bool(np.array_equal(t_c, np.where(h_ours["prim"] >= 0, h_ours["t"], np.inf)))
     if emb:
         sc = emb.build(V32, F32)[0]
         h_emb = emb.trace(sc, O32, D32)
         res["hits"] = compare_hits(h_ours, h_emb)
-    r_ours, r_emb, r_cl = [], [], []
+    r_ours, r_emb, r_cl, r_full = [], [], [], []
     n = len(O)
-    for _ in range(args.runs):
+    ours_fns = ((r_ours, lambda: ours.trace(O, D)), (r_cl, lambda: ours.closest(O, D)),
+                (r_full, lambda: ours.trace(O, D, surface=True)))
+    for run in range(args.runs):
         if emb:
             _, wall, cpu = timed(lambda: emb.trace(sc, O32, D32))
             r_emb.append(dict(wall_s=wall, cpu_s=cpu, mrays_per_s=n / wall / 1e6,
                               mrays_per_cpu_s=n / max(cpu, 1e-9) / 1e6))
-        _, wall, cpu = timed(lambda: ours.trace(O, D))
-        r_ours.append(dict(wall_s=wall, cpu_s=cpu, mrays_per_s=n / wall / 1e6,
-                           mrays_per_cpu_s=n / max(cpu, 1e-9) / 1e6))
-        _, wall, cpu = timed(lambda: ours.closest(O, D))
-        r_cl.append(dict(wall_s=wall, cpu_s=cpu, mrays_per_s=n / wall / 1e6,
-                         mrays_per_cpu_s=n / max(cpu, 1e-9) / 1e6))
+        for k in range(len(ours_fns)):  # our three in turn first after Embree's (its caches' state)
+            runs, fn = ours_fns[(run + k) % len(ours_fns)]
+            _, wall, cpu = timed(fn)
+            runs.append(dict(wall_s=wall, cpu_s=cpu, mrays_per_s=n / wall / 1e6,
+                             mrays_per_cpu_s=n / max(cpu, 1e-9) / 1e6))
     res["primary"] = dict(ours=median_of(r_ours), ours_runs=r_ours,
                        embree=median_of(r_emb) if emb else None, embree_runs=r_emb,
-                       ours_closest=median_of(r_cl), ours_closest_runs=r_cl)
+                       ours_closest=median_of(r_cl), ours_closest_runs=r_cl,
+                       ours_surface=median_of(r_full), ours_surface_runs=r_full)
     print(tables(res), flush=True)
     return PAGE.write(args, res)
 
@@ -269,7 +284,8 @@ def tables(res: dict) -> str:
     anchor = (f"Embree {res['embree_version']}" if res.get("embree_version") else "Embree") + " (embreex)"
     lines = [f"Mesh scene: {res['triangles']} triangles; {res['rays']} camera rays ({res['size']}); "
              f"medians of {runs} runs each, Embree's and ours alternating; numba threads: "
-             f"{res.get('numba_threads')}.  The ratio columns are ours over Embree's (time: below 1 is "
+             f"{res.get('numba_threads')} (threading layer {res.get('numba_threading_layer', '?')}, "
+             f"OMP_WAIT_POLICY {res.get('omp_wait_policy', '?')}).  The ratio columns are ours over Embree's (time: below 1 is "
              "faster; rate: above 1 is faster).", "",
              "## BVH build", "",
              table(["", "ours: build_bvh4 (ms)", f"{anchor}: commit (ms)", "ours / Embree",
@@ -281,23 +297,29 @@ def tables(res: dict) -> str:
              "arrays into Embree's buffers in the wrapper's own loops (no Embree work): a cost of the "
              "binding, shown apart.", "",
              "## Primary rays (closest hit)", "",
-             table(["", "ours: trace_batch", f"{anchor}: run(output=1)", "ours / Embree"],
+             table(["", "ours: trace_batch (t, primitive, geometric normal)", f"{anchor}: run(output=1)",
+                    "ours / Embree"],
                    [["M rays per CPU-second", ro["mrays_per_cpu_s"], re_.get("mrays_per_cpu_s"),
                      ratio(ro["mrays_per_cpu_s"], re_.get("mrays_per_cpu_s"))],
                     ["M rays per second (wall)", ro["mrays_per_s"], re_.get("mrays_per_s"),
                      ratio(ro["mrays_per_s"], re_.get("mrays_per_s"))],
                     ["wall (ms)", 1e3 * ro["wall_s"], 1e3 * re_["wall_s"] if re_ else None, ratio(ro["wall_s"], re_.get("wall_s"))],
                     ["CPU (ms)", 1e3 * ro["cpu_s"], 1e3 * re_["cpu_s"] if re_ else None, ratio(ro["cpu_s"], re_.get("cpu_s"))]])]
-    rc = res["primary"].get("ours_closest")
+    rc, rs = res["primary"].get("ours_closest"), res["primary"].get("ours_surface")
     if rc:
-        lines += ["The closest hits alone (`kernels.intersect.closest`, the function `trace_batch` calls for "
-                  "each ray, without the surface data: normals, uv; the same distances: "
-                  f"{fmt(res.get('closest_only_same_t'))}):", "",
-                  table(["", "ours: closest only", "Embree", "ours / Embree"],
-                        [["M rays per CPU-second", rc["mrays_per_cpu_s"], re_.get("mrays_per_cpu_s"),
-                          ratio(rc["mrays_per_cpu_s"], re_.get("mrays_per_cpu_s"))],
-                         ["M rays per second (wall)", rc["mrays_per_s"], re_.get("mrays_per_s"),
-                          ratio(rc["mrays_per_s"], re_.get("mrays_per_s"))]])]
+        rows = [("closest only", rc)] + ([("trace_batch with the whole surface data", rs)] if rs else [])
+        lines += ["`trace_batch` as `workbench.raytrace.intersect` calls it (above: the distance, the "
+                  "primitive and the geometric normal of each hit, as Embree's `run(output=1)` gives "
+                  "them, with barycentrics); below, the closest hits alone (`kernels.intersect.closest`, "
+                  "the function `trace_batch` calls for each ray; the same distances: "
+                  f"{fmt(res.get('closest_only_same_t'))}) and `trace_batch` with the whole surface data "
+                  "the Whitted wavefront needs (shading normal, uv, object-space point, vertex emission: "
+                  "the arrays of every ray allocated, the hit triangle's normals, uv and emission read):", "",
+                  table(["ours", "M rays per CPU-second", "ours / Embree", "M rays per second (wall)",
+                         "ours / Embree"],
+                        [[name, r["mrays_per_cpu_s"], ratio(r["mrays_per_cpu_s"], re_.get("mrays_per_cpu_s")),
+                          r["mrays_per_s"], ratio(r["mrays_per_s"], re_.get("mrays_per_s"))]
+                         for name, r in rows])]
     hits = res.get("hits")
     if hits:
         lines += ["## Same hits?", "",

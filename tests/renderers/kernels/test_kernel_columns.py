@@ -9,14 +9,14 @@ import pytest
 
 from workbench.renderers.kernels import columns as C
 from workbench.core.columns import Columns, cell, pack, width
-from workbench.renderers.kernels.columns import Light, Mat, PathOpt, Tex, WhittedOpt
+from workbench.renderers.kernels.columns import Light, Mat, PathOpt, Tex, TraversalCount, WalkCount, WhittedOpt
 from workbench.renderers.raytrace.flatten import NPAR, flatten, light_rows
 from workbench.scene import model as m
 from workbench.scene.io import scene_from_dict
 from workbench.scene.kinds import KINDS
 from workbench.scene.kinds.aux_rows import AUX_OFFSET
 
-TABLES = (Mat, Light, Tex, WhittedOpt, PathOpt)
+TABLES = (Mat, Light, Tex, WhittedOpt, PathOpt, WalkCount, TraversalCount)
 KIND_PARS = tuple(k.Par for k in KINDS.values() if hasattr(k, "Par"))
 
 

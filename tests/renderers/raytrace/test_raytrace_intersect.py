@@ -235,6 +235,36 @@ def test_vertex_normals_do_not_change_geometric_normal(blob):
     assert n[0] @ [0, 0, -1] > 0.5
 
 
+def test_geometric_normal_alone_equals_the_whole_surface_data(blob):
+    """``trace_batch`` without the surface arrays (as ``intersect`` calls it) gives the same
+    distances, primitives and geometric normals, to the bit, as with them: a mesh, a sphere
+    and a CSG difference (a flipped face) in one scene."""
+    from workbench.core.tol import tol
+    from workbench.renderers.raytrace.flatten import flatten
+    from workbench.renderers.raytrace.whitted import _alloc, _kernels
+    V, F = blob
+    sc = scene([{"type": "mesh", "vertices": V.tolist(), "faces": F.tolist()},
+                {"type": "sphere", "center": [3, 0, 0], "radius": 1.0},
+                {"type": "csg", "op": "difference", "left": {"type": "box", "min": [-4, -1, -1], "max": [-2, 1, 1]},
+                 "right": {"type": "sphere", "center": [-3, 0, -1], "radius": 0.5}}])
+    rng = np.random.default_rng(9)
+    n = 600
+    O = np.c_[rng.uniform(-5, 5, n), rng.uniform(-2, 2, n), np.full(n, -10.0)]
+    D = np.c_[rng.normal(0, 0.02, (n, 2)), np.ones(n)]
+    sd = flatten(sc)
+    out = []
+    for surface in (True, False):
+        h = _alloc(n, surface)
+        _kernels().trace_batch(sd.kernel_args(), O, D, np.zeros(n), np.full(n, np.inf), tol.zero, tol.ray_offset,
+                               sd.extent, tol.normal_cancel, False, h["t"], h["prim"], h["ng"], h["ns"], h["uv"],
+                               h["po"], h["ev"])
+        hit = h["prim"] >= 0
+        out.append((h["t"], h["prim"], h["ng"][hit]))
+    assert len(set(sd.obj[out[0][1][out[0][1] >= 0]])) == 3  # every object hit
+    for a, b in zip(*out):
+        assert np.array_equal(a, b)
+
+
 # --------------------------------------------------------------------------- self-intersection
 @settings(max_examples=40, deadline=None, derandomize=True)
 @given(seed=st.integers(0, 10_000), scale=st.sampled_from([1e-6, 1e-3, 1.0, 1e3, 1e6]))

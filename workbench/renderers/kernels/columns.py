@@ -1,5 +1,5 @@
 """Named columns of the tables the numba kernels read: materials, lights, fused checker
-textures, and the Whitted and path-tracing options (:class:`workbench.core.columns.Columns`:
+textures, the Whitted and path-tracing options and the kernels' counters (:class:`workbench.core.columns.Columns`:
 ``NAME = first, span``).  The builders (``workbench.renderers.raytrace.flatten``'s
 ``_material_row`` and ``light_rows``, ``whitted.fused_textures``, the sessions' options) write
 by name through :func:`~workbench.core.columns.pack`.  The primitive table's per-kind
@@ -126,6 +126,24 @@ class PathCount(Columns):
     ENDED_BY_BOUNCE_CAP = 6  # paths stopped at ``max_bounces``
 
 
+class WalkCount(Columns):
+    """The two counters of a counting tree walk (:func:`.walks.bvh_walk`,
+    :func:`.intersect.prim_tree_walk` with ``count``), a run of :class:`TraversalCount`."""
+
+    NODES = 0                # 4-wide nodes visited
+    TESTS = 1                # primitive tests (triangles: four per leaf group)
+
+
+class TraversalCount(Columns):
+    """Per-ray traversal statistics ``(N, TRAVERSAL_COUNTS)``
+    (:mod:`workbench.renderers.raytrace.traversal_stats`): a :class:`WalkCount` pair per
+    structure."""
+
+    TRIANGLES = 0, 2         # the triangles' BVH: nodes, tests
+    ANALYTIC = 2, 2          # the analytic primitives' tree (and list): nodes, tests
+
+
 MAT_COLS, LIGHT_COLS, TEX_COLS = width(Mat), width(Light), width(Tex)
 WHITTED_OPTS, PATH_OPTS = width(WhittedOpt), width(PathOpt)
 RAY_COUNTS, PATH_COUNTS = width(RayCount), width(PathCount)
+TRAVERSAL_COUNTS = width(TraversalCount)

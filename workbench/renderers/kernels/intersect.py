@@ -14,6 +14,7 @@ from numba.extending import overload
 from ...scene.kinds import CSGNODE
 from ...scene.kinds.csg import CSG_DEPTH, Par as CsgPar
 from ...scene.kinds.expression import MAX_STACK
+from .columns import WalkCount
 from .flags import GATE, INLINE
 from .shapes import CSG_EVENTS, _normalize, _to_object, csg_hit, object_normal, prim_hit
 from .specialise import has
@@ -141,8 +142,9 @@ def _triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
 def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only, any_hit, zero, eps,
                    stack, st, sp_, sf, sn, count, cnt):
     """:func:`prim_tree_hit`; with ``count`` (the traversal statistics' pass,
-    :mod:`.traversal_stats`) it adds the 4-wide nodes visited to ``cnt[0]`` and the primitive
-    tests to ``cnt[1]`` (the rendering kernels pass ``False``: no counting)."""
+    :mod:`.traversal_stats`) it adds the 4-wide nodes visited to ``cnt[WalkCount.NODES]`` and
+    the primitive tests to ``cnt[WalkCount.TESTS]`` (:class:`.columns.WalkCount`; the
+    rendering kernels pass ``False``: no counting)."""
     shadow, pnode, pchild, pleaf, pref = geo.shadow, geo.pnode, geo.pchild, geo.pleaf, geo.pref
     ray = node_ray(ox, oy, oz, dx, dy, dz, tmin)
     w = eps * inv_w  # coincidence window in ray parameter units (see :func:`nearer`)
@@ -154,7 +156,7 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, s
     while True:
         while code >= 0:
             if count:
-                cnt[0] += 1
+                cnt[WalkCount.NODES] += 1
             sp, code = open_node((pnode, pchild), code, ray, lim, stack, sp, top_)
         if code < -1:
             lf = -2 - code
@@ -163,7 +165,7 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, s
                 if shadow_only and not shadow[k]:
                     continue
                 if count:
-                    cnt[1] += 1
+                    cnt[WalkCount.TESTS] += 1
                 # up to best and its window: a coincident surface of a lower row wins
                 t, p, f = row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, np.nextafter(lim, np.inf),
                                   zero, eps, stack, st, sp_, sf, sn)
@@ -257,22 +259,52 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
 
 
 @nb.njit(**INLINE)
-def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_uv, out_po, out_e, i,
-            stack):
-    """Geometric (outward) normal, shading normal, uv (meshes; analytic primitives leave the
-    mapping to the texturing module), object-space point and vertex emission at a hit, written
-    to row ``i`` of the output arrays (``stack``: scratch of an isosurface's gradient)."""
-    xf, nm, tri_v, tri_n, tri_uv, tri_e = geo.xf, geo.nm, geo.tri_v, geo.tri_n, geo.tri_uv, geo.tri_e
+def object_point(geo, k, px, py, pz):
+    """The world point ``(px, py, pz)`` in row ``k``'s object space."""
+    xf = geo.xf
     x = xf[k, 0] * px + xf[k, 1] * py + xf[k, 2] * pz + xf[k, 3]
     y = xf[k, 4] * px + xf[k, 5] * py + xf[k, 6] * pz + xf[k, 7]
     z = xf[k, 8] * px + xf[k, 9] * py + xf[k, 10] * pz + xf[k, 11]
+    return x, y, z
+
+
+@nb.njit(**INLINE)
+def geometric_normal(geo, k, face, tri, x, y, z, stack):
+    """Unit outward geometric normal (world space) at a hit of row ``k``: of triangle ``tri``
+    (its edges' cross product), or of the analytic primitive's ``face`` at the object-space
+    point ``(x, y, z)`` (:func:`object_point`; the inverse transpose ``nm`` takes it to world
+    space; a flipped CSG face, ``face + 16``, turns it round).  ``stack``: scratch of an
+    isosurface's gradient."""
+    if tri >= 0:
+        tri_v = geo.tri_v
+        e1x, e1y, e1z = tri_v[tri, 3] - tri_v[tri, 0], tri_v[tri, 4] - tri_v[tri, 1], tri_v[tri, 5] - tri_v[tri, 2]
+        e2x, e2y, e2z = tri_v[tri, 6] - tri_v[tri, 0], tri_v[tri, 7] - tri_v[tri, 1], tri_v[tri, 8] - tri_v[tri, 2]
+        return _normalize(e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x)
+    nm = geo.nm
+    f = face - 16 if face >= 16 else face
+    sgn = -1.0 if face >= 16 else 1.0
+    ux, uy, uz = analytic_normal_gate(geo, k, f, x, y, z, stack)
+    wx = sgn * (nm[k, 0] * ux + nm[k, 1] * uy + nm[k, 2] * uz)
+    wy = sgn * (nm[k, 3] * ux + nm[k, 4] * uy + nm[k, 5] * uz)
+    wz = sgn * (nm[k, 6] * ux + nm[k, 7] * uy + nm[k, 8] * uz)
+    return _normalize(wx, wy, wz)
+
+
+@nb.njit(**INLINE)
+def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_uv, out_po, out_e, i,
+            stack):
+    """Geometric (outward) normal (:func:`geometric_normal`), shading normal, uv (meshes;
+    analytic primitives leave the mapping to the texturing module), object-space point and
+    vertex emission at a hit, written to row ``i`` of the output arrays (``stack``: scratch
+    of an isosurface's gradient)."""
+    tri_n, tri_uv, tri_e = geo.tri_n, geo.tri_uv, geo.tri_e
+    x, y, z = object_point(geo, k, px, py, pz)
     out_po[i, 0], out_po[i, 1], out_po[i, 2] = x, y, z
     out_uv[i, 0], out_uv[i, 1] = 0.0, 0.0
     out_e[i, 0], out_e[i, 1], out_e[i, 2] = 0.0, 0.0, 0.0
+    gx, gy, gz = geometric_normal(geo, k, face, tri, x, y, z, stack)
+    out_ng[i, 0], out_ng[i, 1], out_ng[i, 2] = gx, gy, gz
     if tri >= 0:
-        e1x, e1y, e1z = tri_v[tri, 3] - tri_v[tri, 0], tri_v[tri, 4] - tri_v[tri, 1], tri_v[tri, 5] - tri_v[tri, 2]
-        e2x, e2y, e2z = tri_v[tri, 6] - tri_v[tri, 0], tri_v[tri, 7] - tri_v[tri, 1], tri_v[tri, 8] - tri_v[tri, 2]
-        gx, gy, gz = _normalize(e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x)
         b0 = 1.0 - b1 - b2
         sx = b0 * tri_n[tri, 0] + b1 * tri_n[tri, 3] + b2 * tri_n[tri, 6]
         sy = b0 * tri_n[tri, 1] + b1 * tri_n[tri, 4] + b2 * tri_n[tri, 7]
@@ -286,17 +318,8 @@ def surface(geo, k, face, tri, b1, b2, px, py, pz, ncancel, out_ng, out_ns, out_
         out_uv[i, 1] = b0 * tri_uv[tri, 1] + b1 * tri_uv[tri, 3] + b2 * tri_uv[tri, 5]
         for c in range(3):
             out_e[i, c] = b0 * tri_e[tri, c] + b1 * tri_e[tri, 3 + c] + b2 * tri_e[tri, 6 + c]
-        out_ng[i, 0], out_ng[i, 1], out_ng[i, 2] = gx, gy, gz
         out_ns[i, 0], out_ns[i, 1], out_ns[i, 2] = sx, sy, sz
         return
-    f = face - 16 if face >= 16 else face
-    sgn = -1.0 if face >= 16 else 1.0
-    ux, uy, uz = analytic_normal_gate(geo, k, f, x, y, z, stack)
-    wx = sgn * (nm[k, 0] * ux + nm[k, 1] * uy + nm[k, 2] * uz)
-    wy = sgn * (nm[k, 3] * ux + nm[k, 4] * uy + nm[k, 5] * uz)
-    wz = sgn * (nm[k, 6] * ux + nm[k, 7] * uy + nm[k, 8] * uz)
-    gx, gy, gz = _normalize(wx, wy, wz)
-    out_ng[i, 0], out_ng[i, 1], out_ng[i, 2] = gx, gy, gz
     out_ns[i, 0], out_ns[i, 1], out_ns[i, 2] = gx, gy, gz
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+from .columns import WalkCount
 from .flags import INLINE
 from .layout import MAX_DEPTH
 
@@ -207,9 +208,10 @@ def bvh_walk(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack, count, cnt
     and the others wait on ``stack`` (rows ``(entry distance, child)``, nearest on top), skipped
     when popped if the best hit is now nearer than their box; a leaf's triangles are tested four
     at a time.  Returns ``(t, tri, b1, b2)``.  With ``count`` (the traversal statistics' pass,
-    :mod:`..raytrace.traversal_stats`) it adds the 4-wide nodes visited to ``cnt[0]`` and the
-    triangle tests (four per leaf group) to ``cnt[1]``; :func:`bvh_hit` passes ``False``, and
-    the counting compiles away."""
+    :mod:`..raytrace.traversal_stats`) it adds the 4-wide nodes visited to
+    ``cnt[WalkCount.NODES]`` and the triangle tests (four per leaf group) to
+    ``cnt[WalkCount.TESTS]`` (:class:`.columns.WalkCount`); :func:`bvh_hit` passes ``False``,
+    and the counting compiles away."""
     node, child, leaf, first, tv4 = bvh
     ray = node_ray(ox, oy, oz, dx, dy, dz, tmin)
     # the watertight test's shear
@@ -235,13 +237,13 @@ def bvh_walk(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack, count, cnt
     while True:
         while code >= 0:  # a 4-wide node
             if count:
-                cnt[0] += 1
+                cnt[WalkCount.NODES] += 1
             sp, code = open_node((node, child), code, ray, best, stack, sp, top)
         if code < -1:  # a leaf
             lf = -2 - code
             for g in range(leaf[lf, 0], leaf[lf, 0] + leaf[lf, 1]):
                 if count:
-                    cnt[1] += 4
+                    cnt[WalkCount.TESTS] += 4
                 u0 = tri_lane(tv4, g, LANE[0], pk, okx, oky, okz, sx, sy, sz, tmin, best)
                 u1 = tri_lane(tv4, g, LANE[1], pk, okx, oky, okz, sx, sy, sz, tmin, best)
                 u2 = tri_lane(tv4, g, LANE[2], pk, okx, oky, okz, sx, sy, sz, tmin, best)

@@ -76,7 +76,7 @@ def intersect(scene, origins, directions):
         raise WorkbenchError("intersect: a direction has zero length")
     sd = flatten(scene)
     n = len(O)
-    h = _alloc(n)
+    h = _alloc(n, surface=False)  # the geometric normal alone
     _kernels().trace_batch(sd.kernel_args(), O, D, np.zeros(n), np.full(n, np.inf), tol.zero,
                            tol.ray_offset, sd.extent, tol.normal_cancel, False, h["t"], h["prim"], h["ng"],
                            h["ns"], h["uv"], h["po"], h["ev"])

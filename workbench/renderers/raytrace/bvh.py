@@ -19,6 +19,7 @@ triangles are packed by four in the same way (``(G, 9, 4)``).
 from __future__ import annotations
 
 from concurrent.futures import ThreadPoolExecutor
+from contextlib import nullcontext
 from typing import NamedTuple
 
 import numba as nb
@@ -62,15 +63,25 @@ def _grow(acc, o, tb, k):
 
 
 @nb.njit(cache=True)
-def triangle_boxes(tri_v):
-    """Each triangle's box ``(T, 6)`` (min xyz, max xyz)."""
+def _boxes_and_bounds(tri_v):
+    """Each triangle's box ``(T, 6)`` (min xyz, max xyz) of the triangles ``tri_v`` (T, 9) and
+    the boxes' box and centroid bounds (12,) (:func:`_root_bounds`), in one pass."""
     T = tri_v.shape[0]
     tb = np.empty((T, 6))
+    acc = np.empty(12)
+    for a in range(3):
+        acc[a], acc[3 + a], acc[6 + a], acc[9 + a] = np.inf, -np.inf, np.inf, -np.inf
     for i in range(T):
         for a in range(3):
             tb[i, a] = min(tri_v[i, a], tri_v[i, 3 + a], tri_v[i, 6 + a])
             tb[i, 3 + a] = max(tri_v[i, a], tri_v[i, 3 + a], tri_v[i, 6 + a])
-    return tb
+        _grow(acc, 0, tb, i)
+    return tb, acc
+
+
+def triangle_boxes(tri_v):
+    """Each triangle's box ``(T, 6)`` (min xyz, max xyz) of the triangles ``tri_v`` (T, 9)."""
+    return _boxes_and_bounds(tri_v)[0]
 
 
 @nb.njit(cache=True)
@@ -102,8 +113,10 @@ def _build_nodes(tb, idx, s0, e0, depth0, bounds0, limit):
     ``idx`` (T,), reordered in place, from a node at depth ``depth0`` with box and centroid
     bounds ``bounds0`` (12,); at most ``limit`` nodes are made.  Returns the nodes' boxes
     (n, 6) and meta (n, 3) (numbered from 0 at this range's root; leaves' ``first`` index
-    ``tb``) and the nodes still pending (k, 5) ``(start, end, parent, is_right, depth)``
-    with their bounds (k, 12), right child first: none unless the limit was reached.
+    ``tb``; views of the arrays allocated for ``limit`` nodes, not copied: the caller's
+    concatenation or collapse copies them) and the nodes still pending (k, 5) ``(start, end,
+    parent, is_right, depth)`` with their bounds (k, 12), right child first: none unless the
+    limit was reached.
     The boxes are kept in the order of ``idx`` (swapped with it), so that every pass over a
     node's range reads memory in sequence; a box's centroid (its centre) is recomputed where
     needed rather than stored and swapped beside it (less memory traffic, the same values); a
@@ -242,7 +255,7 @@ def _build_nodes(tb, idx, s0, e0, depth0, bounds0, limit):
         stack[sp, 0], stack[sp, 1], stack[sp, 2], stack[sp, 3], stack[sp, 4] = s, mid, node, 0, depth + 1
         bounds[sp, :] = acc[:12]
         sp += 1
-    return box[:n_nodes].copy(), meta[:n_nodes].copy(), stack[:sp].copy(), bounds[:sp].copy()
+    return box[:n_nodes], meta[:n_nodes], stack[:sp].copy(), bounds[:sp].copy()
 
 
 PARALLEL_MIN = 4096
@@ -259,15 +272,19 @@ def _kernel(fn, n: int):
     return fn.py_func if n <= SMALL_BUILD else fn
 
 
-def _build(tb: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The binned SAH build over boxes ``tb`` (T, 6), reordered in place: ``(order (T,), box
-    (n, 6), meta (n, 3))`` as :func:`build_bvh`.  From :data:`PARALLEL_MIN` items the root
-    is split alone and its two subtrees are built by two threads; their nodes are renumbered
+def _build(tb: np.ndarray, b0: np.ndarray | None = None, pool: ThreadPoolExecutor | None = None
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The binned SAH build over boxes ``tb`` (T, 6), reordered in place, whose box and centroid
+    bounds are ``b0`` (12,) (computed here if ``None``): ``(order (T,), box (n, 6), meta (n,
+    3))`` as :func:`build_bvh`.  From :data:`PARALLEL_MIN` items the root
+    is split alone and its two subtrees are built at once, the left one by ``pool``'s thread (a
+    new one if ``None``), the right one by the calling thread; their nodes are renumbered
     into the depth-first order one thread gives (left subtree after the root, then the right),
     so the tree is the same node for node."""
     T = tb.shape[0]
     idx = np.arange(T)
-    b0 = _kernel(_root_bounds, T)(tb)
+    if b0 is None:
+        b0 = _kernel(_root_bounds, T)(tb)
     if T < PARALLEL_MIN:
         box, meta, _, _ = _kernel(_build_nodes, T)(tb, idx, 0, T, 0, b0, 2 * T)
         return idx, box, meta
@@ -275,10 +292,10 @@ def _build(tb: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     if len(pending) == 0:  # the root is a leaf
         return idx, rbox, rmeta
     (s_r, e_r, _, _, d_r), (s_l, e_l, _, _, d_l) = pending
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        left = pool.submit(_build_nodes, tb, idx, s_l, e_l, d_l, pbounds[1], 2 * (e_l - s_l))
-        right = pool.submit(_build_nodes, tb, idx, s_r, e_r, d_r, pbounds[0], 2 * (e_r - s_r))
-        (lbox, lmeta, _, _), (rbox_, rmeta_, _, _) = left.result(), right.result()
+    with ThreadPoolExecutor(max_workers=1) if pool is None else nullcontext(pool) as ex:
+        left = ex.submit(_build_nodes, tb, idx, s_l, e_l, d_l, pbounds[1], 2 * (e_l - s_l))
+        rbox_, rmeta_, _, _ = _build_nodes(tb, idx, s_r, e_r, d_r, pbounds[0], 2 * (e_r - s_r))
+        lbox, lmeta, _, _ = left.result()
     n_left = len(lbox)
     lmeta[lmeta[:, 2] != -1, 0] += 1               # inner nodes' right children: renumbered
     rmeta_[rmeta_[:, 2] != -1, 0] += 1 + n_left    # (leaves' first items index tb already)
@@ -299,7 +316,7 @@ def build_bvh(tri_v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     box : (Nn, 6) node bounds (min xyz, max xyz).
     meta : (Nn, 3) int64, leaf ``(first, count, -1)``, inner ``(right child, 0, axis)``.
     """
-    return _build(triangle_boxes(np.ascontiguousarray(tri_v, dtype=np.float64)))
+    return _build(*_boxes_and_bounds(np.ascontiguousarray(tri_v, dtype=np.float64)))
 
 
 @nb.njit(cache=True)
@@ -358,24 +375,12 @@ def _collapse(box, meta):
     return nbox[:n4].copy(), child[:n4].copy(), leaf[:nl].copy()
 
 
-@nb.njit(cache=True)
-def _pack_leaves(tri_v, order, leaf):
-    """Each leaf's triangles (``tri_v[order[first:first + count]]``) by groups of four,
-    coordinates side by side: ``(G, 9, 4)``; a group of fewer than four repeats its last
-    triangle (the same hit, never a new one).  Returns the groups, each group's first triangle
-    (BVH order) ``(G,)`` and each leaf's
-    ``(first group, group count)`` ``(L, 2)``."""
-    L = leaf.shape[0]
-    ng = 0
-    for l in range(L):
-        ng += (leaf[l, 1] + 3) // 4
-    tv4 = np.empty((ng, 9, 4))
-    first = np.empty(ng, dtype=np.int64)
-    groups = np.empty((L, 2), dtype=np.int64)
-    g = 0
-    for l in range(L):
-        s0, cnt = leaf[l, 0], leaf[l, 1]
-        groups[l, 0], groups[l, 1] = g, (cnt + 3) // 4
+@nb.njit(cache=True, nogil=True)
+def _pack_range(tri_v, order, leaf, groups, l0, l1, tv4, first):
+    """Leaves ``l0 .. l1 - 1`` of :func:`_pack_leaves` into their groups (``groups[l, 0]``
+    onwards) of ``tv4`` and ``first``."""
+    for l in range(l0, l1):
+        s0, cnt, g = leaf[l, 0], leaf[l, 1], groups[l, 0]
         for s in range(s0, s0 + cnt, 4):
             c = min(4, s0 + cnt - s)
             for j in range(4):
@@ -384,6 +389,30 @@ def _pack_leaves(tri_v, order, leaf):
                     tv4[g, a, j] = tri_v[i, a]
             first[g] = s
             g += 1
+
+
+def _pack_leaves(tri_v, order, leaf, pool: ThreadPoolExecutor | None = None):
+    """Each leaf's triangles (``tri_v[order[first:first + count]]``) by groups of four,
+    coordinates side by side: ``(G, 9, 4)``; a group of fewer than four repeats its last
+    triangle (the same hit, never a new one).  Returns the groups, each group's first triangle
+    (BVH order) ``(G,)`` and each leaf's ``(first group, group count)`` ``(L, 2)``.  With
+    ``pool``, its thread packs the second half of the groups while the calling thread packs
+    the first."""
+    counts = (leaf[:, 1] + 3) // 4
+    groups = np.empty((len(leaf), 2), dtype=np.int64)
+    groups[:, 1] = counts
+    groups[:, 0] = np.cumsum(counts) - counts
+    G = int(counts.sum())
+    tv4 = np.empty((G, 9, 4))
+    first = np.empty(G, dtype=np.int64)
+    pack = _kernel(_pack_range, len(tri_v))
+    if pool is None:
+        pack(tri_v, order, leaf, groups, 0, len(leaf), tv4, first)
+    else:
+        half = int(np.searchsorted(groups[:, 0], G // 2))
+        rest = pool.submit(pack, tri_v, order, leaf, groups, half, len(leaf), tv4, first)
+        pack(tri_v, order, leaf, groups, 0, half, tv4, first)
+        rest.result()
     return tv4, first, groups
 
 
@@ -411,11 +440,13 @@ def build_bvh4(tri_v: np.ndarray) -> tuple[np.ndarray, Bvh4]:
     bvh : :class:`Bvh4` over ``tri_v[order]``.
     """
     tri_v = np.ascontiguousarray(tri_v, dtype=np.float64)
-    order, box, meta = _build(_kernel(triangle_boxes, len(tri_v))(tri_v))
-    node, child, leaf = _kernel(_collapse, len(box))(box, meta)
-    bounds = box[0].copy()
-    del box, meta
-    tv4, first, groups = _kernel(_pack_leaves, len(tri_v))(tri_v, order, leaf)
+    T = len(tri_v)
+    with ThreadPoolExecutor(max_workers=1) if T >= PARALLEL_MIN else nullcontext() as pool:
+        order, box, meta = _build(*_kernel(_boxes_and_bounds, T)(tri_v), pool=pool)
+        node, child, leaf = _kernel(_collapse, len(box))(box, meta)
+        bounds = box[0].copy()
+        del box, meta
+        tv4, first, groups = _pack_leaves(tri_v, order, leaf, pool)
     return order, Bvh4(node, child, groups, first, tv4, bounds)
 
 

@@ -32,7 +32,7 @@ from numba import prange
 
 from ..kernels.columns import RAY_COUNTS, Light, Mat, RayCount, WhittedOpt
 from ..kernels.flags import INLINE, NO_REFCOUNT, TASK
-from ..kernels.intersect import closest, scratch, surface
+from ..kernels.intersect import closest, geometric_normal, object_point, scratch, surface
 from ..kernels.optics import (_facing, _feeler, _ior, _light_dir, _pow, camera_ray, checker_color,
                               enter_or_leave, fresnel_reflectance)
 from ..kernels.shapes import _normalize
@@ -61,7 +61,9 @@ def _tasks(nchunks):
 def trace_batch(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_only,
                 t_out, prim_out, ng, ns, uv, po, ev):
     """Closest hits of N rays and their surface data (``prim_out = -1``, ``t = inf`` on a miss);
-    with ``shadow_only``, of the primitives that cast shadows (shadow feelers)."""
+    with ``shadow_only``, of the primitives that cast shadows (shadow feelers).  With ``ns`` of
+    no rows (``uv``, ``po``, ``ev`` likewise: :func:`.whitted._alloc` without ``surface``),
+    of the surface data only the geometric normal (``workbench.raytrace.intersect``)."""
     n = O.shape[0]
     nchunks = (n + CHUNK - 1) // CHUNK
     nit = _tasks(nchunks)
@@ -84,9 +86,14 @@ def trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_on
                                        tmax[i], np.bool_(shadow_only), np.bool_(False), zero, eps, stack, st,
                                        sp_, sf, sn)
         t_out[i], prim_out[i] = t, k
-        if k >= 0:
-            surface(geo, k, f, tri, b1, b2, ox + t * D[i, 0], oy + t * D[i, 1],
-                    oz + t * D[i, 2], ncancel, ng, ns, uv, po, ev, i, stack)
+        if k < 0:
+            continue
+        px, py, pz = ox + t * D[i, 0], oy + t * D[i, 1], oz + t * D[i, 2]
+        if ns.shape[0] == 0:  # the geometric normal alone
+            x, y, z = object_point(geo, k, px, py, pz)
+            ng[i, 0], ng[i, 1], ng[i, 2] = geometric_normal(geo, k, f, tri, x, y, z, stack)
+        else:
+            surface(geo, k, f, tri, b1, b2, px, py, pz, ncancel, ng, ns, uv, po, ev, i, stack)
 
 
 @nb.njit(cache=True, error_model="numpy")

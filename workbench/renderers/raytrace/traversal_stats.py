@@ -32,16 +32,24 @@ import numpy as np
 from numba import prange
 
 from ...core.tol import tol
+from ..kernels.columns import TRAVERSAL_COUNTS, TraversalCount, WalkCount
 from ..kernels.flags import NO_REFCOUNT
 from ..kernels.intersect import nearer, prim_tree_walk, reach, row_hit, scratch
 from ..kernels.walks import _bounds_hit, bvh_walk
 from .kernels import CHUNK, _tasks
 
+_TRI, _AN = int(TraversalCount.TRIANGLES), int(TraversalCount.ANALYTIC)
+"""The first columns of the triangles' and the analytic primitives' :class:`WalkCount` pairs."""
+TRI_NODES, TRI_TESTS = _TRI + WalkCount.NODES, _TRI + WalkCount.TESTS
+AN_NODES, AN_TESTS = _AN + WalkCount.NODES, _AN + WalkCount.TESTS
+_TRI_END, _AN_END = _TRI + TraversalCount.TRIANGLES.span, _AN + TraversalCount.ANALYTIC.span
+
 
 @nb.njit(**NO_REFCOUNT)
 def count_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, stack, cnt):
     """:func:`..kernels.walks.bvh_hit`'s closest-hit traversal (:func:`..kernels.walks.bvh_walk`),
-    adding the 4-wide nodes visited to ``cnt[0]`` and the triangle tests to ``cnt[1]``.
+    adding the 4-wide nodes visited and the triangle tests to ``cnt``
+    (:class:`..kernels.columns.WalkCount`).
     Returns ``(t, tri)``."""
     t, tri, _, _ = bvh_walk(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, False, stack, True, cnt)
     return t, tri
@@ -58,9 +66,9 @@ def _count_chunk(geo_analytic, bvh, bounds, has_tri, O, D, zero, rel_eps, extent
         # the analytic primitives' nearest hit, as closest finds it (the list, then the
         # tree), counted: it is the far end of the triangles' search
         best, brow, w = np.inf, -1, eps * inv_w
-        counts[i, 2], counts[i, 3] = 0, 0
+        counts[i, AN_NODES], counts[i, AN_TESTS] = 0, 0
         for q in range(free.shape[0]):
-            counts[i, 3] += 1
+            counts[i, AN_TESTS] += 1
             t, p, f = row_hit(geo_analytic, free[q], ox, oy, oz, dx, dy, dz, inv_w, 0.0,
                               reach(best, brow, w, np.inf), zero, eps, stack, st, sp_, sf, sn)
             if nearer(t, free[q], best, brow, w, np.inf):
@@ -68,23 +76,25 @@ def _count_chunk(geo_analytic, bvh, bounds, has_tri, O, D, zero, rel_eps, extent
         if pref.shape[0] > 0:
             if _bounds_hit(pbounds, ox, oy, oz, dx, dy, dz, 0.0, reach(best, brow, w, np.inf)):
                 t, _, _, row = prim_tree_walk(geo_analytic, ox, oy, oz, dx, dy, dz, inv_w, 0.0, np.inf, best, brow,
-                                              False, False, zero, eps, stack, st, sp_, sf, sn, True, counts[i, 2:])
+                                              False, False, zero, eps, stack, st, sp_, sf, sn, True,
+                                              counts[i, _AN:_AN_END])
                 if row >= 0:
                     best, brow = t, row
             else:
-                counts[i, 2] = 1
-        counts[i, 0], counts[i, 1] = 1, 0
+                counts[i, AN_NODES] = 1
+        counts[i, TRI_NODES], counts[i, TRI_TESTS] = 1, 0
         lim = reach(best, brow, w, np.inf)
         if has_tri and _bounds_hit(bounds, ox, oy, oz, dx, dy, dz, 0.0, lim):
-            counts[i, 0] = 0
-            count_hit(bvh, ox, oy, oz, dx, dy, dz, 0.0, lim, stack, counts[i])
+            counts[i, TRI_NODES] = 0
+            count_hit(bvh, ox, oy, oz, dx, dy, dz, 0.0, lim, stack,
+                      counts[i, _TRI:_TRI_END])
 
 
 @nb.njit(cache=True, error_model="numpy", parallel=True)
 def count_rays(geo_analytic, bvh, bounds, has_tri, O, D, zero, rel_eps, extent, counts):
-    """Per ray ``counts[i] = (triangle nodes visited, triangle tests, analytic nodes visited,
-    analytic primitive tests)`` of the closest-hit search from ``t = 0`` (see the module
-    docstring); ``geo_analytic`` is the kernels' geometry tuple without its triangles."""
+    """Per ray ``counts[i]`` (columns :class:`..kernels.columns.TraversalCount`: nodes visited
+    and tests, in the triangles' structure and in the analytic primitives') of the closest-hit
+    search from ``t = 0`` (see the module docstring); ``geo_analytic`` is the kernels' geometry tuple without its triangles."""
     n = O.shape[0]
     nchunks = (n + CHUNK - 1) // CHUNK
     nit = _tasks(nchunks)
@@ -96,12 +106,13 @@ def count_rays(geo_analytic, bvh, bounds, has_tri, O, D, zero, rel_eps, extent, 
 
 
 def ray_counts(sd, O: np.ndarray, D: np.ndarray) -> np.ndarray:
-    """(N, 4) int64 per ray ``O + t D``, t >= 0, of the flattened scene ``sd``
-    (:class:`.flatten.SceneData`): nodes visited and tests in the triangles' structure, then
-    in the analytic primitives' (the list's primitives counted as tests)."""
+    """(N, TRAVERSAL_COUNTS) int64 per ray ``O + t D``, t >= 0, of the flattened scene ``sd``
+    (:class:`.flatten.SceneData`; columns :class:`..kernels.columns.TraversalCount`): nodes
+    visited and tests in the triangles' structure and in the analytic primitives' (the list's
+    primitives counted as tests)."""
     geo = sd.kernel_args()._replace(tri_v=np.zeros((0, 9)))  # the analytic primitives only
     b = sd.bvh
-    counts = np.zeros((len(O), 4), dtype=np.int64)
+    counts = np.zeros((len(O), TRAVERSAL_COUNTS), dtype=np.int64)
     count_rays(geo, (b.node, b.child, b.leaf, b.first, b.tv4), b.bounds, len(sd.tri_v) > 0,
                np.ascontiguousarray(O, dtype=np.float64), np.ascontiguousarray(D, dtype=np.float64),
                tol.zero, tol.ray_offset, sd.extent, counts)
@@ -115,7 +126,9 @@ def primary_ray_counts(sd, O: np.ndarray, D: np.ndarray) -> dict:
     triangle tests (``accel_triangle_tests_per_ray``), analytic primitive tests
     (``accel_analytic_tests_per_ray``) and both (``accel_primitive_tests_per_ray``)."""
     c = ray_counts(sd, O, D).mean(axis=0)
-    return {"accel_nodes_per_ray": float(c[0] + c[2]),
-            "accel_triangle_nodes_per_ray": float(c[0]), "accel_analytic_nodes_per_ray": float(c[2]),
-            "accel_triangle_tests_per_ray": float(c[1]), "accel_analytic_tests_per_ray": float(c[3]),
-            "accel_primitive_tests_per_ray": float(c[1] + c[3])}
+    tri_nodes, tri_tests = float(c[TRI_NODES]), float(c[TRI_TESTS])
+    an_nodes, an_tests = float(c[AN_NODES]), float(c[AN_TESTS])
+    return {"accel_nodes_per_ray": tri_nodes + an_nodes,
+            "accel_triangle_nodes_per_ray": tri_nodes, "accel_analytic_nodes_per_ray": an_nodes,
+            "accel_triangle_tests_per_ray": tri_tests, "accel_analytic_tests_per_ray": an_tests,
+            "accel_primitive_tests_per_ray": tri_tests + an_tests}

@@ -344,10 +344,13 @@ def fused_textures(scene: Scene, sd: SceneData):
     return tab
 
 
-def _alloc(n):
-    """Hit records of n rays (rows of missed rays are left unset)."""
+def _alloc(n, surface: bool = True):
+    """Hit records of n rays (rows of missed rays are left unset); without ``surface``, the
+    distance, primitive and geometric normal only (the other records have no rows:
+    :func:`.kernels.trace_batch` then computes the geometric normal alone)."""
+    m = n if surface else 0
     return dict(t=np.empty(n), prim=np.empty(n, np.int64), ng=np.empty((n, 3)),
-                ns=np.empty((n, 3)), uv=np.empty((n, 2)), po=np.empty((n, 3)), ev=np.empty((n, 3)))
+                ns=np.empty((m, 3)), uv=np.empty((m, 2)), po=np.empty((m, 3)), ev=np.empty((m, 3)))
 
 
 def _alloc_children(n):
