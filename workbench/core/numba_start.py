@@ -4,8 +4,8 @@ The first compile or disk-cache load of any numba function loads numba's CPU tar
 registries (``CPUContext.load_additional_registries``), among them ``numba.np.arraymath``,
 whose import probes for a BLAS by importing ``scipy.linalg.cython_blas`` (its flag
 ``_HAVE_BLAS``).  Importing ``scipy.linalg`` imports scipy's array-API layer, which copies
-every attribute of numpy and so imports ``numpy.f2py`` and ``numpy.testing``: about 0.15 s of
-CPU, a quarter of a warm ``workbench render whitted -m raytrace`` (measured: issue #28).
+every attribute of numpy and so imports ``numpy.f2py`` and ``numpy.testing``: about 0.1 s of
+CPU, an eighth of a warm ``workbench render whitted -m raytrace`` (measured: issue #28).
 
 The flag only chooses the inner product of ``np.correlate`` and ``np.convolve`` in jitted code
 (BLAS ``dot`` or numba's own loop); no workbench kernel calls them, and numba's linear algebra
