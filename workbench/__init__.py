@@ -9,12 +9,12 @@ Public API (stable)::
 
 Heavy modules (moderngl, numba, pyrender, matplotlib) load only when a method needs them.
 ``workbench.__version__`` is the installed distribution's version (pyproject.toml's
-``[project] version``, the one place it is written).
+``[project] version``, the one place it is written), looked up when asked (``importlib.metadata``
+takes 20 ms to import, more than a command like ``workbench scenes`` needs in all).
 """
 from __future__ import annotations
 
 import importlib
-import importlib.metadata
 from pathlib import Path
 
 
@@ -22,6 +22,7 @@ def _version() -> str:
     """The version of the installed ``workbench`` distribution; in a checkout that is not
     installed (``PYTHONPATH=checkout``), the ``[project] version`` of its pyproject.toml; else
     ``"0+unknown"``."""
+    import importlib.metadata
     try:
         return importlib.metadata.version("workbench")
     except importlib.metadata.PackageNotFoundError:
@@ -36,11 +37,11 @@ def _version() -> str:
     return "0+unknown"
 
 
-__version__ = _version()
-
 from .core.jit_cache import use_code_keyed_cache
+from .core.numba_start import skip_blas_probe
 
 use_code_keyed_cache()  # before any kernel compiles: numba's cache keyed by this code
+skip_blas_probe()       # before numba loads its registries: no scipy.linalg import (0.1 s of CPU)
 
 from .core.errors import NotApplicable, WorkbenchError  # noqa: E402,F401
 from .scene.io import SceneError, load_scene  # noqa: E402,F401
@@ -65,6 +66,8 @@ def available_methods() -> list[str]:
 
 
 def __getattr__(name):
+    if name == "__version__":
+        return _version()
     if name in _LAZY:
         return importlib.import_module(_LAZY[name])
     raise AttributeError(f"module 'workbench' has no attribute {name!r}")

@@ -18,7 +18,15 @@ def add_parser(sub):
                    help="display mode post-process: direct24, direct16-555, direct16-565, "
                         "indexedN[-mediancut|-kmeans][-bayer|-fs] (N = 2..256); its error against "
                         "direct24 is printed")
-    p.set_defaults(run=run)
+    p.set_defaults(run=run, prepare=prepare)
+
+
+def prepare(args) -> None:
+    """Import a built-in method's renderer during the program's start-up (see :mod:`.cli`);
+    any other name is left to :func:`run`, which checks it in its turn."""
+    from ..renderers.base import BUILTIN, get_renderer
+    if args.method in BUILTIN:
+        get_renderer(args.method)
 
 
 def run(args) -> int:

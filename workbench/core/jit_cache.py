@@ -33,7 +33,9 @@ def code_fingerprint() -> str:
     """SHA-256 (hex) over the workbench's core, scene and renderer sources, sorted by path (what
     a rendered image may depend on: the reference cache's key)."""
     root = Path(__file__).resolve().parents[1]
-    return _digest(root, [p for pkg in CODE_PACKAGES for p in (root / pkg).rglob("*.py")])
+    modules = _module_names(root)
+    layers = tuple(f"{root.name}.{pkg}" for pkg in CODE_PACKAGES)
+    return _digest(root, {p: _read(p) for n, p in modules.items() if n.startswith(layers)})
 
 
 _IMPORT = re.compile(rb"^[ \t]*(?:from[ \t]+(\.*)([\w.]*)[ \t]+import[ \t]+(\([^)]*\)|[^\n]*)|import[ \t]+([\w., \t]+))",
@@ -42,17 +44,26 @@ _IMPORT = re.compile(rb"^[ \t]*(?:from[ \t]+(\.*)([\w.]*)[ \t]+import[ \t]+(\([^
 _NUMBA = re.compile(rb"^[ \t]*(?:import|from)[ \t]+numba\b", re.M)
 
 
-def _module_names(root: Path) -> dict[str, Path]:
-    """Dotted name -> source file of every module of the package (``workbench.core.tol``; a
-    package by its ``__init__.py``)."""
+def _module_names(root: Path) -> dict[str, str]:
+    """Dotted name -> source file (a path string) of every module of the package
+    (``workbench.core.tol``; a package by its ``__init__.py``).  Plain strings and one
+    ``os.walk``: every command computes the fingerprint at start-up."""
     out = {}
-    for p in root.rglob("*.py"):
-        parts = p.relative_to(root.parent).with_suffix("").parts
-        out[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = p
+    top = str(root.parent)
+    for folder, dirs, files in os.walk(root):
+        package = os.path.relpath(folder, top).replace(os.sep, ".")
+        for f in files:
+            if f.endswith(".py"):
+                out[package if f == "__init__.py" else f"{package}.{f[:-3]}"] = os.path.join(folder, f)
     return out
 
 
-def _imports(name: str, is_package: bool, text: bytes, modules: dict[str, Path]) -> set[str]:
+def _read(path: str) -> bytes:
+    with open(path, "rb") as f:
+        return f.read()
+
+
+def _imports(name: str, is_package: bool, text: bytes, modules: dict[str, str]) -> set[str]:
     """The package's modules (dotted names, keys of ``modules``) that module ``name``'s source
     ``text`` imports (absolute and relative imports, at any depth of the file)."""
     here = name.split(".") if is_package else name.split(".")[:-1]   # its package
@@ -69,36 +80,43 @@ def _imports(name: str, is_package: bool, text: bytes, modules: dict[str, Path])
     return found
 
 
+def _kernel_texts() -> dict[str, bytes]:
+    """Source file -> text of the modules numba kernels are compiled from (see
+    :func:`kernel_sources`)."""
+    root = Path(__file__).resolve().parents[1]
+    modules = _module_names(root)
+    layers = tuple(f"{root.name}.{pkg}" for pkg in CODE_PACKAGES)
+    text = {n: _read(p) for n, p in modules.items() if n.startswith(layers)}
+    todo = [n for n, t in text.items() if b"numba" in t and _NUMBA.search(t)]
+    seen: dict[str, bytes] = {}
+    while todo:
+        n = todo.pop()
+        if n not in seen:
+            t = seen[n] = text[n] if n in text else _read(modules[n])
+            todo.extend(_imports(n, modules[n].endswith("__init__.py"), t, modules) - seen.keys())
+    return {modules[n]: t for n, t in seen.items()}
+
+
 def kernel_sources() -> list[Path]:
     """The modules numba kernels are compiled from: every module of the layers kernels live in
     (:data:`CODE_PACKAGES`) that imports numba, and, transitively, every workbench module
     those import (their constants are compiled in), sorted."""
-    root = Path(__file__).resolve().parents[1]
-    modules = _module_names(root)
-    layers = tuple(f"{root.name}.{pkg}" for pkg in CODE_PACKAGES)
-    text = {n: p.read_bytes() for n, p in modules.items() if n.startswith(layers)}
-    todo = [n for n, t in text.items() if b"numba" in t and _NUMBA.search(t)]
-    seen: set[str] = set()
-    while todo:
-        n = todo.pop()
-        if n not in seen:
-            seen.add(n)
-            t = text[n] if n in text else modules[n].read_bytes()
-            todo.extend(_imports(n, modules[n].name == "__init__.py", t, modules) - seen)
-    return sorted(modules[n] for n in seen)
+    return sorted(map(Path, _kernel_texts()))
 
 
 def kernel_fingerprint() -> str:
     """SHA-256 (hex) over :func:`kernel_sources`: the numba cache folder's key."""
-    root = Path(__file__).resolve().parents[1]
-    return _digest(root, kernel_sources())
+    return _digest(Path(__file__).resolve().parents[1], _kernel_texts())
 
 
-def _digest(root: Path, paths) -> str:
+def _digest(root: Path, texts: dict[str, bytes]) -> str:
+    """SHA-256 over each file's path relative to ``root`` and its text, in the order of the
+    paths' parts (as ``pathlib`` sorts them)."""
     h = hashlib.sha256()
-    for p in sorted(paths):
-        h.update(str(p.relative_to(root)).encode())
-        h.update(p.read_bytes())
+    top = str(root)
+    for p in sorted(texts, key=lambda p: os.path.relpath(p, top).split(os.sep)):
+        h.update(os.path.relpath(p, top).encode())
+        h.update(texts[p])
     return h.hexdigest()
 
 

@@ -17,12 +17,10 @@ def run_tasks(kernel, ntasks: int, *args, per_task=None) -> None:
     the task's own arguments, its scratch arrays; none when omitted), on as many threads as
     numba is set to use (``numba.set_num_threads``), and wait for all; an exception of any
     call is raised here."""
-    import numba
-
     def task_args(c):
         return (*args, *(per_task(c) if per_task is not None else ()), c, ntasks)
 
-    threads = max(1, min(ntasks, numba.get_num_threads()))
+    threads = max(1, min(ntasks, _numba_threads()))
     if threads == 1:
         for c in range(ntasks):
             kernel(*task_args(c))
@@ -30,3 +28,17 @@ def run_tasks(kernel, ntasks: int, *args, per_task=None) -> None:
     with ThreadPoolExecutor(max_workers=threads) as pool:
         for f in [pool.submit(kernel, *task_args(c)) for c in range(ntasks)]:
             f.result()
+
+
+def _numba_threads() -> int:
+    """``numba.get_num_threads()``, without starting numba's threading layer when it has not
+    started: until then no ``numba.set_num_threads`` has been called (it starts the layer), and
+    numba's documented default is ``numba.config.NUMBA_NUM_THREADS``.  Starting the layer (the
+    OpenMP library and its threads, which the tasks, on Python threads, do not use) costs a
+    warm render 36 ms."""
+    import numba
+    try:
+        numba.threading_layer()
+    except ValueError:  # "Threading layer is not initialized."
+        return numba.config.NUMBA_NUM_THREADS
+    return numba.get_num_threads()

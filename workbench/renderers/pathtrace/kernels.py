@@ -162,7 +162,7 @@ def render_samples(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sum
     nit = max(1, min(nblocks, MAX_TASKS))
     part = np.zeros((nit, 8), np.int64)
     run_tasks(samples_task, nit, geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq, part,
-              per_task=lambda c: (scratch(), hit_rows()))
+              per_task=lambda c: (scratch.py_func(), hit_rows()))  # numpy's arrays: no dispatcher to load
     counts += part[:, :PATH_COUNTS].sum(axis=0)
 
 

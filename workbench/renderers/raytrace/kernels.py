@@ -444,12 +444,13 @@ def render_pixels(geo, shading, pixels, spp, first, ncancel, counts):
     nit = max(1, min(nblocks, MAX_TASKS))
     part = np.zeros((nit, 8), np.int64)  # a row per task (8: rows a cache line apart)
     cap = 2 * int(shading.opts[WhittedOpt.GENERATIONS]) + 2
+    # the per-task arrays made by numpy here (``scratch.py_func``: the kernel's own Python code):
+    # no dispatcher of theirs to load from numba's cache at start-up
     run_tasks(pixels_task, nit, geo, shading, pixels, spp, first, ncancel, part, stride,
-              per_task=lambda c: (scratch(), ray_stack(cap)))
+              per_task=lambda c: (scratch.py_func(), ray_stack(cap)))
     counts += part[:, :RAY_COUNTS].sum(axis=0)
 
 
-@nb.njit(cache=True, error_model="numpy")
 def ray_stack(cap):
     """Work arrays of :func:`pixels_task`: ``cap`` pending rays (origin, direction, weight,
     media stack and its size, kind, tmin, generation), then the current ray and its hit (one

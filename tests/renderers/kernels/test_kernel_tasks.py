@@ -1,0 +1,52 @@
+"""``kernels.tasks.run_tasks`` runs its tasks on as many threads as numba is set to use: the
+count ``numba.set_num_threads`` sets, else ``NUMBA_NUM_THREADS`` (read without starting
+numba's threading layer, which the tasks do not use)."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import threading
+
+import numba
+
+from workbench.renderers.kernels.tasks import run_tasks
+
+
+def _threads_used(ntasks: int) -> set[int]:
+    seen = set()
+
+    def task(c, n):
+        seen.add(threading.get_ident())
+        threading.Event().wait(0.01)  # long enough for a pool's other thread to take a task
+
+    run_tasks(task, ntasks)
+    return seen
+
+
+def test_set_num_threads_is_honoured():
+    saved = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        assert _threads_used(6) == {threading.get_ident()}   # one thread: this one, no pool
+        if numba.config.NUMBA_NUM_THREADS >= 2:
+            numba.set_num_threads(2)
+            used = _threads_used(6)                           # a pool of at most two threads
+            assert threading.get_ident() not in used and 1 <= len(used) <= 2
+    finally:
+        numba.set_num_threads(saved)
+
+
+def test_the_default_count_does_not_start_numba_threading_layer():
+    code = ("import threading, numba\n"
+            "from workbench.renderers.kernels.tasks import run_tasks\n"
+            "seen = set()\n"
+            "run_tasks(lambda c, n: (seen.add(threading.get_ident()), threading.Event().wait(0.01)), 4)\n"
+            "try:\n"
+            "    numba.threading_layer(); print('started')\n"
+            "except ValueError:\n"
+            "    print(threading.get_ident() in seen, len(seen) <= 2)\n")
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+                       env={**os.environ, "NUMBA_NUM_THREADS": "2"})
+    assert p.returncode == 0, p.stderr[-2000:]
+    assert p.stdout.strip() == "False True"   # a pool of NUMBA_NUM_THREADS, the layer not started
