@@ -38,10 +38,8 @@ def _version() -> str:
 
 
 from .core.jit_cache import use_code_keyed_cache
-from .core.numba_start import skip_blas_probe
 
 use_code_keyed_cache()  # before any kernel compiles: numba's cache keyed by this code
-skip_blas_probe()       # before numba loads its registries: no scipy.linalg import (0.1 s of CPU)
 
 from .core.errors import NotApplicable, WorkbenchError  # noqa: E402,F401
 from .scene.io import SceneError, load_scene  # noqa: E402,F401

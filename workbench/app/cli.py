@@ -29,6 +29,8 @@ import os
 import warnings
 import sys
 
+from ..core.numba_start import skip_blas_probe
+
 COMMANDS = ["cmd_scenes", "cmd_info", "cmd_methods", "cmd_render", "cmd_colour", "cmd_compare", "cmd_study", "cmd_stress", "cmd_snapshot", "cmd_ui"]
 
 
@@ -92,6 +94,7 @@ def main(argv: list[str] | None = None) -> int:
     if argv is not None:
         return _run(argv)
     gc.disable()  # until the command has started: see the module's docstring
+    skip_blas_probe()  # the program only: a library user's process keeps numba's own start-up
     code = _run(None)
     for stream in (sys.stdout, sys.stderr):
         try:

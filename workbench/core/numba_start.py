@@ -14,7 +14,8 @@ in jitted code (``np.dot``, ``np.linalg``) imports scipy itself when such a func
 one-shot import finder: while ``numba.np.arraymath`` runs its module code, in that thread
 only, ``scipy.linalg`` (not yet imported) cannot be imported, the probe answers "no BLAS", and
 the finder removes itself.  A process that imported ``scipy.linalg`` before is left as numba
-makes it (the probe is cheap then).
+makes it (the probe is cheap then).  Only the ``workbench`` program installs it
+(:func:`workbench.app.cli.main`): a process that imports the library keeps numba's own start-up.
 """
 from __future__ import annotations
 
