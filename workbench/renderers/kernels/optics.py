@@ -16,8 +16,12 @@ from .shapes import _normalize
 
 @nb.njit(**INLINE)
 def _pow(base, n):
+    """``base ** n`` for ``base >= 0``; ``0 ** n`` (``n > 0``, the usual case of a highlight
+    turned away) without the call to ``pow``."""
     if n == 0.0:
         return 1.0
+    if base == 0.0 and n > 0.0:
+        return 0.0
     return base ** n
 
 
@@ -122,11 +126,10 @@ def checker_color(tex_tab, mi, x, y, z):
 
 
 @nb.njit(**INLINE)
-def camera_ray(cam, q, o, d):
-    """Row 0 of ``o, d``: the centre ray of image pixel ``q`` (row-major) of the camera ``cam``
-    (``whitted.camera_frame``: position, rotation, tan(fov_y / 2), aspect, width, height)."""
-    width = int(cam[14])
-    i, j = q // width, q % width
+def camera_ray(cam, i, j, o, d):
+    """Row 0 of ``o, d``: the centre ray of the image pixel in row ``i``, column ``j`` of the
+    camera ``cam`` (``whitted.camera_frame``: position, rotation, tan(fov_y / 2), aspect,
+    width, height)."""
     x = ((j + 0.5) / cam[14] * 2.0 - 1.0) * cam[12] * cam[13]
     y = (1.0 - (i + 0.5) / cam[15] * 2.0) * cam[12]
     dx = x * cam[3] + y * cam[4] - cam[5]
