@@ -112,6 +112,34 @@ def xvfb():
     proc.wait(10)
 
 
+PARALLEL_FIRST = (
+    # in-process renders of every bundled scene: they compile most kind-set variants
+    "tests/app/test_every_command.py",
+    "tests/renderers/pathtrace/test_pathtrace.py",
+    "tests/renderers/test_objects_seen.py",
+    "tests/renderers/raytrace/test_raytrace_render.py",
+    # a window session of at least 150 s whatever the cache: not left for the end
+    "tests/app/ui/test_ui_idle.py",
+    # child processes (windows, bench scripts) over every scene: they load the kernels the
+    # files above compiled rather than compile them again, and do not run last
+    "tests/app/ui/test_ui_screens.py",
+    "tests/app/ui/test_ui_command.py",
+    "tests/project/test_bench_smoke.py",
+)
+"""Test files a run on several processes (``pytest -n``, ``--dist loadfile``) hands out
+first, in this order (measured on a cold cache: each takes minutes); the rest follow in
+collection order."""
+
+
+def pytest_collection_modifyitems(config, items):
+    """Under ``pytest -n``: :data:`PARALLEL_FIRST`'s files first (a stable sort: every worker
+    collects the same order, as pytest-xdist requires)."""
+    if "PYTEST_XDIST_WORKER" not in os.environ:
+        return
+    rank = {f: i for i, f in enumerate(PARALLEL_FIRST)}
+    items.sort(key=lambda item: rank.get(item.nodeid.split("::")[0], len(rank)))
+
+
 WARM_MIN_ITEMS = 200
 """A run of at least this many tests starts the kernel warm-up (a single file's run does not)."""
 WARM_CACHED_FILES = 60
