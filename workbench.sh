@@ -40,8 +40,12 @@ fi
 export NUMBA_CACHE_DIR="$PWD/.numba_cache"
 
 if [ "$what" = test ]; then
-  echo "== running the test suite"
-  exec .venv/bin/python -m pytest -q
+  # one test process per core, at most 4 (pytest-xdist); each takes whole test files, so a
+  # file's fixtures and its scenes' compiled kernels stay in one process, handed out in the
+  # order tests/conftest.py gives (PARALLEL_FIRST), not by their number of tests
+  workers=$(nproc); [ "$workers" -gt 4 ] && workers=4
+  echo "== running the test suite ($workers processes)"
+  exec .venv/bin/python -m pytest -q -n "$workers" --dist loadfile --no-loadscope-reorder
 fi
 
 echo "== main job: quick error-vs-time study and side-by-side comparison of every method, on the default scene"

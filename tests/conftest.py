@@ -7,7 +7,6 @@ import os
 import shutil
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pytest
@@ -90,28 +89,55 @@ def window_ctx(gl_ctx):
     gl.release_framebuffer(ctx.screen)  # not left bound (the next test's first FBO failed)
 
 
-def _free_display() -> int:
-    for n in range(90, 200):
-        if not Path(f"/tmp/.X11-unix/X{n}").exists() and not Path(f"/tmp/.X{n}-lock").exists():
-            return n
-    raise RuntimeError("no free X display number")
-
-
 @pytest.fixture(scope="session")
 def xvfb():
-    """A private X server (Xvfb) for the UI tests; its display name (\":N\")."""
+    """A private X server (Xvfb) for the UI tests; its display name (\":N\").  Xvfb picks the
+    free display number itself (``-displayfd``: it takes the number's lock file, then writes
+    the number when it accepts connections), so the servers of two test processes started at
+    once (``pytest -n 2``) never share a number."""
     if shutil.which("Xvfb") is None:
         pytest.skip("Xvfb not installed")
-    n = _free_display()
-    proc = subprocess.Popen(["Xvfb", f":{n}", "-screen", "0", "1920x1080x24", "-nolisten", "tcp"],
+    read, write = os.pipe()
+    proc = subprocess.Popen(["Xvfb", "-displayfd", str(write), "-screen", "0", "1920x1080x24",
+                             "-nolisten", "tcp"], pass_fds=(write,),
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    for _ in range(100):
-        if Path(f"/tmp/.X11-unix/X{n}").exists():
-            break
-        time.sleep(0.05)
-    yield f":{n}"
+    os.close(write)
+    with os.fdopen(read) as f:
+        number = f.readline().strip()   # empty if Xvfb exited without a display
+    if not number:
+        proc.wait(10)
+        pytest.fail(f"Xvfb did not start (exit status {proc.returncode})")
+    yield f":{number}"
     proc.terminate()
     proc.wait(10)
+
+
+PARALLEL_FIRST = (
+    # in-process renders of every bundled scene: they compile most kind-set variants
+    "tests/app/test_every_command.py",
+    "tests/renderers/pathtrace/test_pathtrace.py",
+    "tests/renderers/test_objects_seen.py",
+    "tests/renderers/raytrace/test_raytrace_render.py",
+    # a window session of at least 150 s whatever the cache: not left for the end
+    "tests/app/ui/test_ui_idle.py",
+    # child processes (windows, bench scripts) over every scene: they load the kernels the
+    # files above compiled rather than compile them again, and do not run last
+    "tests/app/ui/test_ui_screens.py",
+    "tests/app/ui/test_ui_command.py",
+    "tests/project/test_bench_smoke.py",
+)
+"""Test files a run on several processes (``pytest -n``, ``--dist loadfile``) hands out
+first, in this order (measured on a cold cache: each takes minutes); the rest follow in
+collection order."""
+
+
+def pytest_collection_modifyitems(config, items):
+    """Under ``pytest -n``: :data:`PARALLEL_FIRST`'s files first (a stable sort: every worker
+    collects the same order, as pytest-xdist requires)."""
+    if "PYTEST_XDIST_WORKER" not in os.environ:
+        return
+    rank = {f: i for i, f in enumerate(PARALLEL_FIRST)}
+    items.sort(key=lambda item: rank.get(item.nodeid.split("::")[0], len(rank)))
 
 
 WARM_MIN_ITEMS = 200
@@ -123,9 +149,11 @@ _WARMER = pytest.StashKey()
 
 
 def pytest_collection_finish(session):
-    """On a cold numba cache, compile the kernels in a niced process beside the run
-    (``tests/warm_kernels.py``); ``WORKBENCH_TEST_WARM=0`` turns it off."""
-    if os.environ.get("WORKBENCH_TEST_WARM", "1") == "0" or len(session.items) < WARM_MIN_ITEMS:
+    """On a cold numba cache, compile the kernels in a niced process beside a run in one
+    process (``tests/warm_kernels.py``); ``WORKBENCH_TEST_WARM=0`` turns it off.  A run on
+    several processes (``pytest -n``, as ``bash workbench.sh test``) has no idle core for it."""
+    if (os.environ.get("WORKBENCH_TEST_WARM", "1") == "0" or len(session.items) < WARM_MIN_ITEMS
+            or "PYTEST_XDIST_WORKER" in os.environ):
         return
     from workbench.core.jit_cache import use_code_keyed_cache
     if sum(1 for _ in use_code_keyed_cache().rglob("*.nbi")) >= WARM_CACHED_FILES:
