@@ -79,3 +79,40 @@ def _check_pruning(tmp_path):
     assert jit_cache.use_code_keyed_cache() == current          # a child: no nesting
     kept = sorted(p.name for p in tmp_path.iterdir())
     assert kept == sorted([fp, "notes"] + [p.name for p in old[-jit_cache.KEEP:]])
+
+
+CACHED = '''
+import workbench, numba
+@numba.njit(cache=True)
+def plus_one(x):
+    return x + 1
+print(plus_one(1.5))
+'''
+
+
+def test_a_cache_save_waits_for_another_process_holding_the_lock(tmp_path):
+    """Numba's save of a new cache entry runs under an exclusive ``flock`` on the function's
+    ``<index>.lock`` (``jit_cache.lock_cache_saves``): while this process holds the lock, a
+    process compiling the cached function cannot finish its save; once released, it does."""
+    import fcntl
+    (tmp_path / "cached.py").write_text(CACHED)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=str(ROOT))
+    base = _cache_dir(ROOT, tmp_path / "cache")
+    run = [sys.executable, "cached.py"]
+    subprocess.run(run, cwd=tmp_path, env=env, check=True, capture_output=True, timeout=300)  # the index exists
+    (index,) = base.rglob("cached.plus_one-*.nbi")
+    for f in base.rglob("cached.plus_one-*.nbc"):
+        f.unlink()
+    index.unlink()                              # a fresh save, under the held lock
+    with open(str(index) + ".lock", "a") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        child = subprocess.Popen(run, cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        try:
+            child.wait(timeout=20)
+            waited = False
+        except subprocess.TimeoutExpired:
+            waited = not index.exists()  # it compiled, and waits to save
+    out, err = child.communicate(timeout=300)
+    assert waited, "the save did not wait for the lock"
+    assert child.returncode == 0 and out.strip() == b"2.5", err[-500:]
+    assert index.exists()

@@ -11,15 +11,31 @@ module that imports numba, and every workbench module those import, whose consta
 kernels compile in), so an edit of any of them compiles afresh while an edit elsewhere (the
 window, the reports, a renderer's Python side) keeps the warm cache; the few most recently
 used older folders are kept, the rest removed.
+
+Several processes share the folder (the test suite's workers, the window's child processes, a
+user's two commands), and numba's save of a new cache entry is not safe against another
+process saving an entry of the same function at the same moment: each reads the function's
+index, picks the first free data-file number, writes the index and then the data, so both may
+pick the same number and the index may point one signature at the other's machine code (numba
+issues 4807 and 10128).  :func:`lock_cache_saves` serialises those saves with an exclusive
+``flock`` on a lock file beside the function's index (loads need no lock: numba writes each
+file to a temporary name and renames it, and a missing data file is a cache miss).
 """
 from __future__ import annotations
 
 import hashlib
+import importlib.abc
+import importlib.util
 import os
 import re
 import shutil
 import sys
 from pathlib import Path
+
+try:
+    import fcntl
+except ImportError:  # not POSIX: numba's saves stay as they are
+    fcntl = None
 
 CODE_PACKAGES = ("core", "scene", "renderers")
 """The layers whose sources numba kernels may read (imports run core -> scene -> renderers)."""
@@ -156,8 +172,63 @@ def use_code_keyed_cache() -> Path:
     except OSError:
         return current  # numba falls back to its own locations when it cannot write here
     _prune(base, current)
+    lock_cache_saves()
     os.environ["NUMBA_CACHE_DIR"] = str(current)
     config = sys.modules.get("numba.core.config")
     if config is not None:
         config.reload_config()
     return current
+
+
+CACHING = "numba.core.caching"
+"""The numba module whose ``IndexDataCacheFile.save`` :func:`lock_cache_saves` wraps."""
+
+
+def lock_cache_saves() -> None:
+    """Wrap numba's cache save in an exclusive ``flock`` on ``<index>.lock`` (see the module's
+    docstring): now if numba's caching module is loaded, else as soon as it is (a one-shot
+    import finder, so that importing workbench does not import numba)."""
+    if fcntl is None:
+        return
+    module = sys.modules.get(CACHING)
+    if module is not None:
+        _wrap_save(module)
+    elif not any(isinstance(f, _AfterCaching) for f in sys.meta_path):
+        sys.meta_path.insert(0, _AfterCaching())
+
+
+def _wrap_save(caching) -> None:
+    cls = caching.IndexDataCacheFile
+    plain = cls.save
+    if getattr(plain, "locked", False):
+        return
+
+    def save(self, key, data):
+        with open(self._index_path + ".lock", "a") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+            plain(self, key, data)
+
+    save.locked = True
+    cls.save = save
+
+
+class _AfterCaching(importlib.abc.MetaPathFinder, importlib.abc.Loader):
+    """Finds :data:`CACHING` through the other finders, runs it, then wraps its save and
+    removes itself."""
+
+    def find_spec(self, name, path=None, target=None):
+        if name != CACHING:
+            return None
+        sys.meta_path.remove(self)
+        spec = importlib.util.find_spec(name)
+        if spec is not None and spec.loader is not None:
+            self.inner = spec.loader
+            spec.loader = self
+        return spec
+
+    def create_module(self, spec):
+        return self.inner.create_module(spec)
+
+    def exec_module(self, module):
+        self.inner.exec_module(module)
+        _wrap_save(module)
