@@ -133,7 +133,7 @@ def scene_screens(request, xvfb, tmp_path_factory):
                         "--methods", ",".join(SCENE_METHODS), "--size", "64",
                         "--script", script_of(SIZES[request.param]), "--out", str(out)],
                        cwd=ROOT, env={**os.environ, "DISPLAY": xvfb}, capture_output=True,
-                       text=True, timeout=500)
+                       text=True, timeout=1100)
     assert p.returncode == 0, p.stderr[-2000:]
     w, h = (int(v) for v in request.param.split("x"))
     return (w, h), out, json.loads((out / "summary.json").read_text())["script"]
@@ -154,6 +154,7 @@ def _nothing_cut(windows: dict, window) -> None:
             assert win["content_width"] <= win["room_width"] + 1.0, (name, win)
 
 
+@pytest.mark.timeout(1200)  # the session (fixture) waits up to sessions.CPU_WAIT_SECONDS a scene
 def test_every_bundled_scene_on_screen_at_both_sizes(scene_screens):
     from workbench.scene.library import bundled
     window, out, log = scene_screens
