@@ -190,9 +190,8 @@ def main(argv=None) -> None:
                 sumsq[p, 1] += g * g
                 sumsq[p, 2] += b * b
 
-    @nb.njit
     def work_arrays():
-        return KI.scratch(), K.hit_rows()
+        return KI.scratch.py_func(), K.hit_rows()  # as render_samples makes them
 
     scene = workbench.load_scene("cornell")
     out = {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "threads": 1, "scene": "cornell",

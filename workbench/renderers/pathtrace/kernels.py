@@ -127,7 +127,6 @@ def phong_lobe(ks, shin, rx, ry, rz, wx, wy, wz):
     return ks * (shin + 2.0) * INV_2PI * c, (shin + 1.0) * INV_2PI * c
 
 
-@nb.njit(cache=True, error_model="numpy")
 def hit_rows():
     """One row per hit record of :func:`..kernels.intersect.surface`: geometric normal, shading
     normal, uv, object-space point, vertex emission; then the media stack (4)."""
@@ -368,15 +367,12 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
             rx, ry, rz = dx + 2.0 * cg_ * fx, dy + 2.0 * cg_ * fy, dz + 2.0 * cg_ * fz
         rx, ry, rz = _normalize(rx, ry, rz)
         # refraction geometry and the Fresnel split of kr, kt (as the ray tracer's shade_hit)
-        new_n = nstk
         tx, ty, tz = dx, dy, dz
-        push = False
         if a_t > 0.0 and solid[k]:
             cf = -(dx * fx + dy * fy + dz * fz)
             if front:
                 n1 = mat_tab[stk[nstk - 1], Mat.IOR] if nstk > 0 else 1.0
                 n2 = mat_tab[mi, Mat.IOR]
-                push = True
             else:
                 n1 = mat_tab[mi, Mat.IOR]
                 jj = nstk - 1
@@ -384,7 +380,6 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
                     jj -= 1
                 n2 = 1.0
                 if jj >= 0:
-                    new_n = nstk - 1
                     top_ = -1
                     for q in range(nstk - 1, -1, -1):
                         if q != jj:
@@ -507,18 +502,8 @@ def trace_path(geo, shading, emitters, opts, key, ox, oy, oz, dx, dy, dz, counts
             delta_before = True
             ox, oy, oz = px - off * fx, py - off * fy, pz - off * fz
             dx, dy, dz = tx, ty, tz
-            if solid[k]:
-                if push:
-                    if nstk < 4:
-                        stk[nstk] = mi
-                        nstk += 1
-                elif new_n < nstk:  # leave: drop the topmost entry of this material
-                    jj = nstk - 1
-                    while stk[jj] != mi:
-                        jj -= 1
-                    for q in range(jj, nstk - 1):
-                        stk[q] = stk[q + 1]
-                    nstk -= 1
+            if solid[k]:  # into the solid through its front, out of it through its back
+                nstk = enter_or_leave(stk, nstk, mi, front)
         tmin, t_acc = tmin_here, 0.0
         counts[PathCount.EXTENSION_RAYS] += 1
     counts[PathCount.ENDED_BY_BOUNCE_CAP] += 1
