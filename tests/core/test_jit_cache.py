@@ -81,6 +81,35 @@ def _check_pruning(tmp_path):
     assert kept == sorted([fp, "notes"] + [p.name for p in old[-jit_cache.KEEP:]])
 
 
+def test_pruning_skips_a_folder_another_process_removed_meanwhile(tmp_path, monkeypatch):
+    """Two processes pruning the same base: a folder listed by one and removed by the other
+    before its ``stat`` is skipped, not raised (it was, with more than KEEP old folders)."""
+    old = [tmp_path / f"{i:016x}" for i in range(jit_cache.KEEP + 3)]
+    for i, p in enumerate(old):
+        p.mkdir()
+        os.utime(p, (1000.0 + i, 1000.0 + i))
+    current = tmp_path / ("f" * jit_cache.DIGITS)
+    current.mkdir()
+    gone = old[1]
+    real_stat = Path.stat
+
+    calls = []
+
+    def stat_after_removal(self, *a, **k):  # the listing's is_dir is the first stat, then removed
+        if self == gone:
+            calls.append(self)
+            if len(calls) == 2:
+                shutil.rmtree(self)
+        return real_stat(self, *a, **k)
+
+    monkeypatch.setattr(Path, "stat", stat_after_removal)
+    jit_cache._prune(tmp_path, current)
+    monkeypatch.undo()
+    assert len(calls) >= 2
+    left = sorted(p.name for p in tmp_path.iterdir())
+    assert left == sorted([current.name] + [p.name for p in old[-jit_cache.KEEP:]])
+
+
 CACHED = '''
 import workbench, numba
 @numba.njit(cache=True)

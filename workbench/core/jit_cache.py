@@ -150,8 +150,14 @@ def _prune(base: Path, current: Path) -> None:
                   and len(p.name) == DIGITS and all(c in "0123456789abcdef" for c in p.name)]
     except OSError:
         return
-    others.sort(key=lambda p: p.stat().st_mtime, reverse=True)
-    for p in others[KEEP:]:
+    used = []
+    for p in others:
+        try:
+            used.append((p.stat().st_mtime, p))
+        except OSError:  # removed meanwhile by another process pruning the same folder
+            continue
+    used.sort(reverse=True)
+    for _, p in used[KEEP:]:
         shutil.rmtree(p, ignore_errors=True)
 
 
