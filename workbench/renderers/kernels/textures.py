@@ -26,8 +26,7 @@ from numba.extending import overload
 
 from ...scene.kinds.hypertexture_kernels import value_noise
 from .columns import (ENV_IMAGE, ENV_NONE, PROJ_CYLINDRICAL, PROJ_PLANAR, PROJ_SOLID, PROJ_UV, TEX_BRICKS,
-                      TEX_CHECKER, TEX_CONSTANT, TEX_GRID, TEX_IMAGE, TEX_MARBLE, TEX_NOISE, TEX_WAVES,
-                      TEX_WOOD, Env, Mat, Tex)
+                      TEX_CHECKER, TEX_CONSTANT, TEX_GRID, TEX_IMAGE, TEX_MARBLE, TEX_NOISE, Env, Mat, Tex)
 from .flags import INLINE, NO_REFCOUNT
 from .layout import marker_features
 from .optics import checker_color
@@ -168,7 +167,7 @@ def pattern_value(kind, s0, s1, s2, solid, width):
         return _grid(s0, s1, width)
     if kind == TEX_MARBLE:
         return 0.5 + 0.5 * math.sin(TWO_PI * (s0 + 2.0 * turbulence(s0, s1, s2)))
-    r = math.hypot(s0, s2) if solid else math.hypot(s0, s1)  # wood
+    r = math.hypot(s0, s2) if solid else math.hypot(s0, s1)  # TEX_WOOD
     t = 4.0 * (r + 0.3 * fbm(s0, s1, s2))
     return smoothstep(0.0, 0.8, t - math.floor(t))
 
@@ -249,7 +248,7 @@ def height(tx, mi, x, y, z):
         return smoothstep(0.5 * hw, 1.5 * hw, mortar_distance(s0, s1, s2, solid))
     if kind == TEX_NOISE:
         return 0.5 + fbm(s0, s1, s2)
-    return 0.5 + 0.25 * (math.sin(TWO_PI * s0) + math.sin(TWO_PI * s1))  # waves
+    return 0.5 + 0.25 * (math.sin(TWO_PI * s0) + math.sin(TWO_PI * s1))  # TEX_WAVES
 
 
 @nb.njit(**NO_REFCOUNT)
@@ -330,8 +329,9 @@ def environment(tx, dx, dy, dz, background):
 
 
 # ----------------------------------------------------------------------------- gates
-def _maps(tx) -> bool:
-    """Whether the record's marker (its numba type at typing time) names ``maps``."""
+def has_maps(tx) -> bool:
+    """Whether a :class:`Textures` record's marker (the record's numba type, at typing time)
+    names ``maps``."""
     return "maps" in marker_features(tx.types[-1])
 
 
@@ -344,7 +344,7 @@ def surface_maps(tx, mat_tab, mi, k, xf, po, uv, ns, col):
 
 @overload(surface_maps, jit_options=INLINE)
 def _surface_maps(tx, mat_tab, mi, k, xf, po, uv, ns, col):
-    on = _maps(tx)
+    on = has_maps(tx)
 
     def impl(tx, mat_tab, mi, k, xf, po, uv, ns, col):
         if mat_tab[mi, Mat.TEXTURED] > 0.5:
@@ -369,7 +369,7 @@ def hit_alpha(tx, mat_tab, mi, k, po, uv):
 
 @overload(hit_alpha, jit_options=INLINE)
 def _hit_alpha(tx, mat_tab, mi, k, po, uv):
-    on = _maps(tx)
+    on = has_maps(tx)
 
     def impl(tx, mat_tab, mi, k, po, uv):
         if on and mat_tab[mi, Mat.OPACITY] > 0.5:
@@ -387,7 +387,7 @@ def miss_radiance(tx, dx, dy, dz, background, out):
 
 @overload(miss_radiance, jit_options=INLINE)
 def _miss_radiance(tx, dx, dy, dz, background, out):
-    on = _maps(tx)
+    on = has_maps(tx)
 
     def impl(tx, dx, dy, dz, background, out):
         if on:
