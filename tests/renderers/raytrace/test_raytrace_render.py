@@ -20,7 +20,7 @@ SMALL = {"whitted": (32, 24), "cornell": (10, 10), "csg": (32, 24), "quadrics": 
 
 @pytest.mark.parametrize("name", sorted(SMALL))
 def test_kernels_match_the_reference(name):
-    """Same image from the numba wavefront kernels and the one-ray-at-a-time reference
+    """Same image from the numba kernel and the one-ray-at-a-time reference
     (except at most 2 % of pixels, where a ray grazes an edge and float rounding decides)."""
     sc = workbench.load_scene(name)
     w, h = SMALL[name]

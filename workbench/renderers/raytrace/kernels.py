@@ -1,14 +1,13 @@
 """Numba drivers of the Whitted ray tracer: the shading and spawning step of a hit
-(:func:`shade_hit`), and the two drivers: the fused kernel (:func:`render_pixels`: each pixel's
-whole ray tree depth first) and the wavefront kernels (:func:`trace_batch`, :func:`shade_batch`:
-each generation of rays is traced, then shaded, then its reflected and refracted children form
-the next generation).  Intersection is :mod:`..kernels.intersect`'s, the surface optics
+(:func:`shade_hit`), the driver (:func:`render_pixels`: each pixel's whole ray tree depth
+first) and the batch intersector of ``workbench.raytrace.intersect`` (:func:`trace_batch`).
+Intersection is :mod:`..kernels.intersect`'s, the surface optics
 :mod:`..kernels.optics`'s.
 
 Everything is scalar code over flat arrays (:mod:`.flatten`; the geometry as the named record
 :class:`..kernels.layout.Geometry`, tables with named columns, :mod:`..kernels.columns`).  The
-drivers run blocks of pixels or chunks of rays on several threads: the fused one as ``nogil``
-tasks on a thread pool (:mod:`..kernels.tasks`), the wavefront ones with ``prange``; each task
+driver runs blocks of pixels as ``nogil`` tasks on a thread pool (:mod:`..kernels.tasks`), the
+batch intersector chunks of rays with ``prange``; each task
 has its own scratch arrays (BVH stack, CSG interval stacks, ray stack) and hands its work to
 functions compiled without reference counting (:data:`..kernels.flags.NO_REFCOUNT`).  Helpers
 take :data:`..kernels.flags.INLINE`: each is compiled once (and cached) and LLVM inlines it
@@ -44,7 +43,7 @@ from .flatten import MAX_CUTOUTS
 from .opacity import _past, opacity_feelers, pass_cutouts
 
 CHUNK = 64
-"""Rays of a wavefront chunk."""
+"""Rays of a chunk of :func:`trace_batch`."""
 
 
 # ----------------------------------------------------------------------------- batch kernels
