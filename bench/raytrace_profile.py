@@ -138,8 +138,8 @@ def _feelers(sd, O, D, h):
 
 def tables(res: dict) -> str:
     fu, me = res["fused"], res["mesh"]
-    out = [f"Whitted scene at {res['size']}, depth 5, threshold 1/255, warm; {res['machine']}; numba threading layer "
-           f"{res.get('numba_threading_layer')}.  No outside anchor (POV-Ray on the same scene: "
+    out = [f"Whitted scene at {res['size']}, depth 5, threshold 1/255, warm; {res['machine']}; the kernel's tasks on "
+           f"{res.get('numba_threads')} Python threads at most.  No outside anchor (POV-Ray on the same scene: "
            "[povray_whitted](povray_whitted.md)).", "",
            "## Whitted scene", "",
            table(["threads", "trace (s)", "trace CPU (s)", "Mrays/s"],
@@ -166,7 +166,7 @@ def main(argv=None) -> dict:
         W, H, REPEATS = 32, 24, 1
     workbench.render(workbench.load_scene("whitted"), "raytrace", width=32, height=24)  # JIT / cache
     res = dict(machine=f"{os.cpu_count()} CPUs (shared); load average {os.getloadavg()[0]:.2f} at start",
-               numba_threading_layer=numba.threading_layer(), size=f"{W}x{H}",
+               numba_threads=numba.get_num_threads(), size=f"{W}x{H}",
                fused=[fused(t) for t in (1, 2)])
     res["mesh"] = mesh_intersection()
     print(json.dumps(res, indent=2))
