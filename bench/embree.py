@@ -20,7 +20,7 @@ the bundled ``mesh`` scene's 81,920 triangles and camera, in one run (issue #28,
    normal and triangle of each ray, one ``rtcIntersect1`` per ray on one thread), the same
    rays in float32.  Also ours without the surface data: ``kernels.intersect.closest`` alone
    over the rays (:func:`closest_kernel`), the traversal nearer to what ``run`` does, and
-   ``trace_batch`` with the whole surface data of the Whitted wavefront (shading normal, uv,
+   ``trace_batch`` with the whole surface data (shading normal, uv,
    object-space point, vertex emission).  The hits are compared (hit or miss per ray; distance within a relative
    ``T_RTOL``; geometric normals parallel), so that both answer the same question.
 
@@ -141,7 +141,7 @@ class OurSide:
 
     def trace(self, O, D, surface=False):
         """``trace_batch`` over the rays as ``intersect`` calls it (the geometric normal alone),
-        or with ``surface``, the wavefront's whole surface data (shading normal, uv, object
+        or with ``surface``, the whole surface data (shading normal, uv, object
         point, vertex emission)."""
         n = len(O)
         h = self.alloc(n, surface)
@@ -313,7 +313,7 @@ def tables(res: dict) -> str:
                   "them, with barycentrics); below, the closest hits alone (`kernels.intersect.closest`, "
                   "the function `trace_batch` calls for each ray; the same distances: "
                   f"{fmt(res.get('closest_only_same_t'))}) and `trace_batch` with the whole surface data "
-                  "the Whitted wavefront needs (shading normal, uv, object-space point, vertex emission: "
+                  "of a hit (shading normal, uv, object-space point, vertex emission: "
                   "the arrays of every ray allocated, the hit triangle's normals, uv and emission read):", "",
                   table(["ours", "M rays per CPU-second", "ours / Embree", "M rays per second (wall)",
                          "ours / Embree"],

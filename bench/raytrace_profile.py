@@ -1,17 +1,11 @@
-"""Where the Whitted ray tracer spends its trace phase, on 1 and 2 threads: the fused kernel
-(whole ray trees per pixel, the path the Whitted scene takes) against the wavefront path
-(the path of scenes with numpy textures), whose numba kernels are timed against the numpy glue
-between ray generations, per generation.  Then the mesh scene (81,920 triangles) on one thread:
-its whole trace phase against the intersection queries of the same rays alone (``mesh``).
+"""Where the Whitted ray tracer spends its trace phase: the Whitted scene's trace on 1 and 2
+threads (the kernel traces whole ray trees per pixel), then the mesh scene (81,920 triangles)
+on one thread: its whole trace phase against the intersection queries of the same rays alone
+(``mesh``).
 
 The Whitted scene at 640 x 480, depth 5, threshold 1/255 (as ``bench/povray_whitted.py``),
-warm JIT cache, best of 3 renders per thread count and path.  For the wavefront runs the
-Whitted scene is sent down the wavefront path (``whitted.fused_textures`` answers None) and
-the kernels of :mod:`workbench.renderers.raytrace.kernels` are wrapped (in this process only)
-by timers that record wall and CPU seconds of each call; ``glue`` is the trace phase minus
-the kernels.
-CPU seconds over wall seconds of a kernel is its thread utilisation (2.0 = both threads busy;
-on a shared machine other processes lower it).
+warm JIT cache, best of 3 renders per thread count.  CPU seconds over wall seconds is the
+thread utilisation (2.0 = both threads busy; on a shared machine other processes lower it).
 
 Writes ``bench/results/raytrace_profile.json`` and ``docs/benchmarks/raytrace_profile.md`` and prints
 it.  Run: ``.venv/bin/python bench/raytrace_profile.py``.  ``--smoke``: 32 x 24, one render per case.
@@ -29,34 +23,6 @@ from _common import Page, first_paragraph, fmt, table
 ROOT = Path(__file__).resolve().parents[1]
 W, H = 640, 480
 REPEATS = 3
-KERNELS = ("trace_batch", "shade_batch", "compact", "accumulate", "column_sums")
-
-
-def _instrument(kernels, whitted, log):
-    """Wrap the kernels and the band tracer so that each kernel call is logged as
-    ``(kernel, generation, rays, wall_s, cpu_s)``."""
-    state = {"gen": -1}
-    for name in KERNELS:
-        f = getattr(kernels, name)
-
-        def timed(*a, _f=f, _n=name):
-            if _n == "trace_batch":
-                state["gen"] += 1
-            t0, c0 = time.perf_counter(), time.process_time()
-            r = _f(*a)
-            log.append((_n, state["gen"], len(a[1]) if _n != "column_sums" else len(a[0]),
-                        time.perf_counter() - t0, time.process_time() - c0))
-            return r
-        timed.signatures = f.signatures
-        setattr(kernels, name, timed)
-    band = whitted._Tracer.trace
-
-    def trace(self, *a, **k):
-        state["gen"] = -1
-        return band(self, *a, **k)
-    whitted._Tracer.trace = trace
-
-
 def fused(threads: int, repeats: int | None = None) -> dict:
     """Best trace phase of the fused path."""
     import numba
@@ -71,44 +37,12 @@ def fused(threads: int, repeats: int | None = None) -> dict:
                 total_rays=r.stats["total_rays"], mrays_per_s=r.stats["total_rays"] / r.timings["trace"] / 1e6)
 
 
-def profile(threads: int, repeats: int | None = None) -> dict:
-    import numba
-
-    import workbench
-    numba.set_num_threads(threads)
-    repeats = repeats or REPEATS
-    scene = workbench.load_scene("whitted")
-    best = None
-    for _ in range(repeats):
-        r = workbench.render(scene, "raytrace", width=W, height=H, threshold=1.0 / 255.0, max_depth=5)
-        log = LOG[:]
-        LOG.clear()
-        if best is None or r.timings["trace"] < best[0].timings["trace"]:
-            best = (r, log)
-    r, log = best
-    kern = {n: dict(wall_s=sum(x[3] for x in log if x[0] == n), cpu_s=sum(x[4] for x in log if x[0] == n))
-            for n in KERNELS}
-    gens = sorted({x[1] for x in log})
-    per_gen = [dict(generation=g + 1, rays=sum(x[2] for x in log if x[1] == g and x[0] == "trace_batch"),
-                    trace_batch_s=sum(x[3] for x in log if x[1] == g and x[0] == "trace_batch"),
-                    shade_batch_s=sum(x[3] for x in log if x[1] == g and x[0] == "shade_batch"))
-               for g in gens]
-    k_wall = sum(v["wall_s"] for v in kern.values())
-    return dict(threads=threads, trace_s=r.timings["trace"], trace_cpu_s=r.timings["trace_cpu"],
-                mrays_per_s=r.stats["total_rays"] / r.timings["trace"] / 1e6,
-                kernels=kern, kernels_wall_s=k_wall, glue_wall_s=r.timings["trace"] - k_wall,
-                glue_share=(r.timings["trace"] - k_wall) / r.timings["trace"],
-                utilisation={n: v["cpu_s"] / max(v["wall_s"], 1e-9) for n, v in kern.items()
-                             if n in ("trace_batch", "shade_batch")},
-                per_generation=per_gen)
-
-
 def mesh_intersection(repeats: int | None = None) -> dict:
     """The mesh scene on one thread: the trace phase of a render against the intersection
     queries of its rays alone, through :func:`intersect.closest` (analytic primitives, the
     mesh's box, the 4-wide BVH) and through the BVH alone (box test + :func:`walks.bvh_hit`):
     the primary rays' closest hits, then the shadow feelers :func:`kernels.shade_hit` traces
-    (:func:`kernels.feeler_batch`, any hit).  Best of ``repeats`` each."""
+    (:func:`_feelers`, any hit).  Best of ``repeats`` each."""
     import numba
     import numpy as np
 
@@ -118,7 +52,7 @@ def mesh_intersection(repeats: int | None = None) -> dict:
     from workbench.renderers.kernels.flags import NO_REFCOUNT
     from workbench.renderers.raytrace import kernels as K
     from workbench.renderers.raytrace.flatten import flatten
-    from workbench.renderers.raytrace.whitted import _alloc, camera_rays, kernel_options
+    from workbench.renderers.raytrace.whitted import _alloc, camera_rays
     numba.set_num_threads(1)
     repeats = repeats or REPEATS
     scene = workbench.load_scene("mesh")
@@ -131,11 +65,7 @@ def mesh_intersection(repeats: int | None = None) -> dict:
     h = _alloc(n)
     K.trace_batch(geo, O, D, np.zeros(n), np.full(n, np.inf), tol.zero, tol.ray_offset, sd.extent,
                   tol.normal_cancel, False, h["t"], h["prim"], h["ng"], h["ns"], h["uv"], h["po"], h["ev"])
-    kopts = kernel_options(1, extent=sd.extent)
-    nl = len(sd.lights)
-    fo, fd = np.empty((n * nl, 3)), np.empty((n * nl, 3))
-    ftmin, ftmax, want = np.empty(n * nl), np.empty(n * nl), np.empty(n * nl, np.bool_)
-    K.feeler_batch(sd.lights, O, D, h["t"], h["prim"], h["ng"], h["ns"], kopts, fo, fd, ftmin, ftmax, want)
+    fo, fd, ftmin, ftmax, want = _feelers(sd, O, D, h)
     sets = dict(primary=(O, D, np.zeros(n), np.full(n, np.inf), False),
                 shadow=(fo[want], fd[want], ftmin[want], ftmax[want], True))
 
@@ -177,24 +107,43 @@ def mesh_intersection(repeats: int | None = None) -> dict:
     return out
 
 
-LOG: list = []
+def _feelers(sd, O, D, h):
+    """The shadow feelers :func:`kernels.shade_hit` traces from the hits ``h`` (point lights
+    only, as in the mesh scene): a row per (hit, light), origin pushed off the surface on the
+    light's side (:func:`..kernels.optics._feeler`), ``want`` where the light faces the
+    shading normal."""
+    import numpy as np
+
+    from workbench.core.tol import tol
+    from workbench.renderers.kernels.columns import Light
+    nl = len(sd.lights)
+    P = O + h["t"][:, None] * D
+    ns = np.where((np.einsum("ij,ij->i", h["ns"], D) > 0)[:, None], -h["ns"], h["ns"])
+    off = tol.ray_offset * np.maximum(np.abs(P).max(1), sd.extent)
+    fo, fd = np.empty((len(O), nl, 3)), np.empty((len(O), nl, 3))
+    ftmin, ftmax, want = np.empty((len(O), nl)), np.empty((len(O), nl)), np.empty((len(O), nl), np.bool_)
+    for li in range(nl):
+        V = sd.lights[li, Light.POSITION:Light.POSITION + 3] - P
+        dist = np.linalg.norm(V, axis=1)
+        L = V / dist[:, None]
+        side = np.where(np.einsum("ij,ij->i", h["ng"], L) >= 0, 1.0, -1.0)
+        fo[:, li] = P + (side * off)[:, None] * h["ng"]
+        fd[:, li], ftmax[:, li] = L, dist - 2 * off
+        ftmin[:, li] = tol.t_min * np.maximum(np.abs(P).max(1), sd.extent)
+        want[:, li] = (h["prim"] >= 0) & (np.einsum("ij,ij->i", ns, L) > 0)
+    return fo.reshape(-1, 3), fd.reshape(-1, 3), ftmin.reshape(-1), ftmax.reshape(-1), want.reshape(-1)
+
+
 
 
 def tables(res: dict) -> str:
-    fu, wf, me = res["fused"], res["wavefront"], res["mesh"]
-    out = [f"Whitted scene at {res['size']}, depth 5, threshold 1/255, warm; {res['machine']}; numba threading layer "
-           f"{res.get('numba_threading_layer')}.  No outside anchor (POV-Ray on the same scene: "
-           "[povray_whitted](povray_whitted.md)); the wavefront path is the baseline of the fused kernel.", "",
-           "## Fused kernel against the wavefront path", "",
-           table(["threads", "fused trace (s)", "fused Mrays/s", "wavefront trace (s)", "wavefront Mrays/s",
-                  "wavefront / fused", "wavefront glue share", "trace_batch utilisation"],
-                 [[f["threads"], f["trace_s"], f["mrays_per_s"], w["trace_s"], w["mrays_per_s"],
-                   f"{w['trace_s'] / f['trace_s']:.2f}", w["glue_share"], w["utilisation"].get("trace_batch")]
-                  for f, w in zip(fu, wf)]),
-           "## Wavefront kernels (wall s, CPU s)", "",
-           table(["threads"] + list(wf[0]["kernels"]),
-                 [[w["threads"]] + [f"{fmt(k['wall_s'])} / {fmt(k['cpu_s'])}" for k in w["kernels"].values()]
-                  for w in wf]),
+    fu, me = res["fused"], res["mesh"]
+    out = [f"Whitted scene at {res['size']}, depth 5, threshold 1/255, warm; {res['machine']}; the kernel's tasks on "
+           f"{res.get('numba_threads')} Python threads at most.  No outside anchor (POV-Ray on the same scene: "
+           "[povray_whitted](povray_whitted.md)).", "",
+           "## Whitted scene", "",
+           table(["threads", "trace (s)", "trace CPU (s)", "Mrays/s"],
+                 [[f["threads"], f["trace_s"], f["trace_cpu_s"], f["mrays_per_s"]] for f in fu]),
            f"## Mesh scene ({me['triangles']} triangles), one thread", "",
            table(["rays", "count", "closest (s)", "BVH alone (s)"],
                  [[k, me[f"{k}_rays"], me[f"{k}_closest_s"], me[f"{k}_bvh_s"]] for k in ("primary", "shadow")]),
@@ -215,16 +164,11 @@ def main(argv=None) -> dict:
     args = PAGE.parse(argparse.ArgumentParser(description=__doc__.splitlines()[0]), argv)
     if args.smoke:
         W, H, REPEATS = 32, 24, 1
-    from workbench.renderers.raytrace import kernels, whitted
     workbench.render(workbench.load_scene("whitted"), "raytrace", width=32, height=24)  # JIT / cache
     res = dict(machine=f"{os.cpu_count()} CPUs (shared); load average {os.getloadavg()[0]:.2f} at start",
-               numba_threading_layer=numba.threading_layer(), size=f"{W}x{H}",
+               numba_threads=numba.get_num_threads(), size=f"{W}x{H}",
                fused=[fused(t) for t in (1, 2)])
     res["mesh"] = mesh_intersection()
-    whitted.fused_textures = lambda scene, sd: None  # the wavefront path from here on
-    workbench.render(workbench.load_scene("whitted"), "raytrace", width=32, height=24)
-    _instrument(kernels, whitted, LOG)
-    res["wavefront"] = [profile(t) for t in (1, 2)]
     print(json.dumps(res, indent=2))
     return PAGE.write(args, res)
 

@@ -153,16 +153,6 @@ def test_raytrace_generations_bounded_by_weights():
         assert a.stats[k] == b.stats[k]
 
 
-def test_wavefront_iteration_capped(monkeypatch):
-    """The wavefront path refuses an iteration beyond the cap its estimate counted."""
-    from workbench.renderers.raytrace import whitted
-    scene = workbench.load_scene(ROOT / "scenes" / "envmap.toml")  # environment: wavefront
-    render(scene, "raytrace", width=16, height=12)
-    monkeypatch.setattr(whitted, "wavefront_cap", lambda *a, **k: 1)  # the chrome sphere reflects more than one ray
-    with pytest.raises(WorkbenchError, match="max_depth"):
-        render(scene, "raytrace", width=16, height=12)
-
-
 def _cli(*args, env=None):
     """The CLI in a child limited to 6 GiB of address space (a regression dies, not the host)."""
     def limit():

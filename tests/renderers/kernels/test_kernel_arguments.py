@@ -17,9 +17,9 @@ from numba.core.registry import CPUDispatcher
 import workbench
 
 LIMIT = 8
-KNOWN = {"compact", "feeler_batch", "shade_batch", "shade_chunk", "trace_batch", "trace_chunk"}
-"""Kernels still over the limit, named so that the list can only shrink: the Whitted wavefront
-drivers (``raytrace/kernels.py``; the kernel-layer issue asks for one Whitted, the fused one)."""
+KNOWN = {"trace_batch", "trace_chunk"}
+"""Kernels still over the limit, named so that the list can only shrink: the batch intersector
+of ``workbench.raytrace.intersect`` (``raytrace/kernels.py``)."""
 RENDERS = [("kinds", "raytrace", {}), ("csg", "raycast", {}), ("mesh", "raytrace", {}),
            ("cornell", "pathtrace", {"spp": 2}), ("cornell", "radiosity", {}),
            ("cornell", "radiosity", {"form_factors": "raycast", "patch_size": 0.2}),

@@ -3,6 +3,7 @@
 vertex emission, the ray tree."""
 from __future__ import annotations
 
+import dataclasses
 import tomllib
 
 import numpy as np
@@ -19,7 +20,7 @@ SMALL = {"whitted": (32, 24), "cornell": (10, 10), "csg": (32, 24), "quadrics": 
 
 @pytest.mark.parametrize("name", sorted(SMALL))
 def test_kernels_match_the_reference(name):
-    """Same image from the numba wavefront kernels and the one-ray-at-a-time reference
+    """Same image from the numba kernel and the one-ray-at-a-time reference
     (except at most 2 % of pixels, where a ray grazes an edge and float rounding decides)."""
     sc = workbench.load_scene(name)
     w, h = SMALL[name]
@@ -31,35 +32,53 @@ def test_kernels_match_the_reference(name):
     assert np.median(err) < 1e-6
 
 
-@pytest.mark.parametrize("name,spp", [("whitted", 1), ("whitted", 2), ("csg", 2), ("cornell", 1),
-                                      ("mesh", 2), ("quadrics", 1)])
-def test_fused_kernel_matches_the_wavefront_kernels(name, spp, monkeypatch):
-    """The fused kernel (whole ray trees pixel by pixel, checker textures evaluated in numba;
-    with spp = 1 it makes the camera rays itself) gives the wavefront kernels' image, depth map
-    and ray counts (generation by generation, textures in numpy); only the order of the
-    floating-point sums and the last bit of the camera rays may differ."""
+def _reference_counts(sc, w, h, **opts):
+    """Ray counts of the readable reference's ray trees (:func:`reference.ray_tree`) over the
+    image: shadow feelers, reflected and refracted rays traced, rays that left the scene."""
+    counts = dict(shadow_rays=0, reflected_rays=0, refracted_rays=0, escaped_rays=0)
+    names = {"reflection": "reflected_rays", "refraction": "refracted_rays"}
+
+    def walk(node):
+        counts["shadow_rays"] += len(node["shadow_feelers"])
+        counts["escaped_rays"] += node["object"] is None
+        for child in node["children"]:
+            if "ray" in child:
+                if child["kind"] in names:
+                    counts[names[child["kind"]]] += 1
+                walk(child["ray"])
+    for i in range(h):
+        for j in range(w):
+            walk(reference.ray_tree(sc, i, j, **opts))
+    return counts
+
+
+@pytest.mark.parametrize("name", ["whitted", "bricks", "envmap", "csg"])
+def test_ray_counts_match_the_reference_ray_trees(name):
+    """The kernel traces the rays the readable reference traces: shadow feelers, reflected and
+    refracted children and escaped rays, summed over the ray trees of every pixel, and the
+    depth map is the primary hits' camera-space depth."""
+    w, h = 12, 9
     sc = workbench.load_scene(name)
-    opts = dict(width=24, height=18, max_depth=5, threshold=1e-3, spp=spp, fresnel="schlick")
-    paths = []
-    fused_trace = whitted._Tracer._trace_fused
-    monkeypatch.setattr(whitted._Tracer, "_trace_fused",
-                        lambda self, *a: paths.append("fused") or fused_trace(self, *a))
-    fused = workbench.render(sc, "raytrace", **opts)
-    monkeypatch.setattr(whitted, "fused_textures", lambda scene, sd: None)
-    wave = workbench.render(sc, "raytrace", **opts)
-    assert paths == ["fused"]  # the first render went through the fused kernel, the second did not
-    assert np.allclose(fused.image, wave.image, rtol=0, atol=1e-6)
-    assert np.allclose(fused.depth, wave.depth, rtol=1e-12, atol=0)
-    assert np.array_equal(np.isinf(fused.depth), np.isinf(wave.depth))
-    assert fused.stats == {**wave.stats, "mrays_per_s": fused.stats["mrays_per_s"]}
+    sc = dataclasses.replace(sc, camera=dataclasses.replace(sc.camera, width=w, height=h))
+    opts = dict(max_depth=4, threshold=1e-3, fresnel="schlick")
+    r = workbench.render(sc, "raytrace", width=w, height=h, **opts)
+    want = _reference_counts(sc, w, h, **opts)
+    for key in ("shadow_rays", "reflected_rays", "refracted_rays", "escaped_rays"):
+        assert r.stats[key] == want[key], (key, r.stats[key], want[key])
+    assert r.stats["primary_rays"] == w * h
 
 
-def test_textures_the_fused_kernel_cannot_evaluate_take_the_wavefront_path():
-    """Image textures, bump maps and environments need numpy between generations."""
-    for name, fused in (("whitted", True), ("globe", False), ("bricks", False), ("envmap", False)):
+def test_only_scenes_with_maps_beyond_checkers_compile_the_maps():
+    """The maps' marker names ``maps`` for image textures, bump maps, opacity maps and
+    environments, not for plain colours and planar or solid checkers (``whitted``: the kernel
+    compiles the checker alone)."""
+    from workbench.renderers.kernels.layout import marker_features
+    from workbench.renderers.raytrace.maps import texture_tables
+    for name, maps in (("whitted", False), ("cornell", False), ("globe", True), ("bricks", True), ("envmap", True)):
         sc = workbench.load_scene(name)
         sd = whitted.flatten(sc)
-        assert (whitted.fused_textures(sc, sd) is not None) == fused, name
+        assert ("maps" in marker_features(texture_tables(sc, sd).marker)) == maps, name
+        assert (whitted.fused_textures(sc, sd) is None) == maps, name
 
 
 def _scaled_whitted(s):

@@ -1,7 +1,7 @@
-"""Named columns of the tables the numba kernels read: materials, lights, fused checker
-textures, the Whitted and path-tracing options and the kernels' counters (:class:`workbench.core.columns.Columns`:
+"""Named columns of the tables the numba kernels read: materials, lights, texture maps and
+the environment, the Whitted and path-tracing options and the kernels' counters (:class:`workbench.core.columns.Columns`:
 ``NAME = first, span``).  The builders (``workbench.renderers.raytrace.flatten``'s
-``_material_row`` and ``light_rows``, ``whitted.fused_textures``, the sessions' options) write
+``_material_row`` and ``light_rows``, ``raytrace.maps.texture_tables``, the sessions' options) write
 by name through :func:`~workbench.core.columns.pack`.  The primitive table's per-kind
 parameters are named by each kind's ``Par`` (``workbench.scene.kinds``).
 """
@@ -24,7 +24,7 @@ class Mat(Columns):
     ABSORPTION = 10, 3   # Beer absorption per unit length
     EMISSION = 13, 3     # emitted radiance
     FRONT_ONLY = 16      # 1: emits from its front side only
-    TEXTURED = 17        # 1: has a texture (the fused checker or numpy texturing)
+    TEXTURED = 17        # 1: has a colour texture (``Tex`` row of the colour table)
     BUMPED = 18          # 1: has a bump map
     OPACITY = 19         # 1: has an opacity map
     ENVIRONMENT = 20     # 1: reflects the environment map
@@ -43,19 +43,50 @@ class Light(Columns):
 
 
 class Tex(Columns):
-    """Fused checker texture table ``(M, TEX_COLS)`` of the per-pixel Whitted kernel."""
+    """Texture map table ``(M, TEX_COLS)``, one row per material, of a colour texture, a bump
+    map or an opacity map (three tables, :mod:`.textures`; ``KIND`` 0: none)."""
 
-    KIND = 0             # CHECKER_PLANAR or CHECKER_SOLID
-    SCALE = 1            # checks per unit
-    CENTER = 2, 3        # pattern origin
-    SE = 5, 3            # planar projection's first axis
-    W = 8, 3             # planar projection's second axis
-    COLOR0 = 11, 3       # first colour
-    COLOR1 = 14, 3       # second colour
+    KIND = 0             # pattern: a ``TEX_*`` code
+    PROJ = 1             # projection: a ``PROJ_*`` code
+    SCALE = 2            # pattern periods per unit
+    CENTER = 3, 3        # pattern origin
+    SP = 6, 3            # pole (unit)
+    SE = 9, 3            # equator made orthogonal to the pole (unit)
+    W = 12, 3            # SP x SE
+    COLOR0 = 15, 3       # first colour
+    COLOR1 = 18, 3       # second colour
+    WIDTH = 21           # mortar (bricks, bump bricks) or line width (grid opacity)
+    STRENGTH = 22        # bump strength
+    VALUE = 23           # constant opacity
+    IMAGE = 24           # first value of the image in the pixel array (RGBA rows, top first)
+    IMAGE_W = 25         # its width
+    IMAGE_H = 26         # its height
+    ALPHA = 27           # opacity image: 1 its alpha channel, 0 its luminance
 
 
-CHECKER_PLANAR, CHECKER_SOLID = 1, 2
-"""``tex_tab`` kinds of the procedural textures the fused kernel evaluates itself."""
+(TEX_NONE, TEX_CHECKER, TEX_BRICKS, TEX_GRID, TEX_MARBLE, TEX_WOOD, TEX_IMAGE, TEX_NOISE, TEX_WAVES,
+ TEX_CONSTANT) = range(10)
+"""``Tex.KIND`` codes: the patterns of :mod:`workbench.renderers.texturing` (colour, bump, opacity)."""
+PROJ_PLANAR, PROJ_CYLINDRICAL, PROJ_SPHERICAL, PROJ_UV, PROJ_SOLID = range(5)
+"""``Tex.PROJ`` codes."""
+
+
+class Env(Columns):
+    """What a ray leaving the scene sees and the texturing tolerances ``(ENV_COLS,)``."""
+
+    KIND = 0             # ENV_NONE (the background colour), ENV_SKY or ENV_IMAGE
+    HORIZON = 1, 3
+    ZENITH = 4, 3
+    GROUND = 7, 3
+    IMAGE = 10           # lat-long image: first value in the pixel array
+    IMAGE_W = 11
+    IMAGE_H = 12
+    ZERO = 13            # tol.zero (the poles of the projections)
+    BUMP_STEP = 14       # tol.bump_step
+
+
+ENV_NONE, ENV_SKY, ENV_IMAGE = range(3)
+"""``Env.KIND`` codes."""
 
 
 class WhittedOpt(Columns):
@@ -143,7 +174,7 @@ class TraversalCount(Columns):
     ANALYTIC = 2, 2          # the analytic primitives' tree (and list): nodes, tests
 
 
-MAT_COLS, LIGHT_COLS, TEX_COLS = width(Mat), width(Light), width(Tex)
+MAT_COLS, LIGHT_COLS, TEX_COLS, ENV_COLS = width(Mat), width(Light), width(Tex), width(Env)
 WHITTED_OPTS, PATH_OPTS = width(WhittedOpt), width(PathOpt)
 RAY_COUNTS, PATH_COUNTS = width(RayCount), width(PathCount)
 TRAVERSAL_COUNTS = width(TraversalCount)

@@ -9,7 +9,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .columns import CHECKER_PLANAR, Light, Mat, Tex
+from .columns import PROJ_PLANAR, Light, Mat, Tex
 from .flags import INLINE
 from .shapes import _normalize
 
@@ -111,10 +111,11 @@ def checker_color(tex_tab, mi, x, y, z):
     """Texture factor of material ``mi`` at object-space point ``(x, y, z)``: the
     ``checker`` pattern of :func:`workbench.renderers.texturing.pattern_value` with the
     ``planar`` (``s = scale (d.Se, d.W)``) or ``solid`` (``s = scale d``) projection,
-    ``d = P - center``.  ``tex_tab`` row: kind, scale, center (3), Se (3), W (3), colors (6)."""
+    ``d = P - center``.  ``tex_tab``: columns :class:`.columns.Tex` (the path tracer's textures and the Whitted
+    kernel's when the scene has no other texture: :mod:`.textures`)."""
     cx, cy, cz = x - tex_tab[mi, Tex.CENTER], y - tex_tab[mi, Tex.CENTER + 1], z - tex_tab[mi, Tex.CENTER + 2]
     sc = tex_tab[mi, Tex.SCALE]
-    if tex_tab[mi, Tex.KIND] == CHECKER_PLANAR:
+    if tex_tab[mi, Tex.PROJ] == PROJ_PLANAR:
         parity = (math.floor(sc * (cx * tex_tab[mi, Tex.SE] + cy * tex_tab[mi, Tex.SE + 1] + cz * tex_tab[mi, Tex.SE + 2]))
                   + math.floor(sc * (cx * tex_tab[mi, Tex.W] + cy * tex_tab[mi, Tex.W + 1] + cz * tex_tab[mi, Tex.W + 2])))
     else:

@@ -2,9 +2,9 @@
 ``intersect`` (``workbench.raytrace.intersect``) and ``ray_tree``.
 
 Modules: :mod:`.flatten` (scene -> arrays, through each object kind's ``flatten``), :mod:`.bvh`
-(binned SAH BVH), :mod:`.kernels` (numba: intersection, shading with shadow feelers, child rays;
-the fused per-pixel kernel), :mod:`.whitted` (the two renderers: the fused path, or the wavefront
-loop with textures through :mod:`workbench.renderers.texturing`), and the readable reference
+(binned SAH BVH), :mod:`.kernels` (numba: shading with shadow feelers, child rays, the per-pixel
+driver, the batch intersector), :mod:`.maps` and :mod:`.opacity` (texture maps in the kernel),
+:mod:`.whitted` (the two renderers), and the readable reference
 :mod:`.reference` with each object kind's ``hits`` and ``normal`` (:mod:`workbench.scene.kinds`)
 and :mod:`.shapes` (triangles) (one ray at a time, the course's
 trace / shade / intersect structure; tested against the kernels).

@@ -1,14 +1,13 @@
 """Numba drivers of the Whitted ray tracer: the shading and spawning step of a hit
-(:func:`shade_hit`), and the two drivers: the fused kernel (:func:`render_pixels`: each pixel's
-whole ray tree depth first) and the wavefront kernels (:func:`trace_batch`, :func:`shade_batch`:
-each generation of rays is traced, then shaded, then its reflected and refracted children form
-the next generation).  Intersection is :mod:`..kernels.intersect`'s, the surface optics
+(:func:`shade_hit`), the driver (:func:`render_pixels`: each pixel's whole ray tree depth
+first) and the batch intersector of ``workbench.raytrace.intersect`` (:func:`trace_batch`).
+Intersection is :mod:`..kernels.intersect`'s, the surface optics
 :mod:`..kernels.optics`'s.
 
 Everything is scalar code over flat arrays (:mod:`.flatten`; the geometry as the named record
 :class:`..kernels.layout.Geometry`, tables with named columns, :mod:`..kernels.columns`).  The
-drivers run blocks of pixels or chunks of rays on several threads: the fused one as ``nogil``
-tasks on a thread pool (:mod:`..kernels.tasks`), the wavefront ones with ``prange``; each task
+driver runs blocks of pixels as ``nogil`` tasks on a thread pool (:mod:`..kernels.tasks`), the
+batch intersector chunks of rays with ``prange``; each task
 has its own scratch arrays (BVH stack, CSG interval stacks, ray stack) and hands its work to
 functions compiled without reference counting (:data:`..kernels.flags.NO_REFCOUNT`).  Helpers
 take :data:`..kernels.flags.INLINE`: each is compiled once (and cached) and LLVM inlines it
@@ -30,18 +29,21 @@ import numba as nb
 import numpy as np
 from numba import prange
 
-from ..kernels.columns import RAY_COUNTS, Light, Mat, RayCount, WhittedOpt
+from ..kernels.columns import RAY_COUNTS, Light, Mat, RayCount, Tex, WhittedOpt
 from ..kernels.flags import INLINE, NO_REFCOUNT, TASK
 from ..kernels.intersect import closest, geometric_normal, object_point, scratch, surface
-from ..kernels.optics import (_facing, _feeler, _ior, _light_dir, _pow, camera_ray, checker_color,
-                              enter_or_leave, fresnel_reflectance)
+from ..kernels.optics import (_facing, _feeler, _ior, _light_dir, _pow, camera_ray, enter_or_leave,
+                              fresnel_reflectance)
 from ..kernels.shapes import _normalize
 from ..kernels.tasks import run_tasks
 from ..kernels.media import march
+from ..kernels.textures import Textures, hit_alpha, miss_radiance, surface_maps
 from .feelers import _transmittance
+from .flatten import MAX_CUTOUTS
+from .opacity import _past, opacity_feelers, pass_cutouts
 
 CHUNK = 64
-"""Rays of a wavefront chunk."""
+"""Rays of a chunk of :func:`trace_batch`."""
 
 
 # ----------------------------------------------------------------------------- batch kernels
@@ -94,14 +96,6 @@ def trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_on
             ng[i, 0], ng[i, 1], ng[i, 2] = geometric_normal(geo, k, f, tri, x, y, z, stack)
         else:
             surface(geo, k, f, tri, b1, b2, px, py, pz, ncancel, ng, ns, uv, po, ev, i, stack)
-
-
-@nb.njit(cache=True, error_model="numpy")
-def accumulate(acc, pix, contrib):
-    """``acc[pix[i]] += contrib[i]`` (serial: several rays may share a pixel)."""
-    for i in range(pix.shape[0]):
-        for c in range(3):
-            acc[pix[i], c] += contrib[i, c]
 
 
 @nb.njit(**INLINE)
@@ -357,40 +351,6 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
         out_gen[s] = depth[i] + 1
 
 
-@nb.njit(cache=True, error_model="numpy", parallel=True)
-def shade_batch(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim, ng, nsh, col, ev,
-                vis, w, depth, stk, nstk, pix, opts, contrib, out_o, out_d, out_w, out_stk, out_nstk,
-                out_kind, out_tmin, out_pix, out_gen, counts):
-    """:func:`shade_hit` on every ray of a generation (the wavefront path).  Child slots:
-    ``2 i`` (reflection), ``2 i + 1`` (refraction), with the parent's pixel ``out_pix``.
-    ``vis``: (N, L) visibility of each light through the shadow feelers, traced by the caller
-    (:func:`feeler_batch`), or (0, L): traced here."""
-    n = O.shape[0]
-    nchunks = (n + CHUNK - 1) // CHUNK
-    nit = _tasks(nchunks)
-    for c in prange(nit):
-        scr = scratch()
-        for q in range(c, nchunks, nit):
-            shade_chunk(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim, ng, nsh,
-                        col, ev, vis, w, depth, stk, nstk, pix, opts, contrib, out_o, out_d, out_w,
-                        out_stk, out_nstk, out_kind, out_tmin, out_pix, out_gen, counts, q * CHUNK,
-                        min(n, (q + 1) * CHUNK), scr)
-
-
-@nb.njit(**NO_REFCOUNT)
-def shade_chunk(geo, mat_of, mat_tab, lights, ambient, background, O, D, t, prim, ng, nsh, col, ev,
-                vis, w, depth, stk, nstk, pix, opts, contrib, out_o, out_d, out_w, out_stk, out_nstk,
-                out_kind, out_tmin, out_pix, out_gen, counts, i0, i1, scr):
-    """Rays ``i0 .. i1 - 1`` of :func:`shade_batch` (``scr``: :func:`scratch`)."""
-    rays, hits = (O, D, w, depth, stk, nstk), (t, prim, ng, nsh, col, ev, vis)
-    out = (out_o, out_d, out_w, out_stk, out_nstk, out_kind, out_tmin, out_gen)
-    for i in range(i0, i1):
-        shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, hits, contrib,
-                  out, 2 * i, counts, scr)
-        out_pix[2 * i] = pix[i]
-        out_pix[2 * i + 1] = pix[i]
-
-
 # ----------------------------------------------------------------------------- fused path
 PIXEL_BLOCK = 64
 
@@ -401,10 +361,10 @@ class Shading(NamedTuple):
 
     mat_of: np.ndarray      # (P,) int64 material row of each primitive row
     mat_tab: np.ndarray     # (M, MAT_COLS) material table (columns ``kernels.columns.Mat``)
-    tex_tab: np.ndarray     # (M, TEX_COLS) fused checker textures (columns ``kernels.columns.Tex``)
+    maps: Textures          # texture maps and environment (``kernels.textures.Textures``)
     lights: np.ndarray      # (L, LIGHT_COLS) point and directional lights (``kernels.columns.Light``)
     ambient: np.ndarray     # (3,) ambient light
-    background: np.ndarray  # (3,) colour of a ray that leaves the scene
+    background: np.ndarray  # (3,) colour of a ray that leaves the scene (no environment)
     opts: np.ndarray        # option vector (``kernels.columns.WhittedOpt``)
 
 
@@ -419,14 +379,21 @@ class Pixels(NamedTuple):
     depth_map: np.ndarray   # (n,) out: camera-space depth of the first sample's primary hit
 
 
+def stack_rows(generations: int, opacity: bool) -> int:
+    """Pending rays a task's stack may hold: a ray popped pushes at most two children, and with
+    opacity maps also its straight continuation (at most :data:`.flatten.MAX_CUTOUTS` along a
+    path), so a path of ``g`` rays leaves at most ``2 g`` pending."""
+    return 2 * (generations + (MAX_CUTOUTS if opacity else 0)) + 4
+
+
 def render_pixels(geo, shading, pixels, spp, first, ncancel, counts):
     """Whole ray trees of every pixel (the fused path): each pixel's ``spp`` primary rays
     (``pixels.O, pixels.D`` rows ``p spp ... p spp + spp - 1``; with ``O`` empty and
     ``spp = 1``, the centre ray of image pixel ``first + p`` of the camera ``pixels.cam``, see
-    ``whitted.camera_frame``) and their reflected and refracted descendants are traced depth
-    first (:func:`pixels_task`), so no array crosses back to Python between ray generations.
-    ``geo``: :class:`..kernels.layout.Geometry`; ``shading``: :class:`Shading`; ``pixels``:
-    :class:`Pixels`.
+    ``whitted.camera_frame``) and their reflected, refracted and (through opacity maps)
+    straight-on descendants are traced depth first (:func:`pixels_task`), so no array crosses
+    back to Python between ray generations.  ``geo``: :class:`..kernels.layout.Geometry`;
+    ``shading``: :class:`Shading`; ``pixels``: :class:`Pixels`.
 
     Writes ``image[p]`` (mean over the samples), ``depth_map[p]`` (camera-space depth of the
     first sample's primary hit, ``fwd`` the unit view axis, ``inf`` on a miss) and adds the
@@ -441,28 +408,33 @@ def render_pixels(geo, shading, pixels, spp, first, ncancel, counts):
     nblocks = (pixels.image.shape[0] + PIXEL_BLOCK - 1) // PIXEL_BLOCK
     nit = max(1, min(nblocks, MAX_TASKS))
     part = np.zeros((nit, 8), np.int64)  # a row per task (8: rows a cache line apart)
-    cap = 2 * int(shading.opts[WhittedOpt.GENERATIONS]) + 2
+    opacity = bool(shading.maps.opacity[:, Tex.KIND].any())
+    cap = stack_rows(int(shading.opts[WhittedOpt.GENERATIONS]), opacity)
+    lights = shading.lights.shape[0] if opacity and shading.opts[WhittedOpt.SHADOWS] > 0.5 else 0
     # the per-task arrays made by numpy here (``scratch.py_func``: the kernel's own Python code):
     # no dispatcher of theirs to load from numba's cache at start-up
     run_tasks(pixels_task, nit, geo, shading, pixels, spp, first, ncancel, part,
-              per_task=lambda c: (scratch.py_func(), ray_stack(cap)))
+              per_task=lambda c: (scratch.py_func(), ray_stack(cap, lights)))
     counts += part[:, :RAY_COUNTS].sum(axis=0)
 
 
-def ray_stack(cap):
+def ray_stack(cap, lights=0):
     """Work arrays of :func:`pixels_task`: ``cap`` pending rays (origin, direction, weight,
-    media stack and its size, kind, tmin, generation), then the current ray and its hit (one
-    row each: origin, direction, weight, media stack and size, generation, t, primitive,
-    normals, uv, object-space point, emission, colour, contribution, counts), the block's
-    ray counts (summed here, written once: the threads' count rows share cache lines) and an
-    empty visibility table (:func:`shade_hit` traces the shadow feelers itself)."""
+    media stack and its size, kind, tmin, generation, continuations on the path), then the
+    current ray and its hit (one row each: origin, direction, weight, media stack and size,
+    generation, t, primitive, normals, uv, object-space point, emission, colour, contribution,
+    counts), the block's ray counts (summed here, written once: the threads' count rows share
+    cache lines), the lights' visibility through opacity maps (``(1, lights)``, or no row:
+    :func:`shade_hit` traces the shadow feelers itself), the radiance of a miss, and a feeler
+    hit's object-space point and uv."""
     return (np.empty((cap, 3)), np.empty((cap, 3)), np.empty((cap, 3)), np.zeros((cap, 4), np.int64),
             np.zeros(cap, np.int64), np.zeros(cap, np.int64), np.empty(cap), np.zeros(cap, np.int64),
             np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 3)), np.zeros((1, 4), np.int64),
             np.zeros(1, np.int64), np.zeros(1, np.int64), np.empty(1), np.empty(1, np.int64),
             np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 2)), np.empty((1, 3)), np.empty((1, 3)),
             np.zeros((1, 3)), np.empty((1, 3)), np.zeros((1, RAY_COUNTS), np.int64), np.zeros(RAY_COUNTS, np.int64),
-            np.empty((0, 1)))
+            np.ones((1 if lights else 0, max(lights, 1))), np.zeros(cap, np.int64), np.empty(3),
+            np.empty((1, 3)), np.zeros((1, 2)))
 
 
 @nb.njit(**TASK)
@@ -470,19 +442,23 @@ def pixels_task(geo, shading, pixels, spp, first, ncancel, part, scr, bufs, c, n
     """Task ``c`` of ``nit`` of :func:`render_pixels`: pixel blocks ``c nblocks / nit`` to
     ``(c + 1) nblocks / nit - 1`` in order, each primary ray and its descendants depth
     first with an explicit stack of pending rays (the course's ``raytrace`` recursion), shaded
-    by :func:`shade_hit`; textured colours from the ``tex_tab`` checkers
-    (:func:`checker_color`).  Adds the ray counts to ``part[c]`` (``RAY_COUNTS``,).  ``scr``:
-    :func:`scratch`; ``bufs``: :func:`ray_stack`, the task's own (made by the caller: this
-    kernel allocates nothing, so it is compiled without reference counting)."""
-    mat_of, mat_tab, tex_tab, lights, ambient, background, opts = shading
+    by :func:`shade_hit`; colours, bumped normals, opacity and the environment from the maps
+    (:mod:`..kernels.textures`).  A surface of opacity ``alpha`` (an opacity map) is shaded
+    with the ray's weight times ``alpha`` and lets the ray go on straight through with the
+    rest (``reference.raytrace``); one cut out (alpha below 0.5) is passed through.  Adds the
+    ray counts to ``part[c]`` (``RAY_COUNTS``,).  ``scr``: :func:`scratch`; ``bufs``:
+    :func:`ray_stack`, the task's own (made by the caller: this kernel allocates nothing, so
+    it is compiled without reference counting)."""
+    mat_of, mat_tab, maps, lights, ambient, background, opts = shading
     O, D, fwd, cam, image, depth_map = pixels
     zero, rel_eps, extent = opts[WhittedOpt.ZERO], opts[WhittedOpt.RAY_OFFSET], opts[WhittedOpt.EXTENT]
     stack, st, sp_, sf, sn = scr
     (r_o, r_d, r_w, r_stk, r_n, r_kind, r_tmin, r_gen, c_o, c_d, c_w, c_stk, c_n, c_gen, h_t, h_p,
-     h_ng, h_ns, h_uv, h_po, h_ev, h_col, contrib, cnt, tot, h_vis) = bufs
+     h_ng, h_ns, h_uv, h_po, h_ev, h_col, contrib, cnt, tot, h_vis, r_hop, h_bg, f_po, f_uv) = bufs
     row = 0  # the current ray's row
     cur = (c_o, c_d, c_w, c_gen, c_stk, c_n)
     hits = (h_t, h_p, h_ng, h_ns, h_col, h_ev, h_vis)
+    surf = (h_ng, h_ns, h_uv, h_po, h_ev)
     pending = (r_o, r_d, r_w, r_stk, r_n, r_kind, r_tmin, r_gen)
     npix = image.shape[0]
     nblocks = (npix + PIXEL_BLOCK - 1) // PIXEL_BLOCK
@@ -502,10 +478,11 @@ def pixels_task(geo, shading, pixels, spp, first, ncancel, part, scr, bufs, c, n
                     camera_ray(cam, row_i, col_j, r_o, r_d)
                 for q in range(3):
                     r_w[0, q] = 1.0
-                r_n[0], r_tmin[0], r_gen[0] = int(opts[WhittedOpt.N_MEDIA]), 0.0, 0  # the media around the camera
+                r_n[0], r_tmin[0], r_gen[0], r_hop[0] = int(opts[WhittedOpt.N_MEDIA]), 0.0, 0, 0  # the media around the camera
                 for q in range(4):
                     r_stk[0, q] = int(opts[WhittedOpt.MEDIA + q])
                 top = 1
+                primary = True
                 while top > 0:
                     top -= 1
                     for q in range(3):
@@ -513,31 +490,48 @@ def pixels_task(geo, shading, pixels, spp, first, ncancel, part, scr, bufs, c, n
                     for q in range(4):
                         c_stk[0, q] = r_stk[top, q]
                     c_n[0], c_gen[0] = r_n[top], r_gen[top]
+                    hop = r_hop[top]
                     ox, oy, oz = c_o[0, 0], c_o[0, 1], c_o[0, 2]
                     dx, dy, dz = c_d[0, 0], c_d[0, 1], c_d[0, 2]
                     eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
                     t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, r_tmin[top], np.inf,
                                                    np.bool_(False), np.bool_(False), zero, eps, stack, st, sp_, sf, sn)
-                    h_t[0], h_p[0] = t, k
-                    if c_gen[0] == 0 and s == 0:
-                        depth_map[p] = t * (dx * fwd[0] + dy * fwd[1] + dz * fwd[2]) if k >= 0 else np.inf
+                    a = 1.0
                     if k >= 0:
                         surface(geo, k, f, tri, b1, b2, ox + t * dx, oy + t * dy, oz + t * dz, ncancel,
                                 h_ng, h_ns, h_uv, h_po, h_ev, 0, stack)
-                        mi = mat_of[k]
-                        if mat_tab[mi, Mat.TEXTURED] > 0.5:
-                            tr_, tg_, tb_ = checker_color(tex_tab, mi, h_po[0, 0], h_po[0, 1], h_po[0, 2])
-                            h_col[0, 0] = mat_tab[mi, Mat.COLOR] * tr_
-                            h_col[0, 1] = mat_tab[mi, Mat.COLOR + 1] * tg_
-                            h_col[0, 2] = mat_tab[mi, Mat.COLOR + 2] * tb_
-                    shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, cur, row, hits,
-                              contrib, pending, top, cnt, scr)
+                        a = hit_alpha(maps, mat_tab, mat_of[k], k, h_po, h_uv)
+                        if a <= 0.0:  # cut out by an opacity map: on to the next surface
+                            t, k, a = pass_cutouts(geo, shading, ox, oy, oz, dx, dy, dz, t, ncancel, surf, scr)
+                    h_t[0], h_p[0] = t, k
+                    if primary and s == 0:
+                        depth_map[p] = t * (dx * fwd[0] + dy * fwd[1] + dz * fwd[2]) if k >= 0 else np.inf
+                    primary = False
+                    base = top
+                    if k >= 0:
+                        surface_maps(maps, mat_tab, mat_of[k], k, geo.xf, h_po, h_uv, h_ns, h_col)
+                        if a < 1.0 and hop < MAX_CUTOUTS:  # alpha blending: the ray also goes on
+                            for q in range(3):
+                                r_o[base, q], r_d[base, q], r_w[base, q] = c_o[0, q], c_d[0, q], c_w[0, q] * (1.0 - a)
+                                c_w[0, q] *= a
+                            for q in range(4):
+                                r_stk[base, q] = c_stk[0, q]
+                            r_n[base], r_gen[base], r_hop[base] = c_n[0], c_gen[0], hop + 1
+                            r_tmin[base] = _past(ox, oy, oz, dx, dy, dz, t, rel_eps, extent)
+                            base += 1
+                        opacity_feelers(geo, shading, ox, oy, oz, dx, dy, dz, t, h_ng, h_ns, h_vis, (f_po, f_uv), scr)
+                    else:
+                        miss_radiance(maps, dx, dy, dz, background, h_bg)
+                    shade_hit(geo, mat_of, mat_tab, lights, ambient, h_bg, opts, cur, row, hits,
+                              contrib, pending, base, cnt, scr)
                     ar += contrib[0, 0]
                     ag += contrib[0, 1]
                     ab += contrib[0, 2]
                     for q in range(RAY_COUNTS):
                         tot[q] += cnt[0, q]
                     # keep the children that exist on the stack
+                    r_hop[base], r_hop[base + 1] = hop, hop
+                    top = base
                     if r_kind[top] != 0:
                         top += 1
                         if r_kind[top] != 0:
@@ -556,38 +550,3 @@ def pixels_task(geo, shading, pixels, spp, first, ncancel, part, scr, bufs, c, n
     for q in range(RAY_COUNTS):
         counts[q] += tot[q]
         tot[q] = 0
-
-
-@nb.njit(cache=True, error_model="numpy")
-def compact(kind, o, d, w, stk, nstk, tmin, pix, gen):
-    """The child rays that exist (``kind != 0``), in slot order, as new contiguous arrays
-    (the next generation): ``(o, d, w, stk, nstk, tmin, pix, gen)``."""
-    m = 0
-    for s in range(kind.shape[0]):
-        if kind[s] != 0:
-            m += 1
-    O, D, W = np.empty((m, 3)), np.empty((m, 3)), np.empty((m, 3))
-    STK = np.empty((m, stk.shape[1]), np.int64)
-    NSTK, TMIN = np.empty(m, np.int64), np.empty(m)
-    PIX, GEN = np.empty(m, np.int64), np.empty(m, np.int64)
-    j = 0
-    for s in range(kind.shape[0]):
-        if kind[s] == 0:
-            continue
-        for c in range(3):
-            O[j, c], D[j, c], W[j, c] = o[s, c], d[s, c], w[s, c]
-        for c in range(stk.shape[1]):
-            STK[j, c] = stk[s, c]
-        NSTK[j], TMIN[j], PIX[j], GEN[j] = nstk[s], tmin[s], pix[s], gen[s]
-        j += 1
-    return O, D, W, STK, NSTK, TMIN, PIX, GEN
-
-
-@nb.njit(cache=True, error_model="numpy")
-def column_sums(counts):
-    """``counts.sum(0)`` of an (n, m) int64 array, row by row."""
-    out = np.zeros(counts.shape[1], np.int64)
-    for i in range(counts.shape[0]):
-        for q in range(counts.shape[1]):
-            out[q] += counts[i, q]
-    return out

@@ -2,21 +2,14 @@
 "lancer de rayons") and ``raytrace`` (plus recursive reflection and refraction, "suivi de rayons",
 Whitted 1980).
 
-Two organisations of the same algorithm, both over bands of rows ("tiles", delivered to
-``on_tile`` as they finish):
-
-* fused (:func:`.kernels.render_pixels`), when every surface colour is plain or a ``checker``
-  (planar or solid) and nothing needs numpy (no image texture, bump, opacity map or
-  environment): one numba kernel traces each pixel's whole ray tree depth first with an
-  explicit stack (the course's ``raytrace``/``shade`` recursion), checkers evaluated in the
-  kernel;
-* wavefront, otherwise: each generation of rays is intersected by a numba kernel, coloured
-  (textures through :mod:`workbench.renderers.texturing` in numpy, so that they match the
-  raster methods exactly), shaded with shadow feelers by a second kernel, which also spawns
-  the reflected and refracted children that form the next generation.
-
-Both shade with :func:`.kernels.shade_hit`; a pixel's colour is the sum of ``weight x local
-colour`` over the ray tree, and the two paths give the same images and ray counts (tested).
+One numba kernel (:func:`.kernels.render_pixels`) traces each pixel's whole ray tree depth
+first with an explicit stack (the course's ``raytrace``/``shade`` recursion), over bands of
+rows ("tiles", delivered to ``on_tile`` as they finish), shading each hit with
+:func:`.kernels.shade_hit`: a pixel's colour is the sum of ``weight x local colour`` over the
+ray tree.  Texture maps (colour patterns and images, bump, opacity, the environment) are
+evaluated in the kernel (:mod:`..kernels.textures`, tables from :mod:`.maps`), as
+:mod:`workbench.renderers.texturing` evaluates them for the raster methods; a scene whose maps
+are at most planar or solid checkers compiles the checker alone.
 
 Options (see ``Option`` help texts): ``max_depth`` (quality knob of ``raytrace``: the maximum
 number of ray generations in a path, primary = 1, as the course's ``recurs_max`` and POV-Ray's
@@ -45,17 +38,17 @@ from ...scene.model import Mesh, Scene
 from ...scene.prepared import prepare
 from .. import support as sp
 from ..base import Knob, Option, RenderResult, callback
-from ..kernels.columns import CHECKER_PLANAR, CHECKER_SOLID, RAY_COUNTS, TEX_COLS, Mat, RayCount, Tex, WhittedOpt
+from ..kernels.columns import RAY_COUNTS, RayCount, WhittedOpt
 from .accel import ACCELS, accel_extra_bytes
-from .flatten import MAX_CUTOUTS, OPACITY_CUT, SHADOW_CROSSINGS, SceneData, flatten, flatten_bytes
+from .flatten import SceneData, flatten, flatten_bytes
+from .maps import checkers_only, texture_tables
 
 _RAYS_PER_BAND = 1 << 16
-"""Primary rays of a band: the wavefront's per-generation arrays are a band's, and a UI's
-``on_tile`` and the progress bar are called once a band."""
+"""Primary rays of a band when ``on_tile`` or the progress bar is called once a band."""
 _FUSED_RAYS_PER_BAND = 1 << 20
-"""Primary rays of a band of the fused path when nothing is called between bands (no
-``on_tile``, no progress bar): it holds no per-ray arrays, only the band's colours and depths
-(32 bytes a pixel), so its bands are larger, and each costs a start of the thread pool, a
+"""Primary rays of a band when nothing is called between bands (no ``on_tile``, no progress
+bar): the kernel holds no per-ray arrays, only the band's colours and depths (32 bytes a
+pixel), so its bands are larger, and each costs a start of the thread pool, a
 scratch set per task and a wait for the slower thread at its end (measured: five bands of 65k
 rays instead of one cost the 640 x 480 Whitted scene's trace 11 % more CPU time on one thread,
 15 % on two)."""
@@ -64,11 +57,6 @@ rays instead of one cost the 640 x 480 Whitted scene's trace 11 % more CPU time 
 _BYTES_PER_PRIMARY_RAY = 160
 """Origin, direction, jitter, pixel index and temporaries of one primary ray (all are built
 up front by :func:`camera_rays`)."""
-_BYTES_PER_WAVEFRONT_RAY = 1536
-"""Arrays of one ray in a wavefront iteration: its state, hit record, shading outputs, two
-child slots, compaction output and texturing temporaries (about 1 kB, measured)."""
-_BYTES_PER_FEELER = 160
-"""A shadow feeler of the wavefront's opacity visibility pass (per ray and light)."""
 _BYTES_PER_STACK_ROW = 136
 """A pending ray of the fused kernel's stack (:func:`.kernels.ray_stack`)."""
 _BYTES_PER_TRIANGLE = 768
@@ -104,24 +92,6 @@ def generation_bound(scene: Scene, max_depth: int, threshold: float, recursive: 
     return int(max_depth)
 
 
-def _growth(scene: Scene, G: int, threshold: float, branches: int) -> float:
-    """Upper bound of (rays of one wavefront iteration) / (primary rays of the band): each
-    iteration at most multiplies the rays by ``branches``, and, where every material has
-    kr + kt <= 1, the rays of generation g above ``threshold`` number at most
-    k^(g-1) / threshold per primary ray (their weights sum to at most k^(g-1))."""
-    if branches <= 1 or G <= 1:
-        return 1.0
-    g = np.arange(1, min(G, 4096) + 1, dtype=np.float64)
-    by_branching = np.exp(np.minimum((g - 1) * np.log(branches), 700.0))
-    k = max((m.kr + m.kt for m in scene.materials.values()), default=0.0)
-    if k <= 1.0 and threshold > 0.0:
-        by_weight = np.exp(np.minimum((g - 1) * np.log(max(k, 1e-300)) - np.log(threshold), 700.0))
-        by_branching = np.minimum(by_branching, np.maximum(by_weight, 1.0))
-    elif G > 4096:
-        return float(np.exp(700.0))
-    return float(by_branching.max())
-
-
 def estimate_trace_bytes(scene: Scene, width: int, height: int, opts: dict, recursive: bool,
                          extra_triangles: int = 0) -> int:
     """Upper bound of the peak bytes of a ray-traced render (see :meth:`_WhittedBase.estimate_bytes`);
@@ -134,29 +104,27 @@ def estimate_trace_bytes(scene: Scene, width: int, height: int, opts: dict, recu
     total += accel_extra_bytes(tris, opts.get("accel", "bvh"))
     total += width * height * spp * _BYTES_PER_PRIMARY_RAY
     G = generation_bound(scene, int(opts.get("max_depth", 1)), float(opts.get("threshold", 0.0)), recursive)
-    if fusable(scene, scene.materials.values()):  # MAX_TASKS stacks of 2 G + 2 pending rays
-        return int(total + 64 * (2 * G + 2) * _BYTES_PER_STACK_ROW)
-    # the wavefront: the largest iteration of a band (capped by _Tracer.ray_cap)
-    cap = wavefront_cap(scene, width, height, spp, G, float(opts.get("threshold", 0.0)), recursive)
-    total += _BYTES_PER_WAVEFRONT_RAY * cap
-    if F.OPACITY in F.scene_needs(scene):
-        total += _BYTES_PER_FEELER * len(scene.lights) * cap
-    return int(total)
+    opacity = any(mt.opacity is not None for mt in scene.materials.values())
+    total += texture_bytes(scene)
+    return int(total + _kernels().MAX_TASKS * _kernels().stack_rows(G, opacity) * _BYTES_PER_STACK_ROW)
 
 
-def wavefront_cap(scene: Scene, width: int, height: int, spp: int, G: int, threshold: float,
-                  recursive: bool) -> int:
-    """Most rays one wavefront iteration may hold: the band's primary rays times
-    :func:`_growth` (reflection, refraction and, with opacity maps, the ray continuing
-    through a partly transparent surface).  :class:`_Tracer` refuses to go beyond it."""
-    n0 = min(height, max(1, _RAYS_PER_BAND // (width * spp))) * width * spp
-    mats = scene.materials.values()
-    branches = (int(recursive and any(m.kr > 0 for m in mats)) + int(recursive and any(m.kt > 0 for m in mats))
-                + int(F.OPACITY in F.scene_needs(scene)))
-    grow = _growth(scene, G, threshold, max(branches, 1))
-    if F.OPACITY in F.scene_needs(scene):
-        grow *= 2.0  # continuations are not threshold-tested: at most one per ray and iteration
-    return int(min(n0 * grow, 2.0 ** 62))
+def texture_bytes(scene: Scene) -> int:
+    """Bytes of the images the kernels' maps hold (float64 RGBA, :mod:`.maps`), from the files'
+    headers (each counted once a use)."""
+    paths = [mp.path for mt in scene.materials.values() for mp in (mt.texture, mt.bump, mt.opacity)
+             if mp is not None and mp.kind == "image"]
+    if scene.environment is not None and scene.environment.kind == "image":
+        paths.append(scene.environment.path)
+    total = 0
+    for path in paths:
+        try:
+            from PIL import Image
+            with Image.open(path) as im:
+                total += 32 * im.width * im.height
+        except OSError:
+            pass  # refused with its reason when the maps are built
+    return total
 
 
 def camera_frame(camera, width: int, height: int) -> np.ndarray:
@@ -203,110 +171,26 @@ def camera_rays(camera, width: int, height: int, spp: int, seed: int):
     return o, d, pix
 
 
-class _Colorizer:
-    """Surface colour ``C`` (material colour times texture), bumped normals and background
-    radiance, through :mod:`workbench.renderers.texturing` when the scene needs it."""
-
-    def __init__(self, scene: Scene, sd: SceneData):
-        self.scene, self.sd = scene, sd
-        self.base = sd.mat_tab[:, Mat.COLOR:Mat.COLOR + 3]
-        needs = F.scene_needs(scene)
-        self.tex = None
-        self.missing: list[str] = []  # features wanted but not evaluated
-        wanted = [f for f in (F.TEXTURES, F.BUMP, F.OPACITY, F.ENVIRONMENT) if f in needs]
-        if wanted:
-            try:
-                from .. import texturing
-                self.tex = texturing
-            except ImportError:
-                self.missing = wanted
-        self.bg = np.asarray(scene.background, dtype=np.float64)
-
-    def _groups(self, prim, attr):
-        """(material, selection, uv or None, world_from_object) for hits whose material has
-        ``attr`` (texture, bump, opacity), split by primitive (each has its own transform)."""
-        sd = self.sd
-        for k in np.flatnonzero(np.bincount(prim[prim >= 0], minlength=len(sd.mat))):
-            m = sd.materials[sd.mat[k]]
-            if getattr(m, attr) is None:
-                continue
-            yield m, prim == k, bool(sd.has_uv[k]), sd.wfo[k]
-
-    def colors(self, prim, P_obj, Ns, uv):
-        """(n, 3) colours ``C`` (set for textured materials only: shade_batch reads the others
-        from the material table) and (n, 3) shading normals (bumped where a material asks)."""
-        if self.tex is None:
-            return self.base[self.sd.mat[np.maximum(prim, 0)]], Ns
-        C = np.empty((len(prim), 3))
-        for m, sel, has_uv, W in self._groups(prim, "texture"):
-            n_obj = Ns[sel] @ W[:3, :3]
-            C[sel] = self.tex.surface_color(m, P_obj[sel], n_obj, uv[sel] if has_uv else None)
-        for m, sel, has_uv, W in self._groups(prim, "bump"):
-            n_obj = Ns[sel] @ W[:3, :3]
-            Ns[sel] = self.tex.bump_normal(m, P_obj[sel], n_obj, Ns[sel], W, uv[sel] if has_uv else None)
-        return C, Ns
-
-    def alpha(self, prim, P_obj, Ns, uv):
-        """(n,) opacity of the hit surfaces (1 where no opacity map)."""
-        a = np.ones(len(prim))
-        if self.tex is None:
-            return a
-        for m, sel, has_uv, W in self._groups(prim, "opacity"):
-            a[sel] = self.tex.alpha(m, P_obj[sel], Ns[sel] @ W[:3, :3], uv[sel] if has_uv else None)
-        return a
-
-    def background(self, D):
-        if self.scene.environment is not None and self.tex is not None:
-            return np.asarray(self.tex.environment(self.scene.environment, D), dtype=np.float64)
-        return np.broadcast_to(self.bg, D.shape)
-
-
 def _kernels():
     from . import kernels
     return kernels
 
 
-def _feelers():
-    from . import feelers
-    return feelers
-
-
-def ensure_compiled(sd: SceneData, fused: bool = False) -> float:
-    """Run the kernels a render needs once on one ray (first-call JIT, or a load from the numba
-    disk cache): :func:`.kernels.render_pixels` for the fused path, the wavefront kernels
-    otherwise.  Returns the seconds spent (a fraction of a millisecond once compiled for this
-    scene's kinds in this process: the kernels are specialised to them, see
-    :mod:`..kernels.specialise`)."""
+def ensure_compiled(sd: SceneData, maps) -> float:
+    """Run :func:`.kernels.render_pixels` once on one ray (first-call JIT, or a load from the
+    numba disk cache), with the scene's texture maps ``maps`` (:func:`.maps.texture_tables`).
+    Returns the seconds spent (a fraction of a millisecond once compiled for this scene's kinds
+    and maps in this process: the kernels are specialised to them, see
+    :mod:`..kernels.specialise` and :mod:`..kernels.textures`)."""
     k = _kernels()
     t0 = time.perf_counter()
     O = np.zeros((1, 3))
     D = np.array([[0.0, 0.0, 1.0]])
-    geo = sd.kernel_args()
-    kopts = kernel_options(1, extent=sd.extent)
-    if fused:
-        shading = k.Shading(sd.mat, sd.mat_tab, np.zeros((len(sd.mat_tab), TEX_COLS)), sd.lights,
-                            np.zeros(3), np.zeros(3), kopts)
-        k.render_pixels(geo, shading, k.Pixels(O, D, np.array([0.0, 0.0, 1.0]), np.zeros(16), np.zeros((1, 3)),
-                                               np.zeros(1)), 1, 0, tol.normal_cancel, np.zeros(RAY_COUNTS, np.int64))
-        return time.perf_counter() - t0
-    arr = _alloc(1)
-    k.trace_batch(geo, O, D, np.zeros(1), np.full(1, np.inf), tol.zero, tol.ray_offset, 1.0,
-                  tol.normal_cancel, False, arr["t"], arr["prim"], arr["ng"], arr["ns"], arr["uv"],
-                  arr["po"], arr["ev"])
-    ch = _alloc_children(1)
-    nl = len(sd.lights)
-    _feelers().feeler_batch(sd.lights, O, D, np.ones(1), np.zeros(1, np.int64), D.copy(), D.copy(), kopts,
-                            np.empty((nl, 3)), np.empty((nl, 3)), np.empty(nl), np.empty(nl), np.empty(nl, np.bool_))
-    k.shade_batch(geo, sd.mat, sd.mat_tab, sd.lights, np.zeros(3), np.zeros(3), O, D, np.ones(1),
-                  np.zeros(1, np.int64), D.copy(), D.copy(), np.ones((1, 3)), np.zeros((1, 3)),
-                  np.empty((0, nl)), np.ones((1, 3)), np.zeros(1, np.int64), np.zeros((1, 4), np.int64),
-                  np.zeros(1, np.int64), np.zeros(1, np.int64), kopts, np.zeros((1, 3)),
-                  ch["o"], ch["d"], ch["w"], ch["stk"], ch["nstk"], ch["kind"], ch["tmin"], ch["pix"],
-                  ch["gen"], np.zeros((1, RAY_COUNTS), np.int64))
-    k.accumulate(np.zeros((1, 3)), np.zeros(1, np.int64), np.zeros((1, 3)))
-    k.compact(ch["kind"], ch["o"], ch["d"], ch["w"], ch["stk"], ch["nstk"], ch["tmin"], ch["pix"],
-              ch["gen"])
-    k.column_sums(np.zeros((1, RAY_COUNTS), np.int64))
+    shading = k.Shading(sd.mat, sd.mat_tab, maps, sd.lights, np.zeros(3), np.zeros(3),
+                        kernel_options(1, extent=sd.extent))
+    k.render_pixels(sd.kernel_args(), shading, k.Pixels(O, D, np.array([0.0, 0.0, 1.0]), np.zeros(16),
+                                                         np.zeros((1, 3)), np.zeros(1)),
+                    1, 0, tol.normal_cancel, np.zeros(RAY_COUNTS, np.int64))
     return time.perf_counter() - t0
 
 
@@ -325,32 +209,13 @@ def kernel_options(generations: int, *, threshold: float = 0.0, fresnel: int = 0
                 media=media + [0] * (4 - len(media)), step_scale=step_scale)
 
 
-def fusable(scene: Scene, materials) -> bool:
-    """Whether the fused kernel can shade ``materials``: no environment, bump or opacity map,
-    and surface colours plain or ``checker`` with the ``planar`` or ``solid`` projection."""
-    return scene.environment is None and all(
-        m.bump is None and m.opacity is None
-        and (m.texture is None or (m.texture.kind == "checker" and m.texture.projection in ("planar", "solid")))
-        for m in materials)
-
-
 def fused_textures(scene: Scene, sd: SceneData):
-    """The (M, TEX_COLS) texture table of :func:`.kernels.render_pixels` when every material's
-    surface colour is one the fused kernel evaluates itself (plain, or a ``checker`` with the
-    ``planar`` or ``solid`` projection) and nothing else needs numpy (bump, opacity, an
-    environment); else None (the wavefront path)."""
-    if not fusable(scene, sd.materials):
+    """The path tracer's (M, TEX_COLS) colour texture table (:func:`.kernels.optics.checker_color`)
+    when the scene's maps are at most planar or solid checkers (:func:`.maps.checkers_only`),
+    else None (the path tracer then leaves the textures out)."""
+    if not checkers_only(scene, sd.materials):
         return None
-    tab = np.zeros((len(sd.materials), TEX_COLS))
-    for i, m in enumerate(sd.materials):
-        tx = m.texture
-        if tx is None:
-            continue
-        from ..texturing import frame
-        _, se, w = frame(tx.pole, tx.equator)
-        tab[i] = pack(Tex, kind=CHECKER_PLANAR if tx.projection == "planar" else CHECKER_SOLID,
-                      scale=tx.scale, center=tx.center, se=se, w=w, color0=tx.colors[0], color1=tx.colors[1])
-    return tab
+    return texture_tables(scene, sd).color
 
 
 def _alloc(n, surface: bool = True):
@@ -362,67 +227,47 @@ def _alloc(n, surface: bool = True):
                 ns=np.empty((m, 3)), uv=np.empty((m, 2)), po=np.empty((m, 3)), ev=np.empty((m, 3)))
 
 
-def _alloc_children(n):
-    """Child ray slots (2 per parent: reflection, refraction), written by shade_batch."""
-    return dict(o=np.empty((2 * n, 3)), d=np.empty((2 * n, 3)), w=np.empty((2 * n, 3)),
-                stk=np.empty((2 * n, 4), np.int64), nstk=np.empty(2 * n, np.int64),
-                kind=np.empty(2 * n, np.int64), tmin=np.empty(2 * n), pix=np.empty(2 * n, np.int64),
-                gen=np.empty(2 * n, np.int64))
-
-
-# the columns of shade_batch's counts
 _COUNTS = tuple(c.name.lower() for c in RayCount)
 """The ``stats`` keys of the kernels' ray counts, in column order."""
 
 
 class _Tracer:
-    """State of one render: scene arrays, options, counters."""
+    """State of one render: scene arrays, texture maps, options, counters."""
 
     def __init__(self, scene: Scene, sd: SceneData, opts: dict, recursive: bool, media: tuple):
         self.scene, self.sd = scene, sd
-        self.col = _Colorizer(scene, sd)
-        needs = F.scene_needs(scene)
         self.do_shadow = bool(len(sd.lights)) and opts["shadows"]
         refl = recursive and any(m.kr > 0 for m in sd.materials)
         refr = recursive and any(m.kt > 0 for m in sd.materials)
         self.do_refl, self.do_refr = refl, refr
         fres = {"none": 0, "schlick": 1, "exact": 2}[opts["fresnel"]]
-        self.env = scene.environment is not None and self.col.tex is not None
         self.G = generation_bound(scene, opts["max_depth"], opts.get("threshold", 0.0), recursive)
-        self.ray_cap = wavefront_cap(scene, scene.camera.width, scene.camera.height, opts["spp"], self.G,
-                                     opts.get("threshold", 0.0), recursive)
         names = [mt.name for mt in sd.materials]
         self.media = ([names.index(mt.name) for mt in media] + sd.media_holding(scene, scene.camera.position))[-4:]
         self.kopts = kernel_options(self.G, threshold=opts.get("threshold", 0.0), fresnel=fres,
                                     transmissive_shadows=opts["transmissive_shadows"], blinn=opts["blinn"],
                                     shadows=self.do_shadow, reflection=refl, refraction=refr,
-                                    extent=sd.extent, background=not self.env, media=self.media,
+                                    extent=sd.extent, background=True, media=self.media,
                                     step_scale=opts["step_scale"] if sd.has_media else 0.0)
         self.ambient = np.asarray(scene.ambient, dtype=np.float64)
+        self.background = np.asarray(scene.background, dtype=np.float64)
         self.geo = sd.kernel_args()
+        self.maps = texture_tables(scene, sd)
         self.stats = dict(primary_rays=0, shadow_rays=0, reflected_rays=0, refracted_rays=0,
                           ended_by_depth=0, ended_by_threshold=0, escaped_rays=0,
                           total_internal_reflections=0)
-        self.has_opacity = F.OPACITY in needs and self.col.tex is not None
-        self.tex_tab = None if self.col.missing else fused_textures(scene, sd)
-        self.fused = self.tex_tab is not None
 
-    def trace(self, O, D, pix, n_pixels, spp, fwd, cam, first):
-        """Trace a band's primary rays and their trees; returns (image (n_pixels, 3), depth).
-        The band's pixels are ``first ... first + n_pixels - 1`` of the image; the fused path
-        makes their centre rays from ``cam`` (:func:`camera_frame`) when ``O`` is empty."""
-        if self.fused:
-            return self._trace_fused(O, D, n_pixels, spp, fwd, cam, first)
-        return self._trace_wavefront(O, D, pix, n_pixels, spp, fwd)
-
-    def _trace_fused(self, O, D, n_pixels, spp, fwd, cam, first):
-        """One :func:`.kernels.render_pixels` call: whole ray trees, pixel by pixel."""
+    def trace(self, O, D, n_pixels, spp, fwd, cam, first):
+        """Trace a band's primary rays and their trees (one :func:`.kernels.render_pixels`
+        call); returns (image (n_pixels, 3), depth).  The band's pixels are ``first ... first
+        + n_pixels - 1`` of the image; the kernel makes their centre rays from ``cam``
+        (:func:`camera_frame`) when ``O`` is empty."""
         sd = self.sd
         image = np.empty((n_pixels, 3))
         depth_map = np.empty(n_pixels)
         counts = np.zeros(RAY_COUNTS, np.int64)
         k = _kernels()
-        shading = k.Shading(sd.mat, sd.mat_tab, self.tex_tab, sd.lights, self.ambient, self.col.bg, self.kopts)
+        shading = k.Shading(sd.mat, sd.mat_tab, self.maps, sd.lights, self.ambient, self.background, self.kopts)
         k.render_pixels(self.geo, shading, k.Pixels(O, D, fwd, cam, image, depth_map), spp, first,
                         tol.normal_cancel, counts)
         self.stats["primary_rays"] += n_pixels * spp
@@ -430,130 +275,9 @@ class _Tracer:
             self.stats[key] += int(v)
         return image, depth_map
 
-    def _trace_wavefront(self, O, D, pix, n_pixels, spp, fwd):
-        """Generation by generation: intersect all rays, colour the hits in numpy, shade."""
-        k = _kernels()
-        sd = self.sd
-        acc = np.zeros((n_pixels, 3))
-        depth_map = np.full(n_pixels, np.inf)
-        n = len(O)
-        self.stats["primary_rays"] += n
-        w = np.ones((n, 3))
-        gen = np.zeros(n, np.int64)
-        stk = np.zeros((n, 4), np.int64)
-        stk[:, :len(self.media)] = self.media
-        nstk = np.full(n, len(self.media), np.int64)
-        tmin = np.zeros(n)
-        first = True
-        while n > 0:
-            h = self._hits(O, D, tmin)
-            prim = h["prim"]
-            if first:
-                sel = np.flatnonzero((prim >= 0) & (np.arange(n) % spp == 0))
-                depth_map[pix[sel]] = h["t"][sel] * (D[sel] @ fwd)
-                first = False
-            if self.env:
-                miss = np.flatnonzero(prim < 0)
-                _accumulate(acc, pix[miss], w[miss] * self.col.background(D[miss]))
-            C, ns = self.col.colors(prim, h["po"], h["ns"], h["uv"])
-            cont = None
-            if self.has_opacity:  # alpha blends the surface with the ray's straight continuation
-                alpha = h["alpha"]
-                part = np.flatnonzero((prim >= 0) & (alpha < 1.0))
-                cont = (O[part], D[part], w[part] * (1.0 - alpha[part, None]), stk[part], nstk[part],
-                        self._past(O[part], D[part], h["t"][part]), pix[part], gen[part])
-                w = w * alpha[:, None]
-            contrib = np.empty((n, 3))
-            ch = _alloc_children(n)
-            counts = np.empty((n, RAY_COUNTS), np.int64)
-            vis = (self._visibility(O, D, h, ns) if self.has_opacity and self.do_shadow
-                   else np.empty((0, len(sd.lights))))
-            k.shade_batch(self.geo, sd.mat, sd.mat_tab, sd.lights, self.ambient, self.col.bg, O, D,
-                          h["t"], prim, h["ng"], ns, C, h["ev"], vis, w, gen, stk, nstk, pix, self.kopts,
-                          contrib, ch["o"], ch["d"], ch["w"], ch["stk"], ch["nstk"], ch["kind"],
-                          ch["tmin"], ch["pix"], ch["gen"], counts)
-            _accumulate(acc, pix, contrib)
-            for key, v in zip(_COUNTS, k.column_sums(counts)):
-                self.stats[key] += int(v)
-            O, D, w, stk, nstk, tmin, pix, gen = k.compact(*(ch[x] for x in (
-                "kind", "o", "d", "w", "stk", "nstk", "tmin", "pix", "gen")))
-            if cont is not None and len(cont[0]):
-                O, D, w, stk, nstk, tmin, pix, gen = (np.concatenate([x, y]) for x, y in
-                                                      zip((O, D, w, stk, nstk, tmin, pix, gen), cont))
-            n = len(O)
-            if n > self.ray_cap:  # the bound estimate_bytes counted on
-                raise WorkbenchError(f"raytrace: a ray generation grew beyond {self.ray_cap} rays (the "
-                                     "memory estimate's bound): lower max_depth or raise threshold")
-        return acc / spp, depth_map
 
-    def _visibility(self, O, D, h, ns):
-        """(n, L) visibility of each light from each hit through its shadow feeler
-        (:func:`.feelers.feeler_batch`: the feelers :func:`.kernels.shade_hit` would trace),
-        with opacity maps: a surface lets ``1 - alpha`` through (all of it where cut out, as
-        for the rays it cuts), and with ``transmissive_shadows`` also ``alpha kt`` (as
-        :func:`.reference.shadow_feeler`)."""
-        sd = self.sd
-        n, nl = len(O), len(sd.lights)
-        fo, fd = np.empty((n * nl, 3)), np.empty((n * nl, 3))
-        tmin, tmax, want = np.empty(n * nl), np.empty(n * nl), np.empty(n * nl, np.bool_)
-        _feelers().feeler_batch(sd.lights, O, D, h["t"], h["prim"], h["ng"], ns, self.kopts, fo, fd, tmin, tmax,
-                                want)
-        vis = np.ones(n * nl)
-        kt = sd.mat_tab[sd.mat, Mat.KT] if self.kopts[WhittedOpt.TRANSMISSIVE_SHADOWS] > 0.5 else np.zeros(len(sd.mat))
-        todo = np.flatnonzero(want)
-        for _ in range(SHADOW_CROSSINGS):
-            if not len(todo):
-                break
-            s = self._trace(fo[todo], fd[todo], tmin[todo], tmax[todo], shadow_only=True)
-            hit = s["prim"] >= 0
-            todo, prim = todo[hit], s["prim"][hit]
-            a = self.col.alpha(prim, s["po"][hit], s["ns"][hit], s["uv"][hit])
-            a[a < OPACITY_CUT] = 0.0
-            vis[todo] *= 1.0 - a + a * kt[prim]
-            go = vis[todo] > 0.0
-            todo = todo[go]
-            tmin[todo] = self._past(fo[todo], fd[todo], s["t"][hit][go])
-        return vis.reshape(n, nl)
-
-    def _past(self, O, D, t):
-        """``tmin`` that restarts rays just beyond their hit at ``t`` (offset scaled with the
-        hit point, :func:`workbench.core.tol.offset_scale`)."""
-        P = O + t[:, None] * D
-        return t + tol.ray_offset * np.maximum(np.abs(P).max(1), self.sd.extent)
-
-    def _trace(self, O, D, tmin, tmax, shadow_only=False):
-        """Closest hits of rays and their surface data (:func:`.kernels.trace_batch`)."""
-        h = _alloc(len(O))
-        _kernels().trace_batch(self.geo, O, D, tmin, tmax, tol.zero, tol.ray_offset, self.sd.extent,
-                               tol.normal_cancel, shadow_only, h["t"], h["prim"], h["ng"], h["ns"],
-                               h["uv"], h["po"], h["ev"])
-        return h
-
-    def _hits(self, O, D, tmin):
-        """Closest hits; surfaces cut out by an opacity map (alpha < 0.5) are passed through."""
-        n = len(O)
-        h = self._trace(O, D, tmin, np.full(n, np.inf))
-        h["alpha"] = np.ones(n)
-        if not self.has_opacity:
-            return h
-        todo = np.arange(n)
-        for _ in range(MAX_CUTOUTS):
-            sel = todo[h["prim"][todo] >= 0]
-            a = self.col.alpha(h["prim"][sel], h["po"][sel], h["ns"][sel], h["uv"][sel])
-            h["alpha"][sel] = a
-            todo = sel[a < OPACITY_CUT]
-            if not len(todo):
-                break
-            sub = self._trace(O[todo], D[todo], self._past(O[todo], D[todo], h["t"][todo]),
-                              np.full(len(todo), np.inf))
-            for key, v in sub.items():
-                h[key][todo] = v
-        h["alpha"][h["alpha"] < OPACITY_CUT] = 0.0
-        return h
-
-
-def _accumulate(acc, pix, values):
-    _kernels().accumulate(acc, pix, np.ascontiguousarray(values))
+_COUNTS = tuple(c.name.lower() for c in RayCount)
+"""The ``stats`` keys of the kernels' ray counts, in column order."""
 
 
 class _WhittedBase:
@@ -573,7 +297,7 @@ class _WhittedBase:
         opts = dict(o)
         opts.setdefault("max_depth", 1)
         tr = _Tracer(scene, sd, opts, self.recursive, prepared.camera_media)
-        timings["compile"] = ensure_compiled(sd, tr.fused)
+        timings["compile"] = ensure_compiled(sd, tr.maps)
         spp = opts["spp"]
         cam = scene.camera
         fwd = np.asarray(cam.look_at, float) - np.asarray(cam.position, float)
@@ -584,21 +308,19 @@ class _WhittedBase:
             bar = tqdm(total=height, unit="row", desc=self.name)
         t1, c1 = time.perf_counter(), time.process_time()  # the trace phase includes the camera rays
         frame = camera_frame(cam, width, height)
-        if tr.fused and spp == 1:  # the kernel makes the pixel-centre rays itself
+        if spp == 1:  # the kernel makes the pixel-centre rays itself
             O = D = np.empty((0, 3))
-            pix = np.empty(0, np.int64)
         else:
-            O, D, pix = camera_rays(cam, width, height, spp, opts["seed"])
+            O, D, _ = camera_rays(cam, width, height, spp, opts["seed"])
         image = np.zeros((height * width, 3), np.float32)
         depth = np.full(height * width, np.inf, np.float32)
-        quiet = tr.fused and opts["on_tile"] is None and bar is None
+        quiet = opts["on_tile"] is None and bar is None
         rows = max(1, (_FUSED_RAYS_PER_BAND if quiet else _RAYS_PER_BAND) // (width * spp))
         bands = list(range(0, height, rows))
         for y0 in bands:
             y1 = min(height, y0 + rows)
             a, b = y0 * width * spp, y1 * width * spp
-            img, dep = tr.trace(O[a:b], D[a:b], pix[a:b] - y0 * width, (y1 - y0) * width, spp, fwd,
-                                frame, y0 * width)
+            img, dep = tr.trace(O[a:b], D[a:b], (y1 - y0) * width, spp, fwd, frame, y0 * width)
             image[y0 * width:y1 * width] = img
             depth[y0 * width:y1 * width] = dep
             if opts["on_tile"] is not None:
@@ -638,9 +360,8 @@ class _WhittedBase:
 
     def estimate_bytes(self, scene: Scene, width: int, height: int, **o) -> int:
         """Upper bound of the render's peak bytes: primary rays (w h spp), image, mesh
-        triangles and BVH, the fused kernel's ray stacks (2 G + 2 rows per task, G from
-        :func:`generation_bound`) and the wavefront's largest iteration
-        (:func:`wavefront_cap`, enforced while tracing)."""
+        triangles and BVH, the kernel's ray stacks (:func:`.kernels.stack_rows` per task, G
+        from :func:`generation_bound`) and the maps' images (:func:`texture_bytes`)."""
         if not 1 <= o["spp"] <= 4096:
             raise WorkbenchError(f"method {self.name!r}: option 'spp' must be within 1..4096, got {o['spp']}")
         return estimate_trace_bytes(scene, width, height, o, self.recursive)
@@ -655,7 +376,6 @@ class _WhittedBase:
         def skipped(f, reason):
             if f not in declared:
                 left.append(sp.Note(f, reason, sp.Status.LEFT_OUT if f in needs else sp.Status.NOT_NEEDED))
-        left += [sp.Note(f, "texturing module not available (untextured colour used)") for f in tr.col.missing]
         if not tr.do_shadow:
             skipped(F.SHADOWS, "no lights (no shadow rays traced)" if not len(tr.sd.lights)
                     else "disabled by option (no shadow rays traced)")
