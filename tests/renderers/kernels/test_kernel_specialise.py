@@ -81,7 +81,8 @@ def test_kernels_under_an_inlined_helper_stay_functions_of_their_own(blob_probe)
 
 def test_features_of_the_bundled_scenes():
     """The marker names the extended group iff the scene has one of its kinds, the triangles
-    iff it has triangles, the media kinds (hypertexture and fur, a group of their own) iff the
+    iff it has triangles or one of the groups (the path tracer's variant of it, whose plain planes
+    are triangles, is then the ray tracer's), the media kinds (hypertexture and fur, a group of their own) iff the
     scene has one; every scene's marker is one of four, or names the media."""
     markers = set()
     for path in sorted((ROOT / "scenes").glob("*.toml")):
@@ -91,8 +92,8 @@ def test_features_of_the_bundled_scenes():
         kinds = {o.kind for o in scene.objects}
         extended = bool(kinds & {"blob", "isosurface", "lathe", "prism", "csg"})
         assert all(n in names for n in EXTENDED) == extended, (path.stem, names)
-        assert ("triangles" in names) == (len(sd.tri_v) > 0), (path.stem, names)
         media = bool(kinds & {"hypertexture", "fur"})
+        assert ("triangles" in names) == (len(sd.tri_v) > 0 or extended or media), (path.stem, names)
         assert all(n in names for n in ("hypertexture", "fur")) == media, (path.stem, names)
         if not {"hypertexture", "fur"} & set(names):
             markers.add(names)
