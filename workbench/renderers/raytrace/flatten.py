@@ -113,21 +113,22 @@ class SceneData:
         """What the kernels compile for this scene (:func:`..kernels.layout.features`), in
         groups, so that all scenes of the package's kinds together need at most four compiled
         variants of each kernel: the extended kinds (the package's kinds with kernel modules of
-        their own, and CSG: all of them if the scene has any among its rows, CSG leaves
-        included), the media kinds (hypertexture, fur: all of them if the scene has one),
+        their own, the media kinds hypertexture and fur among them, and CSG: all of them if the
+        scene has any among its rows, CSG leaves included; one variant for all, since the
+        kernels above the kinds, compiled once per variant, cost more than the kinds' own),
         each plugin kind the scene has (:func:`workbench.scene.kinds.register`), and the
-        triangles' tree (if the scene has triangles) and the analytic rows (if it has a top-level
-        row that is not a mesh: :attr:`top`)."""
+        triangles' tree (if the scene has triangles, or any of the groups before: the path
+        tracer turns a scene's plain planes and polygons into triangles, and its variant and the
+        ray tracer's are then one: ``closest`` and ``surface`` compiled once for both, their
+        triangle walk skipped at run time when there is no triangle) and the analytic rows (if it
+        has a top-level row that is not a mesh: :attr:`top`)."""
         present = {int(p) for p in np.unique(self.ptype)}
-        package = [k for k in kernel_kinds() if k.TYPE in PACKAGE_KINDS and not getattr(k, "MEDIUM", False)]
+        package = [k for k in kernel_kinds() if k.TYPE in PACKAGE_KINDS]
         out = []
-        if present & ({k.PTYPE for k in package} | {CSGNODE}):
+        if present & ({k.PTYPE for k in package} | {CSGNODE}):  # all or none (one compiled variant)
             out += [k.TYPE for k in package] + ["csg"]
-        media = [k for k in kernel_kinds() if getattr(k, "MEDIUM", False)]
-        if present & {k.PTYPE for k in media}:  # the media kinds, all or none (one compiled variant)
-            out += [k.TYPE for k in media]
         out += [marker_name(k) for k in kernel_kinds() if k.TYPE not in PACKAGE_KINDS and k.PTYPE in present]
-        if len(self.tri_v):
+        if len(self.tri_v) or out:  # with a group of kinds, the triangles' walk whether or not it has triangles
             out.append("triangles")
         if self.top.any():
             out.append("analytic")
