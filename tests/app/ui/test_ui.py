@@ -100,7 +100,7 @@ def test_parameters_change_affected_panels_only(session):
 
 
 def test_ray_tree_of_a_pixel_matches_the_raytrace_panel(session):
-    """The ray tree (reference Python tracer) of a pixel gives the wavefront panel's value."""
+    """The ray tree (reference Python tracer) of a pixel gives the raytrace panel's value."""
     out, summary, _ = session
     rt = summary["script"]["ray_tree"]
     i, j = rt["pixel"]
