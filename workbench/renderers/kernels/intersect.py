@@ -147,7 +147,7 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, s
     :mod:`.traversal_stats`) it adds the 4-wide nodes visited to ``cnt[WalkCount.NODES]`` and
     the primitive tests to ``cnt[WalkCount.TESTS]`` (:class:`.columns.WalkCount`; the
     rendering kernels pass ``False``: no counting)."""
-    pnode, pchild = geo.pnode, geo.pchild
+    shadow, pnode, pchild, pleaf, pref = geo.shadow, geo.pnode, geo.pchild, geo.pleaf, geo.pref
     ray = node_ray(ox, oy, oz, dx, dy, dz, tmin)
     w = eps * inv_w  # coincidence window in ray parameter units (see :func:`nearer`)
     lim = reach(best, brow, w, tmax)
@@ -167,12 +167,22 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, s
                 cnt[WalkCount.NODES] += 1
             sp, code = open_node((pnode, pchild), code, ray, lim, stack, sp, top_)
         if code < -1:
-            near, done = leaf_rows(geo, -2 - code, (ox, oy, oz, dx, dy, dz, inv_w), tmin, tmax, w,
-                                   (best, bp, bf, brow, found, lim, lim_up), shadow_only, any_hit, zero, eps,
-                                   (stack, st, sp_, sf, sn), count, cnt)
-            best, bp, bf, brow, found, lim, lim_up = near
-            if done:
-                return best, bp, bf, found
+            lf = -2 - code
+            for q in range(pleaf[lf, 0], pleaf[lf, 0] + pleaf[lf, 1]):
+                k = pref[q]
+                if shadow_only and not shadow[k]:
+                    continue
+                if count:
+                    cnt[WalkCount.TESTS] += 1
+                # up to best and its window: a coincident surface of a lower row wins
+                t, p, f = row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, lim_up,
+                                  zero, eps, stack, st, sp_, sf, sn)
+                if nearer(t, k, best, brow, w, tmax):
+                    best, bp, bf, brow, found = t, p, f, k, k
+                    lim = reach(best, brow, w, tmax)
+                    lim_up = next_up(lim)
+                    if any_hit:
+                        return best, bp, bf, found
         code = -1
         while sp > base:
             sp -= 1
@@ -182,36 +192,6 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, s
         if code == -1:
             break
     return best, bp, bf, found
-
-
-@nb.njit(**INLINE)
-def leaf_rows(geo, lf, ray, tmin, tmax, w, near, shadow_only, any_hit, zero, eps, scr, count, cnt):
-    """The rows of leaf ``lf`` of the analytic primitives' tree in turn, each searched up to the
-    nearest hit so far and its coincidence window (a coincident surface of a lower row wins:
-    :func:`nearer`).  ``ray = (ox, oy, oz, dx, dy, dz, inv_w)``; ``near = (best, bp, bf, brow,
-    found, lim, lim_up)``: the nearest hit so far (``t``, primitive, face, row; ``found`` the row
-    that last replaced it, ``-1`` for none), how far to search (:func:`reach`) and the next
-    float above that (a row's search reaches ``lim`` itself); ``scr``: :func:`scratch`.  Returns
-    the new ``near`` and whether an any-hit search is done.  With ``count`` it adds its tests to
-    ``cnt[WalkCount.TESTS]`` (:func:`prim_tree_walk`)."""
-    ox, oy, oz, dx, dy, dz, inv_w = ray
-    best, bp, bf, brow, found, lim, lim_up = near
-    stack, st, sp_, sf, sn = scr
-    shadow, pleaf, pref = geo.shadow, geo.pleaf, geo.pref
-    for q in range(pleaf[lf, 0], pleaf[lf, 0] + pleaf[lf, 1]):
-        k = pref[q]
-        if shadow_only and not shadow[k]:
-            continue
-        if count:
-            cnt[WalkCount.TESTS] += 1
-        t, p, f = row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, lim_up, zero, eps, stack, st, sp_, sf, sn)
-        if nearer(t, k, best, brow, w, tmax):
-            best, bp, bf, brow, found = t, p, f, k, k
-            lim = reach(best, brow, w, tmax)
-            lim_up = next_up(lim)
-            if any_hit:
-                return (best, bp, bf, brow, found, lim, lim_up), True
-    return (best, bp, bf, brow, found, lim, lim_up), False
 
 
 @intrinsic
@@ -273,10 +253,9 @@ tree's box test."""
 @nb.njit(**INLINE)
 def _one_small_leaf(pchild, pleaf):
     """Whether the analytic primitives' tree is one leaf of at most :data:`SMALL_LEAF` rows (a
-    scene of a few primitives, as Whitted's): its rows are then tested one by one, as POV-Ray
-    tests a few objects.  The tree's box test, three divisions a ray, would cost more than it
-    saves (it culls only rays that miss the whole scene, never a shadow feeler leaving a
-    surface of the tree's), and a box test only culls, so skipping it changes no hit."""
+    scene of a few primitives, as Whitted's): its box test, three divisions a ray, then costs
+    more than it saves (it culls only rays that miss the whole scene, never a shadow feeler
+    leaving a surface of the tree's), and a box test only culls, so skipping it changes no hit."""
     return (pchild[0, 0] <= -2 and pchild[0, 1] == -1 and pchild[0, 2] == -1 and pchild[0, 3] == -1
             and pleaf[-2 - pchild[0, 0], 1] <= SMALL_LEAF)
 
@@ -300,15 +279,8 @@ def analytic_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, shadow_only, an
             best, bp, bf, brow = t, p, f, k
         if any_hit and bp >= 0:
             return best, bp, bf, brow
-    if geo.pref.shape[0] == 0:
-        return best, bp, bf, brow
-    if _one_small_leaf(geo.pchild, geo.pleaf):  # its rows one by one, no box test, no walk
-        lim = reach(best, brow, w, tmax)
-        near, _ = leaf_rows(geo, -2 - geo.pchild[0, 0], (ox, oy, oz, dx, dy, dz, inv_w), tmin, tmax, w,
-                            (best, bp, bf, brow, np.int64(-1), lim, next_up(lim)), shadow_only, any_hit, zero, eps,
-                            (stack, st, sp_, sf, sn), False, sn)
-        return near[0], near[1], near[2], near[3]
-    if _bounds_hit(geo.pbounds, ox, oy, oz, dx, dy, dz, tmin, reach(best, brow, w, tmax)):
+    if geo.pref.shape[0] > 0 and (_one_small_leaf(geo.pchild, geo.pleaf)
+                                  or _bounds_hit(geo.pbounds, ox, oy, oz, dx, dy, dz, tmin, reach(best, brow, w, tmax))):
         t, p, f, row = prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only,
                                      any_hit, zero, eps, stack, st, sp_, sf, sn)
         if row >= 0:
