@@ -295,27 +295,8 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
     one by one, then the analytic primitives' structure, then the triangles' (see
     :mod:`.accel`).  Returns ``(t, prim, face, tri, b1, b2)``; ``prim = -1`` on a miss,
     negative ``face`` is never returned (a flipped CSG normal is ``face + 16``)."""
-    return closest_scaled(geo, ox, oy, oz, dx, dy, dz, 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz), tmin, tmax,
-                          shadow_only, any_hit, zero, eps, stack, st, sp_, sf, sn)
-
-
-@nb.njit(**INLINE)
-def closest_unit(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
-                 st, sp_, sf, sn):
-    """:func:`closest` of a ray whose direction has unit length (the Whitted kernels' rays,
-    normalized where they are made: camera rays, reflected and refracted rays, shadow
-    feelers): its length is taken as 1, within the rounding of that normalization, without a
-    square root and a division at the start of every ray's chain of dependent operations
-    (they cost the Whitted scene's trace about 5 % of its samples, perf)."""
-    return closest_scaled(geo, ox, oy, oz, dx, dy, dz, 1.0, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
-                          st, sp_, sf, sn)
-
-
-@nb.njit(**INLINE)
-def closest_scaled(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
-                   st, sp_, sf, sn):
-    """:func:`closest` with ``inv_w = 1 / |d|`` given."""
     btri, bb1, bb2 = -1, 0.0, 0.0
+    inv_w = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
     w = eps * inv_w
     best, bp, bf, brow = analytic_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, np.bool_(shadow_only),
                                        np.bool_(any_hit), zero, eps, stack, st, sp_, sf, sn)

@@ -31,7 +31,7 @@ from numba import prange
 
 from ..kernels.columns import RAY_COUNTS, Light, Mat, RayCount, Tex, WhittedOpt
 from ..kernels.flags import INLINE, NO_REFCOUNT, TASK
-from ..kernels.intersect import closest, closest_unit, geometric_normal, object_point, scratch, surface
+from ..kernels.intersect import closest, geometric_normal, object_point, scratch, surface
 from ..kernels.optics import (_facing, _feeler, _ior, _light_dir, _pow, camera_ray, enter_or_leave,
                               fresnel_reflectance)
 from ..kernels.shapes import _normalize
@@ -494,8 +494,8 @@ def pixels_task(geo, shading, pixels, spp, first, ncancel, part, scr, bufs, c, n
                     ox, oy, oz = c_o[0, 0], c_o[0, 1], c_o[0, 2]
                     dx, dy, dz = c_d[0, 0], c_d[0, 1], c_d[0, 2]
                     eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
-                    t, k, f, tri, b1, b2 = closest_unit(geo, ox, oy, oz, dx, dy, dz, r_tmin[top], np.inf,
-                                                        np.bool_(False), np.bool_(False), zero, eps, stack, st, sp_, sf, sn)
+                    t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, r_tmin[top], np.inf,
+                                                   np.bool_(False), np.bool_(False), zero, eps, stack, st, sp_, sf, sn)
                     a = 1.0
                     if k >= 0:
                         surface(geo, k, f, tri, b1, b2, ox + t * dx, oy + t * dy, oz + t * dz, ncancel,
