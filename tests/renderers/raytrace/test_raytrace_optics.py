@@ -20,6 +20,20 @@ def make(objects, materials, lights=(), camera=None, **scene_kw):
 
 
 # --------------------------------------------------------------------------- Snell, TIR
+@pytest.mark.parametrize("n", [1.0, 2.0, 20.0, 60.0, 200.0, 300.0, 1023.0, 1024.0, 37.5, 2000.0])
+def test_highlight_power_without_pow(n):
+    """The kernels' Phong power ``optics._pow`` (by squaring for an integer exponent up to 1024,
+    0 where ``n (1 - b)`` says the power is negligible) is ``b ** n`` within a few ulps, and where
+    it answers 0 the power is below 1.1e-20."""
+    from workbench.renderers.kernels.optics import _pow
+    b = np.concatenate([np.linspace(0.0, 1.0, 1001), [1.0 - 1e-12, 0.5 ** 0.5, 1e-300]])
+    got = np.array([_pow(x, n) for x in b])
+    want = b ** n
+    cut = (got == 0.0) & (want > 0.0)
+    assert (want[cut] < 1.1e-20).all()
+    assert np.allclose(got[~cut], want[~cut], rtol=1e-13, atol=0.0)
+
+
 @pytest.mark.parametrize("deg", [0.0, 10.0, 30.0, 41.0, 41.8, 60.0, 89.0])
 def test_snell_descartes_and_critical_angle(deg):
     """n_i sin(i) = n_t sin(t), T in the plane of incidence, unit; from glass (1.5) to air the

@@ -245,6 +245,21 @@ def reach(best, brow, w, tmax):
     return min(best + w, tmax) if brow >= 0 else best
 
 
+SMALL_LEAF = 4
+"""Rows of a primitives' tree made of one leaf (:func:`_one_small_leaf`) tested without the
+tree's box test."""
+
+
+@nb.njit(**INLINE)
+def _one_small_leaf(pchild, pleaf):
+    """Whether the analytic primitives' tree is one leaf of at most :data:`SMALL_LEAF` rows (a
+    scene of a few primitives, as Whitted's): its box test, three divisions a ray, then costs
+    more than it saves (it culls only rays that miss the whole scene, never a shadow feeler
+    leaving a surface of the tree's), and a box test only culls, so skipping it changes no hit."""
+    return (pchild[0, 0] <= -2 and pchild[0, 1] == -1 and pchild[0, 2] == -1 and pchild[0, 3] == -1
+            and pleaf[-2 - pchild[0, 0], 1] <= SMALL_LEAF)
+
+
 @nb.njit(**INLINE)
 def analytic_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
                  st, sp_, sf, sn):
@@ -264,7 +279,8 @@ def analytic_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, shadow_only, an
             best, bp, bf, brow = t, p, f, k
         if any_hit and bp >= 0:
             return best, bp, bf, brow
-    if geo.pref.shape[0] > 0 and _bounds_hit(geo.pbounds, ox, oy, oz, dx, dy, dz, tmin, reach(best, brow, w, tmax)):
+    if geo.pref.shape[0] > 0 and (_one_small_leaf(geo.pchild, geo.pleaf)
+                                  or _bounds_hit(geo.pbounds, ox, oy, oz, dx, dy, dz, tmin, reach(best, brow, w, tmax))):
         t, p, f, row = prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only,
                                      any_hit, zero, eps, stack, st, sp_, sf, sn)
         if row >= 0:

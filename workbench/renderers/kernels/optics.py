@@ -14,14 +14,37 @@ from .flags import INLINE
 from .shapes import _normalize
 
 
+POW_NEGLIGIBLE = 46.0
+"""``n (1 - b)`` beyond which :func:`_pow` takes ``b ** n`` (``0 <= b <= 1``) for 0: it is then
+at most ``exp(-n (1 - b)) < 1.1e-20`` (``ln b <= b - 1``), below the rounding of any
+highlight it would be added to."""
+POW_SQUARING = 1024
+"""Integer exponents up to this are raised by repeated squaring (at most 10 squarings and 10
+products, a few ulps of the correctly rounded power) instead of a call to ``pow``."""
+
+
 @nb.njit(**INLINE)
 def _pow(base, n):
-    """``base ** n`` for ``base >= 0``; ``0 ** n`` (``n > 0``, the usual case of a highlight
-    turned away) without the call to ``pow``."""
+    """``base ** n`` for ``0 <= base <= 1`` and ``n >= 0`` (a Phong highlight), mostly without
+    the call to ``pow`` (the Whitted scene's trace spent 8 % of its time there, measured):
+    ``0 ** n`` (``n > 0``, a highlight turned away) is 0, a negligible power
+    (:data:`POW_NEGLIGIBLE`) 0, an integer exponent (the usual shininess) by squaring
+    (:data:`POW_SQUARING`)."""
     if n == 0.0:
         return 1.0
     if base == 0.0 and n > 0.0:
         return 0.0
+    if n * (1.0 - base) > POW_NEGLIGIBLE:
+        return 0.0
+    if 0.0 < n <= POW_SQUARING and math.floor(n) == n:
+        m = int(n)
+        r, b = 1.0, base
+        while m > 0:
+            if m & 1:
+                r *= b
+            b *= b
+            m >>= 1
+        return r
     return base ** n
 
 

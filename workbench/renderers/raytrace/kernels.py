@@ -375,8 +375,8 @@ class Pixels(NamedTuple):
     D: np.ndarray           # (n spp, 3) their directions
     fwd: np.ndarray         # (3,) unit view axis (depth along it)
     cam: np.ndarray         # (16,) camera frame (``whitted.camera_frame``)
-    image: np.ndarray       # (n, 3) out: mean colour of each pixel's samples
-    depth_map: np.ndarray   # (n,) out: camera-space depth of the first sample's primary hit
+    image: np.ndarray       # (n, 3) float32 out: mean colour of each pixel's samples
+    depth_map: np.ndarray   # (n,) float32 out: camera-space depth of the first sample's primary hit
 
 
 def stack_rows(generations: int, opacity: bool) -> int:
