@@ -159,19 +159,22 @@ def closest_kernel():
     from numba import prange
 
     from workbench.renderers.kernels.intersect import closest, scratch
+    from workbench.renderers.raytrace.kernels import MAX_TASKS, task_run
 
     @nb.njit(parallel=True, error_model="numpy")
     def closest_only(geo, O, D, zero, rel_eps, extent, t_out, tri_out):
         n = O.shape[0]
         nch = (n + 63) // 64
-        for c in prange(64):
-            stack, st, sp_, sf, sn = scratch()
-            for q in range(c, nch, 64):
-                for i in range(q * 64, min(n, q * 64 + 64)):
+        for c in prange(MAX_TASKS):  # runs of consecutive chunks, as trace_batch's
+            q0, q1 = task_run(c, nch)
+            if q0 < q1:
+                stack, st, sp_, sf, sn = scratch()
+                for i in range(q0 * 64, min(n, q1 * 64)):
                     ox, oy, oz = O[i, 0], O[i, 1], O[i, 2]
                     eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
                     t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, D[i, 0], D[i, 1], D[i, 2], 0.0, np.inf,
-                                                   np.bool_(False), np.bool_(False), zero, eps, stack, st, sp_, sf, sn)
+                                                   np.bool_(False), np.bool_(False), zero, eps, stack, st, sp_,
+                                                   sf, sn)
                     t_out[i], tri_out[i] = t, tri
     return closest_only
 

@@ -45,9 +45,10 @@ CHUNK = 64
 
 
 # ----------------------------------------------------------------------------- batch kernels
-MAX_TASKS = 64
-"""``prange`` tasks of a kernel call: each takes every ``MAX_TASKS``-th chunk of rays or block
-of pixels and allocates its scratch arrays once (an allocation per chunk cost more than the
+TASK_BITS = 6
+MAX_TASKS = 2 ** TASK_BITS
+"""``prange`` tasks of a kernel call: each takes its share of the chunks of rays or blocks of
+pixels and allocates its scratch arrays once (an allocation per chunk cost more than the
 chunk's rays).  Enough for a fair split between threads; a constant, because a kernel that
 asks numba for its thread count cannot be cached."""
 
@@ -55,6 +56,20 @@ asks numba for its thread count cannot be cached."""
 @nb.njit(**INLINE)
 def _tasks(nchunks):
     return max(1, min(nchunks, MAX_TASKS))
+
+
+@nb.njit(**INLINE)
+def task_run(c, nchunks):
+    """The chunks ``q0 .. q1 - 1`` of ``prange`` task ``c`` of :data:`MAX_TASKS` over ``nchunks``
+    chunks of rays: run ``r`` of the ``MAX_TASKS`` runs of consecutive chunks (rays given in
+    image order meet the same nodes and triangles: every ``MAX_TASKS``-th chunk instead cost
+    the 81,920-triangle mesh's camera rays 45 % more CPU time, measured), ``r`` the bit
+    reversal of ``c``, so that the tasks numba deals to a thread (a range of consecutive ``c``)
+    take runs spread over the whole image: its costly parts shared out among the threads."""
+    r, b = 0, c
+    for _ in range(TASK_BITS):
+        r, b = 2 * r + (b & 1), b >> 1
+    return r * nchunks // MAX_TASKS, (r + 1) * nchunks // MAX_TASKS
 
 
 @nb.njit(cache=True, error_model="numpy", parallel=True)
@@ -66,12 +81,13 @@ def trace_batch(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_on
     of the surface data only the geometric normal (``workbench.raytrace.intersect``)."""
     n = O.shape[0]
     nchunks = (n + CHUNK - 1) // CHUNK
-    nit = _tasks(nchunks)
-    for c in prange(nit):
-        scr = scratch()
-        for q in range(c, nchunks, nit):
-            trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_only, t_out,
-                        prim_out, ng, ns, uv, po, ev, q * CHUNK, min(n, (q + 1) * CHUNK), scr)
+    for c in prange(MAX_TASKS):
+        q0, q1 = task_run(c, nchunks)
+        if q0 < q1:
+            scr = scratch()
+            for q in range(q0, q1):
+                trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_only, t_out,
+                            prim_out, ng, ns, uv, po, ev, q * CHUNK, min(n, (q + 1) * CHUNK), scr)
 
 
 @nb.njit(**NO_REFCOUNT)
