@@ -32,7 +32,7 @@ from numba import prange
 
 from ..kernels.columns import RAY_COUNTS, Light, Mat, RayCount, WhittedOpt
 from ..kernels.flags import INLINE, NO_REFCOUNT, TASK
-from ..kernels.intersect import closest, geometric_normal, object_point, scratch, surface
+from ..kernels.intersect import closest, closest_normal, geometric_normal, object_point, scratch, surface
 from ..kernels.optics import (_facing, _feeler, _ior, _light_dir, _pow, camera_ray, checker_color,
                               enter_or_leave, fresnel_reflectance)
 from ..kernels.shapes import _normalize
@@ -98,14 +98,16 @@ def trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_on
     for i in range(i0, i1):
         ox, oy, oz = O[i, 0], O[i, 1], O[i, 2]
         eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
-        t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, D[i, 0], D[i, 1], D[i, 2], tmin[i],
-                                       tmax[i], np.bool_(shadow_only), np.bool_(False), zero, eps, stack, st,
-                                       sp_, sf, sn)
+        t, k, f, tri, b1, b2, gx, gy, gz = closest_normal(geo, ox, oy, oz, D[i, 0], D[i, 1], D[i, 2], tmin[i],
+                                                          tmax[i], np.bool_(shadow_only), np.bool_(False), zero,
+                                                          eps, stack, st, sp_, sf, sn)
         t_out[i], prim_out[i] = t, k
         if k < 0:
             continue
         px, py, pz = ox + t * D[i, 0], oy + t * D[i, 1], oz + t * D[i, 2]
-        if ns.shape[0] == 0:  # the geometric normal alone
+        if ns.shape[0] == 0 and tri >= 0:  # the geometric normal alone, a triangle's from its packed group
+            ng[i, 0], ng[i, 1], ng[i, 2] = gx, gy, gz
+        elif ns.shape[0] == 0:
             x, y, z = object_point(geo, k, px, py, pz)
             ng[i, 0], ng[i, 1], ng[i, 2] = geometric_normal(geo, k, f, tri, x, y, z, stack)
         else:
