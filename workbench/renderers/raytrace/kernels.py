@@ -45,12 +45,11 @@ CHUNK = 64
 
 
 # ----------------------------------------------------------------------------- batch kernels
-TASK_BITS = 6
-MAX_TASKS = 2 ** TASK_BITS
-"""``prange`` tasks of a kernel call: each takes its share of the chunks of rays or blocks of
-pixels and allocates its scratch arrays once (an allocation per chunk cost more than the
-chunk's rays).  Enough for a fair split between threads; a constant, because a kernel that
-asks numba for its thread count cannot be cached."""
+MAX_TASKS = 64
+"""Tasks of a kernel call: each takes its share of the chunks of rays or blocks of pixels and
+allocates its scratch arrays once (an allocation per chunk cost more than the chunk's rays).
+Enough for a fair split between threads; a constant, because a kernel that asks numba for its
+thread count cannot be cached."""
 
 
 @nb.njit(**INLINE)
@@ -58,36 +57,35 @@ def _tasks(nchunks):
     return max(1, min(nchunks, MAX_TASKS))
 
 
-@nb.njit(**INLINE)
-def task_run(c, nchunks):
-    """The chunks ``q0 .. q1 - 1`` of ``prange`` task ``c`` of :data:`MAX_TASKS` over ``nchunks``
-    chunks of rays: run ``r`` of the ``MAX_TASKS`` runs of consecutive chunks (rays given in
-    image order meet the same nodes and triangles: every ``MAX_TASKS``-th chunk instead cost
-    the 81,920-triangle mesh's camera rays 45 % more CPU time, measured), ``r`` the bit
-    reversal of ``c``, so that the tasks numba deals to a thread (a range of consecutive ``c``)
-    take runs spread over the whole image: its costly parts shared out among the threads."""
-    r, b = 0, c
-    for _ in range(TASK_BITS):
-        r, b = 2 * r + (b & 1), b >> 1
-    return r * nchunks // MAX_TASKS, (r + 1) * nchunks // MAX_TASKS
-
-
-@nb.njit(cache=True, error_model="numpy", parallel=True)
 def trace_batch(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_only,
                 t_out, prim_out, ng, ns, uv, po, ev):
     """Closest hits of N rays and their surface data (``prim_out = -1``, ``t = inf`` on a miss);
     with ``shadow_only``, of the primitives that cast shadows (shadow feelers).  With ``ns`` of
     no rows (``uv``, ``po``, ``ev`` likewise: :func:`.whitted._alloc` without ``surface``),
-    of the surface data only the geometric normal (``workbench.raytrace.intersect``)."""
+    of the surface data only the geometric normal (``workbench.raytrace.intersect``).
+
+    The rays, in chunks of ``CHUNK``, are cut into ``MAX_TASKS`` runs of consecutive chunks
+    (:func:`trace_task`), which :func:`..kernels.tasks.run_tasks` hands out in turn to whichever
+    thread is free, as :func:`render_pixels` does with pixels: rays given in image order meet the
+    same nodes and triangles (every ``MAX_TASKS``-th chunk to a task instead cost the
+    81,920-triangle mesh's camera rays 45 % more CPU time), and a thread waiting for the others
+    sleeps (numba's ``prange`` workers, OpenMP's, spin: with two threads on a loaded machine the
+    mesh's camera rays took 7 % more CPU time under ``prange``; measured)."""
+    nit = _tasks.py_func((O.shape[0] + CHUNK - 1) // CHUNK)
+    run_tasks(trace_task, nit, geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, bool(shadow_only), t_out,
+              prim_out, ng, ns, uv, po, ev, per_task=lambda c: (scratch.py_func(),))
+
+
+@nb.njit(**TASK)
+def trace_task(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_only, t_out, prim_out,
+               ng, ns, uv, po, ev, scr, c, nit):
+    """Task ``c`` of ``nit`` of :func:`trace_batch`: chunks ``c nchunks / nit`` to ``(c + 1)
+    nchunks / nit - 1`` (:func:`trace_chunk`; ``scr``: :func:`scratch`, the task's own)."""
     n = O.shape[0]
     nchunks = (n + CHUNK - 1) // CHUNK
-    for c in prange(MAX_TASKS):
-        q0, q1 = task_run(c, nchunks)
-        if q0 < q1:
-            scr = scratch()
-            for q in range(q0, q1):
-                trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_only, t_out,
-                            prim_out, ng, ns, uv, po, ev, q * CHUNK, min(n, (q + 1) * CHUNK), scr)
+    for q in range(c * nchunks // nit, (c + 1) * nchunks // nit):
+        trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_only, t_out,
+                    prim_out, ng, ns, uv, po, ev, q * CHUNK, min(n, (q + 1) * CHUNK), scr)
 
 
 @nb.njit(**NO_REFCOUNT)
