@@ -7,8 +7,9 @@ the next generation).  Intersection is :mod:`..kernels.intersect`'s, the surface
 
 Everything is scalar code over flat arrays (:mod:`.flatten`; the geometry as the named record
 :class:`..kernels.layout.Geometry`, tables with named columns, :mod:`..kernels.columns`).  The
-drivers run blocks of pixels or chunks of rays on several threads: the fused one as ``nogil``
-tasks on a thread pool (:mod:`..kernels.tasks`), the wavefront ones with ``prange``; each task
+drivers run blocks of pixels or chunks of rays on several threads: the fused one and
+:func:`trace_batch` as ``nogil`` tasks on a thread pool (:mod:`..kernels.tasks`), the other
+wavefront ones with ``prange``; each task
 has its own scratch arrays (BVH stack, CSG interval stacks, ray stack) and hands its work to
 functions compiled without reference counting (:data:`..kernels.flags.NO_REFCOUNT`).  Helpers
 take :data:`..kernels.flags.INLINE`: each is compiled once (and cached) and LLVM inlines it
