@@ -73,15 +73,17 @@ def trace_batch(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_on
     sleeps (numba's ``prange`` workers, OpenMP's, spin: with two threads on a loaded machine the
     mesh's camera rays took 7 % more CPU time under ``prange``; measured)."""
     nit = _tasks.py_func((O.shape[0] + CHUNK - 1) // CHUNK)
-    run_tasks(trace_task, nit, geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, bool(shadow_only), t_out,
-              prim_out, ng, ns, uv, po, ev, per_task=lambda c: (scratch.py_func(),))
+    run_tasks(trace_task, nit, geo, (O, D, tmin, tmax), (t_out, prim_out, ng, ns, uv, po, ev), zero, rel_eps,
+              extent, ncancel, bool(shadow_only), per_task=lambda c: (scratch.py_func(),))
 
 
 @nb.njit(**TASK)
-def trace_task(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_only, t_out, prim_out,
-               ng, ns, uv, po, ev, scr, c, nit):
+def trace_task(geo, rays, hits, zero, rel_eps, extent, ncancel, shadow_only, scr, c, nit):
     """Task ``c`` of ``nit`` of :func:`trace_batch`: chunks ``c nchunks / nit`` to ``(c + 1)
-    nchunks / nit - 1`` (:func:`trace_chunk`; ``scr``: :func:`scratch`, the task's own)."""
+    nchunks / nit - 1`` (:func:`trace_chunk`) of the rays ``rays = (O, D, tmin, tmax)``, their hits
+    to ``hits = (t_out, prim_out, ng, ns, uv, po, ev)``; ``scr``: :func:`scratch`, the task's own."""
+    O, D, tmin, tmax = rays
+    t_out, prim_out, ng, ns, uv, po, ev = hits
     n = O.shape[0]
     nchunks = (n + CHUNK - 1) // CHUNK
     for q in range(c * nchunks // nit, (c + 1) * nchunks // nit):
