@@ -17,7 +17,7 @@ from numba.core.registry import CPUDispatcher
 import workbench
 
 LIMIT = 8
-KNOWN = {"compact", "feeler_batch", "shade_batch", "shade_chunk", "trace_chunk"}
+KNOWN = {"compact", "feeler_batch", "shade_batch", "shade_chunk"}
 """Kernels still over the limit, named so that the list can only shrink: the Whitted wavefront
 drivers (``raytrace/kernels.py``; the kernel-layer issue asks for one Whitted, the fused one)."""
 RENDERS = [("kinds", "raytrace", {}), ("csg", "raycast", {}), ("mesh", "raytrace", {}),

@@ -65,13 +65,10 @@ def trace_batch(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_on
     no rows (``uv``, ``po``, ``ev`` likewise: :func:`.whitted._alloc` without ``surface``),
     of the surface data only the geometric normal (``workbench.raytrace.intersect``).
 
-    The rays, in chunks of ``CHUNK``, are cut into ``MAX_TASKS`` runs of consecutive chunks
-    (:func:`trace_task`), which :func:`..kernels.tasks.run_tasks` hands out in turn to whichever
-    thread is free, as :func:`render_pixels` does with pixels: rays given in image order meet the
-    same nodes and triangles (every ``MAX_TASKS``-th chunk to a task instead cost the
-    81,920-triangle mesh's camera rays 45 % more CPU time), and a thread waiting for the others
-    sleeps (numba's ``prange`` workers, OpenMP's, spin: with two threads on a loaded machine the
-    mesh's camera rays took 7 % more CPU time under ``prange``; measured)."""
+    Runs of consecutive chunks of rays (:func:`trace_task`) handed out by
+    :func:`..kernels.tasks.run_tasks` as :func:`render_pixels`'s: rays in image order meet the same
+    nodes and triangles (every 64th chunk to a task cost the mesh's camera rays 45 % more CPU time),
+    and a waiting thread sleeps (``prange``'s OpenMP workers spin: 7 % more CPU time; measured)."""
     nit = _tasks.py_func((O.shape[0] + CHUNK - 1) // CHUNK)
     run_tasks(trace_task, nit, geo, (O, D, tmin, tmax), (t_out, prim_out, ng, ns, uv, po, ev), zero, rel_eps,
               extent, ncancel, bool(shadow_only), per_task=lambda c: (scratch.py_func(),))
@@ -80,23 +77,14 @@ def trace_batch(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_on
 @nb.njit(**TASK)
 def trace_task(geo, rays, hits, zero, rel_eps, extent, ncancel, shadow_only, scr, c, nit):
     """Task ``c`` of ``nit`` of :func:`trace_batch`: chunks ``c nchunks / nit`` to ``(c + 1)
-    nchunks / nit - 1`` (:func:`trace_chunk`) of the rays ``rays = (O, D, tmin, tmax)``, their hits
-    to ``hits = (t_out, prim_out, ng, ns, uv, po, ev)``; ``scr``: :func:`scratch`, the task's own."""
+    nchunks / nit - 1`` of the rays ``rays = (O, D, tmin, tmax)``, their hits to ``hits =
+    (t_out, prim_out, ng, ns, uv, po, ev)``; ``scr``: :func:`scratch`, the task's own."""
     O, D, tmin, tmax = rays
     t_out, prim_out, ng, ns, uv, po, ev = hits
+    stack, st, sp_, sf, sn = scr
     n = O.shape[0]
     nchunks = (n + CHUNK - 1) // CHUNK
-    for q in range(c * nchunks // nit, (c + 1) * nchunks // nit):
-        trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_only, t_out,
-                    prim_out, ng, ns, uv, po, ev, q * CHUNK, min(n, (q + 1) * CHUNK), scr)
-
-
-@nb.njit(**NO_REFCOUNT)
-def trace_chunk(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_only, t_out, prim_out,
-                ng, ns, uv, po, ev, i0, i1, scr):
-    """Rays ``i0 .. i1 - 1`` of :func:`trace_batch` (``scr``: :func:`scratch`)."""
-    stack, st, sp_, sf, sn = scr
-    for i in range(i0, i1):
+    for i in range(c * nchunks // nit * CHUNK, min(n, (c + 1) * nchunks // nit * CHUNK)):
         ox, oy, oz = O[i, 0], O[i, 1], O[i, 2]
         eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
         t, k, f, tri, b1, b2, gx, gy, gz = closest_normal(geo, ox, oy, oz, D[i, 0], D[i, 1], D[i, 2], tmin[i],
