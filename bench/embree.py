@@ -15,7 +15,7 @@ the bundled ``mesh`` scene's 81,920 triangles and camera, in one run (issue #28,
    ``trace_batch`` (:mod:`workbench.renderers.raytrace.kernels`: the BVH walk of
    :mod:`workbench.renderers.kernels.walks` and the hit's geometric normal), as the
    public ``workbench.raytrace.intersect`` calls it (its arrays allocated), on numba's
-   threads, warm.  Embree:
+   thread count of Python threads (:func:`workbench.renderers.kernels.tasks.run_tasks`), warm.  Embree:
    ``EmbreeScene.run(origins, directions, output=1)`` (distance, barycentrics, geometric
    normal and triangle of each ray, one ``rtcIntersect1`` per ray on one thread), the same
    rays in float32.  Also ours without the surface data: ``kernels.intersect.closest`` alone
@@ -32,10 +32,10 @@ on a loaded machine), wall and CPU seconds (``time.process_time``:
 every thread of this process, so Embree's TBB threads and numba's alike); the tables give the
 medians and their ratios.  Rays per CPU-second is the fair figure on a loaded machine with
 threads on one side and one thread on the other; on an idle one the CPU seconds also count the
-time thread pools spend waiting actively for work (numba's OpenMP workers, Embree's TBB workers
-after a build), so that CPU can exceed wall times the threads at work; numba's OpenMP workers
-(GNU libgomp) spin after each parallel kernel unless ``OMP_WAIT_POLICY=passive`` is set in
-the environment before the run (recorded in the results).  Timing is never a pass/fail test.
+time thread pools spend waiting actively for work (Embree's TBB workers after a build; numba's
+OpenMP workers, GNU libgomp, after a ``prange`` kernel unless ``OMP_WAIT_POLICY=passive`` is
+set in the environment before the run, recorded in the results: our kernels here run on Python
+threads, which sleep when they wait), so that CPU can exceed wall times the threads at work.  Timing is never a pass/fail test.
 
 Writes ``bench/results/embree.json`` and ``docs/benchmarks/embree.md``.  Run:
 ``.venv/bin/python bench/embree.py [--size 640x480] [--runs 7]``.  Without ``embreex`` our side
@@ -152,27 +152,32 @@ class OurSide:
 
 
 def closest_kernel():
-    """A numba kernel of the closest hits alone: ``kernels.intersect.closest`` (the function
-    ``trace_batch`` calls for each ray) over the rays on numba's threads, writing ``t`` and the
-    triangle, without the surface data.  Built here (not cached: a few seconds to compile)."""
+    """A kernel of the closest hits alone: ``kernels.intersect.closest`` (the function
+    ``trace_batch`` calls for each ray) over the rays, writing ``t`` and the triangle, without
+    the surface data; run as ``trace_batch`` is (runs of consecutive chunks of 64 rays handed
+    out to numba's thread count of Python threads, :func:`workbench.renderers.kernels.tasks.run_tasks`).
+    Built here (not cached: a few seconds to compile)."""
     import numba as nb
-    from numba import prange
 
     from workbench.renderers.kernels.intersect import closest, scratch
+    from workbench.renderers.kernels.tasks import run_tasks
+    from workbench.renderers.raytrace.kernels import MAX_TASKS
 
-    @nb.njit(parallel=True, error_model="numpy")
-    def closest_only(geo, O, D, zero, rel_eps, extent, t_out, tri_out):
+    @nb.njit(nogil=True, error_model="numpy")
+    def closest_task(geo, O, D, zero, rel_eps, extent, t_out, tri_out, c, nit):
         n = O.shape[0]
         nch = (n + 63) // 64
-        for c in prange(64):
-            stack, st, sp_, sf, sn = scratch()
-            for q in range(c, nch, 64):
-                for i in range(q * 64, min(n, q * 64 + 64)):
-                    ox, oy, oz = O[i, 0], O[i, 1], O[i, 2]
-                    eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
-                    t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, D[i, 0], D[i, 1], D[i, 2], 0.0, np.inf,
-                                                   np.bool_(False), np.bool_(False), zero, eps, stack, st, sp_, sf, sn)
-                    t_out[i], tri_out[i] = t, tri
+        stack, st, sp_, sf, sn = scratch()
+        for i in range(c * nch // nit * 64, min(n, (c + 1) * nch // nit * 64)):
+            ox, oy, oz = O[i, 0], O[i, 1], O[i, 2]
+            eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
+            t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, D[i, 0], D[i, 1], D[i, 2], 0.0, np.inf,
+                                           np.bool_(False), np.bool_(False), zero, eps, stack, st, sp_, sf, sn)
+            t_out[i], tri_out[i] = t, tri
+
+    def closest_only(geo, O, D, zero, rel_eps, extent, t_out, tri_out):
+        run_tasks(closest_task, max(1, min((len(O) + 63) // 64, MAX_TASKS)), geo, O, D, zero, rel_eps, extent,
+                  t_out, tri_out)
     return closest_only
 
 
@@ -248,7 +253,10 @@ def main(argv=None) -> dict:
     # ---- 2. primary rays, alternating (both warm: one untimed pass first)
     ours = OurSide(mesh_scene)
     h_ours = ours.trace(O, D)
-    res["numba_threading_layer"] = numba.threading_layer()  # the one loaded (after a parallel kernel ran)
+    try:  # the one loaded by a prange kernel; none if none ran
+        res["numba_threading_layer"] = numba.threading_layer()
+    except ValueError:
+        res["numba_threading_layer"] = "none"
     t_c, _ = ours.closest(O, D)
     res["closest_only_same_t"] = bool(np.array_equal(t_c, np.where(h_ours["prim"] >= 0, h_ours["t"], np.inf)))
     if emb:

@@ -17,9 +17,9 @@ from numba.core.registry import CPUDispatcher
 import workbench
 
 LIMIT = 8
-KNOWN = {"trace_batch", "trace_chunk"}
-"""Kernels still over the limit, named so that the list can only shrink: the batch intersector
-of ``workbench.raytrace.intersect`` (``raytrace/kernels.py``)."""
+KNOWN: set[str] = set()
+"""Kernels still over the limit, named so that the list can only shrink: none now (the Whitted
+wavefront drivers are gone; the batch intersector takes its rays and hits as two tuples)."""
 RENDERS = [("kinds", "raytrace", {}), ("csg", "raycast", {}), ("mesh", "raytrace", {}),
            ("cornell", "pathtrace", {"spp": 2}), ("cornell", "radiosity", {}),
            ("cornell", "radiosity", {"form_factors": "raycast", "patch_size": 0.2}),

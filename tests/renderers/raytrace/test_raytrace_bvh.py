@@ -61,10 +61,10 @@ def _subtree(bvh, leaves, code):
 
 @pytest.mark.parametrize("n", [2, 300])
 def test_4wide_tree_holds_each_triangle_once_inside_its_boxes(n):
-    from workbench.renderers.raytrace.bvh import _build, _collapse, build_bvh4, triangle_boxes
+    from workbench.renderers.raytrace.bvh import _collapse, build_bvh, build_bvh4
     tv = _soup(1, n)
     order, bvh = build_bvh4(tv)
-    leaves = _collapse(*_build(triangle_boxes(tv))[1:])[2]
+    leaves = _collapse(*build_bvh(tv)[1:])[2]
     assert np.array_equal(bvh.leaf[:, 1], (leaves[:, 1] + 3) // 4)  # groups of four per leaf
     tvo = tv[order]
     seen = []
@@ -132,8 +132,8 @@ def _readable_sah(tri_v):
     swaps): this plain build keeps the input order, so it is the same only where no node
     below the root is sampled (asserted).  A node of at most ``SMALL_NODE`` triangles uses
     ``SMALL_NODE_BINS`` bins."""
-    from workbench.renderers.raytrace.bvh import (BIN_SAMPLES, MAX_DEPTH, MAX_LEAF, N_BINS, SMALL_NODE,
-                                                  SMALL_NODE_BINS, TRAVERSAL_COST)
+    from workbench.renderers.raytrace.bvh import (BIN_SAMPLES, GROUP, MAX_DEPTH, N_BINS, SMALL_NODE,
+                                                  SMALL_NODE_BINS, TRAVERSAL_COST, TRI_LEAF)
     t = tri_v.reshape(-1, 3, 3)
     tb = np.concatenate([t.min(1), t.max(1)], 1)
     cen = 0.5 * (tb[:, :3] + tb[:, 3:])
@@ -145,6 +145,9 @@ def _readable_sah(tri_v):
     def union(rows):
         return np.concatenate([rows[:, :3].min(0), rows[:, 3:].max(0)]) if len(rows) else np.r_[[np.inf] * 3, [-np.inf] * 3]
 
+    def groups(n):  # the SAH's count of triangles: packed groups
+        return -(-n // GROUP)
+
     out = []
 
     def node(ids, depth):
@@ -153,7 +156,7 @@ def _readable_sah(tri_v):
         cmin, ext = cen[ids].min(0), cen[ids].max(0) - cen[ids].min(0)
         rec = [box, -1, None]
         out.append(rec)
-        if len(ids) <= MAX_LEAF or not ext.max() > 0.0 or depth >= MAX_DEPTH:
+        if len(ids) <= TRI_LEAF or not ext.max() > 0.0 or depth >= MAX_DEPTH:
             rec[2] = set(ids.tolist())
             return
         best, best_b, axis = np.inf, -1, 0
@@ -166,10 +169,11 @@ def _readable_sah(tri_v):
             for b in range(nbins - 1):
                 left, right = smp[bins <= b], smp[bins > b]
                 if len(left) and len(right):
-                    c = area(union(tb[left])) * len(left) + area(union(tb[right])) * len(right)
+                    c = area(union(tb[left])) * groups(len(left)) + area(union(tb[right])) * groups(len(right))
                     if c < best:
                         best, best_b, axis = c, b, ax
-        if best_b < 0 or (TRAVERSAL_COST + best / max(area(box), 1e-300) >= len(ids) and len(ids) <= 4 * MAX_LEAF):
+        if best_b < 0 or (TRAVERSAL_COST + best / max(area(box), 1e-300) >= groups(len(ids))
+                          and len(ids) <= 4 * TRI_LEAF):
             rec[2] = set(ids.tolist())
             return
         rec[1] = axis
@@ -208,7 +212,7 @@ def test_two_thread_build_is_the_one_thread_tree_node_for_node():
     tb = np.concatenate([c - h, c + h], axis=1)
     one = tb.copy()
     idx = np.arange(len(one))
-    box, meta, pending, _ = B._build_nodes(one, idx, 0, len(one), 0, B._root_bounds(one), 2 * len(one))
+    box, meta, pending, _ = B._build_nodes(one, idx, 0, len(one), 0, B._root_bounds(one), 2 * len(one), B.MAX_LEAF, 1)
     assert len(pending) == 0
     order2, box2, meta2 = B._build(tb.copy())
     assert len(box) > 1000 and (meta[:, 2] == -1).sum() > 500  # a real tree, both subtrees deep

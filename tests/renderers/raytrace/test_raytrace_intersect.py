@@ -331,3 +331,30 @@ def test_rays_in_a_face_plane_of_an_axis_aligned_mesh_are_not_culled():
     inside = (np.abs(O[:, 0]) <= 1.0) & (np.abs(O[:, 1]) <= 1.0)
     assert np.array_equal(np.isfinite(t), inside)
     assert np.allclose(t[inside], 2.0)
+
+
+def test_a_triangles_normal_from_its_packed_group_is_the_tables():
+    """``trace_batch`` without the surface data takes a triangle hit's geometric normal from the
+    packed group the walk tested (``intersect.closest_normal``), with it from the triangle table
+    (``intersect.geometric_normal``): the same normal to the bit, for every hit of the mesh
+    scene's camera rays (a wrong group or lane would give a neighbour's normal)."""
+    from dataclasses import replace
+
+    from workbench.core.tol import tol
+    from workbench.renderers.raytrace.flatten import flatten
+    from workbench.renderers.raytrace.whitted import _alloc, _kernels
+    sc = workbench.load_scene("mesh")
+    sc = replace(sc, camera=sc.camera.with_resolution(48, 36))
+    O, D = (np.ascontiguousarray(a.reshape(-1, 3)) for a in sc.camera.rays())
+    sd = flatten(sc)
+    n = len(O)
+    out = {}
+    for surface in (False, True):
+        h = _alloc(n, surface)
+        _kernels().trace_batch(sd.kernel_args(), O, D, np.zeros(n), np.full(n, np.inf), tol.zero, tol.ray_offset,
+                               sd.extent, tol.normal_cancel, False, h["t"], h["prim"], h["ng"], h["ns"], h["uv"],
+                               h["po"], h["ev"])
+        out[surface] = h
+    tri_hit = np.isin(out[True]["prim"], sd.tri_prim)
+    assert tri_hit.sum() > 200 and np.array_equal(out[False]["prim"], out[True]["prim"])
+    assert np.array_equal(out[False]["ng"][tri_hit], out[True]["ng"][tri_hit])

@@ -20,7 +20,7 @@ from .columns import WalkCount
 from .flags import GATE, INLINE
 from .shapes import CSG_EVENTS, _normalize, _to_object, csg_hit, object_normal, prim_hit
 from .specialise import has
-from .walks import BVH_STACK, _bounds_hit, bvh_hit, node_ray, open_node
+from .walks import BVH_STACK, _bounds_hit, bvh_hit_packed, node_ray, open_node, triangle_normal
 
 
 @nb.njit(**INLINE)
@@ -124,7 +124,7 @@ def _analytic_normal_gate(geo, k, f, x, y, z, stack):
 
 
 def triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
-    """:func:`bvh_hit` over the scene's triangles if it has any."""
+    """:func:`.walks.bvh_hit_packed` over the scene's triangles if it has any."""
     raise TypeError("triangles_gate is callable from numba-compiled code only")
 
 
@@ -134,9 +134,9 @@ def _triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
 
     def impl(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
         if on:
-            return bvh_hit((geo.bvh_node, geo.bvh_child, geo.bvh_leaf, geo.bvh_first, geo.bvh_tv4),
-                           ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack)
-        return np.inf, -1, 0.0, 0.0
+            return bvh_hit_packed((geo.bvh_node, geo.bvh_child, geo.bvh_leaf, geo.bvh_first, geo.bvh_tv4),
+                                  ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack)
+        return np.inf, -1, 0.0, 0.0, np.int64(-1), np.int64(0)
     return impl
 
 
@@ -295,21 +295,34 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
     one by one, then the analytic primitives' structure, then the triangles' (see
     :mod:`.accel`).  Returns ``(t, prim, face, tri, b1, b2)``; ``prim = -1`` on a miss,
     negative ``face`` is never returned (a flipped CSG normal is ``face + 16``)."""
+    t, k, f, tri, b1, b2, _, _, _ = closest_normal(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit,
+                                                   zero, eps, stack, st, sp_, sf, sn)
+    return t, k, f, tri, b1, b2  # (the triangle's normal, unused, is compiled away)
+
+
+@nb.njit(**INLINE)
+def closest_normal(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
+                   st, sp_, sf, sn):
+    """:func:`closest`, and a triangle hit's unit geometric normal (:func:`geometric_normal`'s),
+    read from the packed group the walk has just tested (:func:`.walks.bvh_hit_packed`): ``(t,
+    prim, face, tri, b1, b2, nx, ny, nz)``, the normal zero for other hits."""
     btri, bb1, bb2 = -1, 0.0, 0.0
+    gx, gy, gz = 0.0, 0.0, 0.0
     inv_w = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
     w = eps * inv_w
     best, bp, bf, brow = analytic_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, np.bool_(shadow_only),
                                        np.bool_(any_hit), zero, eps, stack, st, sp_, sf, sn)
     if any_hit and bp >= 0:
-        return best, bp, bf, btri, bb1, bb2
+        return best, bp, bf, btri, bb1, bb2, gx, gy, gz
     lim = reach(best, brow, w, tmax)
     if geo.tri_v.shape[0] > 0 and _bounds_hit(geo.bvh_bounds, ox, oy, oz, dx, dy, dz, tmin, lim):
-        t, tri, b1, b2 = triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, lim, np.bool_(any_hit), stack)
+        t, tri, b1, b2, g, lane = triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, lim, np.bool_(any_hit), stack)
         if tri >= 0 and nearer(t, geo.tri_prim[tri], best, brow, w, tmax):
             best, bp, bf, btri, bb1, bb2 = t, geo.tri_prim[tri], 0, tri, b1, b2
+            gx, gy, gz = triangle_normal(geo.bvh_tv4[g, :, lane])
     if bp < 0:
-        return np.inf, -1, 0, -1, 0.0, 0.0
-    return best, bp, bf, btri, bb1, bb2
+        return np.inf, -1, 0, -1, 0.0, 0.0, 0.0, 0.0, 0.0
+    return best, bp, bf, btri, bb1, bb2, gx, gy, gz
 
 
 @nb.njit(**INLINE)
@@ -330,10 +343,7 @@ def geometric_normal(geo, k, face, tri, x, y, z, stack):
     space; a flipped CSG face, ``face + 16``, turns it round).  ``stack``: scratch of an
     isosurface's gradient."""
     if tri >= 0:
-        tri_v = geo.tri_v
-        e1x, e1y, e1z = tri_v[tri, 3] - tri_v[tri, 0], tri_v[tri, 4] - tri_v[tri, 1], tri_v[tri, 5] - tri_v[tri, 2]
-        e2x, e2y, e2z = tri_v[tri, 6] - tri_v[tri, 0], tri_v[tri, 7] - tri_v[tri, 1], tri_v[tri, 8] - tri_v[tri, 2]
-        return _normalize(e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x)
+        return triangle_normal(geo.tri_v[tri])
     nm = geo.nm
     f = face - 16 if face >= 16 else face
     sgn = -1.0 if face >= 16 else 1.0

@@ -51,7 +51,7 @@ def count_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, stack, cnt):
     adding the 4-wide nodes visited and the triangle tests to ``cnt``
     (:class:`..kernels.columns.WalkCount`).
     Returns ``(t, tri)``."""
-    t, tri, _, _ = bvh_walk(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, False, stack, True, cnt)
+    t, tri, _, _, _, _ = bvh_walk(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, False, stack, True, cnt)
     return t, tri
 
 
