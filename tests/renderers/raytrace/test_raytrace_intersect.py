@@ -335,7 +335,7 @@ def test_rays_in_a_face_plane_of_an_axis_aligned_mesh_are_not_culled():
 
 def test_a_triangles_normal_from_its_packed_group_is_the_tables():
     """``trace_batch`` without the surface data takes a triangle hit's geometric normal from the
-    packed group the walk tested (``intersect.closest_normal``), with it from the triangle table
+    packed group the walk tested (``intersect.closest``), with it from the triangle table
     (``intersect.geometric_normal``): the same normal to the bit, for every hit of the mesh
     scene's camera rays (a wrong group or lane would give a neighbour's normal)."""
     from dataclasses import replace

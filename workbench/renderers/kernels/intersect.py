@@ -293,19 +293,12 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
             st, sp_, sf, sn):
     """Nearest hit of a world ray over all primitives: the list of analytic primitives tested
     one by one, then the analytic primitives' structure, then the triangles' (see
-    :mod:`.accel`).  Returns ``(t, prim, face, tri, b1, b2)``; ``prim = -1`` on a miss,
-    negative ``face`` is never returned (a flipped CSG normal is ``face + 16``)."""
-    t, k, f, tri, b1, b2, _, _, _ = closest_normal(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit,
-                                                   zero, eps, stack, st, sp_, sf, sn)
-    return t, k, f, tri, b1, b2  # (the triangle's normal, unused, is compiled away)
-
-
-@nb.njit(**INLINE)
-def closest_normal(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
-                   st, sp_, sf, sn):
-    """:func:`closest`, and a triangle hit's unit geometric normal (:func:`geometric_normal`'s),
-    read from the packed group the walk has just tested (:func:`.walks.bvh_hit_packed`): ``(t,
-    prim, face, tri, b1, b2, nx, ny, nz)``, the normal zero for other hits."""
+    :mod:`.accel`).  Returns ``(t, prim, face, tri, b1, b2, nx, ny, nz)``; ``prim = -1`` on a
+    miss, negative ``face`` is never returned (a flipped CSG normal is ``face + 16``); ``n`` a
+    triangle hit's unit geometric normal (:func:`geometric_normal`'s), read from the packed
+    group the walk has just tested (:func:`.walks.bvh_hit_packed`), zero for other hits (a
+    caller that does not read it has it compiled away).  One function, not a wrapper without
+    the normal: each level of calls is linked and compiled again in its callers."""
     btri, bb1, bb2 = -1, 0.0, 0.0
     gx, gy, gz = 0.0, 0.0, 0.0
     inv_w = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)

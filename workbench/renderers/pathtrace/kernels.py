@@ -202,8 +202,9 @@ def cast_all(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr):
     """:func:`..kernels.intersect.closest` over every primitive (area lights included), compiled
     once here (not inlined: its call sites share one copy)."""
     stack, st, sp_, sf, sn = scr
-    return closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, np.bool_(False), np.bool_(any_hit), zero, eps, stack, st,
-                   sp_, sf, sn)
+    t, k, f, tri, b1, b2, _, _, _ = closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, np.bool_(False),
+                                            np.bool_(any_hit), zero, eps, stack, st, sp_, sf, sn)
+    return t, k, f, tri, b1, b2
 
 
 def cast(geo, bvh, tri_prim, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr):

@@ -30,7 +30,7 @@ import numpy as np
 
 from ..kernels.columns import RAY_COUNTS, Light, Mat, RayCount, Tex, WhittedOpt
 from ..kernels.flags import INLINE, TASK
-from ..kernels.intersect import closest, closest_normal, geometric_normal, object_point, scratch, surface
+from ..kernels.intersect import closest, geometric_normal, object_point, scratch, surface
 from ..kernels.optics import (_facing, _feeler, _ior, _light_dir, _pow, camera_ray, enter_or_leave,
                               fresnel_reflectance)
 from ..kernels.shapes import _normalize
@@ -87,7 +87,7 @@ def trace_task(geo, rays, hits, zero, rel_eps, extent, ncancel, shadow_only, scr
     for i in range(c * nchunks // nit * CHUNK, min(n, (c + 1) * nchunks // nit * CHUNK)):
         ox, oy, oz = O[i, 0], O[i, 1], O[i, 2]
         eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
-        t, k, f, tri, b1, b2, gx, gy, gz = closest_normal(geo, ox, oy, oz, D[i, 0], D[i, 1], D[i, 2], tmin[i],
+        t, k, f, tri, b1, b2, gx, gy, gz = closest(geo, ox, oy, oz, D[i, 0], D[i, 1], D[i, 2], tmin[i],
                                                           tmax[i], np.bool_(shadow_only), np.bool_(False), zero,
                                                           eps, stack, st, sp_, sf, sn)
         t_out[i], prim_out[i] = t, k
@@ -499,7 +499,7 @@ def pixels_task(geo, shading, pixels, spp, first, ncancel, part, scr, bufs, c, n
                     ox, oy, oz = c_o[0, 0], c_o[0, 1], c_o[0, 2]
                     dx, dy, dz = c_d[0, 0], c_d[0, 1], c_d[0, 2]
                     eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
-                    t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, r_tmin[top], np.inf,
+                    t, k, f, tri, b1, b2, _, _, _ = closest(geo, ox, oy, oz, dx, dy, dz, r_tmin[top], np.inf,
                                                    np.bool_(False), np.bool_(False), zero, eps, stack, st, sp_, sf, sn)
                     a = 1.0
                     if k >= 0:

@@ -44,7 +44,7 @@ def _pass_cutouts(geo, shading, ox, oy, oz, dx, dy, dz, t, ncancel, hit, scr):
         eps = ray_off * max(max(abs(ox), abs(oy), abs(oz)), extent)
         for _ in range(MAX_CUTOUTS - 1):
             tmin = _past(ox, oy, oz, dx, dy, dz, t, ray_off, extent)
-            t, k, f, tri, b1, b2 = closest(geo, ox, oy, oz, dx, dy, dz, tmin, np.inf, np.bool_(False),
+            t, k, f, tri, b1, b2, _, _, _ = closest(geo, ox, oy, oz, dx, dy, dz, tmin, np.inf, np.bool_(False),
                                            np.bool_(False), zero, eps, stack, st, sp_, sf, sn)
             if k < 0:
                 return t, k, 1.0
@@ -92,7 +92,7 @@ def _opacity_feelers(geo, shading, ox, oy, oz, dx, dy, dz, t, ng, ns, vis, spare
             tmin = opts[WhittedOpt.T_MIN] * max(pm, extent)
             v = 1.0
             for _ in range(SHADOW_CROSSINGS):
-                s, k, f, tri, b1, b2 = closest(geo, qx, qy, qz, lx, ly, lz, tmin, tmx, np.bool_(True),
+                s, k, f, tri, b1, b2, _, _, _ = closest(geo, qx, qy, qz, lx, ly, lz, tmin, tmx, np.bool_(True),
                                                np.bool_(False), zero, off, stack, st, sp_, sf, sn)
                 if k < 0:
                     break
