@@ -1,14 +1,16 @@
 """Kernels compiled only for the kinds a scene holds (the kernel layer: ``renderers/kernels``).
 
 The geometry record's kind marker names the scene's features; a kernel compiled for a marker
-without a kind never compiles that kind's kernels.  Checked in a new process (numba's
-dispatchers start empty there): a closest-hit search compiled for the spheres of the Whitted
+without a kind never compiles that kind's kernels.  Checked in a new process on an empty numba
+cache (numba's dispatchers start empty there, and a kernel loaded from a warm cache types none
+of its callees, so would show nothing compiled whatever the marker): a closest-hit search compiled for the spheres of the Whitted
 scene leaves the blob, isosurface, lathe and prism kernels and the CSG walk uncompiled, and the
 same search for a marker naming the blob compiles the blob's kernel and no other, and compiles
 it as a function of its own, not marked for inlining (``kernels/flags.py``)."""
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -51,20 +53,21 @@ print(json.dumps({"compiled": compiled, "inlined": inlined}))
 '''
 
 
-def _compiled(marker: str) -> dict:
-    out = subprocess.run([sys.executable, "-c", PROBE, marker], capture_output=True, text=True, cwd=ROOT,
-                         timeout=600)
+def _probe(code: str, cache: Path, *args: str):
+    """The last line of ``code`` run in a new process on the empty numba cache ``cache``, as JSON."""
+    out = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, cwd=ROOT,
+                         env={**os.environ, "NUMBA_CACHE_DIR": str(cache)}, timeout=600)
     assert out.returncode == 0, out.stderr[-2000:]
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def test_a_scene_of_spheres_compiles_no_kind_kernel():
-    assert _compiled("scene")["compiled"] == {name: 0 for name in EXTENDED}
+def test_a_scene_of_spheres_compiles_no_kind_kernel(tmp_path):
+    assert _probe(PROBE, tmp_path, "scene")["compiled"] == {name: 0 for name in EXTENDED}
 
 
 @pytest.fixture(scope="module")
-def blob_probe() -> dict:
-    return _compiled("blob")
+def blob_probe(tmp_path_factory) -> dict:
+    return _probe(PROBE, tmp_path_factory.mktemp("numba_cache"), "blob")
 
 
 def test_a_marker_naming_the_blob_compiles_the_blob_alone(blob_probe):
@@ -99,20 +102,38 @@ def test_features_of_the_bundled_scenes():
 
 MEDIA_PROBE = r'''
 import json
+import numba as nb
+import numpy as np
 import workbench
+from workbench.renderers.kernels import intersect as k
+from workbench.renderers.kernels.media import march, ratio, track
+from workbench.renderers.raytrace.flatten import flatten
 from workbench.scene.kinds import fur_kernels, hypertexture_kernels
-workbench.render(workbench.load_scene("whitted"), "raytrace", width=16, height=12)
-print(json.dumps([len(f.signatures) for f in (hypertexture_kernels.optics, hypertexture_kernels.density,
-                                               fur_kernels.texel, fur_kernels.optics)]))
+
+@nb.njit(error_model="numpy")
+def media_steps(geo, scr, lights, mat_of, mat_tab):
+    m = march(geo, 0, 0.0, 0.0, 10.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.1, 0.1, 0.1, 1.0, True,
+              (lights, mat_of, mat_tab), scr)
+    t = track(geo, 0, 0.0, 0.0, 10.0, 0.0, 0.0, -1.0, 0.0, 1.0, np.uint64(7), 3)
+    r = ratio(geo, 0, 0.0, 0.0, 10.0, 0.0, 0.0, -1.0, 0.0, 1.0, np.uint64(7), 3)
+    return m[0], m[1], t[0], t[7], r[0], r[1]
+
+geo = flatten(workbench.load_scene("whitted")).kernel_args()
+steps = media_steps(geo, k.scratch(), np.zeros((1, 16)), np.zeros(1, np.int64), np.zeros((1, 40)))
+print(json.dumps({"steps": [float(v) for v in steps],
+                  "compiled": [len(f.signatures) for f in (hypertexture_kernels.optics, hypertexture_kernels.density,
+                                                           fur_kernels.texel, fur_kernels.optics)]}))
 '''
 
 
-def test_a_scene_without_media_compiles_no_medium_code():
-    """A Whitted render of the spheres (in a new process) loads no signature of the media's
-    kernels: the march and the trackers are gates that compile to constants without a medium."""
-    out = subprocess.run([sys.executable, "-c", MEDIA_PROBE], capture_output=True, text=True, cwd=ROOT, timeout=600)
-    assert out.returncode == 0, out.stderr[-2000:]
-    assert json.loads(out.stdout.strip().splitlines()[-1]) == [0, 0, 0, 0]
+def test_a_scene_without_media_compiles_no_medium_code(tmp_path):
+    """The march of the ray caster and Whitted and the path tracer's delta and ratio tracking,
+    compiled for the spheres' marker (in a new process, on an empty cache), type none of the
+    media's kernels: they are gates that compile to constants without a medium (a clear ray:
+    transmittance 1, no emission, no collision, the random dimension unchanged)."""
+    probe = _probe(MEDIA_PROBE, tmp_path)
+    assert probe["compiled"] == [0, 0, 0, 0]
+    assert probe["steps"] == [1.0, 0.0, float("inf"), 3.0, 1.0, 3.0]
 
 
 def test_unknown_feature_is_refused():
