@@ -107,7 +107,7 @@ def test_counting_traversal_finds_the_kernels_hits_and_brute_force_counts_are_ex
         arrays = (tree.node, tree.child, tree.leaf, tree.first, tree.tv4)
         ts = []
         for o, d in zip(O, D):
-            t, tr, _, _ = walks.bvh_hit(arrays, *o, *d, 0.0, np.inf, np.bool_(False), stack)
+            t, tr, _, _, _, _ = walks.bvh_hit(arrays, *o, *d, 0.0, np.inf, np.bool_(False), stack)
             cnt = np.zeros(2, np.int64)
             t2, tr2 = count_hit(arrays, *o, *d, 0.0, np.inf, stack, cnt)
             assert (t2, tr2) == (t, tr)
@@ -189,7 +189,7 @@ def test_octree_of_coincident_triangles_stays_within_its_reference_budget():
     stack = np.empty((walks.BVH_STACK, 2))
     for a, order, tree in _structures(tri):
         arrays = (tree.node, tree.child, tree.leaf, tree.first, tree.tv4)
-        t, k, _, _ = walks.bvh_hit(arrays, 0.2, 0.2, -1.0, 0.0, 0.0, 1.0, 0.0, np.inf, np.bool_(False), stack)
+        t, k, _, _, _, _ = walks.bvh_hit(arrays, 0.2, 0.2, -1.0, 0.0, 0.0, 1.0, 0.0, np.inf, np.bool_(False), stack)
         assert abs(t - 1.0) <= 1e-12 and k >= 0 and tri[order[k], 2] == 0.0, a
-        t, k, _, _ = walks.bvh_hit(arrays, 0.2, 0.2, 2.0, 0.0, 0.0, -1.0, 0.0, np.inf, np.bool_(False), stack)
+        t, k, _, _, _, _ = walks.bvh_hit(arrays, 0.2, 0.2, 2.0, 0.0, 0.0, -1.0, 0.0, np.inf, np.bool_(False), stack)
         assert abs(t - 1.5) <= 1e-12 and tri[order[k], 2] == 0.5, a

@@ -106,7 +106,7 @@ def test_4wide_traversal_equals_brute_force_closest_and_any_hit():
     for o, d in zip(O, D):
         tb, _, _ = shapes.triangles(tvo.reshape(-1, 3, 3), o, d)
         tb = np.where(tb > 1e-9, tb, np.inf)
-        t, tri, b1, b2 = walks.bvh_hit(arrays, *o, *d, 1e-9, np.inf, np.bool_(False), stack)
+        t, tri, b1, b2, _, _ = walks.bvh_hit(arrays, *o, *d, 1e-9, np.inf, np.bool_(False), stack)
         if np.isfinite(tb.min()):
             hits += 1
             assert t == pytest.approx(tb.min(), rel=1e-9)
@@ -117,7 +117,7 @@ def test_4wide_traversal_equals_brute_force_closest_and_any_hit():
         else:
             assert tri == -1 and np.isinf(t)
         # any hit: some triangle within [tmin, tmax] iff brute force has one
-        ta, tria, _, _ = walks.bvh_hit(arrays, *o, *d, 1e-9, 0.5, np.bool_(True), stack)
+        ta, tria, _, _, _, _ = walks.bvh_hit(arrays, *o, *d, 1e-9, 0.5, np.bool_(True), stack)
         assert (tria >= 0) == bool((tb < 0.5).any())
         if tria >= 0:
             assert ta < 0.5 and tb[tria] == pytest.approx(ta, rel=1e-9)

@@ -20,7 +20,7 @@ from .columns import WalkCount
 from .flags import GATE, INLINE
 from .shapes import CSG_EVENTS, _normalize, _to_object, csg_hit, object_normal, prim_hit
 from .specialise import has
-from .walks import BVH_STACK, _bounds_hit, bvh_hit_packed, node_ray, open_node, triangle_normal
+from .walks import BVH_STACK, _bounds_hit, bvh_hit, node_ray, open_node, triangle_normal
 
 
 @nb.njit(**INLINE)
@@ -124,7 +124,7 @@ def _analytic_normal_gate(geo, k, f, x, y, z, stack):
 
 
 def triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
-    """:func:`.walks.bvh_hit_packed` over the scene's triangles if it has any."""
+    """:func:`.walks.bvh_hit` over the scene's triangles if it has any."""
     raise TypeError("triangles_gate is callable from numba-compiled code only")
 
 
@@ -134,8 +134,8 @@ def _triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
 
     def impl(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
         if on:
-            return bvh_hit_packed((geo.bvh_node, geo.bvh_child, geo.bvh_leaf, geo.bvh_first, geo.bvh_tv4),
-                                  ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack)
+            return bvh_hit((geo.bvh_node, geo.bvh_child, geo.bvh_leaf, geo.bvh_first, geo.bvh_tv4),
+                           ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack)
         return np.inf, -1, 0.0, 0.0, np.int64(-1), np.int64(0)
     return impl
 
@@ -296,7 +296,7 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
     :mod:`.accel`).  Returns ``(t, prim, face, tri, b1, b2, nx, ny, nz)``; ``prim = -1`` on a
     miss, negative ``face`` is never returned (a flipped CSG normal is ``face + 16``); ``n`` a
     triangle hit's unit geometric normal (:func:`geometric_normal`'s), read from the packed
-    group the walk has just tested (:func:`.walks.bvh_hit_packed`), zero for other hits (a
+    group the walk has just tested (:func:`.walks.bvh_hit`), zero for other hits (a
     caller that does not read it has it compiled away).  One function, not a wrapper without
     the normal: each level of calls is linked and compiled again in its callers."""
     btri, bb1, bb2 = -1, 0.0, 0.0

@@ -197,20 +197,12 @@ def _slp_vectorized(dispatcher):
 @_slp_vectorized
 @nb.njit(**INLINE)
 def bvh_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
-    """Closest (or any) triangle hit through the 4-wide BVH: :func:`bvh_walk` without counting.
-    Returns ``(t, tri, b1, b2)``."""
-    t, tri, b1, b2, _, _ = bvh_walk(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack, False, stack[0])
-    return t, tri, b1, b2
-
-
-@_slp_vectorized
-@nb.njit(**INLINE)
-def bvh_hit_packed(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
-    """:func:`bvh_hit`, and where the hit triangle lies in the packed groups: ``(t, tri, b1,
-    b2, group, lane)`` (``group = -1`` on a miss): the hit's normal can then be read from the
-    group the walk has just tested, in the cache (:func:`triangle_normal` of ``tv4[group, :,
-    lane]``), rather than from the triangle table (the mesh scene's camera rays: 1 ms of 23 ms,
-    measured)."""
+    """Closest (or any) triangle hit through the 4-wide BVH: :func:`bvh_walk` without counting,
+    the one walk of the ray tracer, the path tracer and radiosity.  Returns ``(t, tri, b1, b2,
+    group, lane)``: with where the hit triangle lies in the packed groups (``group = -1`` on a
+    miss), its normal can be read from the group the walk has just tested, in the cache
+    (:func:`triangle_normal` of ``tv4[group, :, lane]``), rather than from the triangle table; a
+    caller that does not read them has them compiled away."""
     return bvh_walk(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack, False, stack[0])
 
 

@@ -222,7 +222,7 @@ def _cast(geo, bvh, tri_prim, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero,
     kinds = geo.types[-1]  # geo.kinds' type
     if has(kinds, "triangles") and not has(kinds, "analytic"):
         def impl(geo, bvh, tri_prim, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr):
-            t, tri, b1, b2 = bvh_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, scr[0])
+            t, tri, b1, b2, _, _ = bvh_hit(bvh, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, scr[0])
             if tri < 0:
                 return np.inf, -1, 0, -1, 0.0, 0.0
             return t, tri_prim[tri], 0, tri, b1, b2

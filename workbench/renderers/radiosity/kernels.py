@@ -174,7 +174,7 @@ def raycast_rows(tris, tri_patch, first_tri, normals, bvh, bvh_tri, rays, seed, 
             d[0] = x * ux + y * vx + z * n[0]
             d[1] = x * uy + y * vy + z * n[1]
             d[2] = x * uz + y * vz + z * n[2]
-            _, hit, _, _ = bvh_hit(bvh, o[0], o[1], o[2], d[0], d[1], d[2], t_min, np.inf, np.bool_(False), stack)
+            _, hit, _, _, _, _ = bvh_hit(bvh, o[0], o[1], o[2], d[0], d[1], d[2], t_min, np.inf, np.bool_(False), stack)
             if hit >= 0:
                 h = bvh_tri[hit]
                 gx, gy, gz = _cross(tris[h, 1, 0] - tris[h, 0, 0], tris[h, 1, 1] - tris[h, 0, 1],
@@ -349,7 +349,7 @@ def receiver_rows(shooters, polys, patches, samples, bvh, offset, t_edge, zero, 
         total = 0.0
         for k in range(sample_first[i], sample_first[i + 1]):
             total += sample_w[k]
-            _, tri, _, _ = bvh_hit(bvh, ox, oy, oz, points[k, 0] - ox, points[k, 1] - oy, points[k, 2] - oz,
+            _, tri, _, _, _, _ = bvh_hit(bvh, ox, oy, oz, points[k, 0] - ox, points[k, 1] - oy, points[k, 2] - oz,
                                    t_edge, 1.0 - t_edge, np.bool_(True), stack)
             if tri < 0:
                 seen += sample_w[k]
