@@ -9,7 +9,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .columns import PROJ_PLANAR, Light, Mat, Tex
+from .columns import Light, Mat
 from .flags import INLINE
 from .shapes import _normalize
 
@@ -127,26 +127,6 @@ def _feeler(px, py, pz, gx, gy, gz, lx, ly, lz, dist, off):
     side = 1.0 if gx * lx + gy * ly + gz * lz >= 0.0 else -1.0
     tmx = dist - 2.0 * off if dist < np.inf else np.inf
     return px + side * off * gx, py + side * off * gy, pz + side * off * gz, tmx
-
-
-@nb.njit(**INLINE)
-def checker_color(tex_tab, mi, x, y, z):
-    """Texture factor of material ``mi`` at object-space point ``(x, y, z)``: the
-    ``checker`` pattern of :func:`workbench.renderers.texturing.pattern_value` with the
-    ``planar`` (``s = scale (d.Se, d.W)``) or ``solid`` (``s = scale d``) projection,
-    ``d = P - center``.  ``tex_tab``: columns :class:`.columns.Tex` (the path tracer's textures and the Whitted
-    kernel's when the scene has no other texture: :mod:`.textures`)."""
-    cx, cy, cz = x - tex_tab[mi, Tex.CENTER], y - tex_tab[mi, Tex.CENTER + 1], z - tex_tab[mi, Tex.CENTER + 2]
-    sc = tex_tab[mi, Tex.SCALE]
-    if tex_tab[mi, Tex.PROJ] == PROJ_PLANAR:
-        parity = (math.floor(sc * (cx * tex_tab[mi, Tex.SE] + cy * tex_tab[mi, Tex.SE + 1] + cz * tex_tab[mi, Tex.SE + 2]))
-                  + math.floor(sc * (cx * tex_tab[mi, Tex.W] + cy * tex_tab[mi, Tex.W + 1] + cz * tex_tab[mi, Tex.W + 2])))
-    else:
-        parity = math.floor(sc * cx) + math.floor(sc * cy) + math.floor(sc * cz)
-    a = parity - 2.0 * math.floor(parity / 2.0)
-    return (tex_tab[mi, Tex.COLOR0] * (1.0 - a) + tex_tab[mi, Tex.COLOR1] * a,
-            tex_tab[mi, Tex.COLOR0 + 1] * (1.0 - a) + tex_tab[mi, Tex.COLOR1 + 1] * a,
-            tex_tab[mi, Tex.COLOR0 + 2] * (1.0 - a) + tex_tab[mi, Tex.COLOR1 + 2] * a)
 
 
 @nb.njit(**INLINE)

@@ -12,7 +12,7 @@ rows, top row first; a table row holds its image's offset and size) and a marker
 marker's dtype names ``maps`` when the scene has any map but ``checker`` colours with the
 ``planar`` or ``solid`` projection: the gates at the end of this module (``@overload``\\ s,
 as the kind gates of :mod:`.intersect`) then compile the evaluation of every kind; without it
-they compile the checker alone (:func:`.optics.checker_color`), so that a scene of plain and
+they compile the checker alone (:func:`checker_color`), so that a scene of plain and
 checker colours compiles what it did before the other maps came to numba.
 """
 from __future__ import annotations
@@ -29,7 +29,6 @@ from .columns import (ENV_IMAGE, ENV_NONE, PROJ_CYLINDRICAL, PROJ_PLANAR, PROJ_S
                       TEX_CHECKER, TEX_CONSTANT, TEX_GRID, TEX_IMAGE, TEX_MARBLE, TEX_NOISE, Env, Mat, Tex)
 from .flags import INLINE, NO_REFCOUNT
 from .layout import marker_features
-from .optics import checker_color
 from .shapes import _normalize
 
 TWO_PI = 2.0 * math.pi
@@ -154,6 +153,25 @@ def _grid(s0, s1, width):
 def _checker(s0, s1, s2, solid):
     parity = math.floor(s0) + math.floor(s1) + (math.floor(s2) if solid else 0.0)
     return parity - 2.0 * math.floor(parity / 2.0)
+
+
+@nb.njit(**INLINE)
+def checker_color(tab, mi, x, y, z):
+    """Texture factor of material ``mi`` at object-space point ``(x, y, z)`` for a ``checker``
+    with the ``planar`` (``s = scale (d.Se, d.W)``) or ``solid`` (``s = scale d``) projection,
+    ``d = P - center``: the two colours blended by :func:`_checker`.  The whole of
+    :func:`texture_color` that a scene whose only maps are such checkers compiles (the path
+    tracer's textures, and Whitted's without the ``maps`` feature)."""
+    cx, cy, cz = x - tab[mi, Tex.CENTER], y - tab[mi, Tex.CENTER + 1], z - tab[mi, Tex.CENTER + 2]
+    sc = tab[mi, Tex.SCALE]
+    if tab[mi, Tex.PROJ] == PROJ_PLANAR:
+        a = _checker(sc * (cx * tab[mi, Tex.SE] + cy * tab[mi, Tex.SE + 1] + cz * tab[mi, Tex.SE + 2]),
+                     sc * (cx * tab[mi, Tex.W] + cy * tab[mi, Tex.W + 1] + cz * tab[mi, Tex.W + 2]), 0.0, False)
+    else:
+        a = _checker(sc * cx, sc * cy, sc * cz, True)
+    return (tab[mi, Tex.COLOR0] * (1.0 - a) + tab[mi, Tex.COLOR1] * a,
+            tab[mi, Tex.COLOR0 + 1] * (1.0 - a) + tab[mi, Tex.COLOR1 + 1] * a,
+            tab[mi, Tex.COLOR0 + 2] * (1.0 - a) + tab[mi, Tex.COLOR1 + 2] * a)
 
 
 @nb.njit(**NO_REFCOUNT)

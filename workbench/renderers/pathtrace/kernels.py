@@ -73,7 +73,8 @@ from ..kernels.tasks import run_tasks
 from ..kernels.flags import INLINE, NO_REFCOUNT, TASK
 from ..kernels.intersect import closest, scratch, surface
 from ..kernels.media import track
-from ..kernels.optics import _feeler, _light_dir, checker_color, enter_or_leave, fresnel_reflectance
+from ..kernels.optics import _feeler, _light_dir, enter_or_leave, fresnel_reflectance
+from ..kernels.textures import checker_color
 from ..kernels.shapes import _normalize
 from ..kernels.specialise import has
 from ..kernels.walks import bvh_hit

@@ -210,7 +210,7 @@ def kernel_options(generations: int, *, threshold: float = 0.0, fresnel: int = 0
 
 
 def fused_textures(scene: Scene, sd: SceneData):
-    """The path tracer's (M, TEX_COLS) colour texture table (:func:`.kernels.optics.checker_color`)
+    """The path tracer's (M, TEX_COLS) colour texture table (:func:`..kernels.textures.checker_color`)
     when the scene's maps are at most planar or solid checkers (:func:`.maps.checkers_only`),
     else None (the path tracer then leaves the textures out)."""
     if not checkers_only(scene, sd.materials):
