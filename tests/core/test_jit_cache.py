@@ -7,6 +7,7 @@ import os
 import shutil
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 from workbench.core import jit_cache
@@ -119,10 +120,18 @@ print(plus_one(1.5))
 '''
 
 
+def _waits_for_flock(pid: int) -> bool:
+    """Whether process ``pid`` is blocked on an ``flock`` (a ``->`` row of ``/proc/locks``:
+    ``N: -> FLOCK ADVISORY WRITE <pid> ...``)."""
+    return any(f[1:3] == ["->", "FLOCK"] and f[5] == str(pid)
+               for f in (line.split() for line in Path("/proc/locks").read_text().splitlines()) if len(f) > 5)
+
+
 def test_a_cache_save_waits_for_another_process_holding_the_lock(tmp_path):
     """Numba's save of a new cache entry runs under an exclusive ``flock`` on the function's
     ``<index>.lock`` (``jit_cache.lock_cache_saves``): while this process holds the lock, a
-    process compiling the cached function cannot finish its save; once released, it does."""
+    process compiling the cached function cannot finish its save (it is seen blocked on the
+    lock, with no index written, rather than after a fixed wait); once released, it does."""
     import fcntl
     (tmp_path / "cached.py").write_text(CACHED)
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=str(ROOT))
@@ -136,11 +145,10 @@ def test_a_cache_save_waits_for_another_process_holding_the_lock(tmp_path):
     with open(str(index) + ".lock", "a") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         child = subprocess.Popen(run, cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-        try:
-            child.wait(timeout=20)
-            waited = False
-        except subprocess.TimeoutExpired:
-            waited = not index.exists()  # it compiled, and waits to save
+        deadline = time.monotonic() + 300
+        while child.poll() is None and not _waits_for_flock(child.pid) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        waited = child.poll() is None and _waits_for_flock(child.pid) and not index.exists()
     out, err = child.communicate(timeout=300)
     assert waited, "the save did not wait for the lock"
     assert child.returncode == 0 and out.strip() == b"2.5", err[-500:]
