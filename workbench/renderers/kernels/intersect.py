@@ -141,17 +141,44 @@ def _triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
 
 
 @nb.njit(**INLINE)
+def leaf_rows(geo, lf, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only, any_hit, zero, eps,
+              stack, st, sp_, sf, sn, count, cnt):
+    """The rows of leaf ``lf`` of the analytic primitives' tree tested in turn (a hit replaces
+    the nearest so far, ``best`` of row ``brow``, as :func:`nearer` says; with ``any_hit``
+    the first hit ends the search; with ``count``, the tests are added to
+    ``cnt[WalkCount.TESTS]``).  Returns ``(t, prim, face, row)``, ``row = -1`` if nothing
+    replaced ``best``."""
+    shadow, pleaf, pref = geo.shadow, geo.pleaf, geo.pref
+    w = eps * inv_w
+    lim_up = next_up(reach(best, brow, w, tmax))  # a row's search reaches lim itself (once per change of lim)
+    bp, bf, found = -1, 0, np.int64(-1)
+    for q in range(pleaf[lf, 0], pleaf[lf, 0] + pleaf[lf, 1]):
+        k = pref[q]
+        if shadow_only and not shadow[k]:
+            continue
+        if count:
+            cnt[WalkCount.TESTS] += 1
+        # up to best and its window: a coincident surface of a lower row wins
+        t, p, f = row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, lim_up, zero, eps, stack, st, sp_, sf, sn)
+        if nearer(t, k, best, brow, w, tmax):
+            best, bp, bf, brow, found = t, p, f, k, k
+            lim_up = next_up(reach(best, brow, w, tmax))
+            if any_hit:
+                break
+    return best, bp, bf, found
+
+
+@nb.njit(**INLINE)
 def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only, any_hit, zero, eps,
                    stack, st, sp_, sf, sn, count, cnt):
     """:func:`prim_tree_hit`; with ``count`` (the traversal statistics' pass,
     :mod:`.traversal_stats`) it adds the 4-wide nodes visited to ``cnt[WalkCount.NODES]`` and
     the primitive tests to ``cnt[WalkCount.TESTS]`` (:class:`.columns.WalkCount`; the
     rendering kernels pass ``False``: no counting)."""
-    shadow, pnode, pchild, pleaf, pref = geo.shadow, geo.pnode, geo.pchild, geo.pleaf, geo.pref
+    pnode, pchild = geo.pnode, geo.pchild
     ray = node_ray(ox, oy, oz, dx, dy, dz, tmin)
     w = eps * inv_w  # coincidence window in ray parameter units (see :func:`nearer`)
     lim = reach(best, brow, w, tmax)
-    lim_up = next_up(lim)  # a row's search reaches lim itself (once per change of lim)
     bp, bf, found = -1, 0, -1
     base = PRIM_STACK_BASE
     top_ = stack.shape[0] - 1
@@ -167,22 +194,13 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, s
                 cnt[WalkCount.NODES] += 1
             sp, code = open_node((pnode, pchild), code, ray, lim, stack, sp, top_)
         if code < -1:
-            lf = -2 - code
-            for q in range(pleaf[lf, 0], pleaf[lf, 0] + pleaf[lf, 1]):
-                k = pref[q]
-                if shadow_only and not shadow[k]:
-                    continue
-                if count:
-                    cnt[WalkCount.TESTS] += 1
-                # up to best and its window: a coincident surface of a lower row wins
-                t, p, f = row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, lim_up,
-                                  zero, eps, stack, st, sp_, sf, sn)
-                if nearer(t, k, best, brow, w, tmax):
-                    best, bp, bf, brow, found = t, p, f, k, k
-                    lim = reach(best, brow, w, tmax)
-                    lim_up = next_up(lim)
-                    if any_hit:
-                        return best, bp, bf, found
+            t, p, f, row = leaf_rows(geo, -2 - code, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow,
+                                     shadow_only, any_hit, zero, eps, stack, st, sp_, sf, sn, count, cnt)
+            if row >= 0:
+                best, bp, bf, brow, found = t, p, f, row, row
+                lim = reach(best, brow, w, tmax)
+                if any_hit:
+                    return best, bp, bf, found
         code = -1
         while sp > base:
             sp -= 1
@@ -279,8 +297,12 @@ def analytic_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, shadow_only, an
             best, bp, bf, brow = t, p, f, k
         if any_hit and bp >= 0:
             return best, bp, bf, brow
-    if geo.pref.shape[0] > 0 and (_one_small_leaf(geo.pchild, geo.pleaf)
-                                  or _bounds_hit(geo.pbounds, ox, oy, oz, dx, dy, dz, tmin, reach(best, brow, w, tmax))):
+    if geo.pref.shape[0] > 0 and _one_small_leaf(geo.pchild, geo.pleaf):
+        t, p, f, row = leaf_rows(geo, -2 - geo.pchild[0, 0], ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow,
+                                 shadow_only, any_hit, zero, eps, stack, st, sp_, sf, sn, False, sn)
+        if row >= 0:
+            best, bp, bf, brow = t, p, f, row
+    elif geo.pref.shape[0] > 0 and _bounds_hit(geo.pbounds, ox, oy, oz, dx, dy, dz, tmin, reach(best, brow, w, tmax)):
         t, p, f, row = prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only,
                                      any_hit, zero, eps, stack, st, sp_, sf, sn)
         if row >= 0:
@@ -289,7 +311,7 @@ def analytic_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, shadow_only, an
 
 
 @nb.njit(**INLINE)
-def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
+def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, unit, zero, eps, stack,
             st, sp_, sf, sn):
     """Nearest hit of a world ray over all primitives: the list of analytic primitives tested
     one by one, then the analytic primitives' structure, then the triangles' (see
@@ -298,10 +320,16 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
     triangle hit's unit geometric normal (:func:`geometric_normal`'s), read from the packed
     group the walk has just tested (:func:`.walks.bvh_hit_packed`), zero for other hits (a
     caller that does not read it has it compiled away).  One function, not a wrapper without
-    the normal: each level of calls is linked and compiled again in its callers."""
+    the normal: each level of calls is linked and compiled again in its callers.
+
+    ``unit``: the caller has just normalised the direction (the Whitted rays and their shadow
+    feelers), so its length is taken as 1 rather than computed again: the square root and the
+    division of ``1 / |d|`` head the dependent chain of every test, and the ray tracer's
+    renormalisation cost its Whitted scene trace about 5 % (perf).  Else (a batch of rays of
+    any length, the path tracer) ``1 / |d|`` is computed."""
     btri, bb1, bb2 = -1, 0.0, 0.0
     gx, gy, gz = 0.0, 0.0, 0.0
-    inv_w = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
+    inv_w = 1.0 if unit else 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
     w = eps * inv_w
     best, bp, bf, brow = analytic_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, np.bool_(shadow_only),
                                        np.bool_(any_hit), zero, eps, stack, st, sp_, sf, sn)
@@ -341,6 +369,8 @@ def geometric_normal(geo, k, face, tri, x, y, z, stack):
     f = face - 16 if face >= 16 else face
     sgn = -1.0 if face >= 16 else 1.0
     ux, uy, uz = analytic_normal_gate(geo, k, f, x, y, z, stack)
+    if geo.ident[k]:  # nm is the identity too (the transpose of the identity): the same values
+        return _normalize(sgn * ux, sgn * uy, sgn * uz)
     wx = sgn * (nm[k, 0] * ux + nm[k, 1] * uy + nm[k, 2] * uz)
     wy = sgn * (nm[k, 3] * ux + nm[k, 4] * uy + nm[k, 5] * uz)
     wz = sgn * (nm[k, 6] * ux + nm[k, 7] * uy + nm[k, 8] * uz)
