@@ -141,44 +141,20 @@ def _triangles_gate(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, stack):
 
 
 @nb.njit(**INLINE)
-def leaf_rows(geo, lf, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only, any_hit, zero, eps,
-              stack, st, sp_, sf, sn, count, cnt):
-    """The rows of leaf ``lf`` of the analytic primitives' tree tested in turn (a hit replaces
-    the nearest so far, ``best`` of row ``brow``, as :func:`nearer` says; with ``any_hit``
-    the first hit ends the search; with ``count``, the tests are added to
-    ``cnt[WalkCount.TESTS]``).  Returns ``(t, prim, face, row)``, ``row = -1`` if nothing
-    replaced ``best``."""
-    shadow, pleaf, pref = geo.shadow, geo.pleaf, geo.pref
-    w = eps * inv_w
-    lim_up = next_up(reach(best, brow, w, tmax))  # a row's search reaches lim itself (once per change of lim)
-    bp, bf, found = -1, 0, np.int64(-1)
-    for q in range(pleaf[lf, 0], pleaf[lf, 0] + pleaf[lf, 1]):
-        k = pref[q]
-        if shadow_only and not shadow[k]:
-            continue
-        if count:
-            cnt[WalkCount.TESTS] += 1
-        # up to best and its window: a coincident surface of a lower row wins
-        t, p, f = row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, lim_up, zero, eps, stack, st, sp_, sf, sn)
-        if nearer(t, k, best, brow, w, tmax):
-            best, bp, bf, brow, found = t, p, f, k, k
-            lim_up = next_up(reach(best, brow, w, tmax))
-            if any_hit:
-                break
-    return best, bp, bf, found
-
-
-@nb.njit(**INLINE)
 def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only, any_hit, zero, eps,
                    stack, st, sp_, sf, sn, count, cnt):
     """:func:`prim_tree_hit`; with ``count`` (the traversal statistics' pass,
     :mod:`.traversal_stats`) it adds the 4-wide nodes visited to ``cnt[WalkCount.NODES]`` and
     the primitive tests to ``cnt[WalkCount.TESTS]`` (:class:`.columns.WalkCount`; the
     rendering kernels pass ``False``: no counting)."""
-    pnode, pchild = geo.pnode, geo.pchild
-    ray = node_ray(ox, oy, oz, dx, dy, dz, tmin)
+    shadow, pnode, pchild, pleaf, pref = geo.shadow, geo.pnode, geo.pchild, geo.pleaf, geo.pref
+    # the ray as the box tests read it (three divisions) is made at the first node opened: a
+    # tree of one leaf opens none (Whitted's scene: see _one_small_leaf)
+    ray = node_ray(ox, oy, oz, 1.0, 1.0, 1.0, tmin)
+    ready = False
     w = eps * inv_w  # coincidence window in ray parameter units (see :func:`nearer`)
     lim = reach(best, brow, w, tmax)
+    lim_up = next_up(lim)  # a row's search reaches lim itself (once per change of lim)
     bp, bf, found = -1, 0, -1
     base = PRIM_STACK_BASE
     top_ = stack.shape[0] - 1
@@ -192,15 +168,26 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, s
         while code >= 0:
             if count:
                 cnt[WalkCount.NODES] += 1
+            if not ready:
+                ray, ready = node_ray(ox, oy, oz, dx, dy, dz, tmin), True
             sp, code = open_node((pnode, pchild), code, ray, lim, stack, sp, top_)
         if code < -1:
-            t, p, f, row = leaf_rows(geo, -2 - code, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow,
-                                     shadow_only, any_hit, zero, eps, stack, st, sp_, sf, sn, count, cnt)
-            if row >= 0:
-                best, bp, bf, brow, found = t, p, f, row, row
-                lim = reach(best, brow, w, tmax)
-                if any_hit:
-                    return best, bp, bf, found
+            lf = -2 - code
+            for q in range(pleaf[lf, 0], pleaf[lf, 0] + pleaf[lf, 1]):
+                k = pref[q]
+                if shadow_only and not shadow[k]:
+                    continue
+                if count:
+                    cnt[WalkCount.TESTS] += 1
+                # up to best and its window: a coincident surface of a lower row wins
+                t, p, f = row_hit(geo, k, ox, oy, oz, dx, dy, dz, inv_w, tmin, lim_up,
+                                  zero, eps, stack, st, sp_, sf, sn)
+                if nearer(t, k, best, brow, w, tmax):
+                    best, bp, bf, brow, found = t, p, f, k, k
+                    lim = reach(best, brow, w, tmax)
+                    lim_up = next_up(lim)
+                    if any_hit:
+                        return best, bp, bf, found
         code = -1
         while sp > base:
             sp -= 1
@@ -273,7 +260,9 @@ def _one_small_leaf(pchild, pleaf):
     """Whether the analytic primitives' tree is one leaf of at most :data:`SMALL_LEAF` rows (a
     scene of a few primitives, as Whitted's): its box test, three divisions a ray, then costs
     more than it saves (it culls only rays that miss the whole scene, never a shadow feeler
-    leaving a surface of the tree's), and a box test only culls, so skipping it changes no hit."""
+    leaving a surface of the tree's), and a box test only culls, so skipping it changes no hit.
+    :func:`prim_tree_walk` then opens no node, and makes no inverse direction for the box tests
+    (three divisions more)."""
     return (pchild[0, 0] <= -2 and pchild[0, 1] == -1 and pchild[0, 2] == -1 and pchild[0, 3] == -1
             and pleaf[-2 - pchild[0, 0], 1] <= SMALL_LEAF)
 
@@ -297,12 +286,8 @@ def analytic_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, shadow_only, an
             best, bp, bf, brow = t, p, f, k
         if any_hit and bp >= 0:
             return best, bp, bf, brow
-    if geo.pref.shape[0] > 0 and _one_small_leaf(geo.pchild, geo.pleaf):
-        t, p, f, row = leaf_rows(geo, -2 - geo.pchild[0, 0], ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow,
-                                 shadow_only, any_hit, zero, eps, stack, st, sp_, sf, sn, False, sn)
-        if row >= 0:
-            best, bp, bf, brow = t, p, f, row
-    elif geo.pref.shape[0] > 0 and _bounds_hit(geo.pbounds, ox, oy, oz, dx, dy, dz, tmin, reach(best, brow, w, tmax)):
+    if geo.pref.shape[0] > 0 and (_one_small_leaf(geo.pchild, geo.pleaf)
+                                  or _bounds_hit(geo.pbounds, ox, oy, oz, dx, dy, dz, tmin, reach(best, brow, w, tmax))):
         t, p, f, row = prim_tree_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, shadow_only,
                                      any_hit, zero, eps, stack, st, sp_, sf, sn)
         if row >= 0:
@@ -369,12 +354,10 @@ def geometric_normal(geo, k, face, tri, x, y, z, stack):
     f = face - 16 if face >= 16 else face
     sgn = -1.0 if face >= 16 else 1.0
     ux, uy, uz = analytic_normal_gate(geo, k, f, x, y, z, stack)
-    if geo.ident[k]:  # nm is the identity too (the transpose of the identity): the same values
-        return _normalize(sgn * ux, sgn * uy, sgn * uz)
-    wx = sgn * (nm[k, 0] * ux + nm[k, 1] * uy + nm[k, 2] * uz)
-    wy = sgn * (nm[k, 3] * ux + nm[k, 4] * uy + nm[k, 5] * uz)
-    wz = sgn * (nm[k, 6] * ux + nm[k, 7] * uy + nm[k, 8] * uz)
-    return _normalize(wx, wy, wz)
+    if not geo.ident[k]:  # (an identity row's nm is the identity too: the same values without it)
+        ux, uy, uz = (nm[k, 0] * ux + nm[k, 1] * uy + nm[k, 2] * uz, nm[k, 3] * ux + nm[k, 4] * uy + nm[k, 5] * uz,
+                      nm[k, 6] * ux + nm[k, 7] * uy + nm[k, 8] * uz)
+    return _normalize(sgn * ux, sgn * uy, sgn * uz)
 
 
 @nb.njit(**INLINE)
