@@ -172,7 +172,8 @@ def closest_kernel():
             ox, oy, oz = O[i, 0], O[i, 1], O[i, 2]
             eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
             t, k, f, tri, b1, b2, _, _, _ = closest(geo, ox, oy, oz, D[i, 0], D[i, 1], D[i, 2], 0.0, np.inf,
-                                           np.bool_(False), np.bool_(False), zero, eps, stack, st, sp_, sf, sn)
+                                           np.bool_(False), np.bool_(False), np.bool_(False), zero, eps, stack, st,
+                                           sp_, sf, sn)
             t_out[i], tri_out[i] = t, tri
 
     def closest_only(geo, O, D, zero, rel_eps, extent, t_out, tri_out):

@@ -84,8 +84,8 @@ def mesh_intersection(repeats: int | None = None) -> dict:
                     hits += t < np.inf
             else:
                 eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
-                hits += intersect.closest(geo, ox, oy, oz, dx, dy, dz, tmin[i], tmax[i], shadow, shadow, zero, eps,
-                                  stack, st, sp_, sf, sn)[1] >= 0
+                hits += intersect.closest(geo, ox, oy, oz, dx, dy, dz, tmin[i], tmax[i], shadow, shadow, True, zero,
+                                  eps, stack, st, sp_, sf, sn)[1] >= 0
         return hits
 
     scr = numba.njit(lambda: intersect.scratch())()

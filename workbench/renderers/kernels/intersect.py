@@ -148,7 +148,10 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, s
     the primitive tests to ``cnt[WalkCount.TESTS]`` (:class:`.columns.WalkCount`; the
     rendering kernels pass ``False``: no counting)."""
     shadow, pnode, pchild, pleaf, pref = geo.shadow, geo.pnode, geo.pchild, geo.pleaf, geo.pref
-    ray = node_ray(ox, oy, oz, dx, dy, dz, tmin)
+    # the ray as the box tests read it (three divisions) is made at the first node opened: a
+    # tree of one leaf opens none (Whitted's scene: see _one_small_leaf)
+    ray = node_ray(ox, oy, oz, 1.0, 1.0, 1.0, tmin)
+    ready = False
     w = eps * inv_w  # coincidence window in ray parameter units (see :func:`nearer`)
     lim = reach(best, brow, w, tmax)
     lim_up = next_up(lim)  # a row's search reaches lim itself (once per change of lim)
@@ -165,6 +168,8 @@ def prim_tree_walk(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, best, brow, s
         while code >= 0:
             if count:
                 cnt[WalkCount.NODES] += 1
+            if not ready:
+                ray, ready = node_ray(ox, oy, oz, dx, dy, dz, tmin), True
             sp, code = open_node((pnode, pchild), code, ray, lim, stack, sp, top_)
         if code < -1:
             lf = -2 - code
@@ -255,7 +260,9 @@ def _one_small_leaf(pchild, pleaf):
     """Whether the analytic primitives' tree is one leaf of at most :data:`SMALL_LEAF` rows (a
     scene of a few primitives, as Whitted's): its box test, three divisions a ray, then costs
     more than it saves (it culls only rays that miss the whole scene, never a shadow feeler
-    leaving a surface of the tree's), and a box test only culls, so skipping it changes no hit."""
+    leaving a surface of the tree's), and a box test only culls, so skipping it changes no hit.
+    :func:`prim_tree_walk` then opens no node, and makes no inverse direction for the box tests
+    (three divisions more)."""
     return (pchild[0, 0] <= -2 and pchild[0, 1] == -1 and pchild[0, 2] == -1 and pchild[0, 3] == -1
             and pleaf[-2 - pchild[0, 0], 1] <= SMALL_LEAF)
 
@@ -289,7 +296,7 @@ def analytic_hit(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, shadow_only, an
 
 
 @nb.njit(**INLINE)
-def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero, eps, stack,
+def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, unit, zero, eps, stack,
             st, sp_, sf, sn):
     """Nearest hit of a world ray over all primitives: the list of analytic primitives tested
     one by one, then the analytic primitives' structure, then the triangles' (see
@@ -298,10 +305,16 @@ def closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, shadow_only, any_hit, zero,
     triangle hit's unit geometric normal (:func:`geometric_normal`'s), read from the packed
     group the walk has just tested (:func:`.walks.bvh_hit`), zero for other hits (a
     caller that does not read it has it compiled away).  One function, not a wrapper without
-    the normal: each level of calls is linked and compiled again in its callers."""
+    the normal: each level of calls is linked and compiled again in its callers.
+
+    ``unit``: the caller has just normalised the direction (the Whitted rays and their shadow
+    feelers), so its length is taken as 1 rather than computed again: the square root and the
+    division of ``1 / |d|`` head the dependent chain of every test, and the ray tracer's
+    renormalisation cost its Whitted scene trace about 5 % (perf).  Else (a batch of rays of
+    any length, the path tracer) ``1 / |d|`` is computed."""
     btri, bb1, bb2 = -1, 0.0, 0.0
     gx, gy, gz = 0.0, 0.0, 0.0
-    inv_w = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
+    inv_w = 1.0 if unit else 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
     w = eps * inv_w
     best, bp, bf, brow = analytic_gate(geo, ox, oy, oz, dx, dy, dz, inv_w, tmin, tmax, np.bool_(shadow_only),
                                        np.bool_(any_hit), zero, eps, stack, st, sp_, sf, sn)
@@ -341,10 +354,10 @@ def geometric_normal(geo, k, face, tri, x, y, z, stack):
     f = face - 16 if face >= 16 else face
     sgn = -1.0 if face >= 16 else 1.0
     ux, uy, uz = analytic_normal_gate(geo, k, f, x, y, z, stack)
-    wx = sgn * (nm[k, 0] * ux + nm[k, 1] * uy + nm[k, 2] * uz)
-    wy = sgn * (nm[k, 3] * ux + nm[k, 4] * uy + nm[k, 5] * uz)
-    wz = sgn * (nm[k, 6] * ux + nm[k, 7] * uy + nm[k, 8] * uz)
-    return _normalize(wx, wy, wz)
+    if not geo.ident[k]:  # (an identity row's nm is the identity too: the same values without it)
+        ux, uy, uz = (nm[k, 0] * ux + nm[k, 1] * uy + nm[k, 2] * uz, nm[k, 3] * ux + nm[k, 4] * uy + nm[k, 5] * uz,
+                      nm[k, 6] * ux + nm[k, 7] * uy + nm[k, 8] * uz)
+    return _normalize(sgn * ux, sgn * uy, sgn * uz)
 
 
 @nb.njit(**INLINE)

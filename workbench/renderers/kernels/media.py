@@ -105,7 +105,7 @@ def visibility(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmax, eps, scr):
     t0 = eps
     for _ in range(16):
         t, kk, f, tri, b1, b2, _, _, _ = closest(geo, ox, oy, oz, dx, dy, dz, t0, tmax, np.bool_(True), np.bool_(False),
-                                        0.0, eps, stack, st, sp_, sf, sn)
+                                        np.bool_(False), 0.0, eps, stack, st, sp_, sf, sn)
         if kk < 0:
             return 1.0
         if mat_tab[mat_of[kk], Mat.MEDIUM] < 0.0:

@@ -130,15 +130,14 @@ def _feeler(px, py, pz, gx, gy, gz, lx, ly, lz, dist, off):
 
 
 @nb.njit(**INLINE)
-def camera_ray(cam, i, j, o, d):
-    """Row 0 of ``o, d``: the centre ray of the image pixel in row ``i``, column ``j`` of the
-    camera ``cam`` (``whitted.camera_frame``: position, rotation, tan(fov_y / 2), aspect,
-    width, height)."""
+def camera_ray(cam, i, j, d, q):
+    """Row ``q`` of ``d``: the unit direction of the centre ray of the image pixel in row ``i``,
+    column ``j`` of the camera ``cam`` (``whitted.camera_frame``: position, rotation,
+    tan(fov_y / 2), aspect, width, height; the ray's origin is the position ``cam[:3]``)."""
     x = ((j + 0.5) / cam[14] * 2.0 - 1.0) * cam[12] * cam[13]
     y = (1.0 - (i + 0.5) / cam[15] * 2.0) * cam[12]
     dx = x * cam[3] + y * cam[4] - cam[5]
     dy = x * cam[6] + y * cam[7] - cam[8]
     dz = x * cam[9] + y * cam[10] - cam[11]
     n = math.sqrt(dx * dx + dy * dy + dz * dz)
-    o[0, 0], o[0, 1], o[0, 2] = cam[0], cam[1], cam[2]
-    d[0, 0], d[0, 1], d[0, 2] = dx / n, dy / n, dz / n
+    d[q, 0], d[q, 1], d[q, 2] = dx / n, dy / n, dz / n

@@ -204,7 +204,7 @@ def cast_all(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, any_hit, zero, eps, scr):
     once here (not inlined: its call sites share one copy)."""
     stack, st, sp_, sf, sn = scr
     t, k, f, tri, b1, b2, _, _, _ = closest(geo, ox, oy, oz, dx, dy, dz, tmin, tmax, np.bool_(False),
-                                            np.bool_(any_hit), zero, eps, stack, st, sp_, sf, sn)
+                                            np.bool_(any_hit), np.bool_(False), zero, eps, stack, st, sp_, sf, sn)
     return t, k, f, tri, b1, b2
 
 

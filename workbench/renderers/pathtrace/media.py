@@ -39,7 +39,7 @@ def shadow_transmittance(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmin, tma
     m0, m1, m2, m3 = -1, -1, -1, -1
     for _ in range(SHADOW_CROSSINGS):
         t, k, f, tri, b1, b2, _, _, _ = closest(geo, ox, oy, oz, dx, dy, dz, t0, tmax, np.bool_(True), np.bool_(False),
-                                       zero, eps, stack, st, sp_, sf, sn)
+                                       np.bool_(False), zero, eps, stack, st, sp_, sf, sn)
         if k < 0:
             return v, mdim
         med = int(mat_tab[mat_of[k], Mat.MEDIUM])

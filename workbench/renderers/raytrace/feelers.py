@@ -28,7 +28,8 @@ def _transmittance(geo, mat_of, mat_tab, ox, oy, oz, dx, dy, dz, tmin, tmax, tra
     m0, m1, m2, m3 = -1, -1, -1, -1  # media already marched
     for _ in range(SHADOW_CROSSINGS):
         t, k, f, tri, b1, b2, _, _, _ = closest(geo, ox, oy, oz, dx, dy, dz, t0, tmax, np.bool_(True),
-                                       np.bool_(not transmissive and media == 0.0), zero, eps, stack, st, sp_, sf, sn)
+                                       np.bool_(not transmissive and media == 0.0), np.bool_(True), zero, eps, stack, st,
+                                       sp_, sf, sn)
         if k < 0:
             return v
         med = int(mat_tab[mat_of[k], Mat.MEDIUM])

@@ -88,8 +88,8 @@ def trace_task(geo, rays, hits, zero, rel_eps, extent, ncancel, shadow_only, scr
         ox, oy, oz = O[i, 0], O[i, 1], O[i, 2]
         eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
         t, k, f, tri, b1, b2, gx, gy, gz = closest(geo, ox, oy, oz, D[i, 0], D[i, 1], D[i, 2], tmin[i],
-                                                          tmax[i], np.bool_(shadow_only), np.bool_(False), zero,
-                                                          eps, stack, st, sp_, sf, sn)
+                                                   tmax[i], np.bool_(shadow_only), np.bool_(False), np.bool_(False),
+                                                   zero, eps, stack, st, sp_, sf, sn)
         t_out[i], prim_out[i] = t, k
         if k < 0:
             continue
@@ -431,7 +431,7 @@ def ray_stack(cap, lights=0):
     counts), the block's ray counts (summed here, written once: the threads' count rows share
     cache lines), the lights' visibility through opacity maps (``(1, lights)``, or no row:
     :func:`shade_hit` traces the shadow feelers itself), the radiance of a miss, and a feeler
-    hit's object-space point and uv."""
+    hit's object-space point and uv, and the directions of a block's camera rays."""
     return (np.empty((cap, 3)), np.empty((cap, 3)), np.empty((cap, 3)), np.zeros((cap, 4), np.int64),
             np.zeros(cap, np.int64), np.zeros(cap, np.int64), np.empty(cap), np.zeros(cap, np.int64),
             np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 3)), np.zeros((1, 4), np.int64),
@@ -439,7 +439,7 @@ def ray_stack(cap, lights=0):
             np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 2)), np.empty((1, 3)), np.empty((1, 3)),
             np.zeros((1, 3)), np.empty((1, 3)), np.zeros((1, RAY_COUNTS), np.int64), np.zeros(RAY_COUNTS, np.int64),
             np.ones((1 if lights else 0, max(lights, 1))), np.zeros(cap, np.int64), np.empty(3),
-            np.empty((1, 3)), np.zeros((1, 2)))
+            np.empty((1, 3)), np.zeros((1, 2)), np.empty((PIXEL_BLOCK, 3)))
 
 
 @nb.njit(**TASK)
@@ -459,7 +459,7 @@ def pixels_task(geo, shading, pixels, spp, first, ncancel, part, scr, bufs, c, n
     zero, rel_eps, extent = opts[WhittedOpt.ZERO], opts[WhittedOpt.RAY_OFFSET], opts[WhittedOpt.EXTENT]
     stack, st, sp_, sf, sn = scr
     (r_o, r_d, r_w, r_stk, r_n, r_kind, r_tmin, r_gen, c_o, c_d, c_w, c_stk, c_n, c_gen, h_t, h_p,
-     h_ng, h_ns, h_uv, h_po, h_ev, h_col, contrib, cnt, tot, h_vis, r_hop, h_bg, f_po, f_uv) = bufs
+     h_ng, h_ns, h_uv, h_po, h_ev, h_col, contrib, cnt, tot, h_vis, r_hop, h_bg, f_po, f_uv, b_d) = bufs
     row = 0  # the current ray's row
     cur = (c_o, c_d, c_w, c_gen, c_stk, c_n)
     hits = (h_t, h_p, h_ng, h_ns, h_col, h_ev, h_vis)
@@ -470,8 +470,16 @@ def pixels_task(geo, shading, pixels, spp, first, ncancel, part, scr, bufs, c, n
     counts = part[c]
     width = max(1, int(cam[14]))
     for b in range(c * nblocks // nit, (c + 1) * nblocks // nit):
-        # image row and column of the block's first pixel (then stepped: no division a pixel)
-        row_i, col_j = (first + b * PIXEL_BLOCK) // width, (first + b * PIXEL_BLOCK) % width
+        if O.shape[0] == 0:
+            # the block's camera rays made together, before its trees: their square roots and
+            # divisions overlap, where each one headed the dependent chain of its pixel's tree.
+            # Image row and column of the block's first pixel, then stepped: no division a pixel
+            row_i, col_j = (first + b * PIXEL_BLOCK) // width, (first + b * PIXEL_BLOCK) % width
+            for p in range(b * PIXEL_BLOCK, min(npix, (b + 1) * PIXEL_BLOCK)):
+                camera_ray(cam, row_i, col_j, b_d, p - b * PIXEL_BLOCK)
+                col_j += 1
+                if col_j == width:
+                    row_i, col_j = row_i + 1, 0
         for p in range(b * PIXEL_BLOCK, min(npix, (b + 1) * PIXEL_BLOCK)):
             ar, ag, ab = 0.0, 0.0, 0.0
             for s in range(spp):
@@ -480,7 +488,8 @@ def pixels_task(geo, shading, pixels, spp, first, ncancel, part, scr, bufs, c, n
                     for q in range(3):
                         r_o[0, q], r_d[0, q] = O[i, q], D[i, q]
                 else:
-                    camera_ray(cam, row_i, col_j, r_o, r_d)
+                    for q in range(3):
+                        r_o[0, q], r_d[0, q] = cam[q], b_d[p - b * PIXEL_BLOCK, q]
                 for q in range(3):
                     r_w[0, q] = 1.0
                 r_n[0], r_tmin[0], r_gen[0], r_hop[0] = int(opts[WhittedOpt.N_MEDIA]), 0.0, 0, 0  # the media around the camera
@@ -500,7 +509,8 @@ def pixels_task(geo, shading, pixels, spp, first, ncancel, part, scr, bufs, c, n
                     dx, dy, dz = c_d[0, 0], c_d[0, 1], c_d[0, 2]
                     eps = rel_eps * max(max(abs(ox), abs(oy), abs(oz)), extent)
                     t, k, f, tri, b1, b2, _, _, _ = closest(geo, ox, oy, oz, dx, dy, dz, r_tmin[top], np.inf,
-                                                   np.bool_(False), np.bool_(False), zero, eps, stack, st, sp_, sf, sn)
+                                                   np.bool_(False), np.bool_(False), np.bool_(True), zero, eps,
+                                                   stack, st, sp_, sf, sn)
                     a = 1.0
                     if k >= 0:
                         surface(geo, k, f, tri, b1, b2, ox + t * dx, oy + t * dy, oz + t * dz, ncancel,
@@ -549,9 +559,6 @@ def pixels_task(geo, shading, pixels, spp, first, ncancel, part, scr, bufs, c, n
                         r_n[top], r_tmin[top], r_gen[top] = r_n[top + 1], r_tmin[top + 1], r_gen[top + 1]
                         top += 1
             image[p, 0], image[p, 1], image[p, 2] = ar / spp, ag / spp, ab / spp
-            col_j += 1
-            if col_j == width:
-                row_i, col_j = row_i + 1, 0
     for q in range(RAY_COUNTS):
         counts[q] += tot[q]
         tot[q] = 0

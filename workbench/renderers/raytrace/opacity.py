@@ -45,7 +45,7 @@ def _pass_cutouts(geo, shading, ox, oy, oz, dx, dy, dz, t, ncancel, hit, scr):
         for _ in range(MAX_CUTOUTS - 1):
             tmin = _past(ox, oy, oz, dx, dy, dz, t, ray_off, extent)
             t, k, f, tri, b1, b2, _, _, _ = closest(geo, ox, oy, oz, dx, dy, dz, tmin, np.inf, np.bool_(False),
-                                           np.bool_(False), zero, eps, stack, st, sp_, sf, sn)
+                                           np.bool_(False), np.bool_(True), zero, eps, stack, st, sp_, sf, sn)
             if k < 0:
                 return t, k, 1.0
             surface(geo, k, f, tri, b1, b2, ox + t * dx, oy + t * dy, oz + t * dz, ncancel, ng, ns, uv, po, ev, 0,
@@ -93,7 +93,7 @@ def _opacity_feelers(geo, shading, ox, oy, oz, dx, dy, dz, t, ng, ns, vis, spare
             v = 1.0
             for _ in range(SHADOW_CROSSINGS):
                 s, k, f, tri, b1, b2, _, _, _ = closest(geo, qx, qy, qz, lx, ly, lz, tmin, tmx, np.bool_(True),
-                                               np.bool_(False), zero, off, stack, st, sp_, sf, sn)
+                                               np.bool_(False), np.bool_(True), zero, off, stack, st, sp_, sf, sn)
                 if k < 0:
                     break
                 po[0, 0], po[0, 1], po[0, 2] = object_point(geo, k, qx + s * lx, qy + s * ly, qz + s * lz)
