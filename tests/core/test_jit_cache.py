@@ -153,3 +153,17 @@ def test_a_cache_save_waits_for_another_process_holding_the_lock(tmp_path):
     assert waited, "the save did not wait for the lock"
     assert child.returncode == 0 and out.strip() == b"2.5", err[-500:]
     assert index.exists()
+
+
+def test_a_child_process_locks_its_cache_saves_too(tmp_path):
+    """A process started by another (the window's jobs, the suite's workers) inherits
+    ``NUMBA_CACHE_DIR`` already keyed by the code; its saves are locked all the same.  Before:
+    :func:`jit_cache.use_code_keyed_cache` returned early for it, and only the parent's saves
+    took the lock, while the children are the processes that save at the same moment."""
+    probe = "import workbench, numba.core.caching as c; print(getattr(c.IndexDataCacheFile.save, 'locked', False))"
+    fp = jit_cache.kernel_fingerprint()[:jit_cache.DIGITS]
+    for folder in (tmp_path, tmp_path / fp):  # a first process, then a child of it
+        env = {**os.environ, "PYTHONPATH": str(ROOT), "NUMBA_CACHE_DIR": str(folder)}
+        out = subprocess.run([sys.executable, "-c", probe], env=env, cwd=ROOT, capture_output=True, text=True,
+                             timeout=120, check=True)
+        assert out.stdout.strip() == "True", folder

@@ -164,11 +164,12 @@ def _prune(base: Path, current: Path) -> None:
 def use_code_keyed_cache() -> Path:
     """Set ``NUMBA_CACHE_DIR`` to ``BASE/<fingerprint>`` (:func:`kernel_fingerprint`; ``BASE``:
     the variable's value, or :func:`default_base`) and return it; a value that already ends in
-    this fingerprint (a child process) is kept.  Numba imported before this call re-reads its
-    configuration."""
+    this fingerprint (a child process) is kept.  Either way the process's cache saves are locked
+    (:func:`lock_cache_saves`).  Numba imported before this call re-reads its configuration."""
     fp = kernel_fingerprint()[:DIGITS]
     given = os.environ.get("NUMBA_CACHE_DIR")
-    if given and Path(given).name == fp:
+    if given and Path(given).name == fp:  # a child process: the folder is set, its saves not yet locked
+        lock_cache_saves()
         return Path(given)
     base = Path(given) if given else default_base()
     current = base / fp
