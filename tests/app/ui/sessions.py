@@ -28,6 +28,25 @@ PLOT_WAIT_SECONDS = 10.0
 """How long the check script then waits for the error plot's points."""
 
 
+class JobsDone:
+    """Whether every panel's job has ended and the window has taken its final image: the
+    board was idle at this frame's script call and at the previous frame's.  The script runs
+    after the frame's ``update_images``: a job that ends between the two has its last tiles
+    taken only at the next frame, so an idle board alone may still show the previous image
+    (``test_ui_features``' moved light once recorded the old ray-traced image so)."""
+
+    def __init__(self):
+        self.idle_since = None
+
+    def __call__(self, state: AppState) -> bool:
+        if state.jobs.busy():
+            self.idle_since = None
+            return False
+        if self.idle_since is None:
+            self.idle_since = state.frame
+        return state.frame > self.idle_since
+
+
 def _record(state: AppState, out: Path, phase: str) -> None:
     """Each panel's image as ``{phase}_{file stem}.npy`` (a user's model: ``glsl_<name>``)."""
     from workbench.renderers.base import file_stem
@@ -47,6 +66,7 @@ class Check:
 
     def __init__(self, out: Path):
         self.out, self.log, self.t_wait, self.t_plot = out, {}, None, None
+        self.jobs_done = JobsDone()
 
     def __call__(self, state: AppState) -> None:
         f, out = state.frame, self.out
@@ -66,7 +86,7 @@ class Check:
         elif f == 5:
             _record(state, out, "ks")
             self.t_wait = time.perf_counter()
-        elif f > 5 and ((not state.jobs.busy() and self._plotted(state))
+        elif f > 5 and ((self.jobs_done(state) and self._plotted(state))
                         or time.perf_counter() - self.t_wait > CPU_WAIT_SECONDS):
             _record(state, out, "final")
             self.log["cpu_done"] = not state.jobs.busy()
@@ -108,9 +128,10 @@ class Features:
 
     def __init__(self, out: Path):
         self.out, self.log, self.step, self.t_wait = out, {}, 0, time.perf_counter()
+        self.jobs_done = JobsDone()
 
     def _settled(self, state: AppState) -> bool:
-        return (not state.jobs.busy()
+        return (self.jobs_done(state)
                 or time.perf_counter() - self.t_wait > CPU_WAIT_SECONDS)
 
     def __call__(self, state: AppState) -> None:
@@ -220,6 +241,7 @@ class Radiosity:
 
     def __init__(self, out: Path):
         self.out, self.log, self.t_wait = out, {}, time.perf_counter()
+        self.jobs_done = JobsDone()
 
     def __call__(self, state: AppState) -> None:
         from workbench.app.ui.placement import focus
@@ -233,7 +255,7 @@ class Radiosity:
             pick = select_patch(state, i, j)
             self.log["pick"] = {"pixel": [i, j], "patch": pick.patch, "surface": pick.surface,
                                 "row_sum": float(pick.row.sum()), "patches": len(pick.patches)}
-        elif f >= 5 and (not state.jobs.busy()
+        elif f >= 5 and (self.jobs_done(state)
                          or time.perf_counter() - self.t_wait > CPU_WAIT_SECONDS):
             self.log["windows"] = window_report()
             self.log["cpu_done"] = not state.jobs.busy()
@@ -456,6 +478,7 @@ class ExportCheck:
 
     def __init__(self, out: Path, mode: str = "indexed16-mediancut"):
         self.out, self.mode, self.log, self.t0 = out, mode, {}, time.perf_counter()
+        self.jobs_done = JobsDone()
 
     def __call__(self, state: AppState) -> None:
         from workbench.app.ui.state import light_fields, light_value, set_light_value
@@ -474,7 +497,7 @@ class ExportCheck:
             if "raytrace" in state.methods:
                 set_option(state, "raytrace", "max_depth", 3)
             self.t0 = time.perf_counter()
-        elif state.frame > 4 and (not state.jobs.busy()
+        elif state.frame > 4 and (self.jobs_done(state)
                                   or time.perf_counter() - self.t0 > CPU_WAIT_SECONDS):
             self.log["exported"] = [p.name for p in export(state, self.out / "export")]
             self.log["status"] = state.status["export"]
