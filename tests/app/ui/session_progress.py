@@ -13,6 +13,8 @@ from workbench.app.ui.panel_refresh import running_meter
 from workbench.app.ui.plot import reference_meter
 from workbench.app.ui.state import AppState
 
+from sessions import JobsDone
+
 WAIT_SECONDS = 400.0
 """How long a session waits for the jobs and the reference before it gives up (and says so)."""
 
@@ -26,6 +28,7 @@ class Progress:
         self.out, self.t0 = out, time.perf_counter()
         self.log = {"frames": {}, "images": {}, "finished": False, "reference_bar": []}
         self.seen: dict[str, tuple] = {}
+        self.jobs_done = JobsDone()
 
     def __call__(self, state: AppState) -> None:
         for m in state.methods:
@@ -52,7 +55,7 @@ class Progress:
                                               "message": plot.message})
         ready = plot.ref_image is not None
         if ready or time.perf_counter() - self.t0 > WAIT_SECONDS:
-            if not state.jobs.busy() or time.perf_counter() - self.t0 > WAIT_SECONDS:
+            if self.jobs_done(state) or time.perf_counter() - self.t0 > WAIT_SECONDS:
                 self.finish(state, ready)
 
     def finish(self, state: AppState, ready: bool) -> None:
@@ -85,6 +88,7 @@ class Phases:
     def __init__(self, out: Path):
         self.out, self.t0 = out, time.perf_counter()
         self.log = {"frames": {}, "finished": False}
+        self.jobs_done = JobsDone()
 
     def __call__(self, state: AppState) -> None:
         now = time.perf_counter()
@@ -100,7 +104,7 @@ class Phases:
                 "fraction": meter.fraction, "bar": running is not None,
                 "bar_value": None if running is None else running.bar(now - self.t0),
                 "status": state.status.get(m, ""), "job_done": job.done})
-        if state.frame > 2 and (not state.jobs.busy() or now - self.t0 > WAIT_SECONDS):
+        if state.frame > 2 and (self.jobs_done(state) or now - self.t0 > WAIT_SECONDS):
             self.log["finished"] = not state.jobs.busy()
             self.log["jobs"] = {m: {"error": j.error, "done": j.image is not None,
                                     "status": state.status.get(m, "")}
