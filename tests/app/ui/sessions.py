@@ -705,9 +705,11 @@ class Screens:
 class SceneScreens:
     """Every bundled scene in turn (issue #29's acceptance test, ``test_ui_screens.py``): each
     scene is switched to as the Scene window's combo does (the first is the one the window
-    opened with); once nothing is in progress (its jobs, the error plot's reference and
-    points, the GL panels' programs; at most :data:`CPU_WAIT_SECONDS`) and ``frames`` frames
-    later, the window as the X server shows it is saved as ``screen_{scene}.png``
+    opened with); once the panels are done (their jobs, the GL panels' programs; at most
+    :data:`CPU_WAIT_SECONDS`) and ``frames`` frames later, the window as the X server shows it
+    is saved as ``screen_{scene}.png`` (the error plot as a user finds it then: its points, or
+    the reference still rendering with its message and meter; waiting for the references
+    too took most of the session, rock's path-traced one alone 23-110 s at 64 px)
     (``xwd``, :mod:`.screenshot`), each panel's display texture as ``shown_{scene}_{m}.npy``,
     and logged under ``scenes``: the widgets cut at a window's right edge over those frames,
     the section titles wrapped, the window report, the blit rectangles, the panels' and the
@@ -729,7 +731,7 @@ class SceneScreens:
         from workbench.app.ui.state import set_scene
         if self.asked is not None:
             return self._after_resize(state)
-        busy = in_progress(state) and time.perf_counter() - self.t0 < CPU_WAIT_SECONDS
+        busy = in_progress(state, plot=False) and time.perf_counter() - self.t0 < CPU_WAIT_SECONDS
         if state.frame < 2 or busy:
             self.rested, self.cut = None, set()
             return

@@ -287,14 +287,15 @@ def update_images(state: AppState) -> None:
             refresh_cpu(state, m)
 
 
-def in_progress(state: AppState) -> bool:
+def in_progress(state: AppState, plot: bool = True) -> bool:
     """Something on screen changes by itself this frame: a background job or the pyrender child
-    is working, the error plot waits for its reference or evaluations, or a GL panel has edited
-    values still to compile back in.  The loop then runs at full rate (capped while a job runs,
-    :func:`.main.frame_rest`); otherwise it idles."""
+    is working, the error plot waits for its reference or evaluations (unless ``plot`` is
+    False: the panels alone), or a GL panel has edited values still to compile back in.  The
+    loop then runs at full rate (capped while a job runs, :func:`.main.frame_rest`); otherwise
+    it idles."""
     proc = state.pyrender
     g = state.gpu
-    return (state.jobs.busy() or (proc is not None and proc.busy) or state.errors.busy(state.frame)
+    return (state.jobs.busy() or (proc is not None and proc.busy) or (plot and state.errors.busy(state.frame))
             or (g is not None and (any(p.session.live or not p.timed for p in g.raster.values())
                                    or g.modes.busy()
                                    or any(g.stats.get(k, (None,))[0] != v[0]
