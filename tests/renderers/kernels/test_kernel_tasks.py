@@ -1,6 +1,7 @@
-"""``kernels.tasks.run_tasks`` runs its tasks on as many threads as numba is set to use: the
-count ``numba.set_num_threads`` sets, else ``NUMBA_NUM_THREADS`` (read without starting
-numba's threading layer, which the tasks do not use)."""
+"""``kernels.tasks.run_tasks`` runs its tasks on as many threads as numba is set to use (the
+calling thread among them): the count ``numba.set_num_threads`` sets, else
+``NUMBA_NUM_THREADS`` (read without starting numba's threading layer, which the tasks do not
+use); an exception of a task is raised to the caller; each thread makes its scratch once."""
 from __future__ import annotations
 
 import os
@@ -31,8 +32,8 @@ def test_set_num_threads_is_honoured():
         assert _threads_used(6) == {threading.get_ident()}   # one thread: this one, no pool
         if numba.config.NUMBA_NUM_THREADS >= 2:
             numba.set_num_threads(2)
-            used = _threads_used(6)                           # a pool of at most two threads
-            assert threading.get_ident() not in used and 1 <= len(used) <= 2
+            used = _threads_used(6)                           # this thread and at most one helper
+            assert threading.get_ident() in used and 1 <= len(used) <= 2
     finally:
         numba.set_num_threads(saved)
 
@@ -49,4 +50,32 @@ def test_the_default_count_does_not_start_numba_threading_layer():
     p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
                        env={**os.environ, "NUMBA_NUM_THREADS": "2"})
     assert p.returncode == 0, p.stderr[-2000:]
-    assert p.stdout.strip() == "False True"   # a pool of NUMBA_NUM_THREADS, the layer not started
+    assert p.stdout.strip() == "True True"   # this thread and a helper (NUMBA_NUM_THREADS), the layer not started
+
+
+def test_a_task_exception_reaches_the_caller_and_scratch_is_made_per_thread():
+    saved = numba.get_num_threads()
+    made = []
+
+    def scratch():
+        made.append(1)
+        return (bytearray(8),)
+
+    def task(scr, c, n):
+        threading.Event().wait(0.005)
+        if c == 3:
+            raise ValueError("task 3")
+
+    try:
+        for threads in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
+            numba.set_num_threads(threads)
+            made.clear()
+            try:
+                run_tasks(task, 8, per_thread=scratch)
+            except ValueError as e:
+                assert str(e) == "task 3"
+            else:
+                raise AssertionError("the task's exception was not raised")
+            assert 1 <= len(made) <= threads
+    finally:
+        numba.set_num_threads(saved)

@@ -7,8 +7,8 @@ Intersection is :mod:`..kernels.intersect`'s, the surface optics
 Everything is scalar code over flat arrays (:mod:`.flatten`; the geometry as the named record
 :class:`..kernels.layout.Geometry`, tables with named columns, :mod:`..kernels.columns`).  The
 driver runs blocks of pixels, and the batch intersector (:func:`trace_batch`) runs of chunks of
-rays, as ``nogil`` tasks on a thread pool (:mod:`..kernels.tasks`); each task
-has its own scratch arrays (BVH stack, CSG interval stacks, ray stack) and hands its work to
+rays, as ``nogil`` tasks on ``numba.get_num_threads()`` threads (:mod:`..kernels.tasks`); each
+thread has its own scratch arrays (BVH stack, CSG interval stacks, ray stack) and hands its work to
 functions compiled without reference counting (:data:`..kernels.flags.NO_REFCOUNT`).  Helpers
 take :data:`..kernels.flags.INLINE`: each is compiled once (and cached) and LLVM inlines it
 into its callers (``docs/kernels.md``).  The kernels are compiled per set of kinds
@@ -71,14 +71,14 @@ def trace_batch(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_on
     and a waiting thread sleeps (``prange``'s OpenMP workers spin: 7 % more CPU time; measured)."""
     nit = _tasks.py_func((O.shape[0] + CHUNK - 1) // CHUNK)
     run_tasks(trace_task, nit, geo, (O, D, tmin, tmax), (t_out, prim_out, ng, ns, uv, po, ev), zero, rel_eps,
-              extent, ncancel, bool(shadow_only), per_task=lambda c: (scratch.py_func(),))
+              extent, ncancel, bool(shadow_only), per_thread=lambda: (scratch.py_func(),))
 
 
 @nb.njit(**TASK)
 def trace_task(geo, rays, hits, zero, rel_eps, extent, ncancel, shadow_only, scr, c, nit):
     """Task ``c`` of ``nit`` of :func:`trace_batch`: chunks ``c nchunks / nit`` to ``(c + 1)
     nchunks / nit - 1`` of the rays ``rays = (O, D, tmin, tmax)``, their hits to ``hits =
-    (t_out, prim_out, ng, ns, uv, po, ev)``; ``scr``: :func:`scratch`, the task's own."""
+    (t_out, prim_out, ng, ns, uv, po, ev)``; ``scr``: :func:`scratch`, the thread's own."""
     O, D, tmin, tmax = rays
     t_out, prim_out, ng, ns, uv, po, ev = hits
     stack, st, sp_, sf, sn = scr
@@ -416,10 +416,10 @@ def render_pixels(geo, shading, pixels, spp, first, ncancel, counts):
     opacity = bool(shading.maps.opacity[:, Tex.KIND].any())
     cap = stack_rows(int(shading.opts[WhittedOpt.GENERATIONS]), opacity)
     lights = shading.lights.shape[0] if opacity and shading.opts[WhittedOpt.SHADOWS] > 0.5 else 0
-    # the per-task arrays made by numpy here (``scratch.py_func``: the kernel's own Python code):
+    # each thread's arrays made by numpy here (``scratch.py_func``: the kernel's own Python code):
     # no dispatcher of theirs to load from numba's cache at start-up
     run_tasks(pixels_task, nit, geo, shading, pixels, spp, first, ncancel, part,
-              per_task=lambda c: (scratch.py_func(), ray_stack(cap, lights)))
+              per_thread=lambda: (scratch.py_func(), ray_stack(cap, lights)))
     counts += part[:, :RAY_COUNTS].sum(axis=0)
 
 
@@ -452,7 +452,7 @@ def pixels_task(geo, shading, pixels, spp, first, ncancel, part, scr, bufs, c, n
     with the ray's weight times ``alpha`` and lets the ray go on straight through with the
     rest (``reference.raytrace``); one cut out (alpha below 0.5) is passed through.  Adds the
     ray counts to ``part[c]`` (``RAY_COUNTS``,).  ``scr``: :func:`scratch`; ``bufs``:
-    :func:`ray_stack`, the task's own (made by the caller: this kernel allocates nothing, so
+    :func:`ray_stack`, the thread's own (made by the caller: this kernel allocates nothing, so
     it is compiled without reference counting)."""
     mat_of, mat_tab, maps, lights, ambient, background, opts = shading
     O, D, fwd, cam, image, depth_map = pixels
