@@ -10,6 +10,7 @@ import sys
 import threading
 
 import numba
+import numpy as np
 
 from workbench.renderers.kernels.tasks import run_tasks
 
@@ -79,3 +80,16 @@ def test_a_task_exception_reaches_the_caller_and_scratch_is_made_per_thread():
             assert 1 <= len(made) <= threads
     finally:
         numba.set_num_threads(saved)
+
+
+def test_each_threads_scratch_has_cache_lines_of_its_own():
+    from workbench.renderers.kernels.tasks import LINE, own_lines
+    a = (np.arange(6.0).reshape(2, 3), (np.zeros(0), np.ones((0, 1))), np.zeros((1, 7), np.int64), 5)
+    b = own_lines(a)
+    assert np.array_equal(b[0], a[0]) and b[0].flags.c_contiguous and b[0].flags.writeable
+    assert b[1][0].shape == (0,) and b[1][1].shape == (0, 1) and b[3] == 5
+    assert b[2].dtype == np.int64 and b[2].shape == (1, 7)
+    for x in (b[0], b[2]):
+        assert x.ctypes.data % LINE == 0 and x.ctypes.data != a[0].ctypes.data
+        end = x.ctypes.data + -(-x.nbytes // LINE) * LINE      # its last line is its own too
+        assert x.base.ctypes.data <= x.ctypes.data and x.base.ctypes.data + x.base.nbytes >= end
