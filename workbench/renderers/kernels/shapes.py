@@ -232,7 +232,13 @@ def prim_hit(kinds, k, ptype, par, poly_v, aux, ox, oy, oz, dx, dy, dz, ux, uy, 
         den = nx * dx + ny * dy + nz * dz
         if den == 0.0:
             return np.inf, 0
-        t = ((par[k, p0] - ox) * nx + (par[k, p0 + 1] - oy) * ny + (par[k, p0 + 2] - oz) * nz) / den
+        num = (par[k, p0] - ox) * nx + (par[k, p0 + 1] - oy) * ny + (par[k, p0 + 2] - oz) * nz
+        if tmin >= 0.0 and (num <= 0.0 if den > 0.0 else num >= 0.0):
+            # t = num / den <= 0 (the signs alone say so: no division): the ray leaves the
+            # plane or starts on it, as every shadow feeler and reflected ray from a floor,
+            # and every camera ray above the horizon, does.  The same misses as the quotient
+            return np.inf, 0
+        t = num / den
         if not (tmin < t < tmax):
             return np.inf, 0
         qx, qy, qz = ox + t * dx - par[k, p0], oy + t * dy - par[k, p0 + 1], oz + t * dz - par[k, p0 + 2]

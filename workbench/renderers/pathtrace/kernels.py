@@ -162,7 +162,7 @@ def render_samples(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sum
     nit = max(1, min(nblocks, MAX_TASKS))
     part = np.zeros((nit, 8), np.int64)
     run_tasks(samples_task, nit, geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq, part,
-              per_task=lambda c: (scratch.py_func(), hit_rows()))  # numpy's arrays: no dispatcher to load
+              per_thread=lambda: (scratch.py_func(), hit_rows()))  # numpy's arrays: no dispatcher to load
     counts += part[:, :PATH_COUNTS].sum(axis=0)
 
 
@@ -170,7 +170,7 @@ def render_samples(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sum
 def samples_task(geo, shading, emitters, cam, opts, seed, s0, nsamp, sums, sumsq, part, scr, rows, c, nit):
     """Task ``c`` of ``nit`` of :func:`render_samples`: pixel blocks ``c, c + nit, ...``, each
     sample's path in turn; its counts go to ``part[c]``.  ``scr``: :func:`scratch`, ``rows``:
-    :func:`hit_rows`, the task's own (made by the caller: this kernel allocates nothing)."""
+    :func:`hit_rows`, the thread's own (made by the caller: this kernel allocates nothing)."""
     width = int(cam[14])
     centre = opts[PathOpt.PIXEL_FILTER] > 0.5
     npix = sums.shape[0]

@@ -7,8 +7,8 @@ Intersection is :mod:`..kernels.intersect`'s, the surface optics
 Everything is scalar code over flat arrays (:mod:`.flatten`; the geometry as the named record
 :class:`..kernels.layout.Geometry`, tables with named columns, :mod:`..kernels.columns`).  The
 driver runs blocks of pixels, and the batch intersector (:func:`trace_batch`) runs of chunks of
-rays, as ``nogil`` tasks on a thread pool (:mod:`..kernels.tasks`); each task
-has its own scratch arrays (BVH stack, CSG interval stacks, ray stack) and hands its work to
+rays, as ``nogil`` tasks on ``numba.get_num_threads()`` threads (:mod:`..kernels.tasks`); each
+thread has its own scratch arrays (BVH stack, CSG interval stacks, ray stack) and hands its work to
 functions compiled without reference counting (:data:`..kernels.flags.NO_REFCOUNT`).  Helpers
 take :data:`..kernels.flags.INLINE`: each is compiled once (and cached) and LLVM inlines it
 into its callers (``docs/kernels.md``).  The kernels are compiled per set of kinds
@@ -71,14 +71,14 @@ def trace_batch(geo, O, D, tmin, tmax, zero, rel_eps, extent, ncancel, shadow_on
     and a waiting thread sleeps (``prange``'s OpenMP workers spin: 7 % more CPU time; measured)."""
     nit = _tasks.py_func((O.shape[0] + CHUNK - 1) // CHUNK)
     run_tasks(trace_task, nit, geo, (O, D, tmin, tmax), (t_out, prim_out, ng, ns, uv, po, ev), zero, rel_eps,
-              extent, ncancel, bool(shadow_only), per_task=lambda c: (scratch.py_func(),))
+              extent, ncancel, bool(shadow_only), per_thread=lambda: (scratch.py_func(),))
 
 
 @nb.njit(**TASK)
 def trace_task(geo, rays, hits, zero, rel_eps, extent, ncancel, shadow_only, scr, c, nit):
     """Task ``c`` of ``nit`` of :func:`trace_batch`: chunks ``c nchunks / nit`` to ``(c + 1)
     nchunks / nit - 1`` of the rays ``rays = (O, D, tmin, tmax)``, their hits to ``hits =
-    (t_out, prim_out, ng, ns, uv, po, ev)``; ``scr``: :func:`scratch`, the task's own."""
+    (t_out, prim_out, ng, ns, uv, po, ev)``; ``scr``: :func:`scratch`, the thread's own."""
     O, D, tmin, tmax = rays
     t_out, prim_out, ng, ns, uv, po, ev = hits
     stack, st, sp_, sf, sn = scr
@@ -135,9 +135,11 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
     :func:`_transmittance`); ``out = (out_o, out_d, out_w, out_stk, out_nstk,
     out_kind, out_tmin, out_gen)``; ``scr``: :func:`scratch`.  The local colour times the ray's weight goes to ``contrib[i]``, the
     children to slots ``s0`` (reflection) and ``s0 + 1`` (refraction) of the ``out_*`` arrays
-    (``out_kind`` 0 = none, 1 reflected, 2 refracted), the counts to ``counts[i]``: shadow
-    rays, ended by depth, ended by threshold, total internal reflections, reflected and
-    refracted children, escaped (missed everything).
+    (``out_kind`` 0 = none, 1 reflected, 2 refracted), the counts added to ``counts[i]``:
+    shadow rays, ended by depth, ended by threshold, total internal reflections, reflected and
+    refracted children, escaped (missed everything).  (Added, not set: the driver sums a
+    task's rays in that row, with no zeroing and summing of every ray's counts: 14 loads and
+    stores a ray.)
 
     ``opts``: columns :class:`..kernels.columns.WhittedOpt` (a miss adds ``background`` if
     ``WhittedOpt.BACKGROUND``, else nothing here: an environment map is evaluated by the
@@ -159,11 +161,9 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
     nl = lights.shape[0]
     solid = geo.solid
     out_kind[s0], out_kind[s0 + 1] = 0, 0
-    for q in range(RAY_COUNTS):
-        counts[i, q] = 0
     k = prim[i]
     if k < 0:
-        counts[i, RayCount.ESCAPED_RAYS] = 1
+        counts[i, RayCount.ESCAPED_RAYS] += 1
         for q in range(3):
             contrib[i, q] = w[i, q] * background[q] if add_bg else 0.0
         return
@@ -249,7 +249,7 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
         lg += lights[li, Light.POWER + 1] * f * (kd * cg * ndl + spec)
         lb += lights[li, Light.POWER + 2] * f * (kd * cb * ndl + spec)
     contrib[i, 0], contrib[i, 1], contrib[i, 2] = w0 * lr + mr, w1 * lg + mg, w2 * lb + mb
-    counts[i, RayCount.SHADOW_RAYS] = nshadow
+    counts[i, RayCount.SHADOW_RAYS] += nshadow
     # ---- reflection / transmission weights (Whitted 1980; Fresnel optional)
     kr, kt = mat_tab[mi, Mat.KR], mat_tab[mi, Mat.KT]
     if not do_refl:
@@ -290,7 +290,7 @@ def shade_hit(geo, mat_of, mat_tab, lights, ambient, background, opts, rays, i, 
         kk = 1.0 - eta * eta * (1.0 - cosi * cosi)
         if kk <= 0.0:  # total internal reflection (or exactly critical): all to reflection
             wr, wt = kr + kt, 0.0
-            counts[i, RayCount.TOTAL_INTERNAL_REFLECTIONS] = 1
+            counts[i, RayCount.TOTAL_INTERNAL_REFLECTIONS] += 1
         else:
             cost = math.sqrt(kk)
             tx, ty, tz = _normalize(eta * dx + (eta * cosi - cost) * fx,
@@ -416,10 +416,10 @@ def render_pixels(geo, shading, pixels, spp, first, ncancel, counts):
     opacity = bool(shading.maps.opacity[:, Tex.KIND].any())
     cap = stack_rows(int(shading.opts[WhittedOpt.GENERATIONS]), opacity)
     lights = shading.lights.shape[0] if opacity and shading.opts[WhittedOpt.SHADOWS] > 0.5 else 0
-    # the per-task arrays made by numpy here (``scratch.py_func``: the kernel's own Python code):
+    # each thread's arrays made by numpy here (``scratch.py_func``: the kernel's own Python code):
     # no dispatcher of theirs to load from numba's cache at start-up
     run_tasks(pixels_task, nit, geo, shading, pixels, spp, first, ncancel, part,
-              per_task=lambda c: (scratch.py_func(), ray_stack(cap, lights)))
+              per_thread=lambda: (scratch.py_func(), ray_stack(cap, lights)))
     counts += part[:, :RAY_COUNTS].sum(axis=0)
 
 
@@ -428,8 +428,8 @@ def ray_stack(cap, lights=0):
     media stack and its size, kind, tmin, generation, continuations on the path), then the
     current ray and its hit (one row each: origin, direction, weight, media stack and size,
     generation, t, primitive, normals, uv, object-space point, emission, colour, contribution,
-    counts), the block's ray counts (summed here, written once: the threads' count rows share
-    cache lines), the lights' visibility through opacity maps (``(1, lights)``, or no row:
+    the task's ray counts (summed here, written to ``part`` once: the threads' count rows share
+    cache lines)), the lights' visibility through opacity maps (``(1, lights)``, or no row:
     :func:`shade_hit` traces the shadow feelers itself), the radiance of a miss, and a feeler
     hit's object-space point and uv, and the directions of a block's camera rays."""
     return (np.empty((cap, 3)), np.empty((cap, 3)), np.empty((cap, 3)), np.zeros((cap, 4), np.int64),
@@ -437,7 +437,7 @@ def ray_stack(cap, lights=0):
             np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 3)), np.zeros((1, 4), np.int64),
             np.zeros(1, np.int64), np.zeros(1, np.int64), np.empty(1), np.empty(1, np.int64),
             np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 2)), np.empty((1, 3)), np.empty((1, 3)),
-            np.zeros((1, 3)), np.empty((1, 3)), np.zeros((1, RAY_COUNTS), np.int64), np.zeros(RAY_COUNTS, np.int64),
+            np.zeros((1, 3)), np.empty((1, 3)), np.zeros((1, RAY_COUNTS), np.int64),
             np.ones((1 if lights else 0, max(lights, 1))), np.zeros(cap, np.int64), np.empty(3),
             np.empty((1, 3)), np.zeros((1, 2)), np.empty((PIXEL_BLOCK, 3)))
 
@@ -452,14 +452,14 @@ def pixels_task(geo, shading, pixels, spp, first, ncancel, part, scr, bufs, c, n
     with the ray's weight times ``alpha`` and lets the ray go on straight through with the
     rest (``reference.raytrace``); one cut out (alpha below 0.5) is passed through.  Adds the
     ray counts to ``part[c]`` (``RAY_COUNTS``,).  ``scr``: :func:`scratch`; ``bufs``:
-    :func:`ray_stack`, the task's own (made by the caller: this kernel allocates nothing, so
+    :func:`ray_stack`, the thread's own (made by the caller: this kernel allocates nothing, so
     it is compiled without reference counting)."""
     mat_of, mat_tab, maps, lights, ambient, background, opts = shading
     O, D, fwd, cam, image, depth_map = pixels
     zero, rel_eps, extent = opts[WhittedOpt.ZERO], opts[WhittedOpt.RAY_OFFSET], opts[WhittedOpt.EXTENT]
     stack, st, sp_, sf, sn = scr
     (r_o, r_d, r_w, r_stk, r_n, r_kind, r_tmin, r_gen, c_o, c_d, c_w, c_stk, c_n, c_gen, h_t, h_p,
-     h_ng, h_ns, h_uv, h_po, h_ev, h_col, contrib, cnt, tot, h_vis, r_hop, h_bg, f_po, f_uv, b_d) = bufs
+     h_ng, h_ns, h_uv, h_po, h_ev, h_col, contrib, cnt, h_vis, r_hop, h_bg, f_po, f_uv, b_d) = bufs
     row = 0  # the current ray's row
     cur = (c_o, c_d, c_w, c_gen, c_stk, c_n)
     hits = (h_t, h_p, h_ng, h_ns, h_col, h_ev, h_vis)
@@ -542,8 +542,6 @@ def pixels_task(geo, shading, pixels, spp, first, ncancel, part, scr, bufs, c, n
                     ar += contrib[0, 0]
                     ag += contrib[0, 1]
                     ab += contrib[0, 2]
-                    for q in range(RAY_COUNTS):
-                        tot[q] += cnt[0, q]
                     # keep the children that exist on the stack
                     r_hop[base], r_hop[base + 1] = hop, hop
                     top = base
@@ -560,5 +558,5 @@ def pixels_task(geo, shading, pixels, spp, first, ncancel, part, scr, bufs, c, n
                         top += 1
             image[p, 0], image[p, 1], image[p, 2] = ar / spp, ag / spp, ab / spp
     for q in range(RAY_COUNTS):
-        counts[q] += tot[q]
-        tot[q] = 0
+        counts[q] += cnt[0, q]
+        cnt[0, q] = 0
