@@ -93,6 +93,8 @@ def _structures(tri):
 
 def test_counting_traversal_finds_the_kernels_hits_and_brute_force_counts_are_exact():
     from workbench.renderers.kernels import walks
+    from workbench.renderers.kernels.flags import python_twin
+    bvh_hit = python_twin(walks.bvh_hit)
     from workbench.renderers.raytrace.traversal_stats import count_hit
     rng = np.random.default_rng(7)
     c = rng.uniform(-3, 3, size=(500, 1, 3))
@@ -107,7 +109,7 @@ def test_counting_traversal_finds_the_kernels_hits_and_brute_force_counts_are_ex
         arrays = (tree.node, tree.child, tree.leaf, tree.first, tree.tv4)
         ts = []
         for o, d in zip(O, D):
-            t, tr, _, _, _, _ = walks.bvh_hit(arrays, *o, *d, 0.0, np.inf, np.bool_(False), stack)
+            t, tr, _, _, _, _ = bvh_hit(arrays, *o, *d, 0.0, np.inf, np.bool_(False), stack)
             cnt = np.zeros(2, np.int64)
             t2, tr2 = count_hit(arrays, *o, *d, 0.0, np.inf, stack, cnt)
             assert (t2, tr2) == (t, tr)
@@ -181,6 +183,8 @@ def test_octree_of_coincident_triangles_stays_within_its_reference_budget():
     # 600 copies of one triangle: every cut would copy them all into one octant, level after
     # level; the depth and the reference budget end it, and rays still find the triangle
     from workbench.renderers.kernels import walks
+    from workbench.renderers.kernels.flags import python_twin
+    bvh_hit = python_twin(walks.bvh_hit)
     from workbench.renderers.raytrace.octree import REF_FACTOR, build_octree
     tri = np.tile([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], (600, 1))
     tri[:300, 2] = tri[:300, 5] = tri[:300, 8] = 0.5  # and 300 copies of a parallel one, 0.5 behind
@@ -189,7 +193,7 @@ def test_octree_of_coincident_triangles_stays_within_its_reference_budget():
     stack = np.empty((walks.BVH_STACK, 2))
     for a, order, tree in _structures(tri):
         arrays = (tree.node, tree.child, tree.leaf, tree.first, tree.tv4)
-        t, k, _, _, _, _ = walks.bvh_hit(arrays, 0.2, 0.2, -1.0, 0.0, 0.0, 1.0, 0.0, np.inf, np.bool_(False), stack)
+        t, k, _, _, _, _ = bvh_hit(arrays, 0.2, 0.2, -1.0, 0.0, 0.0, 1.0, 0.0, np.inf, np.bool_(False), stack)
         assert abs(t - 1.0) <= 1e-12 and k >= 0 and tri[order[k], 2] == 0.0, a
-        t, k, _, _, _, _ = walks.bvh_hit(arrays, 0.2, 0.2, 2.0, 0.0, 0.0, -1.0, 0.0, np.inf, np.bool_(False), stack)
+        t, k, _, _, _, _ = bvh_hit(arrays, 0.2, 0.2, 2.0, 0.0, 0.0, -1.0, 0.0, np.inf, np.bool_(False), stack)
         assert abs(t - 1.5) <= 1e-12 and tri[order[k], 2] == 0.5, a

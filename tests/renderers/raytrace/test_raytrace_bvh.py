@@ -10,6 +10,8 @@ def test_a_degenerate_tree_stops_at_max_depth_and_is_traversed_exactly():
     # triangles at x = 100 * 2^-k: every SAH split peels one off; the tree stops at MAX_DEPTH
     # with a large leaf, so that no traversal stack ever overflows, and every hit is found
     from workbench.renderers.kernels import walks
+    from workbench.renderers.kernels.flags import python_twin
+    bvh_hit = python_twin(walks.bvh_hit)
     from workbench.renderers.raytrace import shapes
     from workbench.renderers.raytrace.bvh import MAX_DEPTH, build_bvh, build_bvh4
     n = 1200
@@ -33,7 +35,7 @@ def test_a_degenerate_tree_stops_at_max_depth_and_is_traversed_exactly():
         o = np.array([-1.0, 2e-4, 2e-4])
         d = np.array([1.0, 0.0, 0.0])
         tb = shapes.triangles(tvo.reshape(-1, 3, 3), o, d)[0]
-        t = walks.bvh_hit(arrays, *o, *d, x[k] + 1.0 - 1e-12, np.inf, np.bool_(False), stack)[0]
+        t = bvh_hit(arrays, *o, *d, x[k] + 1.0 - 1e-12, np.inf, np.bool_(False), stack)[0]
         expected = np.where(tb > x[k] + 1.0 - 1e-12, tb, np.inf).min()
         assert t == pytest.approx(expected, rel=1e-12)
 
@@ -91,6 +93,8 @@ def test_4wide_tree_holds_each_triangle_once_inside_its_boxes(n):
 
 def test_4wide_traversal_equals_brute_force_closest_and_any_hit():
     from workbench.renderers.kernels import walks
+    from workbench.renderers.kernels.flags import python_twin
+    bvh_hit = python_twin(walks.bvh_hit)
     from workbench.renderers.raytrace import shapes
     from workbench.renderers.raytrace.bvh import build_bvh4
     tv = _soup(2, 400)
@@ -106,7 +110,7 @@ def test_4wide_traversal_equals_brute_force_closest_and_any_hit():
     for o, d in zip(O, D):
         tb, _, _ = shapes.triangles(tvo.reshape(-1, 3, 3), o, d)
         tb = np.where(tb > 1e-9, tb, np.inf)
-        t, tri, b1, b2, _, _ = walks.bvh_hit(arrays, *o, *d, 1e-9, np.inf, np.bool_(False), stack)
+        t, tri, b1, b2, _, _ = bvh_hit(arrays, *o, *d, 1e-9, np.inf, np.bool_(False), stack)
         if np.isfinite(tb.min()):
             hits += 1
             assert t == pytest.approx(tb.min(), rel=1e-9)
@@ -117,7 +121,7 @@ def test_4wide_traversal_equals_brute_force_closest_and_any_hit():
         else:
             assert tri == -1 and np.isinf(t)
         # any hit: some triangle within [tmin, tmax] iff brute force has one
-        ta, tria, _, _, _, _ = walks.bvh_hit(arrays, *o, *d, 1e-9, 0.5, np.bool_(True), stack)
+        ta, tria, _, _, _, _ = bvh_hit(arrays, *o, *d, 1e-9, 0.5, np.bool_(True), stack)
         assert (tria >= 0) == bool((tb < 0.5).any())
         if tria >= 0:
             assert ta < 0.5 and tb[tria] == pytest.approx(ta, rel=1e-9)

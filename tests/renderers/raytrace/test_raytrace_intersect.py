@@ -8,6 +8,7 @@ from hypothesis import given, settings, strategies as st
 
 import workbench
 from workbench.renderers.kernels import shapes as kernel_shapes
+from workbench.renderers.kernels.flags import python_twin
 from workbench.renderers.raytrace import shapes
 from workbench.scene.io import scene_from_dict
 from workbench.scene.kinds import csg, quadric, sphere
@@ -31,7 +32,7 @@ def cast(sc, O, D):
 def test_sphere_away_from_origin_t4_and_t6():
     """DESIGN errata 1: origin 0, direction +z, centre (0, 0, 5), r = 1 -> t = 4 and 6."""
     assert [t for t, _ in sphere.roots((0, 0, 5), 1.0, np.zeros(3), np.array([0, 0, 1.0]))] == pytest.approx([4, 6])
-    ok, t0, t1 = kernel_shapes.sphere_roots(np.array([[0, 0, 5, 1.0]]), 0, 0, 0, 0, 0, 0, 1.0)
+    ok, t0, t1 = python_twin(kernel_shapes.sphere_roots)(np.array([[0, 0, 5, 1.0]]), 0, 0, 0, 0, 0, 0, 1.0)
     assert ok and (t0, t1) == pytest.approx((4, 6))
     sc = scene([{"type": "sphere", "center": [0, 0, 5], "radius": 1.0}])
     t, n, obj = cast(sc, [[0, 0, 0], [0, 0, 5]], [[0, 0, 1], [0, 0, 1]])

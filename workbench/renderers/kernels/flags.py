@@ -22,12 +22,19 @@ links a callee's whole module, with everything it calls, into each caller's modu
 optimises it and generates its machine code again; inlined, these kernels would be copied into
 each call site, and the copies compiled again at each level above (the path tracer's
 ``trace_path`` would be one function holding every kind's code)."""
+INTERNAL = dict(no_cpython_wrapper=True, no_cfunc_wrapper=True)
+"""Options of the kernels called from compiled code only (:data:`INLINE`, :data:`GATE`): numba
+builds no CPython wrapper (the code that unboxes each argument from a Python object: for the
+geometry record, its 29 arrays) nor C-callable wrapper for them, and LLVM does not optimise and
+generate code for either: about a quarter of a cold compile (``docs/kernels.md``).  Such a
+kernel called from Python would jump to an entry point that does not exist (a crash, not an
+exception): tests and benches call one through :func:`python_twin`."""
 TASK = dict(NO_REFCOUNT, nogil=True)
 """Options of the drivers that :func:`.tasks.run_tasks` runs on Python threads: :data:`NO_REFCOUNT`
 and the GIL released.  Such a driver is handed its scratch arrays by its caller, and walks its
 pixel blocks itself: one compiled level fewer between the thread and the per-ray kernels (each
 level links and compiles again the whole module below it)."""
-INLINE = dict(NO_REFCOUNT, forceinline=True)
+INLINE = dict(NO_REFCOUNT, forceinline=True, **INTERNAL)
 """Options of the small helpers: compiled once per signature (and cached) as functions of their
 own, marked ``alwaysinline`` for LLVM, which inlines them into every caller when it links the
 caller's module.  Numba's own ``inline="always"`` copies a helper's IR into each caller and types
@@ -37,7 +44,7 @@ that reach them, the polygon and quadric tests): a call passes the geometry's ar
 which costs the common scenes more than the machine code their inlining adds.  A kernel such a
 helper calls must state ``forceinline=False`` (:data:`NO_REFCOUNT`, :data:`GATE`), or numba
 compiles it inlined too (see the module docstring)."""
-GATE = dict(error_model="numpy", _nrt=False, fastmath=FAST_MATH, forceinline=False)
+GATE = dict(error_model="numpy", _nrt=False, fastmath=FAST_MATH, forceinline=False, **INTERNAL)
 """Options of the kind gates (``@overload`` implementations in :mod:`.specialise` and
 ``csg_gate`` in :mod:`.intersect`): ordinary calls, not inlined, so that a scene's rarely used
 kinds stay out of its hot loops and their code is not copied into every caller.
@@ -45,3 +52,13 @@ kinds stay out of its hot loops and their code is not copied into every caller.
 calling them is typed: left unset, they and the kinds' kernels they call would take that
 helper's setting.  (The gates of the two tree walks take :data:`INLINE`: every ray of a scene
 that has the tree goes through them.)"""
+
+
+def python_twin(kernel):
+    """A copy of the :data:`INTERNAL` kernel ``kernel`` (a numba dispatcher) callable from Python:
+    the same function and options, with numba's wrappers, compiled in the process and not
+    cached (numba's cache index does not tell options apart: it would load the wrapper-less
+    copy).  For tests and benches that call a helper kernel directly."""
+    import numba as nb
+    options = {k: v for k, v in kernel.targetoptions.items() if k not in INTERNAL}
+    return nb.njit(**dict(options, cache=False))(kernel.py_func)
