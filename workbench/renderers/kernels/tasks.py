@@ -30,10 +30,9 @@ def run_tasks(kernel, ntasks: int, *args, per_thread=None) -> None:
     Each thread takes the next task number as it finishes one (a ticket counter: tasks in order,
     the expensive parts of an image shared out as they come).  The threads make their own
     scratch: made for every task by the calling thread before the threads started (a pool's
-    ``submit`` of each task's arguments), the 64 tasks' arrays of a Whitted render kept the GIL
-    from the second thread for one switch interval (5 ms) at the start of every 2-thread trace
-    (measured: its first task began 4 to 6 ms after the first thread's).  The arrays of each
-    thread's scratch are copied into cache lines of their own (:func:`own_lines`)."""
+    ``submit`` of each task's arguments), the tasks' arrays kept the GIL from the second thread
+    for up to a switch interval at the start of every trace (``docs/kernels.md``).  The arrays
+    of each thread's scratch are copied into cache lines of their own (:func:`own_lines`)."""
     threads = max(1, min(ntasks, _numba_threads()))
     if threads == 1:
         own = own_lines(per_thread()) if per_thread is not None else ()
@@ -87,8 +86,7 @@ def own_lines(x):
     lines of its own (:data:`LINE`-aligned, its last line padded): the small scratch arrays two
     threads make (one-row hit records, written every ray) share no cache line.  When they
     did (numpy's allocator placed them side by side), every write of one thread evicted the
-    other's line: 2-thread Whitted traces took up to twice the CPU time, in those renders
-    only (measured: 0 lines shared, 69 ms CPU; 2 to 6 lines, 84 to 160 ms)."""
+    other's line (false sharing: ``docs/kernels.md``)."""
     if isinstance(x, tuple):
         return tuple(own_lines(a) for a in x)
     if not isinstance(x, np.ndarray):
