@@ -91,10 +91,8 @@ def _structures(tri):
         yield a, order, tree
 
 
-def test_counting_traversal_finds_the_kernels_hits_and_brute_force_counts_are_exact():
+def test_counting_traversal_finds_the_kernels_hits_and_brute_force_counts_are_exact(bvh_hit):
     from workbench.renderers.kernels import walks
-    from workbench.renderers.kernels.flags import python_twin
-    bvh_hit = python_twin(walks.bvh_hit)
     from workbench.renderers.raytrace.traversal_stats import count_hit
     rng = np.random.default_rng(7)
     c = rng.uniform(-3, 3, size=(500, 1, 3))
@@ -179,12 +177,10 @@ def test_a_bad_accel_value_is_one_line_and_exit_2(tmp_path):
     assert "Traceback" not in r.stderr and not (tmp_path / "x.png").exists()
 
 
-def test_octree_of_coincident_triangles_stays_within_its_reference_budget():
+def test_octree_of_coincident_triangles_stays_within_its_reference_budget(bvh_hit):
     # 600 copies of one triangle: every cut would copy them all into one octant, level after
     # level; the depth and the reference budget end it, and rays still find the triangle
     from workbench.renderers.kernels import walks
-    from workbench.renderers.kernels.flags import python_twin
-    bvh_hit = python_twin(walks.bvh_hit)
     from workbench.renderers.raytrace.octree import REF_FACTOR, build_octree
     tri = np.tile([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], (600, 1))
     tri[:300, 2] = tri[:300, 5] = tri[:300, 8] = 0.5  # and 300 copies of a parallel one, 0.5 behind

@@ -6,12 +6,10 @@ import numpy as np
 import pytest
 
 
-def test_a_degenerate_tree_stops_at_max_depth_and_is_traversed_exactly():
+def test_a_degenerate_tree_stops_at_max_depth_and_is_traversed_exactly(bvh_hit):
     # triangles at x = 100 * 2^-k: every SAH split peels one off; the tree stops at MAX_DEPTH
     # with a large leaf, so that no traversal stack ever overflows, and every hit is found
     from workbench.renderers.kernels import walks
-    from workbench.renderers.kernels.flags import python_twin
-    bvh_hit = python_twin(walks.bvh_hit)
     from workbench.renderers.raytrace import shapes
     from workbench.renderers.raytrace.bvh import MAX_DEPTH, build_bvh, build_bvh4
     n = 1200
@@ -91,10 +89,8 @@ def test_4wide_tree_holds_each_triangle_once_inside_its_boxes(n):
     assert np.array_equal(bvh.bounds, np.r_[tv.reshape(-1, 3).min(0), tv.reshape(-1, 3).max(0)])
 
 
-def test_4wide_traversal_equals_brute_force_closest_and_any_hit():
+def test_4wide_traversal_equals_brute_force_closest_and_any_hit(bvh_hit):
     from workbench.renderers.kernels import walks
-    from workbench.renderers.kernels.flags import python_twin
-    bvh_hit = python_twin(walks.bvh_hit)
     from workbench.renderers.raytrace import shapes
     from workbench.renderers.raytrace.bvh import build_bvh4
     tv = _soup(2, 400)

@@ -1,0 +1,13 @@
+"""Fixtures of the ray tracer's tests."""
+from __future__ import annotations
+
+import pytest
+
+
+@pytest.fixture(scope="session")
+def bvh_hit():
+    """``kernels.walks.bvh_hit`` callable from Python (``flags.python_twin``), compiled once per
+    test process."""
+    from workbench.renderers.kernels import walks
+    from workbench.renderers.kernels.flags import python_twin
+    return python_twin(walks.bvh_hit)
