@@ -60,5 +60,5 @@ def python_twin(kernel):
     cached (numba's cache index does not tell options apart: it would load the wrapper-less
     copy).  For tests and benches that call a helper kernel directly."""
     import numba as nb
-    options = {k: v for k, v in kernel.targetoptions.items() if k not in INTERNAL}
+    options = {k: v for k, v in kernel.targetoptions.items() if k not in INTERNAL and k != "nopython"}
     return nb.njit(**dict(options, cache=False))(kernel.py_func)
