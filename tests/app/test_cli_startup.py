@@ -42,3 +42,23 @@ def test_a_raytrace_render_imports_only_what_it_uses(tmp_path):
     assert {"numba", "numpy", "workbench.renderers.raytrace.kernels"} <= loaded  # the listing is read right
     heavy = sorted(m for m in loaded if any(m == u or m.startswith(u + ".") for u in UNUSED))
     assert not heavy, heavy
+
+
+REGISTRIES = ("numba.np.arraymath", "numba.np.npyimpl", "numba.np.linalg", "numba.typed.dictimpl",
+              "numba.cpython.unicode")
+"""Numba modules that only its target-context refresh imports: a render whose kernels all come
+from the disk cache loads none of them (:func:`workbench.core.numba_start.load_cache_hits_without_registries`)."""
+
+
+def test_a_warm_render_loads_kernels_without_numbas_registries(tmp_path):
+    runs = []
+    for i in range(2):  # the first run fills the cache if this test process has not yet
+        out, listing = tmp_path / f"t{i}.png", tmp_path / f"modules{i}.txt"
+        p = subprocess.run([sys.executable, "-c", CHILD, str(listing), WORKBENCH, "render", "whitted", "-m", "raytrace",
+                            "--size", "32x24", "--set", "progress=false", "-o", str(out)],
+                           capture_output=True, text=True, cwd=tmp_path, timeout=600)
+        assert p.returncode == 0 and out.is_file(), p.stderr[-2000:]
+        runs.append(set(listing.read_text().split()))
+    assert "workbench.renderers.raytrace.kernels" in runs[1]
+    assert not sorted(m for m in REGISTRIES if m in runs[1])
+    assert (tmp_path / "t0.png").read_bytes() == (tmp_path / "t1.png").read_bytes()

@@ -29,7 +29,7 @@ import os
 import warnings
 import sys
 
-from ..core.numba_start import skip_blas_probe
+from ..core.numba_start import load_cache_hits_without_registries, skip_blas_probe
 
 COMMANDS = ["cmd_scenes", "cmd_info", "cmd_methods", "cmd_render", "cmd_colour", "cmd_compare", "cmd_study", "cmd_stress", "cmd_snapshot", "cmd_ui"]
 
@@ -94,7 +94,9 @@ def main(argv: list[str] | None = None) -> int:
     if argv is not None:
         return _run(argv)
     gc.disable()  # until the command has started: see the module's docstring
-    skip_blas_probe()  # the program only: a library user's process keeps numba's own start-up
+    # the program only: a library user's process keeps numba's own start-up
+    skip_blas_probe()
+    load_cache_hits_without_registries()
     code = _run(None)
     for stream in (sys.stdout, sys.stderr):
         try:

@@ -197,11 +197,23 @@ def lock_cache_saves() -> None:
     import finder, so that importing workbench does not import numba)."""
     if fcntl is None:
         return
+    when_caching_loads(_wrap_save)
+
+
+def when_caching_loads(patch) -> None:
+    """Call ``patch(module)`` with numba's caching module (:data:`CACHING`) now if it is
+    loaded, else as soon as it is (a one-shot import finder, so that importing workbench does
+    not import numba).  A patch given twice runs once."""
     module = sys.modules.get(CACHING)
     if module is not None:
-        _wrap_save(module)
-    elif not any(isinstance(f, _AfterCaching) for f in sys.meta_path):
-        sys.meta_path.insert(0, _AfterCaching())
+        patch(module)
+        return
+    finder = next((f for f in sys.meta_path if isinstance(f, _AfterCaching)), None)
+    if finder is None:
+        finder = _AfterCaching()
+        sys.meta_path.insert(0, finder)
+    if patch not in finder.patches:
+        finder.patches.append(patch)
 
 
 def _wrap_save(caching) -> None:
@@ -220,8 +232,11 @@ def _wrap_save(caching) -> None:
 
 
 class _AfterCaching(importlib.abc.MetaPathFinder, importlib.abc.Loader):
-    """Finds :data:`CACHING` through the other finders, runs it, then wraps its save and
-    removes itself."""
+    """Finds :data:`CACHING` through the other finders, removes itself, runs the module, then
+    calls its patches (:func:`when_caching_loads`) with it."""
+
+    def __init__(self):
+        self.patches = []
 
     def find_spec(self, name, path=None, target=None):
         if name != CACHING:
@@ -238,4 +253,5 @@ class _AfterCaching(importlib.abc.MetaPathFinder, importlib.abc.Loader):
 
     def exec_module(self, module):
         self.inner.exec_module(module)
-        _wrap_save(module)
+        for patch in self.patches:
+            patch(module)

@@ -1,6 +1,7 @@
-"""Numba's start-up without its BLAS probe: scipy.linalg is not imported by a render.
+"""Numba's start-up for the ``workbench`` program: no BLAS probe, and no typing or lowering
+registries loaded for kernels that come from the disk cache.
 
-The first compile or disk-cache load of any numba function loads numba's CPU target
+**The BLAS probe.**  The first compile or disk-cache load of any numba function loads numba's CPU target
 registries (``CPUContext.load_additional_registries``), among them ``numba.np.arraymath``,
 whose import probes for a BLAS by importing ``scipy.linalg.cython_blas`` (its flag
 ``_HAVE_BLAS``).  Importing ``scipy.linalg`` imports scipy's array-API layer, which copies
@@ -14,8 +15,21 @@ in jitted code (``np.dot``, ``np.linalg``) imports scipy itself when such a func
 one-shot import finder: while ``numba.np.arraymath`` runs its module code, in that thread
 only, ``scipy.linalg`` (not yet imported) cannot be imported, the probe answers "no BLAS", and
 the finder removes itself.  A process that imported ``scipy.linalg`` before is left as numba
-makes it (the probe is cheap then).  Only the ``workbench`` program installs it
-(:func:`workbench.app.cli.main`): a process that imports the library keeps numba's own start-up.
+makes it (the probe is cheap then).  
+
+**Cache hits without the registries.**  Before it loads a kernel from the disk cache, numba
+refreshes its CPU target context (``Cache.load_overload`` calls ``refresh``): it imports and
+installs every typing and lowering registry (252 of them: ``numba.np.*``, ``numba.typed.*``,
+``numba.cpython.*``...), which typing and lowering need and a cached kernel does not: the cache
+holds its machine code, linked with everything it calls, and its signature.  What loading does
+need is numba's runtime (NRT: the allocator's symbols the machine code links to), which the
+refresh initialises first.  :func:`load_cache_hits_without_registries` makes a cache hit
+initialise the runtime only; a cache miss compiles, and numba's compiler refreshes both
+contexts itself before it types anything (``CompilerBase.__init__``), so a process that
+compiles after it loaded has every registry as before.
+
+Only the ``workbench`` program installs these (:func:`workbench.app.cli.main`): a process that
+imports the library keeps numba's own start-up.
 """
 from __future__ import annotations
 
@@ -23,6 +37,8 @@ import importlib.abc
 import importlib.machinery
 import sys
 import threading
+
+from .jit_cache import when_caching_loads
 
 PROBER = "numba.np.arraymath"
 """The numba module whose import probes for a BLAS."""
@@ -82,3 +98,32 @@ def skip_blas_probe() -> None:
         return
     if not any(isinstance(f, _SkipBlasProbe) for f in sys.meta_path):
         sys.meta_path.insert(0, _SkipBlasProbe())
+
+
+
+def load_cache_hits_without_registries() -> None:
+    """Make numba's disk-cache loads initialise its runtime (NRT) instead of refreshing the
+    whole target context (see the module's docstring), now if numba's caching module is loaded,
+    else as soon as it is (:func:`.jit_cache.when_caching_loads`: installing it does not import
+    numba)."""
+    when_caching_loads(_hits_without_registries)
+
+
+def _hits_without_registries(caching) -> None:
+    """Replace ``caching.Cache.load_overload``; left as numba makes it if the class lacks the
+    methods this relies on (numba's ``Cache`` of 0.60 to 0.68 has them)."""
+    cache = caching.Cache
+    if getattr(cache.load_overload, "without_registries", False) or not all(
+            hasattr(cache, m) for m in ("_guard_against_spurious_io_errors", "_load_overload")):
+        return
+
+    def load_overload(self, sig, target_context):
+        from numba.core.runtime import rtsys
+        rtsys.initialize(target_context)
+        with self._guard_against_spurious_io_errors():
+            return self._load_overload(sig, target_context)
+        # (None when the guard swallowed an I/O error, as numba's own method returns)
+
+    load_overload.without_registries = True
+    load_overload.__doc__ = cache.load_overload.__doc__
+    cache.load_overload = load_overload
