@@ -1,8 +1,8 @@
 """No Python code calls a kernel compiled without numba's wrappers.
 
-A kernel compiled with ``flags.INTERNAL`` (no CPython wrapper: the helpers and gates that only
+A kernel compiled with ``workbench.core.jit_options.INTERNAL`` (no CPython wrapper: the helpers and gates that only
 compiled code calls) crashes the process when Python calls it, where a user would expect at
-worst an exception.  Tests and benches call such a helper through ``flags.python_twin``.  This
+worst an exception.  Tests and benches call such a helper through ``workbench.core.jit_options.python_twin``.  This
 test reads the package, the tests and the benchmarks with ``ast`` and lists every call, outside
 a jitted function, whose callee resolves through the file's imports (or its own module) to such
 a kernel: ``name(...)`` of ``from module import name``, ``alias.name(...)`` of ``import module as
@@ -16,6 +16,7 @@ import pkgutil
 from pathlib import Path
 
 import workbench
+from workbench.core.jit_options import wrapperless
 
 ROOT = Path(__file__).resolve().parents[2]
 JIT_DECORATORS = ("njit", "jit", "overload", "intrinsic", "register_jitable", "lower_builtin")
@@ -23,8 +24,7 @@ JIT_DECORATORS = ("njit", "jit", "overload", "intrinsic", "register_jitable", "l
 
 
 def _is_internal(obj) -> bool:
-    from numba.core.dispatcher import Dispatcher
-    return isinstance(obj, Dispatcher) and bool(obj.targetoptions.get("no_cpython_wrapper"))
+    return wrapperless(obj)
 
 
 def _module(name: str):

@@ -172,7 +172,9 @@ def test_the_fur_texel_is_one_field_in_numpy_and_numba(base, size, tmp_path):
     """The strand density (0 or 1) of the numba texel equals the readable one at 20000 random
     points of the shell and around it, for both bases."""
     from workbench.renderers.raytrace.flatten import flatten
-    from workbench.scene.kinds import fur as F, fur_kernels as K
+    from kernel_twins import Twins
+    from workbench.scene.kinds import fur as F, fur_kernels
+    K = Twins(fur_kernels)
     p = tmp_path / "fur.toml"
     p.write_text(FUR.format(base=base, size=size))
     scene = load_scene(p)

@@ -274,7 +274,7 @@ def check_back_face(seed: int, tmp_path) -> None:
     # the wall point on the pixel centre's ray (the plane z = -0.3)
     o = np.asarray(cam.position, dtype=np.float64)
     ses = PathTraceSession(sc, 8, 6)
-    from workbench.renderers.kernels.flags import python_twin
+    from workbench.core.jit_options import python_twin
     from workbench.renderers.pathtrace.kernels import camera_ray_at
     d = np.array(python_twin(camera_ray_at)(ses.cam, i, j, 0.5, 0.5))
     q = o + (-0.3 - o[2]) / d[2] * d

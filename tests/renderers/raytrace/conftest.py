@@ -6,8 +6,8 @@ import pytest
 
 @pytest.fixture(scope="session")
 def bvh_hit():
-    """``kernels.walks.bvh_hit`` callable from Python (``flags.python_twin``), compiled once per
+    """``kernels.walks.bvh_hit`` callable from Python (``workbench.core.jit_options.python_twin``), compiled once per
     test process."""
     from workbench.renderers.kernels import walks
-    from workbench.renderers.kernels.flags import python_twin
+    from workbench.core.jit_options import python_twin
     return python_twin(walks.bvh_hit)

@@ -8,7 +8,7 @@ from hypothesis import given, settings, strategies as st
 
 import workbench
 from workbench.renderers.kernels import shapes as kernel_shapes
-from workbench.renderers.kernels.flags import python_twin
+from workbench.core.jit_options import python_twin
 from workbench.renderers.raytrace import shapes
 from workbench.scene.io import scene_from_dict
 from workbench.scene.kinds import csg, quadric, sphere

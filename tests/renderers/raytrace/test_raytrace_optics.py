@@ -25,7 +25,7 @@ def test_highlight_power_without_pow(n):
     """The kernels' Phong power ``optics._pow`` (by squaring for an integer exponent up to 1024,
     0 where ``n (1 - b)`` says the power is negligible) is ``b ** n`` within a few ulps, and where
     it answers 0 the power is below 1.1e-20."""
-    from workbench.renderers.kernels.flags import python_twin
+    from workbench.core.jit_options import python_twin
     from workbench.renderers.kernels.optics import _pow as kernel_pow
     _pow = python_twin(kernel_pow)
     b = np.concatenate([np.linspace(0.0, 1.0, 1001), [1.0 - 1e-12, 0.5 ** 0.5, 1e-300]])

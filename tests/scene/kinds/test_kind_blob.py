@@ -8,9 +8,13 @@ import numpy as np
 import pytest
 
 from kind_checks import SCALES, assert_alternates, mesh_volume, scratch, table, welded_edge_uses
+from kernel_twins import Twins
 from workbench.core.errors import WorkbenchError
 from workbench.scene.kinds import blob as B
-from workbench.scene.kinds import blob_kernels as BK
+from workbench.scene.kinds import blob_kernels
+
+BK = Twins(blob_kernels)
+"""The kind's kernels callable from Python (``kernel_twins.Twins``)."""
 
 REL = 1e-9
 

@@ -103,7 +103,9 @@ def test_numba_field_and_optics_match_numpy():
     """density and optics of the numba twin against the numpy field at 400 random points per
     object inside the bounding cube: |difference| <= 1e-9 (both float64, the same formulas;
     pow and the ramp's division round differently)."""
-    from workbench.scene.kinds import hypertexture_kernels as hk
+    from kernel_twins import Twins
+    from workbench.scene.kinds import hypertexture_kernels
+    hk = Twins(hypertexture_kernels)
     rng = np.random.default_rng(31)
     worst = 0.0
     for h in _objects():
@@ -128,7 +130,9 @@ def test_numba_field_and_optics_match_numpy():
 def test_numba_value_noise_matches_numpy():
     """The lattice value noise at random points from 1e-3 to 1e8 in size, negative too: the
     numba twin gives numpy's value exactly or within 1e-12."""
-    from workbench.scene.kinds import hypertexture_kernels as hk
+    from kernel_twins import Twins
+    from workbench.scene.kinds import hypertexture_kernels
+    hk = Twins(hypertexture_kernels)
     rng = np.random.default_rng(7)
     p = rng.uniform(-1.0, 1.0, (3000, 3)) * 10.0 ** rng.uniform(-3, 8, (3000, 1))
     want = np_value_noise(p)
@@ -141,7 +145,9 @@ def test_numba_value_noise_matches_numpy():
 def test_density_is_zero_outside_the_bounding_sphere(base):
     """D = 0 (numpy and numba) at random points from just outside bound_radius (1 + 1e-9) to 3
     times it, on every object of :func:`_objects` with this base."""
-    from workbench.scene.kinds import hypertexture_kernels as hk
+    from kernel_twins import Twins
+    from workbench.scene.kinds import hypertexture_kernels
+    hk = Twins(hypertexture_kernels)
     rng = np.random.default_rng(hash(base) % 2**32)
     for h in [o for o in _objects() if o.base == base]:
         par, aux = _par(h)

@@ -9,11 +9,16 @@ import numpy as np
 import pytest
 
 from kind_checks import SCALES, assert_alternates, mesh_volume, table, welded_edge_uses
+from kernel_twins import Twins
 from workbench.core.errors import WorkbenchError
 from workbench.scene.kinds import isosurface as I
-from workbench.scene.kinds import isosurface_kernels as IK
+from workbench.scene.kinds import isosurface_kernels
 from workbench.scene.kinds.expression import MAX_STACK, compile_expression, evaluate_numpy, gradient_numpy
-from workbench.scene.kinds.expression_kernels import evaluate, evaluate_gradient
+from workbench.scene.kinds import expression_kernels
+
+IK = Twins(isosurface_kernels)
+EK = Twins(expression_kernels)
+"""The kernels callable from Python (``kernel_twins.Twins``)."""
 
 REL = 1e-9
 GYROID = "sin(x)*cos(y) + sin(y)*cos(z) + sin(z)*cos(x)"
@@ -52,7 +57,7 @@ def test_expression_errors_name_the_position(text, pos):
 def test_expression_precedence(text, x, want):
     p = compile_expression(text)
     assert evaluate_numpy(p, x, 0.0, 0.0) == pytest.approx(want, rel=1e-15)
-    assert evaluate(p.code, 0, p.length, x, 0.0, 0.0, np.zeros((MAX_STACK, 4))) == pytest.approx(want, rel=1e-15)
+    assert EK.evaluate(p.code, 0, p.length, x, 0.0, 0.0, np.zeros((MAX_STACK, 4))) == pytest.approx(want, rel=1e-15)
 
 
 @pytest.mark.parametrize("text", ["(" * 70 + "x" + "+1)" * 70, "x+(" * 70 + "x" + ")" * 70, "-" * 4000 + "x",
@@ -71,8 +76,8 @@ def test_evaluators_and_gradients_agree(text):
     a = evaluate_numpy(p, *P.T)
     v, g = gradient_numpy(p, *P.T)
     st, st4 = np.zeros((MAX_STACK, 4)), np.zeros((MAX_STACK, 4))
-    b = np.array([evaluate(p.code, 0, p.length, *q, st) for q in P])
-    c = np.array([evaluate_gradient(p.code, 0, p.length, *q, st4) for q in P])
+    b = np.array([EK.evaluate(p.code, 0, p.length, *q, st) for q in P])
+    c = np.array([EK.evaluate_gradient(p.code, 0, p.length, *q, st4) for q in P])
     assert np.allclose(a, b, rtol=1e-13, atol=1e-13) and np.array_equal(a, v)
     assert np.allclose(c[:, 0], a, rtol=1e-13, atol=1e-13) and np.allclose(c[:, 1:], g, rtol=1e-12, atol=1e-12)
     h = 1e-6   # central differences: error O(h^2) + O(eps / h)

@@ -9,9 +9,13 @@ import numpy as np
 import pytest
 
 from kind_checks import SCALES, assert_alternates, mesh_volume, scratch, table, welded_edge_uses
+from kernel_twins import Twins
 from workbench.core.errors import WorkbenchError
 from workbench.scene.kinds import lathe as L
-from workbench.scene.kinds import lathe_kernels as LK
+from workbench.scene.kinds import lathe_kernels
+
+LK = Twins(lathe_kernels)
+"""The kind's kernels callable from Python (``kernel_twins.Twins``)."""
 
 REL = 1e-9
 CUP = [[0, 0], [1, 0], [1.5, 2], [1.2, 2], [0.8, 0.3], [0, 0.3]]

@@ -13,10 +13,14 @@ import numpy as np
 import pytest
 
 from kind_checks import SCALES, assert_alternates, mesh_volume, scratch, table, welded_edge_uses
+from kernel_twins import Twins
 from workbench.core.errors import WorkbenchError
 from workbench.scene.kinds import lathe as L
-from workbench.scene.kinds import lathe_kernels as LK
+from workbench.scene.kinds import lathe_kernels
 from workbench.scene.kinds import lathe_spline as S
+
+LK = Twins(lathe_kernels)
+"""The kind's kernels callable from Python (``kernel_twins.Twins``)."""
 
 REL = 1e-9
 CUP = [[0.0, 2.2], [0.0, 0.0], [0.8, 0.05], [1.0, 1.0], [1.3, 2.0], [1.1, 2.1], [0.7, 1.2], [0.0, 1.0], [0.0, -1.0]]

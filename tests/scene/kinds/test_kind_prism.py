@@ -9,9 +9,13 @@ import numpy as np
 import pytest
 
 from kind_checks import SCALES, assert_alternates, mesh_volume, scratch, table, welded_edge_uses
+from kernel_twins import Twins
 from workbench.core.errors import WorkbenchError
 from workbench.scene.kinds import prism as R
-from workbench.scene.kinds import prism_kernels as RK
+from workbench.scene.kinds import prism_kernels
+
+RK = Twins(prism_kernels)
+"""The kind's kernels callable from Python (``kernel_twins.Twins``)."""
 
 REL = 1e-9
 STAR = [[math.cos(a) * (1.0 if i % 2 == 0 else 0.4), math.sin(a) * (1.0 if i % 2 == 0 else 0.4)]

@@ -9,6 +9,7 @@ import numba as nb
 import numpy as np
 
 from kind_checks import NPAR, scratch
+from kernel_twins import Twins
 from workbench.scene.kinds import (blob, blob_kernels, isosurface, isosurface_kernels, lathe, lathe_kernels, prism,
                                    prism_kernels)
 
@@ -80,7 +81,7 @@ def test_nearest_hit_over_a_mixed_table():
 def test_events_of_each_row_match_the_readable_crossings():
     ptype, par, aux = _table()
     rng = np.random.default_rng(10)
-    events = [blob_kernels.events, isosurface_kernels.events, lathe_kernels.events, prism_kernels.events]
+    events = [Twins(m).events for m in (blob_kernels, isosurface_kernels, lathe_kernels, prism_kernels)]
     mods = [blob, isosurface, lathe, prism]
     for k, obj in enumerate(OBJECTS):
         for _ in range(20):

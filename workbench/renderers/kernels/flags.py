@@ -6,6 +6,8 @@ from an :data:`INLINE` helper would be marked ``alwaysinline`` too, and so would
 calls in turn.  So every option set here states ``forceinline``."""
 from __future__ import annotations
 
+from ...core.jit_options import INTERNAL
+
 FAST_MATH = {"nsz", "arcp"}
 """The fast-math flags of the hot kernels: signed zeros may be ignored, a division may become a
 multiplication by a reciprocal.  Not ``nnan``/``ninf``: misses are ``inf`` and the tests look
@@ -22,13 +24,6 @@ links a callee's whole module, with everything it calls, into each caller's modu
 optimises it and generates its machine code again; inlined, these kernels would be copied into
 each call site, and the copies compiled again at each level above (the path tracer's
 ``trace_path`` would be one function holding every kind's code)."""
-INTERNAL = dict(no_cpython_wrapper=True, no_cfunc_wrapper=True)
-"""Options of the kernels called from compiled code only (:data:`INLINE`, :data:`GATE`): numba
-builds no CPython wrapper (the code that unboxes each argument from a Python object: for the
-geometry record, its 29 arrays) nor C-callable wrapper for them, and LLVM does not optimise and
-generate code for either: about a quarter of a cold compile (``docs/kernels.md``).  Such a
-kernel called from Python would jump to an entry point that does not exist (a crash, not an
-exception): tests and benches call one through :func:`python_twin`."""
 TASK = dict(NO_REFCOUNT, nogil=True)
 """Options of the drivers that :func:`.tasks.run_tasks` runs on Python threads: :data:`NO_REFCOUNT`
 and the GIL released.  Such a driver is handed its scratch arrays by its caller, and walks its
@@ -53,12 +48,3 @@ calling them is typed: left unset, they and the kinds' kernels they call would t
 helper's setting.  (The gates of the two tree walks take :data:`INLINE`: every ray of a scene
 that has the tree goes through them.)"""
 
-
-def python_twin(kernel):
-    """A copy of the :data:`INTERNAL` kernel ``kernel`` (a numba dispatcher) callable from Python:
-    the same function and options, with numba's wrappers, compiled in the process and not
-    cached (numba's cache index does not tell options apart: it would load the wrapper-less
-    copy).  For tests and benches that call a helper kernel directly."""
-    import numba as nb
-    options = {k: v for k, v in kernel.targetoptions.items() if k not in INTERNAL and k != "nopython"}
-    return nb.njit(**dict(options, cache=False))(kernel.py_func)

@@ -8,23 +8,27 @@ import math
 import numba as nb
 import numpy as np
 
+from ...core.jit_options import INTERNAL
 from .blob import Par
 from .illinois import change
 
+JIT = dict(cache=True, error_model="numpy", **INTERNAL)
+"""Every kernel here is called from compiled code only (``INTERNAL``: no numba wrappers)."""
 
-@nb.njit(cache=True, error_model="numpy", forceinline=True)
+
+@nb.njit(**JIT, forceinline=True)
 def _poly(p0, p1, p2, p3, p4, v):
     return (((p4 * v + p3) * v + p2) * v + p1) * v + p0
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _poly_at(p, v):
     """The quartic of coefficients ``p = (p0, ..., p4)`` at ``v`` (:func:`.illinois.change`'s
     function)."""
     return _poly(p[0], p[1], p[2], p[3], p[4], v)
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _first_change(p0, p1, p2, p3, p4, lo, hi, c1, c2, c3):
     """First point in ``(lo, hi]`` past which ``poly > 0`` differs from its value at ``lo``,
     given the polynomial is monotone between the sorted breakpoints ``c1 <= c2 <= c3``
@@ -44,7 +48,7 @@ def _first_change(p0, p1, p2, p3, p4, lo, hi, c1, c2, c3):
     return np.inf
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _quadratic_roots(A, B, C):
     """Sorted real roots of ``A v^2 + B v + C`` (inf when absent); a double root counts as none."""
     if A == 0.0:
@@ -59,7 +63,7 @@ def _quadratic_roots(A, B, C):
     return min(r0, r1), max(r0, r1)
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _quartic_change(p0, p1, p2, p3, p4, lo, hi):
     """First sign change of ``p0 + p1 v + ... + p4 v^4`` in ``(lo, hi]``: the critical points
     (roots of the cubic ``p'``, each bracketed between the roots of ``p''``) cut it into
@@ -82,7 +86,7 @@ def _quartic_change(p0, p1, p2, p3, p4, lo, hi):
     return _first_change(p0, p1, p2, p3, p4, lo, hi, r1, r2, r3)
 
 
-@nb.njit(cache=True, error_model="numpy", forceinline=True)
+@nb.njit(**JIT, forceinline=True)
 def _chord_nb(aux, j, ox, oy, oz, ux, uy, uz):
     fx, fy, fz = ox - aux[j], oy - aux[j + 1], oz - aux[j + 2]
     r = aux[j + 3]
@@ -98,7 +102,7 @@ def _chord_nb(aux, j, ox, oy, oz, ux, uy, uz):
     return True, min(t0, q), max(t0, q)
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _interval_quartic(aux, off, n, T, ox, oy, oz, ux, uy, uz, tm):
     """Coefficients (in ``v = t - tm``) of the field minus T on the interval containing ``tm``."""
     p0, p1, p2, p3, p4 = -T, 0.0, 0.0, 0.0, 0.0
@@ -120,7 +124,7 @@ def _interval_quartic(aux, off, n, T, ox, oy, oz, ux, uy, uz, tm):
     return p0, p1, p2, p3, p4
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _next_end(aux, off, n, ox, oy, oz, ux, uy, uz, after):
     """Smallest chord endpoint > ``after`` (inf when none)."""
     best = np.inf
@@ -134,7 +138,7 @@ def _next_end(aux, off, n, ox, oy, oz, ux, uy, uz, after):
     return best
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def blob_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out, cap):
     """Crossings of the surface by ``O + t D`` with ``tmin < t < tmax``, sorted, written to
     ``out`` (at most ``cap``; ``cap = 1`` gives the first hit).  Returns their count.  The
@@ -172,7 +176,7 @@ def blob_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out, cap):
     return m
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
     """Nearest hit ``tmin < t < tmax``: ``(t, 0)``, ``(inf, 0)`` on a miss."""
     if blob_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, np.int64(1)) == 1:  # int64, not a literal: one compile (see kernels.walks.LANE)
@@ -180,7 +184,7 @@ def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
     return np.inf, 0
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
     """Interval list along the whole line (entering / leaving alternate); returns the count."""
     m = blob_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, -np.inf, np.inf, out_t, cap)
@@ -189,7 +193,7 @@ def events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
     return m
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def normal(par, k, aux, face, x, y, z, stack):
     """Outward normal -grad F at the object-space point (not normalised)."""
     off, n = int(par[k, Par.OFFSET]), int(par[k, Par.COUNT])
@@ -207,7 +211,7 @@ def normal(par, k, aux, face, x, y, z, stack):
     return nx, ny, nz
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def inside(par, k, aux, x, y, z, stack):
     """F(x, y, z) > T."""
     off, n = int(par[k, Par.OFFSET]), int(par[k, Par.COUNT])

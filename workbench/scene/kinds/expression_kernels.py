@@ -8,11 +8,15 @@ import math
 import numba as nb
 import numpy as np
 
+from ...core.jit_options import INTERNAL
 from .expression import (ADD, CONST, DIV, FIRST_UNARY, MAX, MIN, MUL, NEG, POW, SUB, VAR_X, VAR_Y,
                          VAR_Z)
 
+JIT = dict(cache=True, error_model="numpy", **INTERNAL)
+"""Every kernel here is called from compiled code only (``INTERNAL``: no numba wrappers)."""
 
-@nb.njit(cache=True, error_model="numpy")
+
+@nb.njit(**JIT)
 def evaluate(code, start, n, x, y, z, stack):
     """The numba stack machine: value of the program ``code[start : start + 2 n]`` (pairs) at
     ``(x, y, z)``; ``stack`` is (depth, 4) scratch (the one :func:`evaluate_gradient` takes;
@@ -91,7 +95,7 @@ def evaluate(code, start, n, x, y, z, stack):
     return stack[0, 0]
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def evaluate_gradient(code, start, n, x, y, z, stack):
     """Value and exact gradient at ``(x, y, z)`` by forward-mode automatic differentiation (the
     numba twin of :func:`gradient_numpy`); ``stack`` is (depth, 4) scratch: value, d/dx, d/dy,

@@ -9,11 +9,12 @@ import math
 import numba as nb
 import numpy as np
 
+from ...core.jit_options import INTERNAL
 from .fur import Par
 from .hypertexture_kernels import _hash3
 from . import medium_sphere
 
-JIT = dict(cache=True, error_model="numpy")
+JIT = dict(cache=True, error_model="numpy", **INTERNAL)
 
 
 @nb.njit(**JIT)

@@ -10,10 +10,11 @@ import math
 import numba as nb
 import numpy as np
 
+from ...core.jit_options import INTERNAL
 from .hypertexture import AUX_ALBEDO, AUX_EMISSION, AUX_STOPS, Par
 from . import medium_sphere
 
-JIT = dict(cache=True, error_model="numpy")
+JIT = dict(cache=True, error_model="numpy", **INTERNAL)
 _M32 = np.uint64(0xFFFFFFFF)
 
 

@@ -8,10 +8,14 @@ from __future__ import annotations
 
 import numba as nb
 
+from ...core.jit_options import INTERNAL
 from .crossing_events import BISECTIONS
 
+JIT = dict(cache=True, error_model="numpy", **INTERNAL)
+"""Every kernel here is called from compiled code only (``INTERNAL``: no numba wrappers)."""
 
-@nb.njit(cache=True, error_model="numpy")
+
+@nb.njit(**JIT)
 def change(f, fargs, a, fa, b, fb):
     """The end past the change of ``f(fargs, t) > 0`` in ``[a, b]`` (``fa``, ``fb``: the values
     at the ends, on the two sides of the change), narrowed to adjacent floats."""

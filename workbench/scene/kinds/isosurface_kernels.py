@@ -8,18 +8,22 @@ import math
 import numba as nb
 import numpy as np
 
+from ...core.jit_options import INTERNAL
 from .illinois import change
 from .isosurface import MIN_STEP, Par
 from .expression_kernels import evaluate, evaluate_gradient
 
+JIT = dict(cache=True, error_model="numpy", **INTERNAL)
+"""Every kernel here is called from compiled code only (``INTERNAL``: no numba wrappers)."""
 
-@nb.njit(cache=True, error_model="numpy")
+
+@nb.njit(**JIT)
 def _g(par, k, aux, ox, oy, oz, dx, dy, dz, t, stack):
     return evaluate(aux, int(par[k, Par.OFFSET]), int(par[k, Par.LENGTH]), ox + t * dx, oy + t * dy, oz + t * dz,
                     stack) - par[k, Par.THRESHOLD]
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _minus_g(ray, t):
     """``-g`` at ``t`` (exactly: ``T - F`` is ``-(F - T)`` in floating point), so that the
     inside ``g < 0`` is :func:`.illinois.change`'s ``> 0``; ``ray = (par, k, aux, o, d, stack)``."""
@@ -27,7 +31,7 @@ def _minus_g(ray, t):
     return -_g(par, k, aux, ox, oy, oz, dx, dy, dz, t, stack)
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, cap, stack):
     """Crossings ``tmin < t < tmax`` of the solid's boundary (see :func:`crossings`), written to
     ``out_t``, ``out_f`` (face), at most ``cap``; returns their count.  ``stack``: (depth, 4)
@@ -78,7 +82,7 @@ def iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f,
     return m
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
     """Nearest hit ``tmin < t < tmax``: ``(t, face)``, ``(inf, 0)`` on a miss."""
     if iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, np.int64(1), stack) == 1:  # int64: see kernels.walks.LANE
@@ -86,13 +90,13 @@ def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
     return np.inf, 0
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
     """Interval list along the whole line (entering / leaving alternate); returns the count."""
     return iso_crossings(par, k, aux, ox, oy, oz, dx, dy, dz, -np.inf, np.inf, out_t, out_f, cap, stack)
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def normal(par, k, aux, face, x, y, z, stack):
     """Outward normal at the object-space point (not normalised); ``stack``: (depth, 4)
     scratch of the gradient evaluator."""
@@ -106,7 +110,7 @@ def normal(par, k, aux, face, x, y, z, stack):
     return gx, gy, gz
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def inside(par, k, aux, x, y, z, stack):
     """f(x, y, z) < threshold inside the bounds."""
     lo, hi = Par.BOUNDS_MIN, Par.BOUNDS_MAX

@@ -8,12 +8,16 @@ import math
 import numba as nb
 import numpy as np
 
+from ...core.jit_options import INTERNAL
 from .illinois import change
 from .lathe import TOL_CUT, TOL_ZERO, Par
 from .lathe_spline import NEWTON, SEED_MARGIN, SEG_FLOATS, SIGMA, STEEP
 
+JIT = dict(cache=True, error_model="numpy", **INTERNAL)
+"""Every kernel here is called from compiled code only (``INTERNAL``: no numba wrappers)."""
 
-@nb.njit(cache=True, error_model="numpy")
+
+@nb.njit(**JIT)
 def sort_hits(out_t, out_f, m):
     """Insertion sort of the first ``m`` hits by t (few hits: no allocation)."""
     for i in range(1, m):
@@ -25,7 +29,7 @@ def sort_hits(out_t, out_f, m):
         out_t[j + 1], out_f[j + 1] = t, f
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _segment_roots(aux, j, ox, oy, oz, dx, dy, dz, zero):
     """Up to two hits ``(n, t0, t1)`` of the surface of the segment at aux[j:j+4]."""
     r0, y0, r1, y1 = aux[j], aux[j + 1], aux[j + 2], aux[j + 3]
@@ -68,7 +72,7 @@ def _segment_roots(aux, j, ox, oy, oz, dx, dy, dz, zero):
     return m, t0, t1
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
     """Nearest hit ``tmin < t < tmax``: ``(t, segment)``, ``(inf, 0)`` on a miss."""
     if par[k, Par.SPLINE] != 0.0:
@@ -86,7 +90,7 @@ def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
     return best, bf
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def inside(par, k, aux, x, y, z, stack):
     """Even-odd test of ``(rho, y)`` against the closed profile."""
     if par[k, Par.CLOSED] == 0.0:
@@ -105,7 +109,7 @@ def inside(par, k, aux, x, y, z, stack):
     return res
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
     """Interval list of a closed lathe along the whole line (entering / leaving alternate),
     written to ``out_t``, ``out_f`` (segment); returns the count (hits past ``cap`` are
@@ -137,7 +141,7 @@ def events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
     return w
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def normal(par, k, aux, face, x, y, z, stack):
     """Normal of segment ``face`` at the object-space point (unit)."""
     if par[k, Par.SPLINE] != 0.0:
@@ -166,17 +170,17 @@ DEG3, DEG6 = np.int64(3), np.int64(6)  # the degrees solved: a profile's cubic, 
 # (int64, not literals: numba compiles a callee once per literal argument, kernels.walks.LANE)
 
 
-@nb.njit(cache=True, error_model="numpy", forceinline=True)
+@nb.njit(**JIT, forceinline=True)
 def _get(st, i):
     return st[i >> 2, i & 3]
 
 
-@nb.njit(cache=True, error_model="numpy", forceinline=True)
+@nb.njit(**JIT, forceinline=True)
 def _put(st, i, v):
     st[i >> 2, i & 3] = v
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _peval(st, base, deg, s):
     v = 0.0
     for i in range(deg, -1, -1):
@@ -184,14 +188,14 @@ def _peval(st, base, deg, s):
     return v
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _peval_at(poly, s):
     """:func:`_peval` of ``poly = (st, base, deg)`` (:func:`.illinois.change`'s function)."""
     st, base, deg = poly
     return _peval(st, base, deg, s)
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _roots_in(st, deg, lo, hi):
     """Sign changes of the polynomial in slots ``0..deg`` in ``(lo, hi]``, isolated by the roots
     of its derivatives (:func:`.lathe_spline.roots_in`); written to slots ``_CRIT..``, returns
@@ -221,17 +225,17 @@ def _roots_in(st, deg, lo, hi):
     return nc
 
 
-@nb.njit(cache=True, error_model="numpy", forceinline=True)
+@nb.njit(**JIT, forceinline=True)
 def _cubic(aux, j, s):
     return ((aux[j + 3] * s + aux[j + 2]) * s + aux[j + 1]) * s + aux[j]
 
 
-@nb.njit(cache=True, error_model="numpy", forceinline=True)
+@nb.njit(**JIT, forceinline=True)
 def _dcubic(aux, j, s):
     return (3.0 * aux[j + 3] * s + 2.0 * aux[j + 2]) * s + aux[j + 1]
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _polish(aux, j, ox, oy, oz, dx, dy, dz, s, t):
     """Newton steps of :func:`.lathe_spline.polish`."""
     for _ in range(NEWTON):
@@ -252,7 +256,7 @@ def _polish(aux, j, ox, oy, oz, dx, dy, dz, s, t):
     return s, t
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _in_bounds(aux, j, ox, oy, oz, dx, dy, dz, tmin, tmax):
     """Whether the line within ``(tmin, tmax)`` meets the segment's cylinder ``rho <= rmax``,
     ``ymin <= y <= ymax`` (aux ``j + 8 .. j + 10``)."""
@@ -276,7 +280,7 @@ def _in_bounds(aux, j, ox, oy, oz, dx, dy, dz, tmin, tmax):
     return max(lo, (-m - sq) / a) <= min(hi, (-m + sq) / a)
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _spline_segment_hits(aux, j, ox, oy, oz, dx, dy, dz, st):
     """Every crossing of the line with the surface of the segment at aux[j:]: ``(t, s)`` in
     slots ``_HITS_T..``, ``_HITS_S..``; returns the count (:func:`.lathe_spline.segment_hits`)."""
@@ -326,7 +330,7 @@ def _spline_segment_hits(aux, j, ox, oy, oz, dx, dy, dz, st):
     return n
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _spline_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, st):
     off, nseg = int(par[k, Par.OFFSET]), int(par[k, Par.SEGMENTS])
     best, bf = tmax, -1
@@ -344,7 +348,7 @@ def _spline_first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, st):
     return best, bf
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _spline_collect(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, st):
     off, nseg = int(par[k, Par.OFFSET]), int(par[k, Par.SEGMENTS])
     m = 0
@@ -360,7 +364,7 @@ def _spline_collect(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, st):
     return m
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _spline_inside(par, k, aux, x, y, z, st):
     """Even-odd count of :func:`.lathe_spline.inside`."""
     off, nseg = int(par[k, Par.OFFSET]), int(par[k, Par.SEGMENTS])
@@ -380,7 +384,7 @@ def _spline_inside(par, k, aux, x, y, z, st):
     return res
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _spline_param(aux, j, x, y, z, st):
     """:func:`.lathe_spline.param_at`."""
     rho = math.hypot(x, z)
@@ -400,7 +404,7 @@ def _spline_param(aux, j, x, y, z, st):
     return best
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _spline_normal(par, k, aux, face, x, y, z, st):
     j = int(par[k, Par.OFFSET]) + SEG_FLOATS * face
     o = par[k, Par.ORIENTATION]

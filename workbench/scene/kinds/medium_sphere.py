@@ -9,8 +9,9 @@ import math
 import numba as nb
 import numpy as np
 
+from ...core.jit_options import INTERNAL
 from .aux_rows import MEDIUM_BOUND as BOUND
-JIT = dict(cache=True, error_model="numpy")
+JIT = dict(cache=True, error_model="numpy", **INTERNAL)
 
 
 @nb.njit(**JIT)

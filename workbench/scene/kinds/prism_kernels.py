@@ -8,11 +8,15 @@ import math
 import numba as nb
 import numpy as np
 
+from ...core.jit_options import INTERNAL
 from .prism import TOL_CUT, Par
 from .lathe_kernels import sort_hits
 
+JIT = dict(cache=True, error_model="numpy", **INTERNAL)
+"""Every kernel here is called from compiled code only (``INTERNAL``: no numba wrappers)."""
 
-@nb.njit(cache=True, error_model="numpy")
+
+@nb.njit(**JIT)
 def _in_polygon_nb(aux, off, n, x, z):
     res = False
     for i in range(n):
@@ -23,13 +27,13 @@ def _in_polygon_nb(aux, off, n, x, z):
     return res
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def inside(par, k, aux, x, y, z, stack):
     return (par[k, Par.Y0] < y < par[k, Par.Y1]
             and _in_polygon_nb(aux, int(par[k, Par.OFFSET]), int(par[k, Par.VERTICES]), x, z))
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def _wall(aux, off, n, i, y0, y1, ox, oy, oz, dx, dy, dz):
     """t of the hit of wall ``i`` (inf when missed)."""
     j, jn = off + 2 * i, off + 2 * ((i + 1) % n)
@@ -46,7 +50,7 @@ def _wall(aux, off, n, i, y0, y1, ox, oy, oz, dx, dy, dz):
     return np.inf
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def prism_hits(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, tmin, tmax):
     """Every wall and cap hit ``tmin < t < tmax`` (unsorted), at most ``cap``; returns the count."""
     off, n, y0, y1 = int(par[k, Par.OFFSET]), int(par[k, Par.VERTICES]), par[k, Par.Y0], par[k, Par.Y1]
@@ -65,7 +69,7 @@ def prism_hits(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, tmin, tma
     return m
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
     """Nearest hit ``tmin < t < tmax``: ``(t, face)``, ``(inf, 0)`` on a miss."""
     off, n, y0, y1 = int(par[k, Par.OFFSET]), int(par[k, Par.VERTICES]), par[k, Par.Y0], par[k, Par.Y1]
@@ -84,7 +88,7 @@ def first(par, k, aux, ox, oy, oz, dx, dy, dz, tmin, tmax, out_t, out_f, stack):
     return best, bf
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
     """Interval list along the whole line (entering / leaving alternate); returns the count."""
     m = prism_hits(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, -np.inf, np.inf)
@@ -104,7 +108,7 @@ def events(par, k, aux, ox, oy, oz, dx, dy, dz, out_t, out_f, cap, stack):
     return w
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(**JIT)
 def normal(par, k, aux, face, x, y, z, stack):
     """Unit outward normal of ``face``."""
     if face < 2:
