@@ -30,8 +30,9 @@ def python_twin(kernel):
     twin = types.FunctionType(f.__code__, f.__globals__, f.__name__, f.__defaults__, f.__closure__)
     twin.__qualname__ = f.__qualname__ + TWIN_SUFFIX
     twin.__module__, twin.__doc__ = f.__module__, f.__doc__
+    # (numba keeps ``cache`` out of ``targetoptions``: stated here)
     options = {k: v for k, v in kernel.targetoptions.items() if k not in INTERNAL and k != "nopython"}
-    return nb.njit(**options)(twin)
+    return nb.njit(**options, cache=True)(twin)
 
 
 def wrapperless(obj) -> bool:
