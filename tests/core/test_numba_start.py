@@ -26,7 +26,7 @@ KERNELS = textwrap.dedent('''
     def compiled(n):
         a = np.arange(n) * 2.0       # an allocation (NRT) and numpy's array lowering
         d = {1: a.sum()}             # a typed dict (numba.typed's registries)
-        return d[1] + np.linalg.norm(a[:3])
+        return d[1] + np.linalg.norm(a[:3]) + cached(9.0)  # and a callee loaded from the cache
 ''')
 
 CHILD = textwrap.dedent('''
@@ -60,7 +60,7 @@ def test_a_cache_hit_loads_no_registries_and_a_later_compile_gets_them(tmp_path)
     assert warm["hits"] == 1                       # `cached` came from the disk cache...
     assert warm["before"] == []                    # ...without the registries
     assert warm["after"] == sorted(REGISTRY_MODULES)  # which the compile of `compiled` loaded
-    expected = sum(2.0 * i for i in range(5)) + (0.0 + 4.0 + 16.0) ** 0.5
+    expected = sum(2.0 * i for i in range(5)) + (0.0 + 4.0 + 16.0) ** 0.5 + 4.0
     for run in (cold, warm):
         assert run["first"] == 3.0
         assert abs(run["second"] - expected) <= 1e-12 * expected

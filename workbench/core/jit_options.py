@@ -23,8 +23,9 @@ def python_twin(kernel):
     the same code and options, with numba's wrappers.  The copy is a function of its own whose
     qualified name ends in :data:`TWIN_SUFFIX`, so that numba caches it on disk apart from the
     wrapper-less kernel (its cache index is keyed by the function's name and signature, not by
-    the options: under the kernel's own name it would load the copy without wrappers).  For
-    tests and benches that call a helper kernel directly."""
+    the options: under the kernel's own name it would load the copy without wrappers); a kernel
+    that passes a function by value (a dispatcher's address) cannot be cached, and numba says
+    so.  For tests and benches that call a helper kernel directly."""
     import numba as nb
     f = kernel.py_func
     twin = types.FunctionType(f.__code__, f.__globals__, f.__name__, f.__defaults__, f.__closure__)

@@ -23,7 +23,10 @@ installs every typing and lowering registry (252 of them: ``numba.np.*``, ``numb
 ``numba.cpython.*``...), which typing and lowering need and a cached kernel does not: the cache
 holds its machine code, linked with everything it calls, and its signature.  What loading does
 need is numba's runtime (NRT: the allocator's symbols the machine code links to), which the
-refresh initialises first.  :func:`load_cache_hits_without_registries` makes a cache hit
+refresh initialises first, and string hashing's secret symbols, which only the import of
+``numba.cpython.hashing`` adds (imported with the patch).  Left out, and so needing a compile
+first in a process: a cached kernel that takes a ``cfunc`` from Python (its ``typeof`` lives
+in a registry module).  :func:`load_cache_hits_without_registries` makes a cache hit
 initialise the runtime only; a cache miss compiles, and numba's compiler refreshes both
 contexts itself before it types anything (``CompilerBase.__init__``), so a process that
 compiles after it loaded has every registry as before.
@@ -33,6 +36,7 @@ imports the library keeps numba's own start-up.
 """
 from __future__ import annotations
 
+import importlib
 import importlib.abc
 import importlib.machinery
 import sys
@@ -112,6 +116,9 @@ def load_cache_hits_without_registries() -> None:
 def _hits_without_registries(caching) -> None:
     """Replace ``caching.Cache.load_overload``; left as numba makes it if the class lacks the
     methods this relies on (numba's ``Cache`` of 0.60 to 0.68 has them)."""
+    # the one registry module that also gives cached machine code symbols: string hashing's
+    # secrets (``_numba_hashsecret_*``), which a kernel hashing str or bytes links to
+    importlib.import_module("numba.cpython.hashing")
     cache = caching.Cache
     if getattr(cache.load_overload, "without_registries", False) or not all(
             hasattr(cache, m) for m in ("_guard_against_spurious_io_errors", "_load_overload")):
