@@ -143,6 +143,13 @@ def equal_rmse(scene, size: int, ref_spp: int, labels: list[str], spps=(16, 64, 
         cpu_per_spp = sum(e["sample_cpu_s"] for e in rows) / sum(e["spp"] for e in rows)
         fit[m] = {"c": max(c2, 0.0) ** 0.5, "c_off_light": max(c2_off, 0.0) ** 0.5,
                   "wall_s_per_spp": wall_per_spp, "cpu_s_per_spp": cpu_per_spp}
+    flat = [m for m, f in fit.items() if f["c"] == 0.0 or f["c_off_light"] == 0.0]
+    if flat:  # (the pooled excess MSE at or below zero: small images and few samples, as --smoke)
+        out.update(constants_measured=fit, skipped=(
+            f"the error of {', '.join(flat)} is not above the reference's own noise at {size} px "
+            f"(pooled over {len(spps) * len(seeds)} renders), so the constant c of excess MSE = c^2 / spp "
+            "cannot be fitted: a larger --rmse-size or more reference samples"))
+        return out
     target = fit["pathtrace"]["c"] / 64 ** 0.5  # the excess RMSE pathtrace reaches at 64 spp
     for m, f in fit.items():
         spp_needed = (f["c"] / target) ** 2
