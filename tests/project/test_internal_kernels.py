@@ -23,10 +23,6 @@ JIT_DECORATORS = ("njit", "jit", "overload", "intrinsic", "register_jitable", "l
 """A function decorated with a name holding one of these is compiled code: its calls are not Python's."""
 
 
-def _is_internal(obj) -> bool:
-    return wrapperless(obj)
-
-
 def _module(name: str):
     """The workbench module ``name``, imported; ``None`` for another package's or one that is
     not a module (a name imported from a module)."""
@@ -108,7 +104,7 @@ def _python_calls_of_internal_kernels(path: Path) -> list[str]:
     def visit(node, in_jit):
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
             in_jit = in_jit or _jitted(node)
-        if isinstance(node, ast.Call) and not in_jit and _is_internal(_resolve(node.func, aliases, own_module)):
+        if isinstance(node, ast.Call) and not in_jit and wrapperless(_resolve(node.func, aliases, own_module)):
             found.append(f"{where}:{node.lineno}: {ast.unparse(node.func)}(...)")
         for child in ast.iter_child_nodes(node):
             visit(child, in_jit)
@@ -123,7 +119,7 @@ def _internal_kernels() -> list[str]:
         module = _module(info.name)
         if module is not None:
             names += [f"{info.name}.{k}" for k, v in vars(module).items()
-                      if _is_internal(v) and v.__module__ == info.name]
+                      if wrapperless(v) and v.__module__ == info.name]
     return names
 
 

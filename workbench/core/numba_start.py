@@ -15,7 +15,7 @@ in jitted code (``np.dot``, ``np.linalg``) imports scipy itself when such a func
 one-shot import finder: while ``numba.np.arraymath`` runs its module code, in that thread
 only, ``scipy.linalg`` (not yet imported) cannot be imported, the probe answers "no BLAS", and
 the finder removes itself.  A process that imported ``scipy.linalg`` before is left as numba
-makes it (the probe is cheap then).  
+makes it (the probe is cheap then).
 
 **Cache hits without the registries.**  Before it loads a kernel from the disk cache, numba
 refreshes its CPU target context (``Cache.load_overload`` calls ``refresh``): it imports and
@@ -104,7 +104,6 @@ def skip_blas_probe() -> None:
         sys.meta_path.insert(0, _SkipBlasProbe())
 
 
-
 def load_cache_hits_without_registries() -> None:
     """Make numba's disk-cache loads initialise its runtime (NRT) instead of refreshing the
     whole target context (see the module's docstring), now if numba's caching module is loaded,
@@ -119,13 +118,13 @@ def _hits_without_registries(caching) -> None:
     # the one registry module that also gives cached machine code symbols: string hashing's
     # secrets (``_numba_hashsecret_*``), which a kernel hashing str or bytes links to
     importlib.import_module("numba.cpython.hashing")
+    from numba.core.runtime import rtsys
     cache = caching.Cache
     if getattr(cache.load_overload, "without_registries", False) or not all(
             hasattr(cache, m) for m in ("_guard_against_spurious_io_errors", "_load_overload")):
         return
 
     def load_overload(self, sig, target_context):
-        from numba.core.runtime import rtsys
         rtsys.initialize(target_context)
         with self._guard_against_spurious_io_errors():
             return self._load_overload(sig, target_context)
